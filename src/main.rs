@@ -1,3 +1,261 @@
+//! The `tresca-cr` command line: `check`, `run`. Library errors become messages and exit codes here.
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use tresca_cr::scene::PartKind;
+use tresca_cr::{Problem, Scene};
+
+#[derive(Parser)]
+#[command(
+    name = "tresca-cr",
+    version,
+    about = "Quasi-static Tresca contact with stabilised Crouzeix-Raviart elements"
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Validate a scene and print what it will model.
+    Check {
+        scene: PathBuf,
+        #[arg(long)]
+        refine: Option<u32>,
+        #[arg(long)]
+        steps: Option<usize>,
+    },
+    /// Run a scene.
+    Run {
+        scene: PathBuf,
+        /// Uniform refinements (overrides mesh.refine).
+        #[arg(long)]
+        refine: Option<u32>,
+        /// Uniform time steps (overrides time.steps).
+        #[arg(long)]
+        steps: Option<usize>,
+        /// Per-step solver (overrides solver.method): ssn, uzawa or pdas.
+        #[arg(long)]
+        solver: Option<String>,
+        /// Print one line per step.
+        #[arg(long, short)]
+        verbose: bool,
+        /// No progress bar.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+}
+
+fn load(path: &PathBuf, refine: Option<u32>, steps: Option<usize>) -> Result<Scene> {
+    let mut scene = Scene::from_file(path)?;
+    if let Some(k) = refine {
+        scene.set_refine(k)?;
+    }
+    if let Some(n) = steps {
+        scene.set_steps(n)?;
+    }
+    Ok(scene)
+}
+
+fn check(scene: Scene) -> Result<()> {
+    let problem = Problem::new(scene)?;
+    let (s, m, sp) = (&problem.scene, &problem.mesh, &problem.space);
+    println!(
+        "scene      {} ({})",
+        s.file,
+        if s.title.is_empty() {
+            "untitled"
+        } else {
+            &s.title
+        }
+    );
+    println!(
+        "mesh       {} vertices, {} triangles, {} edges, h = {:.4e}",
+        m.points.len(),
+        m.tris.len(),
+        m.edges.len(),
+        m.h_max()
+    );
+    println!(
+        "material   E = {}, nu = {} (plane strain: lambda = {:.6e}, mu = {:.6e})",
+        s.material.e,
+        s.material.nu,
+        s.material.lambda(),
+        s.material.mu()
+    );
+    for (p, part) in s.parts.iter().enumerate() {
+        let n = sp.edge_part.iter().filter(|&&q| q == Some(p)).count();
+        let what = match &part.kind {
+            PartKind::Dirichlet => "dirichlet (u = 0)".to_string(),
+            PartKind::Neumann(None) => "neumann, traction free (nothing assembled)".to_string(),
+            PartKind::Neumann(Some(g)) => {
+                format!("neumann, g = ({}, {})", g.0[0].text(), g.0[1].text())
+            }
+            PartKind::Contact(g) => format!("contact u.n = 0, Tresca g_a = {}", g.text()),
+        };
+        println!("part       {:<10} {:>6} edges  {}", part.name, n, what);
+    }
+    println!(
+        "unknowns   {} (paper's count 2(edges - Dirichlet edges) = {}), {} contact unknowns",
+        sp.n_dofs,
+        sp.paper_dofs(),
+        sp.contact.len()
+    );
+    let stab = format!("jump stabilisation (rho = {})", s.rho);
+    let mut terms = vec!["elastic stiffness", stab.as_str()];
+    if s.f.is_some() {
+        terms.push("body force");
+    }
+    if s.parts
+        .iter()
+        .any(|p| matches!(p.kind, PartKind::Neumann(Some(_))))
+    {
+        terms.push("Neumann traction");
+    }
+    if s.has_contact() {
+        terms.push("Tresca friction (condensed on contact unknowns)");
+    } else {
+        terms.push("no contact: plain elasticity");
+    }
+    println!("assembled  {}", terms.join(", "));
+    println!(
+        "time       {} steps on [{}, {}]{}",
+        problem.n_steps(),
+        s.times[0],
+        s.times.last().unwrap_or(&0.0),
+        if s.uniform_time { " (uniform)" } else { "" }
+    );
+    println!(
+        "solver     {} (tol {:.1e}, max_iter {})",
+        s.solver.method.name(),
+        s.solver.tol,
+        s.solver.max_iter
+    );
+    println!(
+        "exact      {}",
+        if s.exact.is_some() {
+            "given: true errors computed"
+        } else {
+            "none"
+        }
+    );
+    Ok(())
+}
+
+fn run(scene: Scene, verbose: bool, quiet: bool) -> Result<()> {
+    let start = std::time::Instant::now();
+    let problem = Problem::new(scene)?;
+    let n = problem.n_steps();
+    let bar = if quiet || verbose || n < 50 {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(n as u64)
+    };
+    let mut max_err = [0.0f64; 3];
+    let (mut iters, mut max_res) = (0usize, 0.0f64);
+    let mut last = None;
+    problem
+        .run(|r| {
+            if let Some(e) = r.errors {
+                max_err = [
+                    max_err[0].max(e.energy),
+                    max_err[1].max(e.h1),
+                    max_err[2].max(e.l2),
+                ];
+            }
+            iters += r.iterations;
+            max_res = max_res.max(r.residual);
+            if verbose {
+                let err = r
+                    .errors
+                    .map(|e| format!("  |||e||| {:.4e}  L2 {:.4e}", e.energy, e.l2))
+                    .unwrap_or_default();
+                println!(
+                    "step {:>5} t = {:<10.6} it {:>5} res {:.2e} stick {:>4} slip {:>4}{}",
+                    r.n,
+                    r.t,
+                    r.iterations,
+                    r.residual,
+                    r.n_stick(),
+                    r.n_slip(),
+                    err
+                );
+            }
+            bar.inc(u64::from(r.n > 0));
+            last = Some(r.clone());
+            Ok(())
+        })
+        .with_context(|| "run stopped")?;
+    bar.finish_and_clear();
+    let sp = &problem.space;
+    println!(
+        "unknowns {} (paper DOF {}), contact edges {}, steps {}",
+        sp.n_dofs,
+        sp.paper_dofs(),
+        sp.contact.len(),
+        n
+    );
+    let st = problem.setup_times;
+    println!(
+        "set-up: mesh {:.3}s, assembly {:.3}s, factorisation {:.3}s, condensation {:.3}s",
+        st[0], st[1], st[2], st[3]
+    );
+    println!(
+        "solver {}: {} iterations in all, max residual {:.2e}; wall time {:.3}s",
+        problem.scene.solver.method.name(),
+        iters,
+        max_res,
+        start.elapsed().as_secs_f64()
+    );
+    if let Some(r) = last {
+        if !r.state.is_empty() {
+            println!(
+                "final step: {} stick, {} slip contact edges",
+                r.n_stick(),
+                r.n_slip()
+            );
+        }
+    }
+    if problem.scene.exact.is_some() {
+        println!(
+            "max over time nodes: energy error {:.6e}, H1 error {:.6e}, L2 error {:.6e}",
+            max_err[0], max_err[1], max_err[2]
+        );
+    }
+    Ok(())
+}
+
 fn main() {
-    println!("Hello, world!");
+    let cli = Cli::parse();
+    let result = match cli.cmd {
+        Cmd::Check {
+            scene,
+            refine,
+            steps,
+        } => load(&scene, refine, steps).and_then(check),
+        Cmd::Run {
+            scene,
+            refine,
+            steps,
+            solver,
+            verbose,
+            quiet,
+        } => load(&scene, refine, steps).and_then(|mut s| {
+            if let Some(m) = solver {
+                s.solver.method = match m.as_str() {
+                    "ssn" => tresca_cr::scene::Method::Ssn,
+                    "uzawa" => tresca_cr::scene::Method::Uzawa,
+                    "pdas" => tresca_cr::scene::Method::Pdas,
+                    other => anyhow::bail!("--solver {other}: expected ssn, uzawa or pdas"),
+                };
+            }
+            run(s, verbose, quiet)
+        }),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
 }

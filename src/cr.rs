@@ -1,0 +1,274 @@
+//! The lowest-order Crouzeix–Raviart element and the discrete space V_h.
+//!
+//! On a triangle with barycentric coordinates λ_i, the basis function of the edge opposite vertex i is
+//! φ_i = 1 − 2λ_i: it is 1 at that edge's midpoint and 0 at the other two, and ∇φ_i = −2∇λ_i is constant.
+//! A vector CR function has one 2-vector per edge midpoint. In V_h the midpoint value is
+//!
+//! * `Fixed` (zero) on Dirichlet edges,
+//! * s_e τ_e on contact edges (τ_e = (−n_y, n_x), n_e outward: the normal part is eliminated), one unknown,
+//! * (u_x, u_y) elsewhere, two unknowns.
+//!
+//! The interpolant I_CR takes edge means (3-point Gauss), which commute with time derivatives.
+
+use crate::error::Result;
+use crate::expr::Vec2Expr;
+use crate::mesh::Mesh;
+use crate::quadrature::{edge_point, GAUSS3};
+use crate::scene::{Part, PartKind};
+
+/// Geometry of one triangle: constant barycentric gradients.
+#[derive(Clone, Copy, Debug)]
+pub struct Element {
+    pub pts: [[f64; 2]; 3],
+    pub area: f64,
+    /// ∇λ_i.
+    pub grad_lambda: [[f64; 2]; 3],
+}
+
+impl Element {
+    /// The element of triangle t.
+    pub fn new(mesh: &Mesh, t: usize) -> Element {
+        let pts = mesh.tris[t].map(|v| mesh.points[v]);
+        let a2 = crate::mesh::area2(pts[0], pts[1], pts[2]);
+        let mut grad_lambda = [[0.0; 2]; 3];
+        for (i, g) in grad_lambda.iter_mut().enumerate() {
+            let (b, c) = (pts[(i + 1) % 3], pts[(i + 2) % 3]);
+            *g = [(b[1] - c[1]) / a2, (c[0] - b[0]) / a2];
+        }
+        Element {
+            pts,
+            area: 0.5 * a2,
+            grad_lambda,
+        }
+    }
+
+    /// ∇φ_i = −2∇λ_i.
+    pub fn grad_phi(&self, i: usize) -> [f64; 2] {
+        [-2.0 * self.grad_lambda[i][0], -2.0 * self.grad_lambda[i][1]]
+    }
+
+    /// Barycentric coordinates of x.
+    pub fn bary(&self, x: [f64; 2]) -> [f64; 3] {
+        let mut l = [0.0; 3];
+        for (i, li) in l.iter_mut().enumerate() {
+            let b = self.pts[(i + 1) % 3];
+            *li = (x[0] - b[0]) * self.grad_lambda[i][0] + (x[1] - b[1]) * self.grad_lambda[i][1];
+        }
+        l
+    }
+
+    /// φ_i at barycentric point l.
+    pub fn phi(l: [f64; 3]) -> [f64; 3] {
+        l.map(|li| 1.0 - 2.0 * li)
+    }
+}
+
+/// How the midpoint value of one edge depends on the unknowns: Σ coef · u[dof].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EdgeDof {
+    Fixed,
+    Free([usize; 2]),
+    Tangential { dof: usize, tau: [f64; 2] },
+}
+
+impl EdgeDof {
+    /// The (dof, vector coefficient) pairs of this edge.
+    pub fn terms(&self) -> impl Iterator<Item = (usize, [f64; 2])> {
+        let t: [Option<(usize, [f64; 2])>; 2] = match *self {
+            EdgeDof::Fixed => [None, None],
+            EdgeDof::Free([a, b]) => [Some((a, [1.0, 0.0])), Some((b, [0.0, 1.0]))],
+            EdgeDof::Tangential { dof, tau } => [Some((dof, tau)), None],
+        };
+        t.into_iter().flatten()
+    }
+}
+
+/// One Γ_C edge: unknown, frame and friction weight.
+#[derive(Clone, Debug)]
+pub struct ContactEdge {
+    pub edge: usize,
+    pub dof: usize,
+    pub normal: [f64; 2],
+    pub tangent: [f64; 2],
+    pub length: f64,
+    /// ḡ_e, the mean of g_a over the edge.
+    pub g_mean: f64,
+}
+
+/// The discrete space V_h on a mesh with its boundary parts bound.
+#[derive(Clone, Debug)]
+pub struct CrSpace {
+    pub edge_dof: Vec<EdgeDof>,
+    /// Scene part of each boundary edge.
+    pub edge_part: Vec<Option<usize>>,
+    pub n_dofs: usize,
+    pub contact: Vec<ContactEdge>,
+    /// Number of Dirichlet edges.
+    pub n_dirichlet: usize,
+}
+
+impl CrSpace {
+    /// Number the unknowns: two per free edge, one per contact edge, none on Dirichlet edges.
+    pub fn new(mesh: &Mesh, parts: &[Part]) -> Result<CrSpace> {
+        let edge_part = mesh.bind_parts(parts)?;
+        let mut edge_dof = Vec::with_capacity(mesh.edges.len());
+        let mut contact = Vec::new();
+        let mut n = 0;
+        let mut n_dirichlet = 0;
+        for e in 0..mesh.edges.len() {
+            let kind = edge_part[e].map(|p| &parts[p].kind);
+            edge_dof.push(match kind {
+                Some(PartKind::Dirichlet) => {
+                    n_dirichlet += 1;
+                    EdgeDof::Fixed
+                }
+                Some(PartKind::Contact(g)) => {
+                    let normal = mesh.outward_normal(e);
+                    let tangent = [-normal[1], normal[0]];
+                    let [a, b] = mesh.edges[e].map(|v| mesh.points[v]);
+                    let mut g_mean = 0.0;
+                    let mut g_min = f64::INFINITY;
+                    for (s, w) in GAUSS3 {
+                        let x = edge_point(a, b, s);
+                        let gv = g.eval(x[0], x[1], 0.0)?;
+                        g_mean += w * gv;
+                        g_min = g_min.min(gv);
+                    }
+                    if g_min < 0.0 {
+                        let m = mesh.midpoint(e);
+                        return Err(crate::error::Error::Expr {
+                            key: format!(
+                                "boundary ({}).g_a",
+                                parts[edge_part[e].expect("bound")].name
+                            ),
+                            expr: g.text().to_string(),
+                            msg: format!("negative friction bound near ({:.6}, {:.6})", m[0], m[1]),
+                        });
+                    }
+                    contact.push(ContactEdge {
+                        edge: e,
+                        dof: n,
+                        normal,
+                        tangent,
+                        length: mesh.edge_length(e),
+                        g_mean,
+                    });
+                    n += 1;
+                    EdgeDof::Tangential {
+                        dof: n - 1,
+                        tau: tangent,
+                    }
+                }
+                _ => {
+                    n += 2;
+                    EdgeDof::Free([n - 2, n - 1])
+                }
+            });
+        }
+        Ok(CrSpace {
+            edge_dof,
+            edge_part,
+            n_dofs: n,
+            contact,
+            n_dirichlet,
+        })
+    }
+
+    /// The paper's DOF count: 2 · (edges − Dirichlet edges) (contact normal components included).
+    pub fn paper_dofs(&self) -> usize {
+        2 * (self.edge_dof.len() - self.n_dirichlet)
+    }
+
+    /// Displacement at every edge midpoint from the unknowns.
+    pub fn midpoint_values(&self, u: &[f64]) -> Vec<[f64; 2]> {
+        self.edge_dof
+            .iter()
+            .map(|d| {
+                d.terms().fold([0.0; 2], |acc, (k, c)| {
+                    [acc[0] + c[0] * u[k], acc[1] + c[1] * u[k]]
+                })
+            })
+            .collect()
+    }
+
+    /// I_CR v: edge means by 3-point Gauss, restricted to V_h (tangential part on contact edges).
+    pub fn interpolate(&self, mesh: &Mesh, v: &Vec2Expr, t: f64) -> Result<Vec<f64>> {
+        let mut u = vec![0.0; self.n_dofs];
+        for (e, d) in self.edge_dof.iter().enumerate() {
+            if *d == EdgeDof::Fixed {
+                continue;
+            }
+            let [a, b] = mesh.edges[e].map(|p| mesh.points[p]);
+            let mut mean = [0.0; 2];
+            for (s, w) in GAUSS3 {
+                let x = edge_point(a, b, s);
+                let val = v.eval(x[0], x[1], t)?;
+                mean = [mean[0] + w * val[0], mean[1] + w * val[1]];
+            }
+            for (k, c) in d.terms() {
+                u[k] = c[0] * mean[0] + c[1] * mean[1];
+            }
+        }
+        Ok(u)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri() -> Element {
+        let mesh = crate::mesh::Mesh::build(crate::mesh::RawMesh {
+            source: "t".into(),
+            points: vec![[0.3, -0.2], [2.0, 0.4], [0.7, 1.9]],
+            tris: vec![[0, 1, 2]],
+            tagged: vec![],
+            tag_names: vec![],
+        })
+        .unwrap();
+        Element::new(&mesh, 0)
+    }
+
+    #[test]
+    fn basis_is_nodal_at_edge_midpoints() {
+        let el = tri();
+        for i in 0..3 {
+            let (b, c) = (el.pts[(i + 1) % 3], el.pts[(i + 2) % 3]);
+            let m = [0.5 * (b[0] + c[0]), 0.5 * (b[1] + c[1])];
+            let phi = Element::phi(el.bary(m));
+            for (j, p) in phi.iter().enumerate() {
+                assert!(
+                    (p - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14,
+                    "φ_{j}(m_{i}) = {p}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn partition_of_unity_and_gradients_sum_to_zero() {
+        let el = tri();
+        for l in [[0.2, 0.3, 0.5], [1.0, 0.0, 0.0], [0.1, 0.8, 0.1]] {
+            let s: f64 = Element::phi(l).iter().sum();
+            assert!((s - 1.0).abs() < 1e-14);
+        }
+        let g: [f64; 2] = (0..3).fold([0.0; 2], |a, i| {
+            [a[0] + el.grad_phi(i)[0], a[1] + el.grad_phi(i)[1]]
+        });
+        assert!(g[0].abs() < 1e-13 && g[1].abs() < 1e-13);
+    }
+
+    #[test]
+    fn gradients_match_finite_differences_of_the_basis() {
+        let el = tri();
+        let x = [0.9, 0.6];
+        let h = 1e-6;
+        for i in 0..3 {
+            let f = |p: [f64; 2]| Element::phi(el.bary(p))[i];
+            let gx = (f([x[0] + h, x[1]]) - f([x[0] - h, x[1]])) / (2.0 * h);
+            let gy = (f([x[0], x[1] + h]) - f([x[0], x[1] - h])) / (2.0 * h);
+            let g = el.grad_phi(i);
+            assert!((gx - g[0]).abs() < 1e-8 && (gy - g[1]).abs() < 1e-8);
+        }
+    }
+}

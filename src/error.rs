@@ -1,0 +1,68 @@
+//! The crate's one error type. Every variant carries the data a user needs to find the problem.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong between reading a scene and writing its results.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A scene value is missing, malformed or out of range.
+    #[error("scene {file}: `{key}`: {msg}")]
+    Scene {
+        file: String,
+        key: String,
+        msg: String,
+    },
+
+    /// An expression failed to parse, uses unknown variables, or evaluated to a non-finite value.
+    #[error("expression `{key}` = \"{expr}\": {msg}")]
+    Expr {
+        key: String,
+        expr: String,
+        msg: String,
+    },
+
+    /// The mesh is unusable (malformed file, degenerate cells, boundary edges without a part, ...).
+    #[error("mesh {source_name}: {msg}")]
+    Mesh { source_name: String, msg: String },
+
+    /// A linear system is singular or not positive definite (for example rigid motions not fixed).
+    #[error("linear algebra: {0}")]
+    Linear(String),
+
+    /// The per-step friction solver did not converge.
+    #[error(
+        "step {step} (t = {time}): {solver} did not converge in {iterations} iterations \
+         (residual {residual:.3e}, tolerance {tol:.1e})"
+    )]
+    NotConverged {
+        step: usize,
+        time: f64,
+        solver: &'static str,
+        iterations: usize,
+        residual: f64,
+        tol: f64,
+    },
+
+    /// Reading or writing a file failed.
+    #[error("{path}: {msg}")]
+    Io { path: PathBuf, msg: String },
+}
+
+/// Result alias used throughout the crate.
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    pub(crate) fn scene(file: &str, key: impl Into<String>, msg: impl Into<String>) -> Self {
+        Error::Scene {
+            file: file.to_string(),
+            key: key.into(),
+            msg: msg.into(),
+        }
+    }
+    pub(crate) fn mesh(source_name: &str, msg: impl Into<String>) -> Self {
+        Error::Mesh {
+            source_name: source_name.to_string(),
+            msg: msg.into(),
+        }
+    }
+}
