@@ -29,7 +29,8 @@ impl Expr {
         if text.trim().is_empty() {
             return Err(err("empty expression".into()));
         }
-        let flat = exmex::parse::<f64>(text).map_err(|e| err(format!("cannot parse: {e}")))?;
+        let normalised = lint(text).map_err(err)?;
+        let flat = exmex::parse::<f64>(&normalised).map_err(|e| err(format!("cannot parse: {e}")))?;
         let mut slots = Vec::new();
         for name in flat.var_names() {
             slots.push(match name.as_str() {
@@ -112,6 +113,116 @@ impl Expr {
     }
 }
 
+/// Reject the two constructs whose exmex reading differs from the usual mathematical one:
+/// a unary minus in front of a power (exmex reads `-x^2` as `(-x)^2`) and chained powers
+/// (exmex reads `2^x^2` as `(2^x)^2`). Both must be parenthesised explicitly.
+/// Returns the text with scientific-notation literals (`1.2e-3`, which exmex cannot read) written out.
+fn lint(text: &str) -> std::result::Result<String, String> {
+    let mut out = String::with_capacity(text.len());
+    #[derive(Clone, Copy, PartialEq)]
+    enum Tok {
+        Atom,
+        Ident,
+        Open,
+        Close,
+        Comma,
+        Op(char),
+    }
+    let mut toks = Vec::new();
+    let mut chars = text.chars().peekable();
+    while let Some(&c) = chars.peek() {
+        if c.is_whitespace() {
+            out.push(c);
+            chars.next();
+        } else if c.is_ascii_digit() || c == '.' {
+            let mut lit = String::new();
+            while let Some(d) = chars.next_if(|d| d.is_ascii_digit() || *d == '.') {
+                lit.push(d);
+            }
+            // exponent notation such as 1e-3
+            if chars.peek().is_some_and(|d| *d == 'e' || *d == 'E') {
+                let mut look = chars.clone();
+                look.next();
+                let sign = look.next_if(|d| *d == '-' || *d == '+');
+                if look.peek().is_some_and(|d| d.is_ascii_digit()) {
+                    chars.next();
+                    lit.push('e');
+                    if let Some(sg) = sign {
+                        chars.next();
+                        lit.push(sg);
+                    }
+                    while let Some(d) = chars.next_if(|d| d.is_ascii_digit()) {
+                        lit.push(d);
+                    }
+                }
+            }
+            let v: f64 = lit.parse().map_err(|_| format!("malformed number `{lit}`"))?;
+            if lit.contains('e') {
+                // Rust's Display never uses exponent notation and round-trips exactly
+                out.push_str(&format!("{v}"));
+            } else {
+                out.push_str(&lit);
+            }
+            toks.push(Tok::Atom);
+        } else if c.is_alphanumeric() || c == '_' {
+            while let Some(d) = chars.next_if(|d| d.is_alphanumeric() || *d == '_') {
+                out.push(d);
+            }
+            toks.push(Tok::Ident);
+        } else {
+            out.push(c);
+            chars.next();
+            toks.push(match c {
+                '(' => Tok::Open,
+                ')' => Tok::Close,
+                ',' => Tok::Comma,
+                other => Tok::Op(other),
+            });
+        }
+    }
+    // index just past the operand starting at i (atom, identifier, call or parenthesised group)
+    let skip_operand = |i: usize| -> usize {
+        let mut j = i;
+        if toks.get(j) == Some(&Tok::Ident) && toks.get(j + 1) == Some(&Tok::Open) {
+            j += 1;
+        }
+        if toks.get(j) == Some(&Tok::Open) {
+            let mut depth = 0;
+            while j < toks.len() {
+                match toks[j] {
+                    Tok::Open => depth += 1,
+                    Tok::Close => {
+                        depth -= 1;
+                        if depth == 0 {
+                            return j + 1;
+                        }
+                    }
+                    _ => {}
+                }
+                j += 1;
+            }
+            return j;
+        }
+        j + 1
+    };
+    for i in 0..toks.len() {
+        let unary = toks[i] == Tok::Op('-') && (i == 0 || matches!(toks[i - 1], Tok::Open | Tok::Comma | Tok::Op(_)));
+        if unary && toks.get(skip_operand(i + 1)) == Some(&Tok::Op('^')) {
+            return Err("ambiguous unary minus before a power: exmex reads -a^b as (-a)^b; write -(a^b) or (-a)^b".into());
+        }
+        if toks[i] == Tok::Op('^') {
+            let mut j = i + 1;
+            while toks.get(j).is_some_and(|t| matches!(t, Tok::Op('-') | Tok::Op('+'))) {
+                j += 1;
+            }
+            if toks.get(skip_operand(j)) == Some(&Tok::Op('^')) {
+                return Err("chained powers: exmex reads a^b^c as (a^b)^c; parenthesise, e.g. a^(b^c)".into());
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// A vector expression (two components).
 #[derive(Clone, Debug)]
 pub struct Vec2Expr(pub [Expr; 2]);
@@ -172,6 +283,29 @@ mod tests {
     }
 
     #[test]
+    fn precedence_matches_mathematics_or_is_rejected() {
+        let v = |s: &str| Expr::parse("k", s).unwrap().eval(3.0, 2.0, 0.5).unwrap();
+        assert_eq!(v("-2*x"), -6.0);
+        assert_eq!(v("x*(-y)"), -6.0);
+        assert_eq!(v("x - y - 1"), 0.0);
+        assert_eq!(v("x / y / 3"), 0.5);
+        assert_eq!(v("x/y*4"), 6.0);
+        assert_eq!(v("1 - x*y + 2"), -3.0);
+        assert_eq!(v("x*y^2/4"), 3.0);
+        assert_eq!(v("-(x^2)"), -9.0);
+        assert_eq!(v("(-x)^2"), 9.0);
+        assert_eq!(v("2^(x^2)"), 512.0);
+        assert_eq!(v("1e-3*x"), 0.003);
+        assert_eq!(v("2.5E+2 + 1e2*y"), 450.0);
+        assert_eq!(v("exp(-x)"), (-3.0f64).exp());
+        assert_eq!(v("x*y - x^2"), -3.0);
+        for bad in ["-x^2", "-sin(t)^2", "2^x^2", "(1 + -x^2)", "min(-x^2, 1)", "-(x)^2"] {
+            let e = Expr::parse("k", bad).unwrap_err().to_string();
+            assert!(e.contains("exmex reads"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
     fn constants_and_zero_detection() {
         assert!(Expr::parse("f", "0").unwrap().is_zero());
         assert!(!Expr::parse("f", "0*x").unwrap().is_zero());
@@ -179,3 +313,4 @@ mod tests {
         assert!((pi - std::f64::consts::PI).abs() < 1e-15);
     }
 }
+

@@ -1,0 +1,43 @@
+# tresca-cr: `make verify` (the verification suite) and `make test` (the tests). Both install what they
+# need, idempotently: Debian packages (HDF5, pkg-config), the Rust release build, and a Python 3.12 venv
+# with the pinned versions of requirements.txt.
+
+SHELL := /bin/bash
+VENV  := .venv
+PY    := $(VENV)/bin/python
+BIN   := target/release/tresca-cr
+PY312 := $(shell command -v python3.12 2>/dev/null || (command -v pyenv >/dev/null && ls $$(pyenv root)/versions/3.12*/bin/python3.12 2>/dev/null | head -1))
+
+.PHONY: all deps build venv test verify bench clean-out
+
+all: build
+
+# Debian packages: HDF5 headers for the hdf5-metno crate (apt needs an index update on a fresh machine).
+deps:
+	@if ! pkg-config --exists hdf5 2>/dev/null; then \
+	  echo "installing libhdf5-dev pkg-config"; \
+	  (apt-get update -qq && apt-get install -y -qq libhdf5-dev pkg-config) >/dev/null || \
+	  (sudo apt-get update -qq && sudo apt-get install -y -qq libhdf5-dev pkg-config) >/dev/null; \
+	fi
+
+build: deps
+	cargo build --release --locked
+
+$(VENV)/.stamp: requirements.txt
+	@test -n "$(PY312)" || { echo "error: Python 3.12 not found (pyenv install 3.12.1)"; exit 1; }
+	$(PY312) -m venv $(VENV)
+	$(VENV)/bin/pip install -q --upgrade pip
+	$(VENV)/bin/pip install -q -r requirements.txt
+	touch $@
+
+venv: $(VENV)/.stamp
+
+test: build venv
+	cargo test --release --locked
+	$(PY) verification/python_tests.py
+
+verify: build venv
+	$(PY) verification/run_all.py
+
+bench: build venv
+	$(PY) verification/bench.py
