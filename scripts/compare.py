@@ -11,6 +11,7 @@ files may number vertices and edges differently.  For every time node n it repor
     dsig   = |sigma_t,A - sigma_t,B|_inf / max_e gbar_e      (tangential traction on Gamma_C)
     flags  = number of contact edges whose stick/slip state differs
     derr_* = relative difference of the true errors (energy, h1, l2), when both files have them
+             (0 when both are below --err-floor, as in patch tests)
 
 and exits with status 1 if max(du, dE, dsig, derr) > tol or the meshes/times do not match.  Differing
 stick/slip flags are reported but only fail the comparison with --strict-flags (a flag may flip at an
@@ -72,6 +73,8 @@ def main(argv=None):
     ap.add_argument("b")
     ap.add_argument("--tol", type=float, default=1e-8)
     ap.add_argument("--quiet", action="store_true", help="print only the summary")
+    ap.add_argument("--err-floor", type=float, default=1e-12,
+                    help="true errors below this (absolute) count as equal, e.g. in patch tests (1e-12)")
     ap.add_argument("--strict-flags", action="store_true", help="fail on any differing stick/slip flag")
     args = ap.parse_args(argv)
     A, B = load(args.a), load(args.b)
@@ -104,7 +107,8 @@ def main(argv=None):
               else abs(B["energy"][n])) if "energy" in A and "energy" in B else 0.0
         dsig = float(np.max(np.abs(A["sigma_t"][n] - sB[n]))) / gscale if has_c else 0.0
         fl = int(np.sum(A["state"][n] != stB[n])) if has_c else 0
-        de = [abs(A["errors"][k][n] - B["errors"][k][n]) / max(abs(A["errors"][k][n]), 1e-300) for k in errs]
+        de = [abs(A["errors"][k][n] - B["errors"][k][n]) / max(abs(A["errors"][k][n]), abs(B["errors"][k][n]))
+              if max(abs(A["errors"][k][n]), abs(B["errors"][k][n])) > args.err_floor else 0.0 for k in errs]
         worst["du"] = max(worst["du"], du)
         worst["dE"] = max(worst["dE"], dE)
         worst["dsig"] = max(worst["dsig"], dsig)

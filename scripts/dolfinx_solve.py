@@ -162,6 +162,10 @@ class DolfinxProblem:
                                for i in range(2)]) - ufl.grad(self.uh)
             Es = ufl.sym(G)
             el = (lam * ufl.tr(Es) ** 2 + 2 * mu * ufl.inner(Es, Es)) * dx4
+            # jump part of the energy error as an integral of squares (no cancellation)
+            el = el + 2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(self.uh), ufl.jump(self.uh)) * dS2
+            if ids["dirichlet"]:
+                el = el + pen * ufl.inner(self.uh, self.uh) * ds(ids["dirichlet"], metadata={"quadrature_degree": 3})
             self.err_forms = [fem.form(el), fem.form(ufl.inner(G, G) * dx4),
                               fem.form(ufl.inner(ue - self.uh, ue - self.uh) * dx4)]
 
