@@ -12,7 +12,8 @@ use exmex::prelude::*;
 pub struct Expr {
     key: String,
     text: String,
-    flat: FlatEx<f64>,
+    /// Boxed: exmex's FlatEx keeps ~20 kB of inline storage.
+    flat: Box<FlatEx<f64>>,
     /// For each of the expression's variables (in exmex's alphabetical order): 0 = x, 1 = y, 2 = t.
     slots: Vec<usize>,
     constant: Option<f64>,
@@ -30,7 +31,8 @@ impl Expr {
             return Err(err("empty expression".into()));
         }
         let normalised = lint(text).map_err(err)?;
-        let flat = exmex::parse::<f64>(&normalised).map_err(|e| err(format!("cannot parse: {e}")))?;
+        let flat =
+            exmex::parse::<f64>(&normalised).map_err(|e| err(format!("cannot parse: {e}")))?;
         let mut slots = Vec::new();
         for name in flat.var_names() {
             slots.push(match name.as_str() {
@@ -58,7 +60,7 @@ impl Expr {
         Ok(Expr {
             key: key.to_string(),
             text: text.to_string(),
-            flat,
+            flat: Box::new(flat),
             slots,
             constant,
         })
@@ -123,6 +125,8 @@ fn lint(text: &str) -> std::result::Result<String, String> {
     enum Tok {
         Atom,
         Ident,
+        /// min, max, atan2: exmex's two-argument functions, which it cannot nest
+        Binary,
         Open,
         Close,
         Comma,
@@ -156,7 +160,9 @@ fn lint(text: &str) -> std::result::Result<String, String> {
                     }
                 }
             }
-            let v: f64 = lit.parse().map_err(|_| format!("malformed number `{lit}`"))?;
+            let v: f64 = lit
+                .parse()
+                .map_err(|_| format!("malformed number `{lit}`"))?;
             if lit.contains('e') {
                 // Rust's Display never uses exponent notation and round-trips exactly
                 out.push_str(&format!("{v}"));
@@ -165,10 +171,16 @@ fn lint(text: &str) -> std::result::Result<String, String> {
             }
             toks.push(Tok::Atom);
         } else if c.is_alphanumeric() || c == '_' {
+            let mut name = String::new();
             while let Some(d) = chars.next_if(|d| d.is_alphanumeric() || *d == '_') {
-                out.push(d);
+                name.push(d);
             }
-            toks.push(Tok::Ident);
+            out.push_str(&name);
+            toks.push(if matches!(name.as_str(), "min" | "max" | "atan2") {
+                Tok::Binary
+            } else {
+                Tok::Ident
+            });
         } else {
             out.push(c);
             chars.next();
@@ -183,7 +195,9 @@ fn lint(text: &str) -> std::result::Result<String, String> {
     // index just past the operand starting at i (atom, identifier, call or parenthesised group)
     let skip_operand = |i: usize| -> usize {
         let mut j = i;
-        if toks.get(j) == Some(&Tok::Ident) && toks.get(j + 1) == Some(&Tok::Open) {
+        if matches!(toks.get(j), Some(Tok::Ident | Tok::Binary))
+            && toks.get(j + 1) == Some(&Tok::Open)
+        {
             j += 1;
         }
         if toks.get(j) == Some(&Tok::Open) {
@@ -205,18 +219,50 @@ fn lint(text: &str) -> std::result::Result<String, String> {
         }
         j + 1
     };
+    // depth of parentheses at which each open two-argument call started
+    let mut calls: Vec<usize> = Vec::new();
+    let mut depth = 0usize;
+    for (i, t) in toks.iter().enumerate() {
+        match t {
+            Tok::Open => depth += 1,
+            Tok::Close => {
+                depth = depth.saturating_sub(1);
+                if calls.last() == Some(&depth) {
+                    calls.pop();
+                }
+            }
+            Tok::Binary => {
+                if !calls.is_empty() {
+                    return Err(
+                        "exmex cannot nest min/max/atan2 inside another min/max/atan2; \
+                                write max(a, b) as (a + b + abs(a - b))/2"
+                            .into(),
+                    );
+                }
+                calls.push(depth);
+            }
+            _ => {}
+        }
+    }
     for i in 0..toks.len() {
-        let unary = toks[i] == Tok::Op('-') && (i == 0 || matches!(toks[i - 1], Tok::Open | Tok::Comma | Tok::Op(_)));
+        let unary = toks[i] == Tok::Op('-')
+            && (i == 0 || matches!(toks[i - 1], Tok::Open | Tok::Comma | Tok::Op(_)));
         if unary && toks.get(skip_operand(i + 1)) == Some(&Tok::Op('^')) {
             return Err("ambiguous unary minus before a power: exmex reads -a^b as (-a)^b; write -(a^b) or (-a)^b".into());
         }
         if toks[i] == Tok::Op('^') {
             let mut j = i + 1;
-            while toks.get(j).is_some_and(|t| matches!(t, Tok::Op('-') | Tok::Op('+'))) {
+            while toks
+                .get(j)
+                .is_some_and(|t| matches!(t, Tok::Op('-') | Tok::Op('+')))
+            {
                 j += 1;
             }
             if toks.get(skip_operand(j)) == Some(&Tok::Op('^')) {
-                return Err("chained powers: exmex reads a^b^c as (a^b)^c; parenthesise, e.g. a^(b^c)".into());
+                return Err(
+                    "chained powers: exmex reads a^b^c as (a^b)^c; parenthesise, e.g. a^(b^c)"
+                        .into(),
+                );
             }
         }
     }
@@ -299,9 +345,21 @@ mod tests {
         assert_eq!(v("2.5E+2 + 1e2*y"), 450.0);
         assert_eq!(v("exp(-x)"), (-3.0f64).exp());
         assert_eq!(v("x*y - x^2"), -3.0);
-        for bad in ["-x^2", "-sin(t)^2", "2^x^2", "(1 + -x^2)", "min(-x^2, 1)", "-(x)^2"] {
+        assert_eq!(v("max(0, x)*min(y, 1) + max(x, y)"), 6.0);
+        for bad in [
+            "-x^2",
+            "-sin(t)^2",
+            "2^x^2",
+            "(1 + -x^2)",
+            "min(-x^2, 1)",
+            "-(x)^2",
+        ] {
             let e = Expr::parse("k", bad).unwrap_err().to_string();
             assert!(e.contains("exmex reads"), "{bad}: {e}");
+        }
+        for bad in ["max(0, min(1, x))", "min(x, 2*max(y, 1))"] {
+            let e = Expr::parse("k", bad).unwrap_err().to_string();
+            assert!(e.contains("cannot nest"), "{bad}: {e}");
         }
     }
 
@@ -313,4 +371,3 @@ mod tests {
         assert!((pi - std::f64::consts::PI).abs() < 1e-15);
     }
 }
-

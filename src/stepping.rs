@@ -65,8 +65,13 @@ impl StepResult {
 impl Problem {
     /// Mesh, space, assembly, factorisation and condensation: all the work done once per run.
     pub fn new(scene: Scene) -> Result<Problem> {
-        let t0 = Instant::now();
         let mesh = Mesh::from_spec(&scene.mesh)?;
+        Problem::with_mesh(scene, mesh)
+    }
+
+    /// As [`Problem::new`] on a given mesh (the scene's `[mesh]` table is ignored).
+    pub fn with_mesh(scene: Scene, mesh: Mesh) -> Result<Problem> {
+        let t0 = Instant::now();
         let space = CrSpace::new(&mesh, &scene.parts)?;
         let t1 = Instant::now();
         let k = stiffness(&mesh, &space, &scene.material, scene.rho)?;

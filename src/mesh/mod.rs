@@ -14,6 +14,9 @@ use crate::error::{Error, Result};
 use crate::scene::{MeshSpec, Part};
 use std::collections::HashMap;
 
+pub use gmsh::parse as parse_gmsh;
+pub use structured::generate as structured_raw;
+
 /// Mesh data before topology is built: points, triangles and tagged boundary edges.
 #[derive(Clone, Debug)]
 pub struct RawMesh {

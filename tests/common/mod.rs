@@ -1,0 +1,88 @@
+//! Helpers shared by the integration tests: running scenes, collecting errors, fitting rates.
+#![allow(dead_code)]
+
+use tresca_cr::{Problem, Scene, StepResult};
+
+/// Read a scene from the repository.
+pub fn scene(path: &str) -> Scene {
+    Scene::from_file(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(path)
+            .as_path(),
+    )
+    .unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// Run a scene and keep every step.
+pub fn run(scene: Scene) -> (Problem, Vec<StepResult>) {
+    let p = Problem::new(scene).unwrap();
+    let mut out = Vec::new();
+    p.run(|r| {
+        out.push(r.clone());
+        Ok(())
+    })
+    .unwrap();
+    (p, out)
+}
+
+/// Max over time nodes of (energy, L²) errors.
+pub fn max_errors(steps: &[StepResult]) -> (f64, f64) {
+    steps.iter().fold((0.0, 0.0), |(a, b), r| {
+        let e = r.errors.expect("scene has an exact solution");
+        (a.max(e.energy), b.max(e.l2))
+    })
+}
+
+/// Observed orders between successive levels: log(e_i/e_{i+1}) / log(h_i/h_{i+1}).
+pub fn successive_rates(h: &[f64], e: &[f64]) -> Vec<f64> {
+    (1..h.len())
+        .map(|i| (e[i - 1] / e[i]).ln() / (h[i - 1] / h[i]).ln())
+        .collect()
+}
+
+/// Least-squares slope of log e against log h.
+pub fn fitted_rate(h: &[f64], e: &[f64]) -> f64 {
+    let x: Vec<f64> = h.iter().map(|v| v.ln()).collect();
+    let y: Vec<f64> = e.iter().map(|v| v.ln()).collect();
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
+    sxy / sxx
+}
+
+/// Print a convergence table.
+pub fn print_table(title: &str, h: &[f64], cols: &[(&str, &[f64])]) {
+    println!("\n{title}");
+    print!("{:>10}", "h");
+    for (name, _) in cols {
+        print!(" {:>12} {:>6}", name, "order");
+    }
+    println!();
+    for i in 0..h.len() {
+        print!("{:>10.4e}", h[i]);
+        for (_, e) in cols {
+            let r = if i == 0 {
+                "-".to_string()
+            } else {
+                format!("{:.3}", (e[i - 1] / e[i]).ln() / (h[i - 1] / h[i]).ln())
+            };
+            print!(" {:>12.4e} {:>6}", e[i], r);
+        }
+        println!();
+    }
+}
+
+/// Relative max-norm difference of two vectors.
+pub fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    let scale = a.iter().chain(b).fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = a
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    if scale == 0.0 {
+        0.0
+    } else {
+        diff / scale
+    }
+}
