@@ -18,17 +18,11 @@ use faer::sparse::{SparseColMat, Triplet};
 
 /// Add the coupling block between the midpoint values of edges a and b to the triplets:
 /// K[k, l] += Σ_cd v_k[c] block[c][d] w_l[d] over the terms of both edges.
-fn scatter(
-    space: &CrSpace,
-    a: usize,
-    b: usize,
-    block: [[f64; 2]; 2],
-    trip: &mut Vec<Triplet<usize, usize, f64>>,
-) {
+fn scatter(space: &CrSpace, a: usize, b: usize, block: [[f64; 2]; 2], trip: &mut Vec<Triplet<usize, usize, f64>>) {
     for (k, v) in space.edge_dof[a].terms() {
         for (l, w) in space.edge_dof[b].terms() {
-            let val = v[0] * (block[0][0] * w[0] + block[0][1] * w[1])
-                + v[1] * (block[1][0] * w[0] + block[1][1] * w[1]);
+            let val =
+                v[0] * (block[0][0] * w[0] + block[0][1] * w[1]) + v[1] * (block[1][0] * w[0] + block[1][1] * w[1]);
             if val != 0.0 {
                 trip.push(Triplet::new(k, l, val));
             }
@@ -75,24 +69,13 @@ pub fn is_stabilised(mesh: &Mesh, space: &CrSpace, e: usize) -> bool {
 }
 
 /// Assemble K (both triangles of the symmetric matrix stored).
-pub fn stiffness(
-    mesh: &Mesh,
-    space: &CrSpace,
-    mat: &Material,
-    rho: f64,
-) -> Result<SparseColMat<usize, f64>> {
+pub fn stiffness(mesh: &Mesh, space: &CrSpace, mat: &Material, rho: f64) -> Result<SparseColMat<usize, f64>> {
     let mut trip = Vec::with_capacity(36 * mesh.tris.len() + 100 * mesh.edges.len());
     for t in 0..mesh.tris.len() {
         let el = Element::new(mesh, t);
         for i in 0..3 {
             for j in 0..3 {
-                scatter(
-                    space,
-                    mesh.tri_edges[t][i],
-                    mesh.tri_edges[t][j],
-                    element_block(&el, mat, i, j),
-                    &mut trip,
-                );
+                scatter(space, mesh.tri_edges[t][i], mesh.tri_edges[t][j], element_block(&el, mat, i, j), &mut trip);
             }
         }
     }
@@ -112,9 +95,8 @@ pub fn stiffness(
             }
         }
     }
-    SparseColMat::try_new_from_triplets(space.n_dofs, space.n_dofs, &trip).map_err(|e| {
-        crate::error::Error::Linear(format!("cannot build the stiffness matrix: {e:?}"))
-    })
+    SparseColMat::try_new_from_triplets(space.n_dofs, space.n_dofs, &trip)
+        .map_err(|e| crate::error::Error::Linear(format!("cannot build the stiffness matrix: {e:?}")))
 }
 
 /// y = K x for a CSC matrix.
@@ -163,16 +145,10 @@ impl Loads {
                     let phi = Element::phi(l);
                     let wt = w * el.area;
                     let edges = [0, 1, 2].map(|i| (mesh.tri_edges[t][i], wt * phi[i]));
-                    points.push(LoadPoint {
-                        x: tri_point(el.pts, l),
-                        edges,
-                    });
+                    points.push(LoadPoint { x: tri_point(el.pts, l), edges });
                 }
             }
-            terms.push(LoadTerm {
-                expr: f.clone(),
-                points,
-            });
+            terms.push(LoadTerm { expr: f.clone(), points });
         }
         for (p, part) in scene.parts.iter().enumerate() {
             let PartKind::Neumann(Some(g)) = &part.kind else {
@@ -194,15 +170,9 @@ impl Loads {
                     points.push(LoadPoint { x, edges });
                 }
             }
-            terms.push(LoadTerm {
-                expr: g.clone(),
-                points,
-            });
+            terms.push(LoadTerm { expr: g.clone(), points });
         }
-        Loads {
-            terms,
-            n_dofs: space.n_dofs,
-        }
+        Loads { terms, n_dofs: space.n_dofs }
     }
 
     /// True if some load depends on t.

@@ -13,9 +13,8 @@
 
 use crate::cr::CrSpace;
 use crate::error::Error;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::Llt;
-use faer::{Mat, MatMut};
+use crate::factor::Factor;
+use faer::Mat;
 use nalgebra::DMatrix;
 
 /// Condensed operator of the contact unknowns.
@@ -35,24 +34,14 @@ pub struct Condensed {
 /// Largest Z kept in memory (entries); beyond it a second triangular solve per step is cheaper in memory.
 const Z_MAX_ENTRIES: usize = 50_000_000;
 
-/// Solve K x = b in place with the factor.
-pub fn solve_in_place(llt: &Llt<usize, f64>, b: &mut [f64]) {
-    let n = b.len();
-    llt.solve_in_place(MatMut::from_column_major_slice_mut(b, n, 1));
-}
-
 impl Condensed {
     /// Build C (and Z) with blocked multi-right-hand-side solves.
-    pub fn new(space: &CrSpace, llt: &Llt<usize, f64>) -> Condensed {
+    pub fn new(space: &CrSpace, llt: &Factor) -> Condensed {
         let n = space.n_dofs;
         let dofs: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
         let nc = dofs.len();
         let keep_z = n.saturating_mul(nc) <= Z_MAX_ENTRIES;
-        let mut z = if keep_z {
-            Some(vec![0.0; n * nc])
-        } else {
-            None
-        };
+        let mut z = if keep_z { Some(vec![0.0; n * nc]) } else { None };
         let mut c = DMatrix::zeros(nc, nc);
         const BLOCK: usize = 64;
         for start in (0..nc).step_by(BLOCK) {
@@ -61,7 +50,7 @@ impl Condensed {
             for j in start..end {
                 rhs[(dofs[j], j - start)] = 1.0;
             }
-            llt.solve_in_place(rhs.as_mut());
+            llt.solve_many(rhs.as_mut());
             for j in start..end {
                 for i in 0..nc {
                     c[(i, j)] = rhs[(dofs[i], j - start)];
@@ -80,7 +69,7 @@ impl Condensed {
     }
 
     /// u ← u_f − K⁻¹ E μ.
-    pub fn apply_friction(&self, llt: &Llt<usize, f64>, u: &mut [f64], mu: &[f64]) {
+    pub fn apply_friction(&self, llt: &Factor, u: &mut [f64], mu: &[f64]) {
         let n = u.len();
         match &self.z {
             Some(z) => {
@@ -96,7 +85,7 @@ impl Condensed {
                 for (j, &m) in mu.iter().enumerate() {
                     b[self.dofs[j]] = m;
                 }
-                solve_in_place(llt, &mut b);
+                llt.solve_in_place(&mut b);
                 u.iter_mut().zip(&b).for_each(|(ui, bi)| *ui -= bi);
             }
         }
@@ -171,12 +160,5 @@ pub struct FrictionSolution {
 
 /// Failure of a per-step solver before its iteration limit (e.g. detected cycling).
 pub fn not_converged(solver: &'static str, iterations: usize, residual: f64, tol: f64) -> Error {
-    Error::NotConverged {
-        step: 0,
-        time: f64::NAN,
-        solver,
-        iterations,
-        residual,
-        tol,
-    }
+    Error::NotConverged { step: 0, time: f64::NAN, solver, iterations, residual, tol }
 }

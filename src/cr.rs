@@ -35,11 +35,7 @@ impl Element {
             let (b, c) = (pts[(i + 1) % 3], pts[(i + 2) % 3]);
             *g = [(b[1] - c[1]) / a2, (c[0] - b[0]) / a2];
         }
-        Element {
-            pts,
-            area: 0.5 * a2,
-            grad_lambda,
-        }
+        Element { pts, area: 0.5 * a2, grad_lambda }
     }
 
     /// ∇φ_i = −2∇λ_i.
@@ -137,27 +133,14 @@ impl CrSpace {
                     if g_min < 0.0 {
                         let m = mesh.midpoint(e);
                         return Err(crate::error::Error::Expr {
-                            key: format!(
-                                "boundary ({}).g_a",
-                                parts[edge_part[e].expect("bound")].name
-                            ),
+                            key: format!("boundary ({}).g_a", parts[edge_part[e].expect("bound")].name),
                             expr: g.text().to_string(),
                             msg: format!("negative friction bound near ({:.6}, {:.6})", m[0], m[1]),
                         });
                     }
-                    contact.push(ContactEdge {
-                        edge: e,
-                        dof: n,
-                        normal,
-                        tangent,
-                        length: mesh.edge_length(e),
-                        g_mean,
-                    });
+                    contact.push(ContactEdge { edge: e, dof: n, normal, tangent, length: mesh.edge_length(e), g_mean });
                     n += 1;
-                    EdgeDof::Tangential {
-                        dof: n - 1,
-                        tau: tangent,
-                    }
+                    EdgeDof::Tangential { dof: n - 1, tau: tangent }
                 }
                 _ => {
                     n += 2;
@@ -165,13 +148,7 @@ impl CrSpace {
                 }
             });
         }
-        Ok(CrSpace {
-            edge_dof,
-            edge_part,
-            n_dofs: n,
-            contact,
-            n_dirichlet,
-        })
+        Ok(CrSpace { edge_dof, edge_part, n_dofs: n, contact, n_dirichlet })
     }
 
     /// The paper's DOF count: 2 · (edges − Dirichlet edges) (contact normal components included).
@@ -183,11 +160,7 @@ impl CrSpace {
     pub fn midpoint_values(&self, u: &[f64]) -> Vec<[f64; 2]> {
         self.edge_dof
             .iter()
-            .map(|d| {
-                d.terms().fold([0.0; 2], |acc, (k, c)| {
-                    [acc[0] + c[0] * u[k], acc[1] + c[1] * u[k]]
-                })
-            })
+            .map(|d| d.terms().fold([0.0; 2], |acc, (k, c)| [acc[0] + c[0] * u[k], acc[1] + c[1] * u[k]]))
             .collect()
     }
 
@@ -237,10 +210,7 @@ mod tests {
             let m = [0.5 * (b[0] + c[0]), 0.5 * (b[1] + c[1])];
             let phi = Element::phi(el.bary(m));
             for (j, p) in phi.iter().enumerate() {
-                assert!(
-                    (p - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14,
-                    "φ_{j}(m_{i}) = {p}"
-                );
+                assert!((p - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14, "φ_{j}(m_{i}) = {p}");
             }
         }
     }
@@ -252,9 +222,7 @@ mod tests {
             let s: f64 = Element::phi(l).iter().sum();
             assert!((s - 1.0).abs() < 1e-14);
         }
-        let g: [f64; 2] = (0..3).fold([0.0; 2], |a, i| {
-            [a[0] + el.grad_phi(i)[0], a[1] + el.grad_phi(i)[1]]
-        });
+        let g: [f64; 2] = (0..3).fold([0.0; 2], |a, i| [a[0] + el.grad_phi(i)[0], a[1] + el.grad_phi(i)[1]]);
         assert!(g[0].abs() < 1e-13 && g[1].abs() < 1e-13);
     }
 

@@ -7,19 +7,11 @@ use std::path::PathBuf;
 pub enum Error {
     /// A scene value is missing, malformed or out of range.
     #[error("scene {file}: `{key}`: {msg}")]
-    Scene {
-        file: String,
-        key: String,
-        msg: String,
-    },
+    Scene { file: String, key: String, msg: String },
 
     /// An expression failed to parse, uses unknown variables, or evaluated to a non-finite value.
     #[error("expression `{key}` = \"{expr}\": {msg}")]
-    Expr {
-        key: String,
-        expr: String,
-        msg: String,
-    },
+    Expr { key: String, expr: String, msg: String },
 
     /// The mesh is unusable (malformed file, degenerate cells, boundary edges without a part, ...).
     #[error("mesh {source_name}: {msg}")]
@@ -34,14 +26,7 @@ pub enum Error {
         "step {step} (t = {time}): {solver} did not converge in {iterations} iterations \
          (residual {residual:.3e}, tolerance {tol:.1e})"
     )]
-    NotConverged {
-        step: usize,
-        time: f64,
-        solver: &'static str,
-        iterations: usize,
-        residual: f64,
-        tol: f64,
-    },
+    NotConverged { step: usize, time: f64, solver: &'static str, iterations: usize, residual: f64, tol: f64 },
 
     /// Reading or writing a file failed.
     #[error("{path}: {msg}")]
@@ -53,16 +38,9 @@ pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
     pub(crate) fn scene(file: &str, key: impl Into<String>, msg: impl Into<String>) -> Self {
-        Error::Scene {
-            file: file.to_string(),
-            key: key.into(),
-            msg: msg.into(),
-        }
+        Error::Scene { file: file.to_string(), key: key.into(), msg: msg.into() }
     }
     pub(crate) fn mesh(source_name: &str, msg: impl Into<String>) -> Self {
-        Error::Mesh {
-            source_name: source_name.to_string(),
-            msg: msg.into(),
-        }
+        Error::Mesh { source_name: source_name.to_string(), msg: msg.into() }
     }
 }

@@ -22,34 +22,23 @@ pub struct Expr {
 impl Expr {
     /// Parse `text` (scene key `key`, used in messages).
     pub fn parse(key: &str, text: &str) -> Result<Self> {
-        let err = |msg: String| Error::Expr {
-            key: key.to_string(),
-            expr: text.to_string(),
-            msg,
-        };
+        let err = |msg: String| Error::Expr { key: key.to_string(), expr: text.to_string(), msg };
         if text.trim().is_empty() {
             return Err(err("empty expression".into()));
         }
         let normalised = lint(text).map_err(err)?;
-        let flat =
-            exmex::parse::<f64>(&normalised).map_err(|e| err(format!("cannot parse: {e}")))?;
+        let flat = exmex::parse::<f64>(&normalised).map_err(|e| err(format!("cannot parse: {e}")))?;
         let mut slots = Vec::new();
         for name in flat.var_names() {
             slots.push(match name.as_str() {
                 "x" => 0,
                 "y" => 1,
                 "t" => 2,
-                other => {
-                    return Err(err(format!(
-                        "unknown variable `{other}` (allowed: x, y, t)"
-                    )))
-                }
+                other => return Err(err(format!("unknown variable `{other}` (allowed: x, y, t)"))),
             });
         }
         let constant = if slots.is_empty() {
-            let v = flat
-                .eval(&[])
-                .map_err(|e| err(format!("cannot evaluate: {e}")))?;
+            let v = flat.eval(&[]).map_err(|e| err(format!("cannot evaluate: {e}")))?;
             if !v.is_finite() {
                 return Err(err(format!("evaluates to {v}")));
             }
@@ -57,13 +46,7 @@ impl Expr {
         } else {
             None
         };
-        Ok(Expr {
-            key: key.to_string(),
-            text: text.to_string(),
-            flat: Box::new(flat),
-            slots,
-            constant,
-        })
+        Ok(Expr { key: key.to_string(), text: text.to_string(), flat: Box::new(flat), slots, constant })
     }
 
     /// The constant value if the expression has no variables.
@@ -96,14 +79,11 @@ impl Expr {
         for (v, &s) in vals.iter_mut().zip(&self.slots) {
             *v = all[s];
         }
-        let v = self
-            .flat
-            .eval(&vals[..self.slots.len()])
-            .map_err(|e| Error::Expr {
-                key: self.key.clone(),
-                expr: self.text.clone(),
-                msg: format!("cannot evaluate at (x={x}, y={y}, t={t}): {e}"),
-            })?;
+        let v = self.flat.eval(&vals[..self.slots.len()]).map_err(|e| Error::Expr {
+            key: self.key.clone(),
+            expr: self.text.clone(),
+            msg: format!("cannot evaluate at (x={x}, y={y}, t={t}): {e}"),
+        })?;
         if !v.is_finite() {
             return Err(Error::Expr {
                 key: self.key.clone(),
@@ -160,9 +140,7 @@ fn lint(text: &str) -> std::result::Result<String, String> {
                     }
                 }
             }
-            let v: f64 = lit
-                .parse()
-                .map_err(|_| format!("malformed number `{lit}`"))?;
+            let v: f64 = lit.parse().map_err(|_| format!("malformed number `{lit}`"))?;
             if lit.contains('e') {
                 // Rust's Display never uses exponent notation and round-trips exactly
                 out.push_str(&format!("{v}"));
@@ -176,11 +154,7 @@ fn lint(text: &str) -> std::result::Result<String, String> {
                 name.push(d);
             }
             out.push_str(&name);
-            toks.push(if matches!(name.as_str(), "min" | "max" | "atan2") {
-                Tok::Binary
-            } else {
-                Tok::Ident
-            });
+            toks.push(if matches!(name.as_str(), "min" | "max" | "atan2") { Tok::Binary } else { Tok::Ident });
         } else {
             out.push(c);
             chars.next();
@@ -195,9 +169,7 @@ fn lint(text: &str) -> std::result::Result<String, String> {
     // index just past the operand starting at i (atom, identifier, call or parenthesised group)
     let skip_operand = |i: usize| -> usize {
         let mut j = i;
-        if matches!(toks.get(j), Some(Tok::Ident | Tok::Binary))
-            && toks.get(j + 1) == Some(&Tok::Open)
-        {
+        if matches!(toks.get(j), Some(Tok::Ident | Tok::Binary)) && toks.get(j + 1) == Some(&Tok::Open) {
             j += 1;
         }
         if toks.get(j) == Some(&Tok::Open) {
@@ -222,7 +194,7 @@ fn lint(text: &str) -> std::result::Result<String, String> {
     // depth of parentheses at which each open two-argument call started
     let mut calls: Vec<usize> = Vec::new();
     let mut depth = 0usize;
-    for (i, t) in toks.iter().enumerate() {
+    for t in &toks {
         match t {
             Tok::Open => depth += 1,
             Tok::Close => {
@@ -233,11 +205,9 @@ fn lint(text: &str) -> std::result::Result<String, String> {
             }
             Tok::Binary => {
                 if !calls.is_empty() {
-                    return Err(
-                        "exmex cannot nest min/max/atan2 inside another min/max/atan2; \
+                    return Err("exmex cannot nest min/max/atan2 inside another min/max/atan2; \
                                 write max(a, b) as (a + b + abs(a - b))/2"
-                            .into(),
-                    );
+                        .into());
                 }
                 calls.push(depth);
             }
@@ -245,24 +215,19 @@ fn lint(text: &str) -> std::result::Result<String, String> {
         }
     }
     for i in 0..toks.len() {
-        let unary = toks[i] == Tok::Op('-')
-            && (i == 0 || matches!(toks[i - 1], Tok::Open | Tok::Comma | Tok::Op(_)));
+        let unary = toks[i] == Tok::Op('-') && (i == 0 || matches!(toks[i - 1], Tok::Open | Tok::Comma | Tok::Op(_)));
         if unary && toks.get(skip_operand(i + 1)) == Some(&Tok::Op('^')) {
-            return Err("ambiguous unary minus before a power: exmex reads -a^b as (-a)^b; write -(a^b) or (-a)^b".into());
+            return Err(
+                "ambiguous unary minus before a power: exmex reads -a^b as (-a)^b; write -(a^b) or (-a)^b".into()
+            );
         }
         if toks[i] == Tok::Op('^') {
             let mut j = i + 1;
-            while toks
-                .get(j)
-                .is_some_and(|t| matches!(t, Tok::Op('-') | Tok::Op('+')))
-            {
+            while toks.get(j).is_some_and(|t| matches!(t, Tok::Op('-') | Tok::Op('+'))) {
                 j += 1;
             }
             if toks.get(skip_operand(j)) == Some(&Tok::Op('^')) {
-                return Err(
-                    "chained powers: exmex reads a^b^c as (a^b)^c; parenthesise, e.g. a^(b^c)"
-                        .into(),
-                );
+                return Err("chained powers: exmex reads a^b^c as (a^b)^c; parenthesise, e.g. a^(b^c)".into());
             }
         }
     }
@@ -276,10 +241,7 @@ pub struct Vec2Expr(pub [Expr; 2]);
 impl Vec2Expr {
     /// Parse two component strings; `key` names the scene entry.
     pub fn parse(key: &str, comps: &[String; 2]) -> Result<Self> {
-        Ok(Vec2Expr([
-            Expr::parse(&format!("{key}[0]"), &comps[0])?,
-            Expr::parse(&format!("{key}[1]"), &comps[1])?,
-        ]))
+        Ok(Vec2Expr([Expr::parse(&format!("{key}[0]"), &comps[0])?, Expr::parse(&format!("{key}[1]"), &comps[1])?]))
     }
     /// The zero vector.
     pub fn zero() -> Self {
@@ -315,10 +277,7 @@ mod tests {
     #[test]
     fn unknown_variable_is_rejected_with_its_name() {
         let e = Expr::parse("loads.f[0]", "x + z").unwrap_err().to_string();
-        assert!(
-            e.contains("unknown variable `z`") && e.contains("loads.f[0]"),
-            "{e}"
-        );
+        assert!(e.contains("unknown variable `z`") && e.contains("loads.f[0]"), "{e}");
     }
 
     #[test]
@@ -346,14 +305,7 @@ mod tests {
         assert_eq!(v("exp(-x)"), (-3.0f64).exp());
         assert_eq!(v("x*y - x^2"), -3.0);
         assert_eq!(v("max(0, x)*min(y, 1) + max(x, y)"), 6.0);
-        for bad in [
-            "-x^2",
-            "-sin(t)^2",
-            "2^x^2",
-            "(1 + -x^2)",
-            "min(-x^2, 1)",
-            "-(x)^2",
-        ] {
+        for bad in ["-x^2", "-sin(t)^2", "2^x^2", "(1 + -x^2)", "min(-x^2, 1)", "-(x)^2"] {
             let e = Expr::parse("k", bad).unwrap_err().to_string();
             assert!(e.contains("exmex reads"), "{bad}: {e}");
         }

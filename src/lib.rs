@@ -16,6 +16,7 @@ pub mod contact;
 pub mod cr;
 pub mod error;
 pub mod expr;
+pub mod factor;
 pub mod mesh;
 pub mod norms;
 pub mod pdas;
@@ -23,6 +24,7 @@ pub mod quadrature;
 pub mod scene;
 pub mod ssn;
 pub mod stepping;
+pub mod superpose;
 pub mod uzawa;
 
 pub use error::{Error, Result};

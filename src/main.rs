@@ -7,11 +7,7 @@ use tresca_cr::scene::PartKind;
 use tresca_cr::{Problem, Scene};
 
 #[derive(Parser)]
-#[command(
-    name = "tresca-cr",
-    version,
-    about = "Quasi-static Tresca contact with stabilised Crouzeix-Raviart elements"
-)]
+#[command(name = "tresca-cr", version, about = "Quasi-static Tresca contact with stabilised Crouzeix-Raviart elements")]
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,
@@ -62,15 +58,7 @@ fn load(path: &PathBuf, refine: Option<u32>, steps: Option<usize>) -> Result<Sce
 fn check(scene: Scene) -> Result<()> {
     let problem = Problem::new(scene)?;
     let (s, m, sp) = (&problem.scene, &problem.mesh, &problem.space);
-    println!(
-        "scene      {} ({})",
-        s.file,
-        if s.title.is_empty() {
-            "untitled"
-        } else {
-            &s.title
-        }
-    );
+    println!("scene      {} ({})", s.file, if s.title.is_empty() { "untitled" } else { &s.title });
     println!(
         "mesh       {} vertices, {} triangles, {} edges, h = {:.4e}",
         m.points.len(),
@@ -108,10 +96,7 @@ fn check(scene: Scene) -> Result<()> {
     if s.f.is_some() {
         terms.push("body force");
     }
-    if s.parts
-        .iter()
-        .any(|p| matches!(p.kind, PartKind::Neumann(Some(_))))
-    {
+    if s.parts.iter().any(|p| matches!(p.kind, PartKind::Neumann(Some(_)))) {
         terms.push("Neumann traction");
     }
     if s.has_contact() {
@@ -127,20 +112,8 @@ fn check(scene: Scene) -> Result<()> {
         s.times.last().unwrap_or(&0.0),
         if s.uniform_time { " (uniform)" } else { "" }
     );
-    println!(
-        "solver     {} (tol {:.1e}, max_iter {})",
-        s.solver.method.name(),
-        s.solver.tol,
-        s.solver.max_iter
-    );
-    println!(
-        "exact      {}",
-        if s.exact.is_some() {
-            "given: true errors computed"
-        } else {
-            "none"
-        }
-    );
+    println!("solver     {} (tol {:.1e}, max_iter {})", s.solver.method.name(), s.solver.tol, s.solver.max_iter);
+    println!("exact      {}", if s.exact.is_some() { "given: true errors computed" } else { "none" });
     Ok(())
 }
 
@@ -159,19 +132,12 @@ fn run(scene: Scene, verbose: bool, quiet: bool) -> Result<()> {
     problem
         .run(|r| {
             if let Some(e) = r.errors {
-                max_err = [
-                    max_err[0].max(e.energy),
-                    max_err[1].max(e.h1),
-                    max_err[2].max(e.l2),
-                ];
+                max_err = [max_err[0].max(e.energy), max_err[1].max(e.h1), max_err[2].max(e.l2)];
             }
             iters += r.iterations;
             max_res = max_res.max(r.residual);
             if verbose {
-                let err = r
-                    .errors
-                    .map(|e| format!("  |||e||| {:.4e}  L2 {:.4e}", e.energy, e.l2))
-                    .unwrap_or_default();
+                let err = r.errors.map(|e| format!("  |||e||| {:.4e}  L2 {:.4e}", e.energy, e.l2)).unwrap_or_default();
                 println!(
                     "step {:>5} t = {:<10.6} it {:>5} res {:.2e} stick {:>4} slip {:>4}{}",
                     r.n,
@@ -190,13 +156,7 @@ fn run(scene: Scene, verbose: bool, quiet: bool) -> Result<()> {
         .with_context(|| "run stopped")?;
     bar.finish_and_clear();
     let sp = &problem.space;
-    println!(
-        "unknowns {} (paper DOF {}), contact edges {}, steps {}",
-        sp.n_dofs,
-        sp.paper_dofs(),
-        sp.contact.len(),
-        n
-    );
+    println!("unknowns {} (paper DOF {}), contact edges {}, steps {}", sp.n_dofs, sp.paper_dofs(), sp.contact.len(), n);
     let st = problem.setup_times;
     println!(
         "set-up: mesh {:.3}s, assembly {:.3}s, factorisation {:.3}s, condensation {:.3}s",
@@ -211,11 +171,7 @@ fn run(scene: Scene, verbose: bool, quiet: bool) -> Result<()> {
     );
     if let Some(r) = last {
         if !r.state.is_empty() {
-            println!(
-                "final step: {} stick, {} slip contact edges",
-                r.n_stick(),
-                r.n_slip()
-            );
+            println!("final step: {} stick, {} slip contact edges", r.n_stick(), r.n_slip());
         }
     }
     if problem.scene.exact.is_some() {
@@ -230,19 +186,8 @@ fn run(scene: Scene, verbose: bool, quiet: bool) -> Result<()> {
 fn main() {
     let cli = Cli::parse();
     let result = match cli.cmd {
-        Cmd::Check {
-            scene,
-            refine,
-            steps,
-        } => load(&scene, refine, steps).and_then(check),
-        Cmd::Run {
-            scene,
-            refine,
-            steps,
-            solver,
-            verbose,
-            quiet,
-        } => load(&scene, refine, steps).and_then(|mut s| {
+        Cmd::Check { scene, refine, steps } => load(&scene, refine, steps).and_then(check),
+        Cmd::Run { scene, refine, steps, solver, verbose, quiet } => load(&scene, refine, steps).and_then(|mut s| {
             if let Some(m) = solver {
                 s.solver.method = match m.as_str() {
                     "ssn" => tresca_cr::scene::Method::Ssn,

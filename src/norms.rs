@@ -32,9 +32,7 @@ pub struct ErrorEvaluator {
 
 impl ErrorEvaluator {
     pub fn new(mesh: &Mesh, space: &CrSpace, mat: &Material, rho: f64) -> Self {
-        let elements = (0..mesh.tris.len())
-            .map(|t| Element::new(mesh, t))
-            .collect();
+        let elements = (0..mesh.tris.len()).map(|t| Element::new(mesh, t)).collect();
         let pen = 2.0 * rho * mat.mu();
         let mut jumps = Vec::new();
         for e in 0..mesh.edges.len() {
@@ -44,22 +42,11 @@ impl ErrorEvaluator {
                 }
             }
         }
-        ErrorEvaluator {
-            elements,
-            jumps,
-            lam: mat.lambda(),
-            mu: mat.mu(),
-        }
+        ErrorEvaluator { elements, jumps, lam: mat.lambda(), mu: mat.mu() }
     }
 
     /// Errors of the CR field with midpoint values `mid` against `exact` at time t.
-    pub fn errors(
-        &self,
-        mesh: &Mesh,
-        exact: &Exact,
-        mid: &[[f64; 2]],
-        t: f64,
-    ) -> Result<ErrorNorms> {
+    pub fn errors(&self, mesh: &Mesh, exact: &Exact, mid: &[[f64; 2]], t: f64) -> Result<ErrorNorms> {
         let (mut en, mut h1, mut l2) = (0.0f64, 0.0f64, 0.0f64);
         for (k, el) in self.elements.iter().enumerate() {
             let ue = mesh.tri_edges[k].map(|e| mid[e]);
@@ -87,19 +74,11 @@ impl ErrorEvaluator {
                         g[c][d] = exact.grad[c][d].eval(x[0], x[1], t)? - gh[c][d];
                     }
                 }
-                let eps = [
-                    [g[0][0], 0.5 * (g[0][1] + g[1][0])],
-                    [0.5 * (g[0][1] + g[1][0]), g[1][1]],
-                ];
+                let eps = [[g[0][0], 0.5 * (g[0][1] + g[1][0])], [0.5 * (g[0][1] + g[1][0]), g[1][1]]];
                 let tr = eps[0][0] + eps[1][1];
-                let ee =
-                    eps[0][0] * eps[0][0] + 2.0 * eps[0][1] * eps[0][1] + eps[1][1] * eps[1][1];
+                let ee = eps[0][0] * eps[0][0] + 2.0 * eps[0][1] * eps[0][1] + eps[1][1] * eps[1][1];
                 en += wt * (self.lam * tr * tr + 2.0 * self.mu * ee);
-                h1 += wt
-                    * (g[0][0] * g[0][0]
-                        + g[0][1] * g[0][1]
-                        + g[1][0] * g[1][0]
-                        + g[1][1] * g[1][1]);
+                h1 += wt * (g[0][0] * g[0][0] + g[0][1] * g[0][1] + g[1][0] * g[1][0] + g[1][1] * g[1][1]);
             }
         }
         for (w, terms) in &self.jumps {
@@ -109,10 +88,6 @@ impl ErrorEvaluator {
             }
             en += w * (j[0] * j[0] + j[1] * j[1]);
         }
-        Ok(ErrorNorms {
-            energy: en.max(0.0).sqrt(),
-            h1: h1.sqrt(),
-            l2: l2.sqrt(),
-        })
+        Ok(ErrorNorms { energy: en.max(0.0).sqrt(), h1: h1.sqrt(), l2: l2.sqrt() })
     }
 }

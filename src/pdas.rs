@@ -17,17 +17,9 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
     for it in 0..=max_iter {
         let ds = qp.slip_increment(&mu);
         let feasible = (0..n).all(|e| mu[e].abs() <= qp.w[e] * (1.0 + 1e-14));
-        let res = if feasible {
-            qp.residual(&mu, &ds)
-        } else {
-            f64::INFINITY
-        };
+        let res = if feasible { qp.residual(&mu, &ds) } else { f64::INFINITY };
         if res <= tol {
-            return Ok(FrictionSolution {
-                mu,
-                iterations: it,
-                residual: res,
-            });
+            return Ok(FrictionSolution { mu, iterations: it, residual: res });
         }
         let set: Vec<i8> = (0..n)
             .map(|e| {
@@ -42,11 +34,7 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
             })
             .collect();
         if it == max_iter || !seen.insert(set.clone()) {
-            let what = if it == max_iter {
-                "pdas"
-            } else {
-                "pdas (cycling: an active set repeated)"
-            };
+            let what = if it == max_iter { "pdas" } else { "pdas (cycling: an active set repeated)" };
             return Err(not_converged(what, it, res, tol));
         }
         let stick: Vec<usize> = (0..n).filter(|&e| set[e] == 0).collect();
@@ -59,18 +47,12 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
             let css = DMatrix::from_fn(stick.len(), stick.len(), |i, j| qp.c[(stick[i], stick[j])]);
             let rhs = DVector::from_iterator(
                 stick.len(),
-                stick.iter().map(|&i| {
-                    qp.d[i]
-                        - (0..n)
-                            .filter(|&j| set[j] != 0)
-                            .map(|j| qp.c[(i, j)] * mu[j])
-                            .sum::<f64>()
-                }),
+                stick
+                    .iter()
+                    .map(|&i| qp.d[i] - (0..n).filter(|&j| set[j] != 0).map(|j| qp.c[(i, j)] * mu[j]).sum::<f64>()),
             );
-            let sol = css
-                .cholesky()
-                .ok_or_else(|| not_converged("pdas (singular stick block)", it, res, tol))?
-                .solve(&rhs);
+            let sol =
+                css.cholesky().ok_or_else(|| not_converged("pdas (singular stick block)", it, res, tol))?.solve(&rhs);
             for (k, &e) in stick.iter().enumerate() {
                 mu[e] = sol[k];
             }

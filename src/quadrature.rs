@@ -30,19 +30,12 @@ pub const GAUSS2: [(f64, f64); 2] = {
 /// 3-point Gauss–Legendre on [0, 1]: (s, weight).
 pub const GAUSS3: [(f64, f64); 3] = {
     const D: f64 = 0.387_298_334_620_741_689; // √(3/5)/2
-    [
-        (0.5 - D, 5.0 / 18.0),
-        (0.5, 8.0 / 18.0),
-        (0.5 + D, 5.0 / 18.0),
-    ]
+    [(0.5 - D, 5.0 / 18.0), (0.5, 8.0 / 18.0), (0.5 + D, 5.0 / 18.0)]
 };
 
 /// Point of the triangle (a, b, c) with barycentric coordinates l.
 pub fn tri_point(p: [[f64; 2]; 3], l: [f64; 3]) -> [f64; 2] {
-    [
-        l[0] * p[0][0] + l[1] * p[1][0] + l[2] * p[2][0],
-        l[0] * p[0][1] + l[1] * p[1][1] + l[2] * p[2][1],
-    ]
+    [l[0] * p[0][0] + l[1] * p[1][0] + l[2] * p[2][0], l[0] * p[0][1] + l[1] * p[1][1] + l[2] * p[2][1]]
 }
 
 /// Point a + s (b − a).
@@ -68,9 +61,7 @@ mod tests {
                     let k = d - i - j;
                     let q: f64 = TRI4
                         .iter()
-                        .map(|(l, w)| {
-                            w * l[0].powi(i as i32) * l[1].powi(j as i32) * l[2].powi(k as i32)
-                        })
+                        .map(|(l, w)| w * l[0].powi(i as i32) * l[1].powi(j as i32) * l[2].powi(k as i32))
                         .sum();
                     let err = (q - exact(i, j, k)).abs();
                     if d <= 4 {

@@ -125,12 +125,7 @@ pub enum Diagonal {
 #[derive(Clone, Debug)]
 pub enum MeshSpec {
     /// Quadrilateral c0 c1 c2 c3 (counter-clockwise), n × m cells, each split by one diagonal.
-    Structured {
-        corners: [[f64; 2]; 4],
-        cells: [usize; 2],
-        diagonal: Diagonal,
-        refine: u32,
-    },
+    Structured { corners: [[f64; 2]; 4], cells: [usize; 2], diagonal: Diagonal, refine: u32 },
     /// Gmsh 4.1 ASCII file, `refine` red refinements.
     Gmsh { path: PathBuf, refine: u32 },
 }
@@ -242,11 +237,7 @@ fn positive_finite(file: &str, key: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(Error::scene(
-            file,
-            key,
-            format!("must be a positive finite number, got {v}"),
-        ))
+        Err(Error::scene(file, key, format!("must be a positive finite number, got {v}")))
     }
 }
 
@@ -257,10 +248,8 @@ fn nonzero(v: Option<Vec2Expr>) -> Option<Vec2Expr> {
 impl Scene {
     /// Read and validate a scene file.
     pub fn from_file(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: path.to_path_buf(),
-            msg: format!("cannot read scene: {e}"),
-        })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::Io { path: path.to_path_buf(), msg: format!("cannot read scene: {e}") })?;
         let mut scene = Self::from_str(&text, &path.display().to_string())?;
         // relative mesh paths are relative to the scene file
         if let MeshSpec::Gmsh { path: p, .. } = &mut scene.mesh {
@@ -276,51 +265,33 @@ impl Scene {
     /// Parse and validate scene text; `file` is used in messages.
     pub fn from_str(text: &str, file: &str) -> Result<Self> {
         let raw: RawScene = toml::from_str(text).map_err(|e| {
-            let span = e
-                .span()
-                .map(|s| line_of(text, s.start))
-                .map(|l| format!("line {l}"))
-                .unwrap_or_default();
+            let span = e.span().map(|s| line_of(text, s.start)).map(|l| format!("line {l}")).unwrap_or_default();
             Error::scene(file, span, e.message().to_string())
         })?;
         let mesh = match (&raw.mesh.file, raw.mesh.corners, raw.mesh.cells) {
             (Some(p), None, None) => {
                 if raw.mesh.diagonal.is_some() {
-                    return Err(Error::scene(
-                        file,
-                        "mesh.diagonal",
-                        "only for structured meshes",
-                    ));
+                    return Err(Error::scene(file, "mesh.diagonal", "only for structured meshes"));
                 }
-                MeshSpec::Gmsh {
-                    path: p.clone(),
-                    refine: raw.mesh.refine,
-                }
+                MeshSpec::Gmsh { path: p.clone(), refine: raw.mesh.refine }
             }
             (None, Some(corners), Some(cells)) => {
                 if cells[0] == 0 || cells[1] == 0 {
-                    return Err(Error::scene(
-                        file,
-                        "mesh.cells",
-                        "cell counts must be at least 1",
-                    ));
+                    return Err(Error::scene(file, "mesh.cells", "cell counts must be at least 1"));
                 }
                 if corners.iter().flatten().any(|c| !c.is_finite()) {
                     return Err(Error::scene(file, "mesh.corners", "corners must be finite"));
                 }
                 let diagonal = raw.mesh.diagonal.unwrap_or(Diagonal::First);
-                MeshSpec::Structured {
-                    corners,
-                    cells,
-                    diagonal,
-                    refine: raw.mesh.refine,
-                }
+                MeshSpec::Structured { corners, cells, diagonal, refine: raw.mesh.refine }
             }
-            _ => return Err(Error::scene(
-                file,
-                "mesh",
-                "give either `file` (Gmsh) or both `corners` and `cells` (structured), not both",
-            )),
+            _ => {
+                return Err(Error::scene(
+                    file,
+                    "mesh",
+                    "give either `file` (Gmsh) or both `corners` and `cells` (structured), not both",
+                ))
+            }
         };
         if raw.mesh.refine > 12 {
             return Err(Error::scene(
@@ -332,11 +303,7 @@ impl Scene {
         let e = positive_finite(file, "material.E", raw.material.E)?;
         let nu = raw.material.nu;
         if !(nu.is_finite() && nu > -1.0 && nu < 0.5) {
-            return Err(Error::scene(
-                file,
-                "material.nu",
-                format!("must satisfy -1 < nu < 0.5, got {nu}"),
-            ));
+            return Err(Error::scene(file, "material.nu", format!("must satisfy -1 < nu < 0.5, got {nu}")));
         }
         let mut parts = Vec::new();
         for (i, b) in raw.boundary.iter().enumerate() {
@@ -345,18 +312,10 @@ impl Scene {
                 return Err(Error::scene(file, key("name"), "boundary part named twice"));
             }
             if b.traction.is_some() && b.kind != RawKind::Neumann {
-                return Err(Error::scene(
-                    file,
-                    key("traction"),
-                    "only neumann parts take a traction",
-                ));
+                return Err(Error::scene(file, key("traction"), "only neumann parts take a traction"));
             }
             if b.g_a.is_some() && b.kind != RawKind::Contact {
-                return Err(Error::scene(
-                    file,
-                    key("g_a"),
-                    "only contact parts take a friction bound g_a",
-                ));
+                return Err(Error::scene(file, key("g_a"), "only contact parts take a friction bound g_a"));
             }
             let kind = match b.kind {
                 RawKind::Dirichlet => PartKind::Dirichlet,
@@ -365,34 +324,21 @@ impl Scene {
                     None => None,
                 }),
                 RawKind::Contact => {
-                    let text = b
-                        .g_a
-                        .as_deref()
-                        .ok_or_else(|| Error::scene(file, key("g_a"), "contact part needs g_a"))?;
+                    let text =
+                        b.g_a.as_deref().ok_or_else(|| Error::scene(file, key("g_a"), "contact part needs g_a"))?;
                     let g = Expr::parse(&key("g_a"), text)?;
                     if g.depends_on_t() {
-                        return Err(Error::scene(
-                            file,
-                            key("g_a"),
-                            "the friction bound must not depend on t",
-                        ));
+                        return Err(Error::scene(file, key("g_a"), "the friction bound must not depend on t"));
                     }
                     if let Some(c) = g.constant() {
                         if c < 0.0 {
-                            return Err(Error::scene(
-                                file,
-                                key("g_a"),
-                                format!("must be >= 0, got {c}"),
-                            ));
+                            return Err(Error::scene(file, key("g_a"), format!("must be >= 0, got {c}")));
                         }
                     }
                     PartKind::Contact(g)
                 }
             };
-            parts.push(Part {
-                name: b.name.clone(),
-                kind,
-            });
+            parts.push(Part { name: b.name.clone(), kind });
         }
         if !parts.iter().any(|p| matches!(p.kind, PartKind::Dirichlet)) {
             return Err(Error::scene(
@@ -422,42 +368,28 @@ impl Scene {
             }
             (None, None, Some(ts)) => {
                 if ts.len() < 2 {
-                    return Err(Error::scene(
-                        file,
-                        "time.times",
-                        "needs at least two time nodes",
-                    ));
+                    return Err(Error::scene(file, "time.times", "needs at least two time nodes"));
                 }
                 for (k, w) in ts.windows(2).enumerate() {
                     if !(w[0].is_finite() && w[1].is_finite() && w[1] > w[0]) {
                         return Err(Error::scene(
                             file,
                             "time.times",
-                            format!("must be finite and strictly increasing: times[{k}] = {}, times[{}] = {}", w[0], k + 1, w[1]),
+                            format!(
+                                "must be finite and strictly increasing: times[{k}] = {}, times[{}] = {}",
+                                w[0],
+                                k + 1,
+                                w[1]
+                            ),
                         ));
                     }
                 }
                 (ts, false)
             }
-            _ => {
-                return Err(Error::scene(
-                    file,
-                    "time",
-                    "give either `T` and `steps`, or `times`",
-                ))
-            }
+            _ => return Err(Error::scene(file, "time", "give either `T` and `steps`, or `times`")),
         };
-        let rho = positive_finite(
-            file,
-            "discretisation.rho",
-            raw.discretisation.map(|d| d.rho).unwrap_or(10.0),
-        )?;
-        let rs = raw.solver.unwrap_or(RawSolver {
-            method: None,
-            tol: None,
-            max_iter: None,
-            uzawa_step: None,
-        });
+        let rho = positive_finite(file, "discretisation.rho", raw.discretisation.map(|d| d.rho).unwrap_or(10.0))?;
+        let rs = raw.solver.unwrap_or(RawSolver { method: None, tol: None, max_iter: None, uzawa_step: None });
         let method = rs.method.unwrap_or(Method::Ssn);
         let solver = SolverSettings {
             method,
@@ -482,13 +414,8 @@ impl Scene {
         };
         let exact = match raw.exact {
             Some(x) => {
-                let g = |i: usize, j: usize| {
-                    Expr::parse(&format!("exact.grad[{i}][{j}]"), &x.grad[i][j])
-                };
-                Some(Exact {
-                    u: Vec2Expr::parse("exact.u", &x.u)?,
-                    grad: [[g(0, 0)?, g(0, 1)?], [g(1, 0)?, g(1, 1)?]],
-                })
+                let g = |i: usize, j: usize| Expr::parse(&format!("exact.grad[{i}][{j}]"), &x.grad[i][j]);
+                Some(Exact { u: Vec2Expr::parse("exact.u", &x.u)?, grad: [[g(0, 0)?, g(0, 1)?], [g(1, 0)?, g(1, 1)?]] })
             }
             None => None,
         };
@@ -513,11 +440,7 @@ impl Scene {
     /// Override the number of uniform refinements (`--refine`).
     pub fn set_refine(&mut self, k: u32) -> Result<()> {
         if k > 12 {
-            return Err(Error::scene(
-                &self.file,
-                "--refine",
-                format!("{k} refinements is beyond any machine"),
-            ));
+            return Err(Error::scene(&self.file, "--refine", format!("{k} refinements is beyond any machine")));
         }
         match &mut self.mesh {
             MeshSpec::Structured { refine, .. } | MeshSpec::Gmsh { refine, .. } => *refine = k,
@@ -536,18 +459,13 @@ impl Scene {
         }
         let t0 = self.times[0];
         let t = *self.times.last().expect("at least two nodes") - t0;
-        self.times = uniform_times(&self.file, t, n)?
-            .into_iter()
-            .map(|s| s + t0)
-            .collect();
+        self.times = uniform_times(&self.file, t, n)?.into_iter().map(|s| s + t0).collect();
         Ok(())
     }
 
     /// True if the scene has a contact part.
     pub fn has_contact(&self) -> bool {
-        self.parts
-            .iter()
-            .any(|p| matches!(p.kind, PartKind::Contact(_)))
+        self.parts.iter().any(|p| matches!(p.kind, PartKind::Contact(_)))
     }
 }
 

@@ -23,11 +23,7 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
         let ds = qp.slip_increment(&mu);
         let res = qp.residual(&mu, &ds);
         if res <= tol {
-            return Ok(FrictionSolution {
-                mu,
-                iterations: it,
-                residual: res,
-            });
+            return Ok(FrictionSolution { mu, iterations: it, residual: res });
         }
         if it == max_iter {
             return Err(not_converged("ssn", it, res, tol));
@@ -40,26 +36,17 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
             .min(1e-3 * wmax);
         let active: Vec<bool> = (0..n)
             .map(|e| {
-                (mu[e] >= qp.w[e] - eps && g[e] < 0.0)
-                    || (mu[e] <= -qp.w[e] + eps && g[e] > 0.0)
-                    || qp.w[e] == 0.0
+                (mu[e] >= qp.w[e] - eps && g[e] < 0.0) || (mu[e] <= -qp.w[e] + eps && g[e] > 0.0) || qp.w[e] == 0.0
             })
             .collect();
         let free: Vec<usize> = (0..n).filter(|&e| !active[e]).collect();
-        let mut p: Vec<f64> = (0..n)
-            .map(|e| if active[e] { -g[e] / qp.c[(e, e)] } else { 0.0 })
-            .collect();
+        let mut p: Vec<f64> = (0..n).map(|e| if active[e] { -g[e] / qp.c[(e, e)] } else { 0.0 }).collect();
         if !free.is_empty() {
             let cff = DMatrix::from_fn(free.len(), free.len(), |i, j| qp.c[(free[i], free[j])]);
             let rhs = DVector::from_iterator(free.len(), free.iter().map(|&e| -g[e]));
-            let chol = cff.cholesky().ok_or_else(|| {
-                not_converged(
-                    "ssn (condensed operator not positive definite)",
-                    it,
-                    res,
-                    tol,
-                )
-            })?;
+            let chol = cff
+                .cholesky()
+                .ok_or_else(|| not_converged("ssn (condensed operator not positive definite)", it, res, tol))?;
             let pf = chol.solve(&rhs);
             for (k, &e) in free.iter().enumerate() {
                 p[e] = pf[k];
@@ -69,22 +56,13 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
         let mut alpha = 1.0;
         let mut accepted = false;
         for _ in 0..60 {
-            let trial: Vec<f64> = (0..n)
-                .map(|e| qp.project(e, mu[e] + alpha * p[e]))
-                .collect();
+            let trial: Vec<f64> = (0..n).map(|e| qp.project(e, mu[e] + alpha * p[e])).collect();
             let delta: Vec<f64> = (0..n).map(|e| trial[e] - mu[e]).collect();
             // q(μ+δ) − q(μ) = gᵀδ + ½ δᵀCδ
             let cd = qp.c * DVector::from_column_slice(&delta);
             let dq: f64 = (0..n).map(|e| delta[e] * (g[e] + 0.5 * cd[e])).sum();
-            let pred: f64 = (0..n)
-                .map(|e| {
-                    if active[e] {
-                        g[e] * (mu[e] - trial[e])
-                    } else {
-                        -alpha * g[e] * p[e]
-                    }
-                })
-                .sum();
+            let pred: f64 =
+                (0..n).map(|e| if active[e] { g[e] * (mu[e] - trial[e]) } else { -alpha * g[e] * p[e] }).sum();
             if -dq >= SIGMA * pred || delta.iter().all(|v| *v == 0.0) {
                 mu = trial;
                 accepted = true;

@@ -6,16 +6,16 @@
 //! handed to a callback (the writer), so nothing is lost if a later step fails.
 
 use crate::assemble::{matvec, stiffness, Loads};
-use crate::contact::{classify, solve_in_place, Condensed, FrictionSolution, Qp};
+use crate::contact::{classify, Condensed, FrictionSolution, Qp};
 use crate::cr::CrSpace;
 use crate::error::{Error, Result};
+use crate::factor::Factor;
 use crate::mesh::Mesh;
 use crate::norms::{ErrorEvaluator, ErrorNorms};
 use crate::scene::{Method, Scene};
+use crate::superpose::LoadBasis;
 use crate::{pdas, ssn, uzawa};
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::SparseColMat;
-use faer::Side;
 use std::time::Instant;
 
 /// Everything assembled once per run.
@@ -24,8 +24,10 @@ pub struct Problem {
     pub mesh: Mesh,
     pub space: CrSpace,
     pub k: SparseColMat<usize, f64>,
-    pub llt: Llt<usize, f64>,
+    pub llt: Factor,
     pub loads: Loads,
+    /// Superposition of load patterns, when the loads span few of them (see `superpose`).
+    pub basis: Option<LoadBasis>,
     pub condensed: Option<Condensed>,
     pub errors: Option<ErrorEvaluator>,
     /// Wall times of the set-up phases (seconds): mesh+space, assembly, factorisation, condensation.
@@ -77,22 +79,12 @@ impl Problem {
         let k = stiffness(&mesh, &space, &scene.material, scene.rho)?;
         let loads = Loads::new(&scene, &mesh, &space);
         let t2 = Instant::now();
-        let sym = SymbolicLlt::try_new(k.symbolic(), Side::Lower)
-            .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))?;
-        let llt = Llt::try_new_with_symbolic(sym, k.as_ref(), Side::Lower).map_err(|e| {
-            Error::Linear(format!("the stiffness matrix is not positive definite ({e:?}): are rigid motions fixed by a Dirichlet part?"))
-        })?;
+        let llt = Factor::new(&k, std::env::var_os("TRESCA_SIMPLICIAL").is_some())?;
         let t3 = Instant::now();
-        let condensed = if space.contact.is_empty() {
-            None
-        } else {
-            Some(Condensed::new(&space, &llt))
-        };
+        let condensed = if space.contact.is_empty() { None } else { Some(Condensed::new(&space, &llt)) };
+        let basis = LoadBasis::build(&loads, &space, &scene.times, &llt)?;
         let t4 = Instant::now();
-        let errors = scene
-            .exact
-            .as_ref()
-            .map(|_| ErrorEvaluator::new(&mesh, &space, &scene.material, scene.rho));
+        let errors = scene.exact.as_ref().map(|_| ErrorEvaluator::new(&mesh, &space, &scene.material, scene.rho));
         let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
         Ok(Problem {
             setup_times: [d(t0, t1), d(t1, t2), d(t2, t3), d(t3, t4)],
@@ -102,6 +94,7 @@ impl Problem {
             k,
             llt,
             loads,
+            basis,
             condensed,
             errors,
         })
@@ -121,135 +114,115 @@ impl Problem {
         };
         let nc = self.space.contact.len();
         let slip = self.space.contact.iter().map(|c| u[c.dof]).collect();
-        self.finish(0, t, u, vec![0.0; nc], slip, vec![0; nc], 0, 0.0, 0.0)
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn finish(
-        &self,
-        n: usize,
-        t: f64,
-        u: Vec<f64>,
-        mu: Vec<f64>,
-        slip: Vec<f64>,
-        state: Vec<u8>,
-        iterations: usize,
-        residual: f64,
-        wall: f64,
-    ) -> Result<StepResult> {
         let mut ku = vec![0.0; u.len()];
         matvec(&self.k, &u, &mut ku);
         let energy = u.iter().zip(&ku).map(|(a, b)| a * b).sum();
-        let errors = match (&self.errors, &self.scene.exact) {
-            (Some(ev), Some(ex)) => {
-                Some(ev.errors(&self.mesh, ex, &self.space.midpoint_values(&u), t)?)
-            }
-            _ => None,
-        };
-        if u.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Linear(format!(
-                "step {n}: the solution is not finite (singular or ill-conditioned system)"
-            )));
-        }
-        Ok(StepResult {
-            n,
+        let r = StepResult {
+            n: 0,
             t,
             u,
-            mu,
+            mu: vec![0.0; nc],
             slip,
-            state,
-            iterations,
-            residual,
+            state: vec![0; nc],
+            iterations: 0,
+            residual: 0.0,
             energy,
-            errors,
-            wall,
-        })
+            errors: None,
+            wall: 0.0,
+        };
+        self.finish(r)
+    }
+
+    /// Finiteness check and true errors.
+    fn finish(&self, mut r: StepResult) -> Result<StepResult> {
+        if r.u.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Linear(format!(
+                "step {}: the solution is not finite (singular or ill-conditioned system)",
+                r.n
+            )));
+        }
+        if let (Some(ev), Some(ex)) = (&self.errors, &self.scene.exact) {
+            r.errors = Some(ev.errors(&self.mesh, ex, &self.space.midpoint_values(&r.u), r.t)?);
+        }
+        Ok(r)
     }
 
     /// Solve step n from the previous step's result. `load` is scratch space.
     pub fn step(&self, n: usize, prev: &StepResult, load: &mut Vec<f64>) -> Result<StepResult> {
         let start = Instant::now();
         let t = self.scene.times[n];
-        self.loads.assemble(&self.space, t, load)?;
-        let mut u = load.clone();
-        solve_in_place(&self.llt, &mut u);
+        let dofs = self.space.n_dofs;
+        let mut u = Vec::with_capacity(dofs);
+        match &self.basis {
+            Some(b) => {
+                b.load(n, dofs, load);
+                b.response(n, dofs, &mut u);
+            }
+            None => {
+                self.loads.assemble(&self.space, t, load)?;
+                u.extend_from_slice(load);
+                self.llt.solve_in_place(&mut u);
+            }
+        }
+        // a_h(u, u) = (l, u) − Σ_e μ_e s_e, since K u = l − Eμ
+        let load_work: f64 = load.iter().zip(&u).map(|(a, b)| a * b).sum();
         let Some(cd) = &self.condensed else {
-            return self.finish(
+            let r = StepResult {
                 n,
                 t,
                 u,
-                vec![],
-                vec![],
-                vec![],
-                1,
-                0.0,
-                start.elapsed().as_secs_f64(),
-            );
+                mu: vec![],
+                slip: vec![],
+                state: vec![],
+                iterations: 1,
+                residual: 0.0,
+                energy: load_work,
+                errors: None,
+                wall: start.elapsed().as_secs_f64(),
+            };
+            return self.finish(r);
         };
-        let d: Vec<f64> = cd
-            .dofs
-            .iter()
-            .zip(&prev.slip)
-            .map(|(&k, s)| u[k] - s)
-            .collect();
-        let qp = Qp {
-            c: &cd.c,
-            d: &d,
-            w: &cd.w,
-        };
+        let d: Vec<f64> = cd.dofs.iter().zip(&prev.slip).map(|(&k, s)| u[k] - s).collect();
+        let qp = Qp { c: &cd.c, d: &d, w: &cd.w };
         let s = &self.scene.solver;
         let sol: Result<FrictionSolution> = match s.method {
             Method::Ssn => ssn::solve(&qp, &prev.mu, s.tol, s.max_iter),
             Method::Pdas => pdas::solve(&qp, &prev.mu, s.tol, s.max_iter),
             Method::Uzawa => {
-                let rho = if s.uzawa_step > 0.0 {
-                    s.uzawa_step
-                } else {
-                    uzawa::auto_step(&qp, &cd.g)
-                };
+                let rho = if s.uzawa_step > 0.0 { s.uzawa_step } else { uzawa::auto_step(&qp, &cd.g) };
                 uzawa::solve(&qp, &cd.g, &prev.mu, rho, s.tol, s.max_iter)
             }
         };
         let sol = sol.map_err(|e| match e {
-            Error::NotConverged {
-                solver,
-                iterations,
-                residual,
-                tol,
-                ..
-            } => Error::NotConverged {
-                step: n,
-                time: t,
-                solver,
-                iterations,
-                residual,
-                tol,
-            },
+            Error::NotConverged { solver, iterations, residual, tol, .. } => {
+                Error::NotConverged { step: n, time: t, solver, iterations, residual, tol }
+            }
             other => other,
         })?;
         cd.apply_friction(&self.llt, &mut u, &sol.mu);
         let slip: Vec<f64> = cd.dofs.iter().map(|&k| u[k]).collect();
         let ds: Vec<f64> = slip.iter().zip(&prev.slip).map(|(a, b)| a - b).collect();
         let state = classify(&qp, &sol.mu, &ds);
-        self.finish(
+        let load_work: f64 = load.iter().zip(&u).map(|(a, b)| a * b).sum();
+        let energy = load_work - sol.mu.iter().zip(&slip).map(|(m, s)| m * s).sum::<f64>();
+        let r = StepResult {
             n,
             t,
             u,
-            sol.mu,
+            mu: sol.mu,
             slip,
             state,
-            sol.iterations,
-            sol.residual,
-            start.elapsed().as_secs_f64(),
-        )
+            iterations: sol.iterations,
+            residual: sol.residual,
+            energy,
+            errors: None,
+            wall: start.elapsed().as_secs_f64(),
+        };
+        self.finish(r)
     }
 
     /// Run steps from `from` (whose result is given) to N, handing every result to `on_step`.
-    pub fn run_from(
-        &self,
-        from: StepResult,
-        mut on_step: impl FnMut(&StepResult) -> Result<()>,
-    ) -> Result<()> {
+    pub fn run_from(&self, from: StepResult, mut on_step: impl FnMut(&StepResult) -> Result<()>) -> Result<()> {
         let mut load = Vec::with_capacity(self.space.n_dofs);
         let mut prev = from;
         for n in prev.n + 1..=self.n_steps() {

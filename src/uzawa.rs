@@ -17,9 +17,7 @@ pub fn auto_step(qp: &Qp, g: &[f64]) -> f64 {
     let mut lam = 0.0;
     for _ in 0..200 {
         let sv: Vec<f64> = (0..n).map(|e| s[e] * v[e]).collect();
-        let mut y: Vec<f64> = (0..n)
-            .map(|i| (0..n).map(|j| qp.c[(i, j)] * sv[j]).sum::<f64>() * s[i])
-            .collect();
+        let mut y: Vec<f64> = (0..n).map(|i| (0..n).map(|j| qp.c[(i, j)] * sv[j]).sum::<f64>() * s[i]).collect();
         let norm = y.iter().map(|x| x * x).sum::<f64>().sqrt();
         if norm == 0.0 {
             return 1.0;
@@ -36,24 +34,10 @@ pub fn auto_step(qp: &Qp, g: &[f64]) -> f64 {
 }
 
 /// Uzawa from the warm start `mu0` with step `rho` (the paper's ρ̃).
-pub fn solve(
-    qp: &Qp,
-    g: &[f64],
-    mu0: &[f64],
-    rho: f64,
-    tol: f64,
-    max_iter: usize,
-) -> Result<FrictionSolution> {
+pub fn solve(qp: &Qp, g: &[f64], mu0: &[f64], rho: f64, tol: f64, max_iter: usize) -> Result<FrictionSolution> {
     let n = qp.d.len();
-    let mut lam: Vec<f64> = (0..n)
-        .map(|e| {
-            if qp.w[e] > 0.0 {
-                (mu0[e] / qp.w[e]).clamp(-1.0, 1.0)
-            } else {
-                0.0
-            }
-        })
-        .collect();
+    let mut lam: Vec<f64> =
+        (0..n).map(|e| if qp.w[e] > 0.0 { (mu0[e] / qp.w[e]).clamp(-1.0, 1.0) } else { 0.0 }).collect();
     let mut mu: Vec<f64> = (0..n).map(|e| qp.w[e] * lam[e]).collect();
     let mut diff = f64::INFINITY;
     for it in 1..=max_iter {
@@ -70,11 +54,7 @@ pub fn solve(
         }
         if diff < tol {
             let ds = qp.slip_increment(&mu);
-            return Ok(FrictionSolution {
-                residual: qp.residual(&mu, &ds),
-                mu,
-                iterations: it,
-            });
+            return Ok(FrictionSolution { residual: qp.residual(&mu, &ds), mu, iterations: it });
         }
     }
     Err(not_converged("uzawa", max_iter, diff, tol))

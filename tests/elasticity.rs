@@ -19,11 +19,11 @@ fn patch_scene(mesh_toml: &str, sides: &[(&str, [f64; 2])], clamp: &str) -> (Sce
     let mut text = format!("{mesh_toml}\n[material]\nE = {e}\nnu = {nu}\n[time]\nT = 1.0\nsteps = 1\n[exact]\nu = [\"{a}*x\", \"{b}*x\"]\ngrad = [[\"{a}\", \"0\"], [\"{b}\", \"0\"]]\n");
     text += &format!("[[boundary]]\nname = \"{clamp}\"\nkind = \"dirichlet\"\n");
     for (name, n) in sides {
-        let t = [
-            s[0][0] * n[0] + s[0][1] * n[1],
-            s[1][0] * n[0] + s[1][1] * n[1],
-        ];
-        text += &format!("[[boundary]]\nname = \"{name}\"\nkind = \"neumann\"\ntraction = [\"{:?}\", \"{:?}\"]\n", t[0], t[1]);
+        let t = [s[0][0] * n[0] + s[0][1] * n[1], s[1][0] * n[0] + s[1][1] * n[1]];
+        text += &format!(
+            "[[boundary]]\nname = \"{name}\"\nkind = \"neumann\"\ntraction = [\"{:?}\", \"{:?}\"]\n",
+            t[0], t[1]
+        );
     }
     (Scene::from_str(&text, "patch").unwrap(), [a, b])
 }
@@ -36,11 +36,8 @@ fn jitter(raw: &mut RawMesh, amount: f64) {
         state ^= state << 17;
         (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
     };
-    let on_boundary: std::collections::HashSet<usize> = raw
-        .tagged
-        .iter()
-        .flat_map(|(e, _)| e.iter().copied())
-        .collect();
+    let on_boundary: std::collections::HashSet<usize> =
+        raw.tagged.iter().flat_map(|(e, _)| e.iter().copied()).collect();
     for (i, p) in raw.points.iter_mut().enumerate() {
         if !on_boundary.contains(&i) {
             p[0] += amount * rnd();
@@ -57,50 +54,33 @@ fn check_patch(scene: Scene, mesh: Mesh, ab: [f64; 2]) {
             let mid = p.space.midpoint_values(&r.u);
             for (e, m) in mid.iter().enumerate() {
                 let x = p.mesh.midpoint(e)[0];
-                worst = worst
-                    .max((m[0] - ab[0] * x).abs())
-                    .max((m[1] - ab[1] * x).abs());
+                worst = worst.max((m[0] - ab[0] * x).abs()).max((m[1] - ab[1] * x).abs());
             }
             let err = r.errors.unwrap();
-            assert!(
-                err.energy < 1e-11 && err.l2 < 1e-12,
-                "{}: {err:?}",
-                p.mesh.source
-            );
+            assert!(err.energy < 1e-11 && err.l2 < 1e-12, "{}: {err:?}", p.mesh.source);
         }
         Ok(())
     })
     .unwrap();
     // the affine field lies in V_h and a_h is consistent for it: only rounding remains
-    assert!(
-        worst < 1e-12,
-        "patch test: max midpoint deviation {worst:e}"
-    );
+    assert!(worst < 1e-12, "patch test: max midpoint deviation {worst:e}");
 }
 
 /// The solver shall reproduce any affine displacement with matching tractions to 1e-12 on unstructured meshes.
 #[test]
 fn patch_test_on_unstructured_meshes() {
     // a jittered structured mesh (every interior vertex moved, all angles different)
-    let mesh_toml =
-        "[mesh]\ncorners = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]]\ncells = [8, 4]";
-    let sides = [
-        ("bottom", [0.0, -1.0]),
-        ("right", [1.0, 0.0]),
-        ("top", [0.0, 1.0]),
-    ];
+    let mesh_toml = "[mesh]\ncorners = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]]\ncells = [8, 4]";
+    let sides = [("bottom", [0.0, -1.0]), ("right", [1.0, 0.0]), ("top", [0.0, 1.0])];
     let (scene, ab) = patch_scene(mesh_toml, &sides, "left");
     let c = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]];
-    let mut raw =
-        tresca_cr::mesh::structured_raw(&c, [8, 4], tresca_cr::scene::Diagonal::First).unwrap();
+    let mut raw = tresca_cr::mesh::structured_raw(&c, [8, 4], tresca_cr::scene::Diagonal::First).unwrap();
     jitter(&mut raw, 0.12);
     check_patch(scene, Mesh::build(raw).unwrap(), ab);
     // a Gmsh L-shape, as read and after one red refinement
     for refine in [0, 1] {
-        let mesh_toml = format!(
-            "[mesh]\nfile = \"{}/tests/scenes/lshape.msh\"\nrefine = {refine}",
-            env!("CARGO_MANIFEST_DIR")
-        );
+        let mesh_toml =
+            format!("[mesh]\nfile = \"{}/tests/scenes/lshape.msh\"\nrefine = {refine}", env!("CARGO_MANIFEST_DIR"));
         // L-shape: floor y=0 (n = (0,-1)); "loaded" has several normals, so apply the traction per edge via
         // the exact σn: split into a scene whose loaded part is traction free is not affine-consistent,
         // so use an L-shape-specific traction expression that is piecewise by position.
@@ -119,19 +99,10 @@ fn lshape_patch_scene(mesh_toml: &str) -> (Scene, [f64; 2]) {
     let mu = e / (2.0 * (1.0 + nu));
     let s = [[(lam + 2.0 * mu) * a, mu * b], [mu * b, lam * a]];
     // indicator of a vertical side (normal (1,0)): x = 2, or x = 1 with y > 1; otherwise horizontal (0,1)
-    let vertical = "0.5*(1 + signum(x - 1.999999)) + 0.25*(1 + signum(0.000001 - abs(x - 1)))*(1 + signum(y - 1.000001))";
-    let tx = format!(
-        "({v})*({:?}) + (1 - ({v}))*({:?})",
-        s[0][0],
-        s[0][1],
-        v = vertical
-    );
-    let ty = format!(
-        "({v})*({:?}) + (1 - ({v}))*({:?})",
-        s[1][0],
-        s[1][1],
-        v = vertical
-    );
+    let vertical =
+        "0.5*(1 + signum(x - 1.999999)) + 0.25*(1 + signum(0.000001 - abs(x - 1)))*(1 + signum(y - 1.000001))";
+    let tx = format!("({v})*({:?}) + (1 - ({v}))*({:?})", s[0][0], s[0][1], v = vertical);
+    let ty = format!("({v})*({:?}) + (1 - ({v}))*({:?})", s[1][0], s[1][1], v = vertical);
     let floor = [-s[0][1], -s[1][1]];
     let text = format!(
         "{mesh_toml}\n[material]\nE = {e}\nnu = {nu}\n[time]\nT = 1.0\nsteps = 1\n[exact]\nu = [\"{a}*x\", \"{b}*x\"]\ngrad = [[\"{a}\", \"0\"], [\"{b}\", \"0\"]]\n\
@@ -146,28 +117,18 @@ fn lshape_patch_scene(mesh_toml: &str) -> (Scene, [f64; 2]) {
 #[test]
 fn rigid_motions_are_in_the_kernel_and_clamping_makes_k_spd() {
     let c = [[0.0, 0.0], [3.0, 0.0], [3.0, 2.0], [0.0, 2.0]];
-    let raw =
-        tresca_cr::mesh::structured_raw(&c, [6, 4], tresca_cr::scene::Diagonal::Second).unwrap();
+    let raw = tresca_cr::mesh::structured_raw(&c, [6, 4], tresca_cr::scene::Diagonal::Second).unwrap();
     let mesh = Mesh::build(raw).unwrap();
     let mat = tresca_cr::scene::Material { e: 10.0, nu: 0.3 };
     let free: Vec<Part> = ["bottom", "right", "top", "left"]
         .iter()
-        .map(|n| Part {
-            name: n.to_string(),
-            kind: PartKind::Neumann(None),
-        })
+        .map(|n| Part { name: n.to_string(), kind: PartKind::Neumann(None) })
         .collect();
     let space = CrSpace::new(&mesh, &free).unwrap();
     let k = stiffness(&mesh, &space, &mat, 10.0).unwrap();
     let norm_k = k.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    for r in [
-        |_x: f64, _y: f64| [1.0, 0.0],
-        |_x, _y| [0.0, 1.0],
-        |x: f64, y: f64| [-y, x],
-    ] {
-        let u: Vec<f64> = (0..mesh.edges.len())
-            .flat_map(|e| r(mesh.midpoint(e)[0], mesh.midpoint(e)[1]))
-            .collect();
+    for r in [|_x: f64, _y: f64| [1.0, 0.0], |_x, _y| [0.0, 1.0], |x: f64, y: f64| [-y, x]] {
+        let u: Vec<f64> = (0..mesh.edges.len()).flat_map(|e| r(mesh.midpoint(e)[0], mesh.midpoint(e)[1])).collect();
         let mut ku = vec![0.0; u.len()];
         matvec(&k, &u, &mut ku);
         let a: f64 = u.iter().zip(&ku).map(|(x, y)| x * y).sum();
@@ -175,9 +136,7 @@ fn rigid_motions_are_in_the_kernel_and_clamping_makes_k_spd() {
         assert!(a.abs() < 1e-12 * norm_k * uu, "a_h(r, r) = {a:e}");
     }
     // a strain mode is not in the kernel
-    let u: Vec<f64> = (0..mesh.edges.len())
-        .flat_map(|e| [mesh.midpoint(e)[0], 0.0])
-        .collect();
+    let u: Vec<f64> = (0..mesh.edges.len()).flat_map(|e| [mesh.midpoint(e)[0], 0.0]).collect();
     let mut ku = vec![0.0; u.len()];
     matvec(&k, &u, &mut ku);
     assert!(u.iter().zip(&ku).map(|(x, y)| x * y).sum::<f64>() > 1.0);
@@ -197,16 +156,10 @@ fn rigid_motions_are_in_the_kernel_and_clamping_makes_k_spd() {
             dense[(i, j)] = col[i];
         }
     }
-    assert!(
-        (&dense - dense.transpose()).amax() < 1e-12 * dense.amax(),
-        "K is not symmetric"
-    );
+    assert!((&dense - dense.transpose()).amax() < 1e-12 * dense.amax(), "K is not symmetric");
     let eig = nalgebra::SymmetricEigen::new(dense).eigenvalues;
     let (lo, hi) = (eig.min(), eig.max());
-    assert!(
-        lo > 1e-8 * hi,
-        "smallest eigenvalue {lo:e} vs largest {hi:e}"
-    );
+    assert!(lo > 1e-8 * hi, "smallest eigenvalue {lo:e} vs largest {hi:e}");
 }
 
 /// The paper's meshes on (0,4)² with the right side clamped give DOF 28, 104, 400, 1568, 6208.
@@ -218,11 +171,7 @@ fn paper_dof_counts() {
         let mesh = Mesh::from_spec(&s.mesh).unwrap();
         let space = CrSpace::new(&mesh, &s.parts).unwrap();
         assert_eq!(space.paper_dofs(), want, "n = {}", 2 << k);
-        assert_eq!(
-            space.n_dofs,
-            want - space.contact.len(),
-            "contact normal components are eliminated"
-        );
+        assert_eq!(space.n_dofs, want - space.contact.len(), "contact normal components are eliminated");
     }
 }
 
@@ -248,9 +197,7 @@ fn elastic_rates(path: &str) {
         "energy orders {re:?}, fit {fe}"
     );
     assert!(
-        (fl - 2.0).abs() <= 0.15
-            && re.len() >= 4
-            && rl.iter().skip(1).all(|r| (r - 2.0).abs() <= 0.15),
+        (fl - 2.0).abs() <= 0.15 && re.len() >= 4 && rl.iter().skip(1).all(|r| (r - 2.0).abs() <= 0.15),
         "L2 orders {rl:?}, fit {fl}"
     );
 }

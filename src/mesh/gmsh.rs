@@ -23,13 +23,9 @@ impl<'a> Tokens<'a> {
                 self.line_no = k + 1;
                 Ok(l.trim())
             }
-            None => Err(Error::mesh(
-                &self.src,
-                format!(
-                    "unexpected end of file after line {} (truncated?)",
-                    self.line_no
-                ),
-            )),
+            None => {
+                Err(Error::mesh(&self.src, format!("unexpected end of file after line {} (truncated?)", self.line_no)))
+            }
         }
     }
     fn nums<T: std::str::FromStr>(&mut self, min: usize) -> Result<Vec<T>> {
@@ -37,10 +33,7 @@ impl<'a> Tokens<'a> {
         let v: std::result::Result<Vec<T>, _> = l.split_whitespace().map(str::parse).collect();
         match v {
             Ok(v) if v.len() >= min => Ok(v),
-            Ok(v) => Err(self.err(format!(
-                "expected at least {min} numbers, found {}",
-                v.len()
-            ))),
+            Ok(v) => Err(self.err(format!("expected at least {min} numbers, found {}", v.len()))),
             Err(_) => Err(self.err(format!("cannot parse numbers in `{l}`"))),
         }
     }
@@ -56,20 +49,14 @@ impl<'a> Tokens<'a> {
 
 /// Read a Gmsh 4.1 ASCII file.
 pub fn read(path: &Path) -> Result<RawMesh> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-        path: path.to_path_buf(),
-        msg: format!("cannot read mesh: {e}"),
-    })?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::Io { path: path.to_path_buf(), msg: format!("cannot read mesh: {e}") })?;
     parse(&text, &path.display().to_string())
 }
 
 /// Parse Gmsh 4.1 ASCII text; `src` names it in messages.
 pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
-    let mut tk = Tokens {
-        src: src.to_string(),
-        lines: text.lines().enumerate().peekable(),
-        line_no: 0,
-    };
+    let mut tk = Tokens { src: src.to_string(), lines: text.lines().enumerate().peekable(), line_no: 0 };
     let mut names: HashMap<i64, String> = HashMap::new(); // 1D physical tag → name
     let mut curve_phys: HashMap<i64, Vec<i64>> = HashMap::new();
     let mut nodes: HashMap<i64, [f64; 2]> = HashMap::new();
@@ -124,14 +111,9 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
                     let v = tk.nums::<f64>(8)?;
                     let np = v[7] as usize;
                     if v.len() < 8 + np {
-                        return Err(
-                            tk.err("curve entity lists fewer physical tags than it declares")
-                        );
+                        return Err(tk.err("curve entity lists fewer physical tags than it declares"));
                     }
-                    curve_phys.insert(
-                        v[0] as i64,
-                        v[8..8 + np].iter().map(|&x| x as i64).collect(),
-                    );
+                    curve_phys.insert(v[0] as i64, v[8..8 + np].iter().map(|&x| x as i64).collect());
                 }
                 for _ in 0..c[2] + c[3] {
                     tk.line()?;
@@ -153,10 +135,9 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
                             return Err(tk.err("non-finite node coordinate"));
                         }
                         if x[2] != 0.0 {
-                            return Err(tk.err(format!(
-                                "node {tag} has z = {} (only planar meshes in the xy plane)",
-                                x[2]
-                            )));
+                            return Err(
+                                tk.err(format!("node {tag} has z = {} (only planar meshes in the xy plane)", x[2]))
+                            );
                         }
                         if nodes.insert(tag, [x[0], x[1]]).is_some() {
                             return Err(tk.err(format!("node tag {tag} defined twice")));
@@ -192,10 +173,7 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
         }
     }
     if !seen_format {
-        return Err(Error::mesh(
-            src,
-            "missing $MeshFormat section (not a Gmsh file?)",
-        ));
+        return Err(Error::mesh(src, "missing $MeshFormat section (not a Gmsh file?)"));
     }
     if tris_tags.is_empty() {
         return Err(Error::mesh(src, "no 3-node triangles"));
@@ -207,9 +185,8 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
     for t in &tris_tags {
         let mut tri = [0; 3];
         for (k, tag) in t.iter().enumerate() {
-            let p = *nodes.get(tag).ok_or_else(|| {
-                Error::mesh(src, format!("triangle refers to undefined node {tag}"))
-            })?;
+            let p =
+                *nodes.get(tag).ok_or_else(|| Error::mesh(src, format!("triangle refers to undefined node {tag}")))?;
             tri[k] = *index.entry(*tag).or_insert_with(|| {
                 points.push(p);
                 points.len() - 1
@@ -217,20 +194,14 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
         }
         tris.push(tri);
     }
-    let mut sorted: Vec<([u64; 2], usize)> = points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| ([p[0].to_bits(), p[1].to_bits()], i))
-        .collect();
+    let mut sorted: Vec<([u64; 2], usize)> =
+        points.iter().enumerate().map(|(i, p)| ([p[0].to_bits(), p[1].to_bits()], i)).collect();
     sorted.sort_unstable();
     if let Some(w) = sorted.windows(2).find(|w| w[0].0 == w[1].0) {
         let p = points[w[0].1];
         return Err(Error::mesh(
             src,
-            format!(
-                "duplicate nodes at ({}, {}): the mesh is not conforming there",
-                p[0], p[1]
-            ),
+            format!("duplicate nodes at ({}, {}): the mesh is not conforming there", p[0], p[1]),
         ));
     }
     let mut tag_names: Vec<String> = Vec::new();
@@ -241,12 +212,7 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
         let name = match named.as_slice() {
             [] => continue, // an untagged line: its edge will be reported if it is on the boundary
             [n] => (*n).clone(),
-            _ => {
-                return Err(Error::mesh(
-                    src,
-                    format!("curve {entity} is in several physical groups: {named:?}"),
-                ))
-            }
+            _ => return Err(Error::mesh(src, format!("curve {entity} is in several physical groups: {named:?}"))),
         };
         let tag = match tag_names.iter().position(|n| *n == name) {
             Some(k) => k,
@@ -258,21 +224,12 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
         let (Some(&a), Some(&b)) = (index.get(&pair[0]), index.get(&pair[1])) else {
             return Err(Error::mesh(
                 src,
-                format!(
-                    "boundary line of `{}` refers to a node of no triangle",
-                    tag_names[tag]
-                ),
+                format!("boundary line of `{}` refers to a node of no triangle", tag_names[tag]),
             ));
         };
         tagged.push(([a, b], tag));
     }
-    Ok(RawMesh {
-        source: src.to_string(),
-        points,
-        tris,
-        tagged,
-        tag_names,
-    })
+    Ok(RawMesh { source: src.to_string(), points, tris, tagged, tag_names })
 }
 
 #[cfg(test)]

@@ -56,12 +56,7 @@ impl Mesh {
     /// Generate or read the mesh a scene describes, refined as asked.
     pub fn from_spec(spec: &MeshSpec) -> Result<Mesh> {
         let raw = match spec {
-            MeshSpec::Structured {
-                corners,
-                cells,
-                diagonal,
-                refine,
-            } => {
+            MeshSpec::Structured { corners, cells, diagonal, refine } => {
                 let f = 1usize << refine;
                 structured::generate(corners, [cells[0] * f, cells[1] * f], *diagonal)?
             }
@@ -86,24 +81,16 @@ impl Mesh {
         let mut tris = raw.tris.clone();
         for (k, t) in tris.iter_mut().enumerate() {
             if t.iter().any(|&v| v >= np) {
-                return Err(Error::mesh(
-                    src,
-                    format!("triangle {k} refers to a missing vertex"),
-                ));
+                return Err(Error::mesh(src, format!("triangle {k} refers to a missing vertex")));
             }
             let [a, b, c] = t.map(|v| raw.points[v]);
             let a2 = area2(a, b, c);
-            let scale = [(a, b), (b, c), (c, a)]
-                .iter()
-                .map(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1]))
-                .fold(0.0, f64::max);
+            let scale =
+                [(a, b), (b, c), (c, a)].iter().map(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1])).fold(0.0, f64::max);
             if !(a2.abs() > 1e-12 * scale * scale) {
                 return Err(Error::mesh(
                     src,
-                    format!(
-                        "triangle {k} at ({:.6}, {:.6}) is degenerate (zero area)",
-                        a[0], a[1]
-                    ),
+                    format!("triangle {k} at ({:.6}, {:.6}) is degenerate (zero area)", a[0], a[1]),
                 ));
             }
             if a2 < 0.0 {
@@ -127,7 +114,13 @@ impl Mesh {
                 if edge_tris[e].0 != k {
                     if edge_tris[e].1.is_some() {
                         let p = raw.points[a];
-                        return Err(Error::mesh(src, format!("edge at ({:.6}, {:.6}) is shared by more than two triangles (non-manifold)", p[0], p[1])));
+                        return Err(Error::mesh(
+                            src,
+                            format!(
+                                "edge at ({:.6}, {:.6}) is shared by more than two triangles (non-manifold)",
+                                p[0], p[1]
+                            ),
+                        ));
                     }
                     edge_tris[e].1 = Some(k);
                 }
@@ -140,16 +133,18 @@ impl Mesh {
             if let Some(t2) = t2 {
                 let [a, b] = edges[e].map(|v| raw.points[v]);
                 let opp = |t: usize| {
-                    tris[t]
-                        .iter()
-                        .copied()
-                        .find(|v| !edges[e].contains(v))
-                        .expect("triangle has a third vertex")
+                    tris[t].iter().copied().find(|v| !edges[e].contains(v)).expect("triangle has a third vertex")
                 };
                 let s1 = area2(a, b, raw.points[opp(t1)]);
                 let s2 = area2(a, b, raw.points[opp(t2)]);
                 if s1 * s2 >= 0.0 {
-                    return Err(Error::mesh(src, format!("triangles {t1} and {t2} overlap across the edge at ({:.6}, {:.6}) (inverted element)", a[0], a[1])));
+                    return Err(Error::mesh(
+                        src,
+                        format!(
+                            "triangles {t1} and {t2} overlap across the edge at ({:.6}, {:.6}) (inverted element)",
+                            a[0], a[1]
+                        ),
+                    ));
                 }
             }
         }
@@ -158,7 +153,13 @@ impl Mesh {
             let key = [pair[0].min(pair[1]), pair[0].max(pair[1])];
             let p = raw.points.get(key[0]).copied().unwrap_or([f64::NAN; 2]);
             let Some(&e) = index.get(&key) else {
-                return Err(Error::mesh(src, format!("boundary element at ({:.6}, {:.6}) of part `{}` is not an edge of any triangle", p[0], p[1], raw.tag_names[tag])));
+                return Err(Error::mesh(
+                    src,
+                    format!(
+                        "boundary element at ({:.6}, {:.6}) of part `{}` is not an edge of any triangle",
+                        p[0], p[1], raw.tag_names[tag]
+                    ),
+                ));
             };
             if edge_tris[e].1.is_some() {
                 return Err(Error::mesh(
@@ -198,11 +199,8 @@ impl Mesh {
     /// in a declared part, and every declared part must have edges.
     pub fn bind_parts(&self, parts: &[Part]) -> Result<Vec<Option<usize>>> {
         let src = self.source.as_str();
-        let tag_to_part: Vec<Option<usize>> = self
-            .tag_names
-            .iter()
-            .map(|n| parts.iter().position(|p| &p.name == n))
-            .collect();
+        let tag_to_part: Vec<Option<usize>> =
+            self.tag_names.iter().map(|n| parts.iter().position(|p| &p.name == n)).collect();
         let mut out = vec![None; self.edges.len()];
         let mut count = vec![0usize; parts.len()];
         for e in 0..self.edges.len() {
@@ -211,16 +209,16 @@ impl Mesh {
             }
             let m = self.midpoint(e);
             let tag = self.edge_tag[e].ok_or_else(|| {
+                Error::mesh(src, format!("boundary edge at ({:.6}, {:.6}) belongs to no boundary part", m[0], m[1]))
+            })?;
+            let p = tag_to_part[tag].ok_or_else(|| {
                 Error::mesh(
                     src,
                     format!(
-                        "boundary edge at ({:.6}, {:.6}) belongs to no boundary part",
-                        m[0], m[1]
+                        "boundary part `{}` of the mesh is not declared in the scene ([[boundary]] name = \"{}\")",
+                        self.tag_names[tag], self.tag_names[tag]
                     ),
                 )
-            })?;
-            let p = tag_to_part[tag].ok_or_else(|| {
-                Error::mesh(src, format!("boundary part `{}` of the mesh is not declared in the scene ([[boundary]] name = \"{}\")", self.tag_names[tag], self.tag_names[tag]))
             })?;
             count[p] += 1;
             out[e] = Some(p);
@@ -230,10 +228,7 @@ impl Mesh {
                 let known = self.tag_names.join(", ");
                 return Err(Error::mesh(
                     src,
-                    format!(
-                        "scene part `{}` has no boundary edges in the mesh (mesh parts: {known})",
-                        p.name
-                    ),
+                    format!("scene part `{}` has no boundary edges in the mesh (mesh parts: {known})", p.name),
                 ));
             }
         }
@@ -258,11 +253,7 @@ impl Mesh {
         let [a, b] = self.edges[e].map(|v| self.points[v]);
         let len = self.edge_length(e);
         let n = [(b[1] - a[1]) / len, -(b[0] - a[0]) / len];
-        let opp = self.tris[t]
-            .iter()
-            .copied()
-            .find(|v| !self.edges[e].contains(v))
-            .expect("third vertex");
+        let opp = self.tris[t].iter().copied().find(|v| !self.edges[e].contains(v)).expect("third vertex");
         let c = self.points[opp];
         let d = [c[0] - a[0], c[1] - a[1]];
         if n[0] * d[0] + n[1] * d[1] > 0.0 {
@@ -280,9 +271,7 @@ impl Mesh {
 
     /// Largest edge length (the mesh size h).
     pub fn h_max(&self) -> f64 {
-        (0..self.edges.len())
-            .map(|e| self.edge_length(e))
-            .fold(0.0, f64::max)
+        (0..self.edges.len()).map(|e| self.edge_length(e)).fold(0.0, f64::max)
     }
 }
 
@@ -293,13 +282,8 @@ mod tests {
 
     fn square(n: usize) -> Mesh {
         let c = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]];
-        Mesh::from_spec(&MeshSpec::Structured {
-            corners: c,
-            cells: [n, n],
-            diagonal: Diagonal::First,
-            refine: 0,
-        })
-        .unwrap()
+        Mesh::from_spec(&MeshSpec::Structured { corners: c, cells: [n, n], diagonal: Diagonal::First, refine: 0 })
+            .unwrap()
     }
 
     #[test]
@@ -311,11 +295,7 @@ mod tests {
             assert_eq!(m.points.len() + m.tris.len() - m.edges.len(), 1);
             let boundary = m.edge_tris.iter().filter(|e| e.1.is_none()).count();
             assert_eq!(boundary, 4 * n);
-            assert!(m
-                .edge_tag
-                .iter()
-                .zip(&m.edge_tris)
-                .all(|(t, e)| t.is_some() == e.1.is_none()));
+            assert!(m.edge_tag.iter().zip(&m.edge_tris).all(|(t, e)| t.is_some() == e.1.is_none()));
         }
     }
 
@@ -352,10 +332,7 @@ mod tests {
             tagged: vec![],
             tag_names: vec![],
         };
-        assert!(Mesh::build(raw)
-            .unwrap_err()
-            .to_string()
-            .contains("degenerate"));
+        assert!(Mesh::build(raw).unwrap_err().to_string().contains("degenerate"));
         let raw = RawMesh {
             source: "t".into(),
             points: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0], [0.0, -1.0]],
@@ -363,9 +340,6 @@ mod tests {
             tagged: vec![],
             tag_names: vec![],
         };
-        assert!(Mesh::build(raw)
-            .unwrap_err()
-            .to_string()
-            .contains("non-manifold"));
+        assert!(Mesh::build(raw).unwrap_err().to_string().contains("non-manifold"));
     }
 }

@@ -28,11 +28,5 @@ pub fn red(raw: &RawMesh) -> RawMesh {
         tagged.push(([a, m], tag));
         tagged.push(([m, b], tag));
     }
-    RawMesh {
-        source: raw.source.clone(),
-        points,
-        tris,
-        tagged,
-        tag_names: raw.tag_names.clone(),
-    }
+    RawMesh { source: raw.source.clone(), points, tris, tagged, tag_names: raw.tag_names.clone() }
 }

@@ -14,10 +14,7 @@ pub fn generate(c: &[[f64; 2]; 4], [n, m]: [usize; 2], diagonal: Diagonal) -> Re
         || area2(c[0], c[1], c[3]) <= 0.0
         || area2(c[1], c[2], c[3]) <= 0.0
     {
-        return Err(Error::mesh(
-            src,
-            "corners must form a convex quadrilateral listed counter-clockwise",
-        ));
+        return Err(Error::mesh(src, "corners must form a convex quadrilateral listed counter-clockwise"));
     }
     if (n + 1).checked_mul(m + 1).is_none_or(|p| p > 200_000_000) {
         return Err(Error::mesh(src, format!("{n} x {m} cells is too many")));
@@ -58,14 +55,6 @@ pub fn generate(c: &[[f64; 2]; 4], [n, m]: [usize; 2], diagonal: Diagonal) -> Re
         tagged.push(([id(n, j), id(n, j + 1)], 1));
         tagged.push(([id(0, j), id(0, j + 1)], 3));
     }
-    let tag_names = ["bottom", "right", "top", "left"]
-        .map(String::from)
-        .to_vec();
-    Ok(RawMesh {
-        source: src.into(),
-        points,
-        tris,
-        tagged,
-        tag_names,
-    })
+    let tag_names = ["bottom", "right", "top", "left"].map(String::from).to_vec();
+    Ok(RawMesh { source: src.into(), points, tris, tagged, tag_names })
 }

@@ -5,12 +5,8 @@ use tresca_cr::{Problem, Scene, StepResult};
 
 /// Read a scene from the repository.
 pub fn scene(path: &str) -> Scene {
-    Scene::from_file(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join(path)
-            .as_path(),
-    )
-    .unwrap_or_else(|e| panic!("{path}: {e}"))
+    Scene::from_file(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path).as_path())
+        .unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
 /// Run a scene and keep every step.
@@ -35,9 +31,7 @@ pub fn max_errors(steps: &[StepResult]) -> (f64, f64) {
 
 /// Observed orders between successive levels: log(e_i/e_{i+1}) / log(h_i/h_{i+1}).
 pub fn successive_rates(h: &[f64], e: &[f64]) -> Vec<f64> {
-    (1..h.len())
-        .map(|i| (e[i - 1] / e[i]).ln() / (h[i - 1] / h[i]).ln())
-        .collect()
+    (1..h.len()).map(|i| (e[i - 1] / e[i]).ln() / (h[i - 1] / h[i]).ln()).collect()
 }
 
 /// Least-squares slope of log e against log h.
@@ -76,10 +70,7 @@ pub fn print_table(title: &str, h: &[f64], cols: &[(&str, &[f64])]) {
 /// Relative max-norm difference of two vectors.
 pub fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
     let scale = a.iter().chain(b).fold(0.0f64, |m, v| m.max(v.abs()));
-    let diff = a
-        .iter()
-        .zip(b)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    let diff = a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     if scale == 0.0 {
         0.0
     } else {

@@ -1,0 +1,284 @@
+//! The `tresca` group of the README (the layout every tool of the project reads), plus
+//! `tresca/energy` (a_h(uⁿ,uⁿ)) and `tresca/contact/mu` (the friction force μ_e, kept bit-exact so
+//! a resumed run is bit-identical; σ_τ = −μ/|e| alone would round).
+//!
+//! Time series (first axis = completed steps, grown one row per step):
+//! `times`, `u` (·, E, 2), `energy`, `steps/{iterations, residual, n_stick, n_slip, wall_time}`,
+//! `contact/{slip, sigma_t, state, mu}` (·, C) when Γ_C exists, `errors/{energy, h1, l2}` when `[exact]`.
+//! `tresca/steps` carries the attribute `completed` (number of complete steps), written after every
+//! other dataset of a step. The unknown vector of the last step is rebuilt exactly from `u` (free
+//! edges hold the two unknowns verbatim) and `contact/slip` (the one unknown of a contact edge).
+
+use super::h5::{attr, attr_str, attr_vec, put, Series};
+use crate::cr::EdgeDof;
+use crate::norms::ErrorNorms;
+use crate::stepping::{Problem, StepResult};
+use hdf5::{File, Group};
+
+/// Steps per chunk so that a chunk is about 64 KiB.
+fn chunk_steps(bytes_per_step: usize) -> usize {
+    (65536 / bytes_per_step.max(1)).clamp(1, 4096)
+}
+
+pub struct Tresca {
+    pub group: Group,
+    steps_group: Group,
+    times: Series,
+    u: Series,
+    energy: Series,
+    iterations: Series,
+    residual: Series,
+    n_stick: Series,
+    n_slip: Series,
+    wall: Series,
+    /// slip, sigma_t, state, mu.
+    contact: Option<[Series; 4]>,
+    /// energy, h1, l2.
+    errors: Option<[Series; 3]>,
+}
+
+const SCALARS: [&str; 6] = [
+    "times",
+    "energy",
+    "steps/iterations",
+    "steps/residual",
+    "steps/n_stick",
+    "steps/n_slip",
+];
+
+impl Tresca {
+    /// Create the group with static data, attributes and empty series.
+    pub fn create(file: &File, p: &Problem, git_commit: &str) -> hdf5::Result<Tresca> {
+        let g = file.create_group("tresca")?;
+        let (mesh, space, s) = (&p.mesh, &p.space, &p.scene);
+        let mg = g.create_group("mesh")?;
+        let pts: Vec<f64> = mesh.points.iter().flatten().copied().collect();
+        put(&mg, "points", &[mesh.points.len(), 2], &pts)?;
+        let tris: Vec<i64> = mesh.tris.iter().flatten().map(|&v| v as i64).collect();
+        put(&mg, "triangles", &[mesh.tris.len(), 3], &tris)?;
+        let edges: Vec<i64> = mesh.edges.iter().flatten().map(|&v| v as i64).collect();
+        put(&mg, "edges", &[mesh.edges.len(), 2], &edges)?;
+        let mids: Vec<f64> = (0..mesh.edges.len()).flat_map(|e| mesh.midpoint(e)).collect();
+        put(&mg, "midpoints", &[mesh.edges.len(), 2], &mids)?;
+        let ne = mesh.edges.len();
+        let sc = chunk_steps(8);
+        let sg = g.create_group("steps")?;
+        let contact = if space.contact.is_empty() {
+            None
+        } else {
+            let cg = g.create_group("contact")?;
+            let c = &space.contact;
+            let nc = c.len();
+            put(&cg, "edges", &[nc], &c.iter().map(|c| c.edge as i64).collect::<Vec<_>>())?;
+            put(&cg, "normal", &[nc, 2], &c.iter().flat_map(|c| c.normal).collect::<Vec<_>>())?;
+            put(&cg, "tangent", &[nc, 2], &c.iter().flat_map(|c| c.tangent).collect::<Vec<_>>())?;
+            put(&cg, "g", &[nc], &c.iter().map(|c| c.g_mean).collect::<Vec<_>>())?;
+            let k = chunk_steps(8 * nc);
+            Some([
+                Series::create::<f64>(&cg, "slip", 1, &[nc], k)?,
+                Series::create::<f64>(&cg, "sigma_t", 1, &[nc], k)?,
+                Series::create::<u8>(&cg, "state", 1, &[nc], k)?,
+                Series::create::<f64>(&cg, "mu", 1, &[nc], k)?,
+            ])
+        };
+        let errors = if p.errors.is_some() {
+            let eg = g.create_group("errors")?;
+            Some([
+                Series::create::<f64>(&eg, "energy", 1, &[], sc)?,
+                Series::create::<f64>(&eg, "h1", 1, &[], sc)?,
+                Series::create::<f64>(&eg, "l2", 1, &[], sc)?,
+            ])
+        } else {
+            None
+        };
+        let loc = &*g;
+        attr_str(loc, "scene", &s.text)?;
+        attr_str(loc, "scene_path", &s.file)?;
+        attr_str(loc, "title", &s.title)?;
+        attr_str(loc, "version", env!("CARGO_PKG_VERSION"))?;
+        attr_str(loc, "git_commit", git_commit)?;
+        attr_str(loc, "solver", s.solver.method.name())?;
+        attr(loc, "tol", s.solver.tol)?;
+        attr(loc, "max_iter", s.solver.max_iter as i64)?;
+        attr(loc, "uzawa_step", s.solver.uzawa_step)?;
+        attr(loc, "rho", s.rho)?;
+        attr(loc, "E", s.material.e)?;
+        attr(loc, "nu", s.material.nu)?;
+        attr(loc, "steps", p.n_steps() as i64)?;
+        attr(loc, "n_edges", ne as i64)?;
+        attr(loc, "n_contact", space.contact.len() as i64)?;
+        attr(loc, "n_dofs", space.n_dofs as i64)?;
+        attr(loc, "paper_dofs", space.paper_dofs() as i64)?;
+        attr(loc, "h", mesh.h_max())?;
+        attr_vec(loc, "setup_times", &p.setup_times)?;
+        attr_str(loc, "setup_times_meaning", "mesh+space, assembly, factorisation, condensation (s)")?;
+        attr_str(loc, "status", "running")?;
+        attr(&sg, "completed", 0i64)?;
+        Ok(Tresca {
+            times: Series::create::<f64>(&g, "times", 1, &[], sc)?,
+            u: Series::create::<f64>(&g, "u", 1, &[ne, 2], chunk_steps(16 * ne))?,
+            energy: Series::create::<f64>(&g, "energy", 1, &[], sc)?,
+            iterations: Series::create::<i64>(&sg, "iterations", 1, &[], sc)?,
+            residual: Series::create::<f64>(&sg, "residual", 1, &[], sc)?,
+            n_stick: Series::create::<i64>(&sg, "n_stick", 1, &[], sc)?,
+            n_slip: Series::create::<i64>(&sg, "n_slip", 1, &[], sc)?,
+            wall: Series::create::<f64>(&sg, "wall_time", 1, &[], sc)?,
+            contact,
+            errors,
+            steps_group: sg,
+            group: g,
+        })
+    }
+
+    /// Open the group of an existing file.
+    pub fn open(file: &File) -> hdf5::Result<Tresca> {
+        let g = file.group("tresca")?;
+        let sg = g.group("steps")?;
+        let contact = match g.group("contact") {
+            Ok(cg) => Some([
+                Series::open(&cg, "slip", 1)?,
+                Series::open(&cg, "sigma_t", 1)?,
+                Series::open(&cg, "state", 1)?,
+                Series::open(&cg, "mu", 1)?,
+            ]),
+            Err(_) => None,
+        };
+        let errors = match g.group("errors") {
+            Ok(eg) => Some([
+                Series::open(&eg, "energy", 1)?,
+                Series::open(&eg, "h1", 1)?,
+                Series::open(&eg, "l2", 1)?,
+            ]),
+            Err(_) => None,
+        };
+        Ok(Tresca {
+            times: Series::open(&g, SCALARS[0], 1)?,
+            u: Series::open(&g, "u", 1)?,
+            energy: Series::open(&g, SCALARS[1], 1)?,
+            iterations: Series::open(&g, SCALARS[2], 1)?,
+            residual: Series::open(&g, SCALARS[3], 1)?,
+            n_stick: Series::open(&g, SCALARS[4], 1)?,
+            n_slip: Series::open(&g, SCALARS[5], 1)?,
+            wall: Series::open(&g, "steps/wall_time", 1)?,
+            contact,
+            errors,
+            steps_group: sg,
+            group: g,
+        })
+    }
+
+    fn all(&self) -> Vec<&Series> {
+        let mut v = vec![
+            &self.times,
+            &self.u,
+            &self.energy,
+            &self.iterations,
+            &self.residual,
+            &self.n_stick,
+            &self.n_slip,
+            &self.wall,
+        ];
+        v.extend(self.contact.iter().flatten());
+        v.extend(self.errors.iter().flatten());
+        v
+    }
+
+    /// The `completed` attribute.
+    pub fn completed(&self) -> hdf5::Result<usize> {
+        Ok(self.steps_group.attr("completed")?.read_scalar::<i64>()?.max(0) as usize)
+    }
+
+    /// Append step r.n (all series, not yet `completed`).
+    pub fn write(&self, r: &StepResult, mid: &[[f64; 2]], sigma_t: &[f64]) -> hdf5::Result<()> {
+        let n = r.n;
+        self.times.write(n, &[r.t])?;
+        let flat: &[f64] = mid.as_flattened();
+        self.u.write(n, flat)?;
+        self.energy.write(n, &[r.energy])?;
+        self.iterations.write(n, &[r.iterations as i64])?;
+        self.residual.write(n, &[r.residual])?;
+        self.n_stick.write(n, &[r.n_stick() as i64])?;
+        self.n_slip.write(n, &[r.n_slip() as i64])?;
+        self.wall.write(n, &[r.wall])?;
+        if let Some([slip, sig, state, mu]) = &self.contact {
+            slip.write(n, &r.slip)?;
+            sig.write(n, sigma_t)?;
+            state.write(n, &r.state)?;
+            mu.write(n, &r.mu)?;
+        }
+        if let (Some([en, h1, l2]), Some(e)) = (&self.errors, &r.errors) {
+            en.write(n, &[e.energy])?;
+            h1.write(n, &[e.h1])?;
+            l2.write(n, &[e.l2])?;
+        }
+        Ok(())
+    }
+
+    /// Mark `count` steps complete.
+    pub fn set_completed(&self, count: usize) -> hdf5::Result<()> {
+        attr(&self.steps_group, "completed", count as i64)
+    }
+
+    /// Drop everything beyond `steps` complete steps.
+    pub fn truncate(&self, steps: usize) -> hdf5::Result<()> {
+        for s in self.all() {
+            if s.steps() > steps {
+                s.truncate(steps)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Smallest number of steps any series holds (a partial step shows up as a shorter series).
+    pub fn min_steps(&self) -> usize {
+        self.all().iter().map(|s| s.steps()).min().unwrap_or(0)
+    }
+
+    /// Rebuild the StepResult of stored step n (exact unknowns, μ, slip, state, statistics).
+    pub fn read_step(&self, p: &Problem, n: usize) -> hdf5::Result<StepResult> {
+        let t = self.times.read::<f64>(n)?[0];
+        let mid = self.u.read::<f64>(n)?;
+        let mut u = vec![0.0; p.space.n_dofs];
+        for (e, d) in p.space.edge_dof.iter().enumerate() {
+            if let EdgeDof::Free([a, b]) = d {
+                u[*a] = mid[2 * e];
+                u[*b] = mid[2 * e + 1];
+            }
+        }
+        let (mut mu, mut slip, mut state) = (vec![], vec![], vec![]);
+        if let Some([sl, _, st, m]) = &self.contact {
+            slip = sl.read::<f64>(n)?;
+            state = st.read::<u8>(n)?;
+            mu = m.read::<f64>(n)?;
+            for (c, s) in p.space.contact.iter().zip(&slip) {
+                u[c.dof] = *s;
+            }
+        }
+        let errors = match &self.errors {
+            Some([en, h1, l2]) => Some(ErrorNorms {
+                energy: en.read::<f64>(n)?[0],
+                h1: h1.read::<f64>(n)?[0],
+                l2: l2.read::<f64>(n)?[0],
+            }),
+            None => None,
+        };
+        Ok(StepResult {
+            n,
+            t,
+            u,
+            mu,
+            slip,
+            state,
+            iterations: self.iterations.read::<i64>(n)?[0] as usize,
+            residual: self.residual.read::<f64>(n)?[0],
+            energy: self.energy.read::<f64>(n)?[0],
+            errors,
+            wall: self.wall.read::<f64>(n)?[0],
+        })
+    }
+
+    /// Record why the run stopped.
+    pub fn set_status(&self, status: &str) -> hdf5::Result<()> {
+        attr_str(&self.group, "status", status)
+    }
+}

@@ -1,0 +1,93 @@
+//! Solving by superposition when the loads of all time nodes span a low-dimensional space.
+//!
+//! Many scenes load the body proportionally (Example 5.1: g(x, t) = t g₁(x)) or by a few time-modulated
+//! patterns. At set-up the loads l(t₀), …, l(t_N) are orthonormalised in time order (classical Gram–Schmidt,
+//! applied twice); if every l(tₙ) lies in the span of at most [`MAX_RANK`] vectors b_j (residual
+//! ≤ [`SPAN_TOL`] ‖l(tₙ)‖), the run stores w_j = K⁻¹b_j and coefficients cₙⱼ, and each step gets
+//! u_f = K⁻¹l(tₙ) = Σ_j cₙⱼ w_j without a triangular solve. Otherwise nothing is kept and every step
+//! assembles and solves. The basis depends only on the scene, so a resumed run computes the same numbers.
+
+use crate::assemble::Loads;
+use crate::cr::CrSpace;
+use crate::error::Result;
+use crate::factor::Factor;
+
+/// Largest number of load patterns handled by superposition.
+pub const MAX_RANK: usize = 4;
+/// Relative residual below which a load counts as in the span (a few hundred ulps of the load).
+pub const SPAN_TOL: f64 = 1e-13;
+
+/// Orthonormal load patterns, their responses and the coefficients of every time node.
+pub struct LoadBasis {
+    b: Vec<Vec<f64>>,
+    w: Vec<Vec<f64>>,
+    coef: Vec<Vec<f64>>,
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+impl LoadBasis {
+    /// Try to build the basis; `None` if the loads need more than [`MAX_RANK`] patterns.
+    pub fn build(loads: &Loads, space: &CrSpace, times: &[f64], factor: &Factor) -> Result<Option<LoadBasis>> {
+        let mut b: Vec<Vec<f64>> = Vec::new();
+        let mut coef = Vec::with_capacity(times.len());
+        let mut l = Vec::new();
+        for &t in times {
+            loads.assemble(space, t, &mut l)?;
+            let norm = dot(&l, &l).sqrt();
+            let mut r = l.clone();
+            let mut c = vec![0.0; b.len()];
+            for _ in 0..2 {
+                for (j, bj) in b.iter().enumerate() {
+                    let p = dot(bj, &r);
+                    c[j] += p;
+                    r.iter_mut().zip(bj).for_each(|(ri, bi)| *ri -= p * bi);
+                }
+            }
+            let rn = dot(&r, &r).sqrt();
+            if rn > SPAN_TOL * norm {
+                if b.len() == MAX_RANK {
+                    return Ok(None);
+                }
+                r.iter_mut().for_each(|v| *v /= rn);
+                b.push(r);
+                c.push(rn);
+            }
+            coef.push(c);
+        }
+        let w = b
+            .iter()
+            .map(|bj| {
+                let mut x = bj.clone();
+                factor.solve_in_place(&mut x);
+                x
+            })
+            .collect();
+        Ok(Some(LoadBasis { b, w, coef }))
+    }
+
+    /// Number of load patterns.
+    pub fn rank(&self) -> usize {
+        self.b.len()
+    }
+
+    fn combine(vs: &[Vec<f64>], c: &[f64], n: usize, out: &mut Vec<f64>) {
+        out.clear();
+        out.resize(n, 0.0);
+        for (v, &cj) in vs.iter().zip(c) {
+            out.iter_mut().zip(v).for_each(|(o, x)| *o += cj * x);
+        }
+    }
+
+    /// l(tₙ) = Σ_j cₙⱼ b_j.
+    pub fn load(&self, n: usize, dofs: usize, out: &mut Vec<f64>) {
+        Self::combine(&self.b, &self.coef[n], dofs, out);
+    }
+
+    /// K⁻¹ l(tₙ) = Σ_j cₙⱼ w_j.
+    pub fn response(&self, n: usize, dofs: usize, out: &mut Vec<f64>) {
+        Self::combine(&self.w, &self.coef[n], dofs, out);
+    }
+}
