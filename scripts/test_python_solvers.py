@@ -15,7 +15,9 @@ Plain script (no pytest needed); prints one line per check and exits non-zero if
 7. every stored step satisfies the discrete variational inequality: K_r r = P^T l - B mu,
    |mu_e| <= w_e, mu_e = w_e sign(ds_e) where ds_e != 0 (checked from the results file alone);
 8. manufactured elasticity: energy error O(h), L2 error O(h^2);
-9. bad scenes fail with a one-line ``error:`` message.
+9. bad scenes fail with a one-line ``error:`` message;
+10. if present: skfem == dolfinx on verification/cases/*.toml, and skfem == Rust (target/release/tresca-cr
+    run SCENE -o OUT) on the scenes above.
 The scenes of 4 and 8 are generated here with sympy (f = -div sigma(u), g = sigma(u) n).
 """
 import argparse
@@ -327,6 +329,40 @@ def main():
             tb = solve("dolfinx", paths[name], b, mpi=2)
             ok, line = compare(a, b)
             check(f"dolfinx serial == mpirun -n 2 on {name} (1e-8)", ok, f"{line}  [{tb:.1f} s]")
+
+    # the repository's verification scenes (manufactured Tresca solutions), when present
+    cases = os.path.join(os.path.dirname(HERE), "verification", "cases")
+    if os.path.isdir(cases):
+        for fn in sorted(os.listdir(cases)):
+            if not fn.endswith(".toml"):
+                continue
+            name = "v_" + fn[:-5]
+            paths[name] = os.path.join(cases, fn)
+            a, b = os.path.join(tmp, f"{name}_sk.h5"), os.path.join(tmp, f"{name}_dx.h5")
+            try:
+                solve("skfem", paths[name], a)
+                solve("dolfinx", paths[name], b)
+            except RuntimeError as err:
+                check(f"verification/cases/{fn} runs", False, str(err))
+                continue
+            ok, line = compare(a, b)
+            check(f"skfem == dolfinx on verification/cases/{fn} (1e-8)", ok, line)
+
+    # the Rust solver, when its binary can write results (-o)
+    rust = os.path.join(os.path.dirname(HERE), "target", "release", "tresca-cr")
+    if os.path.exists(rust):
+        helptext = run([rust, "run", "--help"], expect_ok=False).stdout
+        if "--output" in helptext or " -o" in helptext:
+            for name in ("example51", "cyclic", "trapezoid", "patch_contact", "mms_elastic"):
+                out = os.path.join(tmp, f"{name}_rs.h5")
+                p = run([rust, "run", paths[name], "-o", out, "-q"], expect_ok=False)
+                if p.returncode != 0:
+                    check(f"Rust runs {name}", False, (p.stderr or p.stdout).strip()[-300:])
+                    continue
+                ok, line = compare(os.path.join(tmp, f"{name}_sk.h5"), out, tol=1e-8)
+                check(f"skfem == Rust on {name} (1e-8)", ok, line)
+        else:
+            print("       (Rust binary cannot write results yet: no -o option; skipped)")
 
     if not args.quick:
         errs = {}
