@@ -496,6 +496,8 @@ def gmsh_mesh(path) -> Mesh:
             raise SceneError(f"{path}: a boundary line uses a node that belongs to no triangle")
         L = renum[L]
         for tag in np.unique(T):
+            if int(tag) == 0:          # lines outside any physical group name no boundary part
+                continue
             if int(tag) not in names:
                 raise SceneError(f"{path}: physical line tag {tag} has no name")
             segs[names[int(tag)]] = L[T == tag]
@@ -731,7 +733,9 @@ class StepSolver:
         Kr = (self.P.T @ K @ self.P).tocsc()
         Kr = (0.5 * (Kr + Kr.T)).tocsc()
         self.Kr = Kr
-        self.lu = spla.splu(Kr)
+        # K_r is SPD: symmetric minimum-degree ordering and diagonal pivots (SuperLU symmetric mode)
+        self.lu = spla.splu(Kr, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                            options=dict(SymmetricMode=True))
         self.w = disc.weight
         C = len(self.ic)
         if C:
