@@ -8,7 +8,7 @@
 //! Δs = d − Cμ and μ solves the box-constrained dual QP
 //!   min_μ q(μ) = ½ μᵀCμ − dᵀμ   subject to |μ_e| ≤ w_e,
 //! whose KKT conditions are exactly Tresca's law on every edge. The natural residual
-//!   r(μ) = max_e |μ_e − P_e(μ_e + Δs_e / C_ee)| / max_e w_e
+//!   r(μ) = max_e |μ_e − P_e(μ_e + Δs_e / C_ee)| / F,   F = max_e min(w_e, |d_e|/C_ee),
 //! vanishes exactly at the solution and is what every solver reports.
 
 use crate::cr::CrSpace;
@@ -121,17 +121,24 @@ impl Qp<'_> {
         v.clamp(-self.w[e], self.w[e])
     }
 
-    /// Natural residual r(μ) (see module doc), given Δs.
+    /// Force scale F = max_e min(w_e, |d_e|/C_ee): the size of the friction forces of this step (all-stick
+    /// forces are about |d|/C_ee, all-slip forces are w). Residuals are relative to it, so a huge bound
+    /// (g_a → ∞) does not make every iterate look converged.
+    pub fn force_scale(&self) -> f64 {
+        (0..self.d.len()).map(|e| self.w[e].min(self.d[e].abs() / self.c[(e, e)])).fold(0.0, f64::max)
+    }
+
+    /// Natural residual r(μ) = max_e |μ_e − P_e(μ_e + Δs_e/C_ee)| / F, given Δs (see module doc).
     pub fn residual(&self, mu: &[f64], ds: &[f64]) -> f64 {
-        let wmax = self.w.iter().cloned().fold(0.0, f64::max);
-        if wmax == 0.0 {
-            return 0.0;
-        }
         let mut r: f64 = 0.0;
         for e in 0..mu.len() {
             r = r.max((mu[e] - self.project(e, mu[e] + ds[e] / self.c[(e, e)])).abs());
         }
-        r / wmax
+        if r == 0.0 {
+            0.0
+        } else {
+            r / self.force_scale().max(f64::MIN_POSITIVE)
+        }
     }
 }
 

@@ -112,7 +112,7 @@ fn check(scene: Scene) -> Result<()> {
         s.times.last().unwrap_or(&0.0),
         if s.uniform_time { " (uniform)" } else { "" }
     );
-    println!("solver     {} (tol {:.1e}, max_iter {})", s.solver.method.name(), s.solver.tol, s.solver.max_iter);
+    println!("solver     {} (tol {:.1e}, max_iter {})", s.solver.method.name(), s.solver.tol, s.solver.max_iter());
     println!("exact      {}", if s.exact.is_some() { "given: true errors computed" } else { "none" });
     Ok(())
 }

@@ -33,6 +33,9 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
                 }
             })
             .collect();
+        if std::env::var_os("TRESCA_DEBUG_PDAS").is_some() {
+            eprintln!("pdas it {it}: residual {res:.3e} set {set:?}");
+        }
         if it == max_iter || !seen.insert(set.clone()) {
             let what = if it == max_iter { "pdas" } else { "pdas (cycling: an active set repeated)" };
             return Err(not_converged(what, it, res, tol));

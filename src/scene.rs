@@ -195,9 +195,18 @@ pub struct SolverSettings {
     pub method: Method,
     /// Stopping tolerance (see README).
     pub tol: f64,
-    pub max_iter: usize,
+    /// Iteration limit per step; `None` = the method's default ([`SolverSettings::max_iter`]).
+    pub max_iter_given: Option<usize>,
     /// The paper's Uzawa step ρ̃; 0 = automatic.
     pub uzawa_step: f64,
+}
+
+impl SolverSettings {
+    /// Iteration limit per step: as given, else 100 for the Newton-type methods and 200 000 for Uzawa
+    /// (a projected-gradient method whose iteration count grows with the condition number of C).
+    pub fn max_iter(&self) -> usize {
+        self.max_iter_given.unwrap_or(if self.method == Method::Uzawa { 200_000 } else { 100 })
+    }
 }
 
 /// Exact solution and its gradient, for true errors.
@@ -394,11 +403,9 @@ impl Scene {
         let solver = SolverSettings {
             method,
             tol: positive_finite(file, "solver.tol", rs.tol.unwrap_or(1e-12))?,
-            max_iter: match rs.max_iter {
+            max_iter_given: match rs.max_iter {
                 Some(0) => return Err(Error::scene(file, "solver.max_iter", "must be at least 1")),
-                Some(n) => n,
-                None if method == Method::Uzawa => 200_000,
-                None => 100,
+                other => other,
             },
             uzawa_step: match rs.uzawa_step {
                 Some(s) if !(s.is_finite() && s >= 0.0) => {

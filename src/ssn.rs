@@ -18,7 +18,7 @@ const SIGMA: f64 = 1e-4;
 pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<FrictionSolution> {
     let n = qp.d.len();
     let mut mu: Vec<f64> = (0..n).map(|e| qp.project(e, mu0[e])).collect();
-    let wmax = qp.w.iter().cloned().fold(0.0, f64::max);
+    let fscale = qp.force_scale();
     for it in 0..=max_iter {
         let ds = qp.slip_increment(&mu);
         let res = qp.residual(&mu, &ds);
@@ -33,7 +33,7 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
         let eps = (0..n)
             .map(|e| (mu[e] - qp.project(e, mu[e] - g[e] / qp.c[(e, e)])).abs())
             .fold(0.0, f64::max)
-            .min(1e-3 * wmax);
+            .min(1e-3 * fscale);
         let active: Vec<bool> = (0..n)
             .map(|e| {
                 (mu[e] >= qp.w[e] - eps && g[e] < 0.0) || (mu[e] <= -qp.w[e] + eps && g[e] > 0.0) || qp.w[e] == 0.0

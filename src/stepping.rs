@@ -186,11 +186,11 @@ impl Problem {
         let qp = Qp { c: &cd.c, d: &d, w: &cd.w };
         let s = &self.scene.solver;
         let sol: Result<FrictionSolution> = match s.method {
-            Method::Ssn => ssn::solve(&qp, &prev.mu, s.tol, s.max_iter),
-            Method::Pdas => pdas::solve(&qp, &prev.mu, s.tol, s.max_iter),
+            Method::Ssn => ssn::solve(&qp, &prev.mu, s.tol, s.max_iter()),
+            Method::Pdas => pdas::solve(&qp, &prev.mu, s.tol, s.max_iter()),
             Method::Uzawa => {
                 let rho = if s.uzawa_step > 0.0 { s.uzawa_step } else { uzawa::auto_step(&qp, &cd.g) };
-                uzawa::solve(&qp, &cd.g, &prev.mu, rho, s.tol, s.max_iter)
+                uzawa::solve(&qp, &cd.g, &prev.mu, rho, s.tol, s.max_iter())
             }
         };
         let sol = sol.map_err(|e| match e {
