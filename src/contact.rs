@@ -68,6 +68,13 @@ impl Condensed {
         Condensed { dofs, w, g, c, z }
     }
 
+    /// Eᵀ K⁻¹ l = Zᵀ l (requires Z).
+    pub fn trace_of_solution(&self, l: &[f64]) -> Vec<f64> {
+        let z = self.z.as_ref().expect("Z is kept");
+        let n = l.len();
+        (0..self.dofs.len()).map(|j| z[j * n..(j + 1) * n].iter().zip(l).map(|(a, b)| a * b).sum()).collect()
+    }
+
     /// u ← u_f − K⁻¹ E μ.
     pub fn apply_friction(&self, llt: &Factor, u: &mut [f64], mu: &[f64]) {
         let n = u.len();

@@ -19,11 +19,14 @@ pub mod expr;
 pub mod factor;
 pub mod mesh;
 pub mod norms;
+pub mod output;
 pub mod pdas;
+pub mod prolong;
 pub mod quadrature;
 pub mod scene;
 pub mod ssn;
 pub mod stepping;
+pub mod study;
 pub mod superpose;
 pub mod uzawa;
 

@@ -42,6 +42,85 @@ enum Cmd {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Convergence study: run the scene at several levels and print/write errors and observed orders.
+    Study {
+        scene: PathBuf,
+        /// Levels as refine:steps, comma separated, e.g. 0:40,1:80,2:160,3:320.
+        #[arg(long, value_delimiter = ',', required = true)]
+        levels: Vec<tresca_cr::study::Level>,
+        /// A finer reference run (refine:steps) to measure errors against.
+        #[arg(long)]
+        reference: Option<tresca_cr::study::Level>,
+        /// Per-step solver (overrides solver.method).
+        #[arg(long)]
+        solver: Option<String>,
+        /// Write the table as CSV.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+    },
+}
+
+fn method(name: &str) -> Result<tresca_cr::scene::Method> {
+    Ok(match name {
+        "ssn" => tresca_cr::scene::Method::Ssn,
+        "uzawa" => tresca_cr::scene::Method::Uzawa,
+        "pdas" => tresca_cr::scene::Method::Pdas,
+        other => anyhow::bail!("--solver {other}: expected ssn, uzawa or pdas"),
+    })
+}
+
+fn study(
+    scene: Scene,
+    levels: &[tresca_cr::study::Level],
+    reference: Option<tresca_cr::study::Level>,
+    csv: Option<PathBuf>,
+) -> Result<()> {
+    use tresca_cr::study::{csv_row, run_study, CSV_HEADER};
+    let order = |a: f64, b: f64, ha: f64, hb: f64| (a / b).ln() / (ha / hb).ln();
+    println!(
+        "{:>3} {:>6} {:>9} {:>9} {:>8} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>8}",
+        "ref", "steps", "h", "k", "DOF", "energy", "ord", "L2", "ord", "consec(T)", "ord", "vs ref(T)", "ord", "wall s"
+    );
+    let mut prev: Option<tresca_cr::study::LevelResult> = None;
+    let results = run_study(&scene, levels, reference, |r| {
+        let o = |f: &dyn Fn(&tresca_cr::study::LevelResult) -> Option<f64>| match (&prev, f(r)) {
+            (Some(p), Some(b)) => f(p).map(|a| format!("{:.3}", order(a, b, p.h, r.h))).unwrap_or_default(),
+            _ => String::new(),
+        };
+        let v = |x: Option<f64>| x.map(|x| format!("{x:.4e}")).unwrap_or_else(|| "-".into());
+        let en = |r: &tresca_cr::study::LevelResult| r.max_err.map(|e| e[0]);
+        let l2 = |r: &tresca_cr::study::LevelResult| r.max_err.map(|e| e[2]);
+        let co = |r: &tresca_cr::study::LevelResult| r.consecutive.map(|e| e[1]);
+        let rf = |r: &tresca_cr::study::LevelResult| r.reference.map(|e| e[1]);
+        println!(
+            "{:>3} {:>6} {:>9.3e} {:>9.3e} {:>8} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>8.3}",
+            r.refine,
+            r.steps,
+            r.h,
+            r.k,
+            r.paper_dofs,
+            v(en(r)),
+            o(&en),
+            v(l2(r)),
+            o(&l2),
+            v(co(r)),
+            o(&co),
+            v(rf(r)),
+            o(&rf),
+            r.wall
+        );
+        prev = Some(r.clone());
+    })?;
+    if let Some(path) = csv {
+        let mut text = String::from(CSV_HEADER);
+        text.push('\n');
+        for r in &results {
+            text += &csv_row(r);
+            text.push('\n');
+        }
+        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
 }
 
 fn load(path: &PathBuf, refine: Option<u32>, steps: Option<usize>) -> Result<Scene> {
@@ -189,14 +268,15 @@ fn main() {
         Cmd::Check { scene, refine, steps } => load(&scene, refine, steps).and_then(check),
         Cmd::Run { scene, refine, steps, solver, verbose, quiet } => load(&scene, refine, steps).and_then(|mut s| {
             if let Some(m) = solver {
-                s.solver.method = match m.as_str() {
-                    "ssn" => tresca_cr::scene::Method::Ssn,
-                    "uzawa" => tresca_cr::scene::Method::Uzawa,
-                    "pdas" => tresca_cr::scene::Method::Pdas,
-                    other => anyhow::bail!("--solver {other}: expected ssn, uzawa or pdas"),
-                };
+                s.solver.method = method(&m)?;
             }
             run(s, verbose, quiet)
+        }),
+        Cmd::Study { scene, levels, reference, solver, csv } => load(&scene, None, None).and_then(|mut s| {
+            if let Some(m) = solver {
+                s.solver.method = method(&m)?;
+            }
+            study(s, &levels, reference, csv)
         }),
     };
     if let Err(e) = result {

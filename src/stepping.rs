@@ -147,26 +147,39 @@ impl Problem {
         Ok(r)
     }
 
-    /// Solve step n from the previous step's result. `load` is scratch space.
-    pub fn step(&self, n: usize, prev: &StepResult, load: &mut Vec<f64>) -> Result<StepResult> {
+    /// Solve step n from the previous step's result. `load` is scratch space. With `want_u = false` only
+    /// the contact state (slip, μ, stick/slip) is computed — enough to continue stepping — and `u` is left
+    /// empty with `energy` NaN: with superposed loads such a step costs O(n_c²), independent of the mesh.
+    pub fn step(&self, n: usize, prev: &StepResult, load: &mut Vec<f64>, want_u: bool) -> Result<StepResult> {
         let start = Instant::now();
         let t = self.scene.times[n];
         let dofs = self.space.n_dofs;
-        let mut u = Vec::with_capacity(dofs);
-        match &self.basis {
-            Some(b) => {
-                b.load(n, dofs, load);
-                b.response(n, dofs, &mut u);
+        let want_u = want_u || self.errors.is_some();
+        let mut u = Vec::new();
+        // u_f = K⁻¹ l(t) where needed; its contact trace s_f always
+        let s_free: Vec<f64> = match (&self.basis, &self.condensed) {
+            (Some(b), cd) => {
+                if want_u || cd.is_none() {
+                    b.load(n, dofs, load);
+                    b.response(n, dofs, &mut u);
+                }
+                cd.as_ref().map(|c| b.response_at(n, &c.dofs)).unwrap_or_default()
             }
-            None => {
+            (None, cd) => {
                 self.loads.assemble(&self.space, t, load)?;
-                u.extend_from_slice(load);
-                self.llt.solve_in_place(&mut u);
+                match cd {
+                    Some(c) if !want_u && c.z.is_some() => c.trace_of_solution(load),
+                    _ => {
+                        u.extend_from_slice(load);
+                        self.llt.solve_in_place(&mut u);
+                        cd.as_ref().map(|c| c.dofs.iter().map(|&k| u[k]).collect()).unwrap_or_default()
+                    }
+                }
             }
-        }
-        // a_h(u, u) = (l, u) − Σ_e μ_e s_e, since K u = l − Eμ
-        let load_work: f64 = load.iter().zip(&u).map(|(a, b)| a * b).sum();
+        };
         let Some(cd) = &self.condensed else {
+            // a_h(u, u) = (l, u)
+            let energy = load.iter().zip(&u).map(|(a, b)| a * b).sum();
             let r = StepResult {
                 n,
                 t,
@@ -176,13 +189,13 @@ impl Problem {
                 state: vec![],
                 iterations: 1,
                 residual: 0.0,
-                energy: load_work,
+                energy,
                 errors: None,
                 wall: start.elapsed().as_secs_f64(),
             };
             return self.finish(r);
         };
-        let d: Vec<f64> = cd.dofs.iter().zip(&prev.slip).map(|(&k, s)| u[k] - s).collect();
+        let d: Vec<f64> = s_free.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
         let qp = Qp { c: &cd.c, d: &d, w: &cd.w };
         let s = &self.scene.solver;
         let sol: Result<FrictionSolution> = match s.method {
@@ -199,12 +212,17 @@ impl Problem {
             }
             other => other,
         })?;
-        cd.apply_friction(&self.llt, &mut u, &sol.mu);
-        let slip: Vec<f64> = cd.dofs.iter().map(|&k| u[k]).collect();
-        let ds: Vec<f64> = slip.iter().zip(&prev.slip).map(|(a, b)| a - b).collect();
+        // s = s_f − Cμ
+        let ds = qp.slip_increment(&sol.mu);
+        let slip: Vec<f64> = prev.slip.iter().zip(&ds).map(|(a, b)| a + b).collect();
         let state = classify(&qp, &sol.mu, &ds);
-        let load_work: f64 = load.iter().zip(&u).map(|(a, b)| a * b).sum();
-        let energy = load_work - sol.mu.iter().zip(&slip).map(|(m, s)| m * s).sum::<f64>();
+        let mut energy = f64::NAN;
+        if want_u {
+            cd.apply_friction(&self.llt, &mut u, &sol.mu);
+            // a_h(u, u) = (l, u) − Σ_e μ_e s_e, since K u = l − Eμ
+            let load_work: f64 = load.iter().zip(&u).map(|(a, b)| a * b).sum();
+            energy = load_work - sol.mu.iter().zip(&slip).map(|(m, s)| m * s).sum::<f64>();
+        }
         let r = StepResult {
             n,
             t,
@@ -221,16 +239,26 @@ impl Problem {
         self.finish(r)
     }
 
-    /// Run steps from `from` (whose result is given) to N, handing every result to `on_step`.
-    pub fn run_from(&self, from: StepResult, mut on_step: impl FnMut(&StepResult) -> Result<()>) -> Result<()> {
+    /// Run steps from `from` to N, forming u only at the steps `want` selects (see [`Problem::step`]).
+    pub fn run_selected(
+        &self,
+        from: StepResult,
+        want: impl Fn(usize) -> bool,
+        mut on_step: impl FnMut(&StepResult) -> Result<()>,
+    ) -> Result<()> {
         let mut load = Vec::with_capacity(self.space.n_dofs);
         let mut prev = from;
         for n in prev.n + 1..=self.n_steps() {
-            let r = self.step(n, &prev, &mut load)?;
+            let r = self.step(n, &prev, &mut load, want(n))?;
             on_step(&r)?;
             prev = r;
         }
         Ok(())
+    }
+
+    /// Run steps from `from` (whose result is given) to N, handing every result to `on_step`.
+    pub fn run_from(&self, from: StepResult, on_step: impl FnMut(&StepResult) -> Result<()>) -> Result<()> {
+        self.run_selected(from, |_| true, on_step)
     }
 
     /// Run all steps, including step 0, handing every result to `on_step`.

@@ -86,6 +86,11 @@ impl LoadBasis {
         Self::combine(&self.b, &self.coef[n], dofs, out);
     }
 
+    /// Entries `idx` of K⁻¹ l(tₙ): O(rank · idx.len()).
+    pub fn response_at(&self, n: usize, idx: &[usize]) -> Vec<f64> {
+        idx.iter().map(|&k| self.w.iter().zip(&self.coef[n]).map(|(w, c)| c * w[k]).sum()).collect()
+    }
+
     /// K⁻¹ l(tₙ) = Σ_j cₙⱼ w_j.
     pub fn response(&self, n: usize, dofs: usize, out: &mut Vec<f64>) {
         Self::combine(&self.w, &self.coef[n], dofs, out);
