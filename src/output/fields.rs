@@ -81,10 +81,8 @@ impl Fields {
         let mut contact_len = Vec::with_capacity(nc);
         for c in &space.contact {
             let t = mesh.edge_tris[c.edge].0;
-            let i = mesh.tri_edges[t]
-                .iter()
-                .position(|&e| e == c.edge)
-                .expect("contact edge is an edge of its triangle");
+            let i =
+                mesh.tri_edges[t].iter().position(|&e| e == c.edge).expect("contact edge is an edge of its triangle");
             connectivity.push((3 * t + (i + 1) % 3) as i64);
             connectivity.push((3 * t + (i + 2) % 3) as i64);
             offsets.push(connectivity.len() as i64);
@@ -137,8 +135,7 @@ impl Fields {
             let u = te.map(|e| mid[e]);
             let s = [u[0][0] + u[1][0] + u[2][0], u[0][1] + u[1][1] + u[2][1]];
             for uj in &u {
-                out.displacement
-                    .extend_from_slice(&[(s[0] - 2.0 * uj[0]) as f32, (s[1] - 2.0 * uj[1]) as f32, 0.0]);
+                out.displacement.extend_from_slice(&[(s[0] - 2.0 * uj[0]) as f32, (s[1] - 2.0 * uj[1]) as f32, 0.0]);
             }
             let mut g = [[0.0; 2]; 2];
             for (ui, gi) in u.iter().zip(gp) {
@@ -151,10 +148,8 @@ impl Fields {
             let (exx, eyy, exy) = (g[0][0], g[1][1], 0.5 * (g[0][1] + g[1][0]));
             let tr = exx + eyy;
             let (sxx, syy, szz, sxy) = (lam * tr + 2.0 * mu * exx, lam * tr + 2.0 * mu * eyy, lam * tr, 2.0 * mu * exy);
-            out.strain
-                .extend_from_slice(&[exx as f32, eyy as f32, 0.0, exy as f32, 0.0, 0.0]);
-            out.stress
-                .extend_from_slice(&[sxx as f32, syy as f32, szz as f32, sxy as f32, 0.0, 0.0]);
+            out.strain.extend_from_slice(&[exx as f32, eyy as f32, 0.0, exy as f32, 0.0, 0.0]);
+            out.stress.extend_from_slice(&[sxx as f32, syy as f32, szz as f32, sxy as f32, 0.0, 0.0]);
             let vm = (0.5 * ((sxx - syy).powi(2) + (syy - szz).powi(2) + (szz - sxx).powi(2)) + 3.0 * sxy * sxy).sqrt();
             out.von_mises.push(vm as f32);
         }
@@ -175,8 +170,7 @@ impl Fields {
         for k in 0..nc {
             out.sigma_t.push((-r.mu[k] / self.contact_len[k]) as f32);
             out.slip.push(r.slip[k] as f32);
-            out.slip_increment
-                .push(prev_slip.map_or(0.0, |p| r.slip[k] - p[k]) as f32);
+            out.slip_increment.push(prev_slip.map_or(0.0, |p| r.slip[k] - p[k]) as f32);
             out.stick_slip.push(r.state[k]);
         }
     }

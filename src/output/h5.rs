@@ -7,17 +7,11 @@ use hdf5::{Dataset, Extent, Extents, Group, H5Type, Hyperslab, Location, Selecti
 use ndarray::{ArrayView, IxDyn};
 use std::path::{Path, PathBuf};
 
-/// Result with the crate error.
-pub type R<T> = std::result::Result<T, Error>;
-
 /// Convert an HDF5 error into the crate's I/O error naming the file.
 pub fn io(path: &Path, what: &str) -> impl FnOnce(hdf5::Error) -> Error {
     let path: PathBuf = path.to_path_buf();
     let what = what.to_string();
-    move |e| Error::Io {
-        path,
-        msg: format!("{what}: {e}"),
-    }
+    move |e| Error::Io { path, msg: format!("{what}: {e}") }
 }
 
 /// Write a whole static dataset of the given shape.
@@ -45,10 +39,8 @@ pub fn attr_vec<T: H5Type>(loc: &Location, name: &str, v: &[T]) -> hdf5::Result<
 
 /// Variable-length UTF-8 string attribute (replaced if present).
 pub fn attr_str(loc: &Location, name: &str, v: &str) -> hdf5::Result<()> {
-    let s: VarLenUnicode = v
-        .replace('\0', " ")
-        .parse()
-        .map_err(|e: hdf5::types::StringError| hdf5::Error::from(e.to_string()))?;
+    let s: VarLenUnicode =
+        v.replace('\0', " ").parse().map_err(|e: hdf5::types::StringError| hdf5::Error::from(e.to_string()))?;
     if loc.attr(name).is_ok() {
         loc.delete_attr(name)?;
     }
@@ -81,16 +73,18 @@ pub struct Series {
 
 impl Series {
     /// Create with zero rows; one chunk holds `chunk_steps` steps.
-    pub fn create<T: H5Type>(g: &Group, name: &str, block: usize, rest: &[usize], chunk_steps: usize) -> hdf5::Result<Series> {
+    pub fn create<T: H5Type>(
+        g: &Group,
+        name: &str,
+        block: usize,
+        rest: &[usize],
+        chunk_steps: usize,
+    ) -> hdf5::Result<Series> {
         let mut ext = vec![Extent::resizable(0)];
         ext.extend(rest.iter().map(|&r| Extent::fixed(r)));
         let mut chunk = vec![(block * chunk_steps).max(1)];
         chunk.extend(rest.iter().map(|&r| r.max(1)));
-        let ds = g
-            .new_dataset::<T>()
-            .chunk(chunk)
-            .shape(Extents::from(ext))
-            .create(name)?;
+        let ds = g.new_dataset::<T>().chunk(chunk).shape(Extents::from(ext)).create(name)?;
         Ok(Series { ds, block, rest: rest.to_vec() })
     }
 
@@ -106,17 +100,20 @@ impl Series {
         self.ds.shape()[0] / self.block.max(1)
     }
 
-    /// Write step n (resizing to n + 1 steps); `data` holds block · Π rest values.
-    pub fn write<T: H5Type>(&self, n: usize, data: &[T]) -> hdf5::Result<()> {
-        let mut shape = vec![self.block];
+    /// Write steps first..first+count (resizing as needed); `data` holds count · block · Π rest values.
+    pub fn write_steps<T: H5Type>(&self, first: usize, count: usize, data: &[T]) -> hdf5::Result<()> {
+        if count == 0 {
+            return Ok(());
+        }
+        let mut shape = vec![count * self.block];
         shape.extend(&self.rest);
         let view = ArrayView::from_shape(IxDyn(&shape), data).map_err(|e| hdf5::Error::from(e.to_string()))?;
-        let mut full = vec![(n + 1) * self.block];
+        let mut full = vec![(first + count) * self.block];
         full.extend(&self.rest);
         if self.ds.shape()[0] < full[0] {
             self.ds.resize(full)?;
         }
-        self.ds.write_slice(&view, rows(n * self.block, (n + 1) * self.block, &self.rest))
+        self.ds.write_slice(&view, rows(first * self.block, (first + count) * self.block, &self.rest))
     }
 
     /// Keep only the first `steps` steps.
@@ -128,9 +125,7 @@ impl Series {
 
     /// Read step n.
     pub fn read<T: H5Type>(&self, n: usize) -> hdf5::Result<Vec<T>> {
-        let a = self
-            .ds
-            .read_slice::<T, _, IxDyn>(rows(n * self.block, (n + 1) * self.block, &self.rest))?;
-        Ok(a.iter().cloned().collect())
+        let a = self.ds.read_slice::<T, _, IxDyn>(rows(n * self.block, (n + 1) * self.block, &self.rest))?;
+        Ok(a.into_raw_vec_and_offset().0)
     }
 }

@@ -1,13 +1,14 @@
 //! The `tresca` group of the README (the layout every tool of the project reads), plus
 //! `tresca/energy` (a_h(uⁿ,uⁿ)) and `tresca/contact/mu` (the friction force μ_e, kept bit-exact so
-//! a resumed run is bit-identical; σ_τ = −μ/|e| alone would round).
+//! a resumed run is bit-identical; σ_τ = −μ/|e| alone would round) and `tresca/contact/dof` (the contact
+//! unknown of uⁿ, equal to `slip` up to rounding).
 //!
 //! Time series (first axis = completed steps, grown one row per step):
 //! `times`, `u` (·, E, 2), `energy`, `steps/{iterations, residual, n_stick, n_slip, wall_time}`,
-//! `contact/{slip, sigma_t, state, mu}` (·, C) when Γ_C exists, `errors/{energy, h1, l2}` when `[exact]`.
+//! `contact/{slip, sigma_t, state, mu, dof}` (·, C) when Γ_C exists, `errors/{energy, h1, l2}` when `[exact]`.
 //! `tresca/steps` carries the attribute `completed` (number of complete steps), written after every
 //! other dataset of a step. The unknown vector of the last step is rebuilt exactly from `u` (free
-//! edges hold the two unknowns verbatim) and `contact/slip` (the one unknown of a contact edge).
+//! edges hold the two unknowns verbatim) and `contact/dof` (the one unknown of a contact edge).
 
 use super::h5::{attr, attr_str, attr_vec, put, Series};
 use crate::cr::EdgeDof;
@@ -18,6 +19,56 @@ use hdf5::{File, Group};
 /// Steps per chunk so that a chunk is about 64 KiB.
 fn chunk_steps(bytes_per_step: usize) -> usize {
     (65536 / bytes_per_step.max(1)).clamp(1, 4096)
+}
+
+/// Rows of consecutive steps buffered for one write.
+#[derive(Default)]
+pub struct Rows {
+    pub first: usize,
+    pub count: usize,
+    times: Vec<f64>,
+    u: Vec<f64>,
+    energy: Vec<f64>,
+    iterations: Vec<i64>,
+    residual: Vec<f64>,
+    n_stick: Vec<i64>,
+    n_slip: Vec<i64>,
+    wall: Vec<f64>,
+    slip: Vec<f64>,
+    sigma_t: Vec<f64>,
+    state: Vec<u8>,
+    mu: Vec<f64>,
+    dof: Vec<f64>,
+    errors: [Vec<f64>; 3],
+}
+
+impl Rows {
+    pub fn push(&mut self, r: &StepResult, mid: &[[f64; 2]], sigma_t: &[f64], dof: &[f64]) {
+        self.count += 1;
+        self.times.push(r.t);
+        self.u.extend_from_slice(mid.as_flattened());
+        self.energy.push(r.energy);
+        self.iterations.push(r.iterations as i64);
+        self.residual.push(r.residual);
+        self.n_stick.push(r.n_stick() as i64);
+        self.n_slip.push(r.n_slip() as i64);
+        self.wall.push(r.wall);
+        self.slip.extend_from_slice(&r.slip);
+        self.sigma_t.extend_from_slice(sigma_t);
+        self.state.extend_from_slice(&r.state);
+        self.mu.extend_from_slice(&r.mu);
+        self.dof.extend_from_slice(dof);
+        if let Some(e) = &r.errors {
+            self.errors[0].push(e.energy);
+            self.errors[1].push(e.h1);
+            self.errors[2].push(e.l2);
+        }
+    }
+
+    /// Empty the buffer; the next row is step `first`.
+    pub fn reset(&mut self, first: usize) {
+        *self = Rows { first, ..Default::default() };
+    }
 }
 
 pub struct Tresca {
@@ -31,20 +82,13 @@ pub struct Tresca {
     n_stick: Series,
     n_slip: Series,
     wall: Series,
-    /// slip, sigma_t, state, mu.
-    contact: Option<[Series; 4]>,
+    /// slip, sigma_t, state, mu, dof.
+    contact: Option<[Series; 5]>,
     /// energy, h1, l2.
     errors: Option<[Series; 3]>,
 }
 
-const SCALARS: [&str; 6] = [
-    "times",
-    "energy",
-    "steps/iterations",
-    "steps/residual",
-    "steps/n_stick",
-    "steps/n_slip",
-];
+const SCALARS: [&str; 6] = ["times", "energy", "steps/iterations", "steps/residual", "steps/n_stick", "steps/n_slip"];
 
 impl Tresca {
     /// Create the group with static data, attributes and empty series.
@@ -79,6 +123,7 @@ impl Tresca {
                 Series::create::<f64>(&cg, "sigma_t", 1, &[nc], k)?,
                 Series::create::<u8>(&cg, "state", 1, &[nc], k)?,
                 Series::create::<f64>(&cg, "mu", 1, &[nc], k)?,
+                Series::create::<f64>(&cg, "dof", 1, &[nc], k)?,
             ])
         };
         let errors = if p.errors.is_some() {
@@ -99,7 +144,7 @@ impl Tresca {
         attr_str(loc, "git_commit", git_commit)?;
         attr_str(loc, "solver", s.solver.method.name())?;
         attr(loc, "tol", s.solver.tol)?;
-        attr(loc, "max_iter", s.solver.max_iter as i64)?;
+        attr(loc, "max_iter", s.solver.max_iter() as i64)?;
         attr(loc, "uzawa_step", s.solver.uzawa_step)?;
         attr(loc, "rho", s.rho)?;
         attr(loc, "E", s.material.e)?;
@@ -140,15 +185,12 @@ impl Tresca {
                 Series::open(&cg, "sigma_t", 1)?,
                 Series::open(&cg, "state", 1)?,
                 Series::open(&cg, "mu", 1)?,
+                Series::open(&cg, "dof", 1)?,
             ]),
             Err(_) => None,
         };
         let errors = match g.group("errors") {
-            Ok(eg) => Some([
-                Series::open(&eg, "energy", 1)?,
-                Series::open(&eg, "h1", 1)?,
-                Series::open(&eg, "l2", 1)?,
-            ]),
+            Ok(eg) => Some([Series::open(&eg, "energy", 1)?, Series::open(&eg, "h1", 1)?, Series::open(&eg, "l2", 1)?]),
             Err(_) => None,
         };
         Ok(Tresca {
@@ -188,28 +230,28 @@ impl Tresca {
         Ok(self.steps_group.attr("completed")?.read_scalar::<i64>()?.max(0) as usize)
     }
 
-    /// Append step r.n (all series, not yet `completed`).
-    pub fn write(&self, r: &StepResult, mid: &[[f64; 2]], sigma_t: &[f64]) -> hdf5::Result<()> {
-        let n = r.n;
-        self.times.write(n, &[r.t])?;
-        let flat: &[f64] = mid.as_flattened();
-        self.u.write(n, flat)?;
-        self.energy.write(n, &[r.energy])?;
-        self.iterations.write(n, &[r.iterations as i64])?;
-        self.residual.write(n, &[r.residual])?;
-        self.n_stick.write(n, &[r.n_stick() as i64])?;
-        self.n_slip.write(n, &[r.n_slip() as i64])?;
-        self.wall.write(n, &[r.wall])?;
-        if let Some([slip, sig, state, mu]) = &self.contact {
-            slip.write(n, &r.slip)?;
-            sig.write(n, sigma_t)?;
-            state.write(n, &r.state)?;
-            mu.write(n, &r.mu)?;
+    /// Append buffered rows (all series; `completed` is not changed).
+    pub fn write_rows(&self, b: &Rows) -> hdf5::Result<()> {
+        let (n, k) = (b.first, b.count);
+        self.times.write_steps(n, k, &b.times)?;
+        self.u.write_steps(n, k, &b.u)?;
+        self.energy.write_steps(n, k, &b.energy)?;
+        self.iterations.write_steps(n, k, &b.iterations)?;
+        self.residual.write_steps(n, k, &b.residual)?;
+        self.n_stick.write_steps(n, k, &b.n_stick)?;
+        self.n_slip.write_steps(n, k, &b.n_slip)?;
+        self.wall.write_steps(n, k, &b.wall)?;
+        if let Some([slip, sig, state, mu, d]) = &self.contact {
+            slip.write_steps(n, k, &b.slip)?;
+            sig.write_steps(n, k, &b.sigma_t)?;
+            state.write_steps(n, k, &b.state)?;
+            mu.write_steps(n, k, &b.mu)?;
+            d.write_steps(n, k, &b.dof)?;
         }
-        if let (Some([en, h1, l2]), Some(e)) = (&self.errors, &r.errors) {
-            en.write(n, &[e.energy])?;
-            h1.write(n, &[e.h1])?;
-            l2.write(n, &[e.l2])?;
+        if let Some(es) = &self.errors {
+            for (s, v) in es.iter().zip(&b.errors) {
+                s.write_steps(n, k, v)?;
+            }
         }
         Ok(())
     }
@@ -246,20 +288,18 @@ impl Tresca {
             }
         }
         let (mut mu, mut slip, mut state) = (vec![], vec![], vec![]);
-        if let Some([sl, _, st, m]) = &self.contact {
+        if let Some([sl, _, st, m, d]) = &self.contact {
             slip = sl.read::<f64>(n)?;
             state = st.read::<u8>(n)?;
             mu = m.read::<f64>(n)?;
-            for (c, s) in p.space.contact.iter().zip(&slip) {
+            for (c, s) in p.space.contact.iter().zip(&d.read::<f64>(n)?) {
                 u[c.dof] = *s;
             }
         }
         let errors = match &self.errors {
-            Some([en, h1, l2]) => Some(ErrorNorms {
-                energy: en.read::<f64>(n)?[0],
-                h1: h1.read::<f64>(n)?[0],
-                l2: l2.read::<f64>(n)?[0],
-            }),
+            Some([en, h1, l2]) => {
+                Some(ErrorNorms { energy: en.read::<f64>(n)?[0], h1: h1.read::<f64>(n)?[0], l2: l2.read::<f64>(n)?[0] })
+            }
             None => None,
         };
         Ok(StepResult {

@@ -1,0 +1,402 @@
+//! Results output: one HDF5 file `run.h5` holding three views of the same run, and an XDMF3 sidecar.
+//!
+//! | group | for | content |
+//! |---|---|---|
+//! | `/tresca` | the project's tools (`scripts/`) | the README table, f64, one row per completed step ([`tresca`]) |
+//! | `/VTKHDF` | ParaView ≥ 5.13, VTK ≥ 9.3 `vtkHDFReader` | temporal UnstructuredGrid: broken mesh (3 points per triangle) + Γ_C line cells, f32 fields ([`vtkhdf`], [`fields`]) |
+//! | `/xdmf` | `run.xdmf` (meshio, ParaView's XDMF readers) | static mixed topology and per-step virtual datasets onto `/VTKHDF` arrays ([`xdmf`]) |
+//!
+//! **What is written when.** Every step goes to `/tresca`; the VTKHDF/XDMF views get *frames*: the
+//! steps n with n % `frame_every` == 0 and the last step ([`Options::frame_every`]; by default at most
+//! [`AUTO_FRAMES`] frames, since each frame costs ~0.3 MB and 8 HDF5 objects).
+//!
+//! **Crash safety.** Steps handed to [`Writer::write_step`] are committed in batches: a batch is written
+//! as soon as [`Options::commit_interval`] seconds have passed since the previous commit (default
+//! 0.05 s; 0 = every step), at the last step, and by [`Writer::finish`] / drop. A commit appends the
+//! batch to every time-dependent (chunked, resizable) dataset, then sets `tresca/steps` attribute
+//! `completed` and `VTKHDF/Steps` attribute `NSteps`, flushes the file (H5Fflush), and only then appends
+//! the frames to `run.xdmf`. A process killed at any moment therefore leaves every committed step
+//! readable and loses at most `commit_interval` seconds of work (a partial batch shows up only as longer
+//! series, ignored via `completed`/`NSteps`; HDF5 has no journal, so a kill *inside* H5Fflush is the one
+//! window this does not cover). [`Writer::resume`]
+//! truncates a partial step and returns the last complete one; continuing from it is bit-identical to
+//! an uninterrupted run because a step depends on the previous one only through its slip and μ, both
+//! stored exactly. Non-finite values are refused before anything of the step is written.
+//!
+//! Attributes of `/tresca`: `scene` (full text), `scene_path`, `title`, `version` (crate),
+//! `git_commit` (environment variable `TRESCA_GIT_COMMIT` at run time, else "unknown"), `solver`, `tol`,
+//! `max_iter`, `uzawa_step`, `rho`, `E`, `nu`, `steps` (N), `n_edges`, `n_contact`, `n_dofs`,
+//! `paper_dofs`, `h`, `setup_times` (4 wall times, s), `status` ("running", then what
+//! [`Writer::finish`] records: "completed" or the error of the failed step).
+
+pub mod fields;
+mod h5;
+pub mod tresca;
+pub mod vtkhdf;
+pub mod xdmf;
+
+use crate::cr::CrSpace;
+use crate::error::{Error, Result};
+use crate::stepping::{Problem, StepResult};
+use fields::{Fields, StepFields};
+use h5::io;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use tresca::{Rows, Tresca};
+use vtkhdf::{FrameRows, Frames, VtkHdf};
+use xdmf::Xdmf;
+
+pub use xdmf::sidecar;
+
+/// Default upper bound on the number of visualisation frames.
+pub const AUTO_FRAMES: usize = 51;
+
+/// How a [`Writer`] is created.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Overwrite an existing file.
+    pub force: bool,
+    /// Visualisation frame every k steps (plus the last step); `None`: ⌈N / (AUTO_FRAMES − 1)⌉.
+    pub frame_every: Option<usize>,
+    /// Seconds between commits (write + flush); 0 commits every step.
+    pub commit_interval: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options { force: false, frame_every: None, commit_interval: 0.05 }
+    }
+}
+
+/// Appends the steps of a run to a results file.
+pub struct Writer {
+    path: PathBuf,
+    file: hdf5::File,
+    space: CrSpace,
+    fields: Fields,
+    tresca: Tresca,
+    vtk: VtkHdf,
+    xdmf: Xdmf,
+    frames: Frames,
+    interval: f64,
+    buf: StepFields,
+    rows: Rows,
+    frame_rows: FrameRows,
+    /// Step numbers of the buffered frames.
+    frame_steps: Vec<usize>,
+    prev_slip: Option<Vec<f64>>,
+    /// Committed steps and frames.
+    completed: usize,
+    frames_done: usize,
+    last_commit: Instant,
+    finished: bool,
+    /// Seconds spent in write_step (all of it) and in H5Fflush alone.
+    pub seconds: [f64; 2],
+}
+
+fn ioerr(path: &Path, what: &'static str) -> impl FnOnce(std::io::Error) -> Error {
+    let path = path.to_path_buf();
+    move |e| Error::Io { path, msg: format!("{what}: {e}") }
+}
+
+fn check_finite<'a>(path: &Path, n: usize, what: &str, v: impl IntoIterator<Item = &'a f64>) -> Result<()> {
+    match v.into_iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(k) => Err(Error::Io {
+            path: path.to_path_buf(),
+            msg: format!("step {n}: {what}[{k}] is not finite; the step was not written"),
+        }),
+    }
+}
+
+impl Writer {
+    /// Create `path` (and `run.xdmf` next to it) with mesh, static data and attributes. An existing file
+    /// is refused unless `force`.
+    pub fn create(path: &Path, problem: &Problem, force: bool) -> Result<Writer> {
+        Writer::create_with(path, problem, &Options { force, ..Options::default() })
+    }
+
+    /// [`Writer::create`] with all options.
+    pub fn create_with(path: &Path, problem: &Problem, opts: &Options) -> Result<Writer> {
+        if path.exists() && !opts.force {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg:
+                    "results file already exists; pass --force to overwrite it or --resume to continue the run it holds"
+                        .into(),
+            });
+        }
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(ioerr(path, "cannot create the directory"))?;
+        }
+        if path.exists() {
+            std::fs::remove_file(path).map_err(ioerr(path, "cannot remove the old file"))?;
+        }
+        let file = hdf5::File::create(path).map_err(io(path, "cannot create HDF5 file"))?;
+        let fields = Fields::new(problem);
+        let contact = !problem.space.contact.is_empty();
+        let commit = std::env::var("TRESCA_GIT_COMMIT").unwrap_or_else(|_| "unknown".into());
+        let n = problem.n_steps();
+        let every = opts.frame_every.unwrap_or(n.div_ceil(AUTO_FRAMES - 1)).max(1);
+        let frames = Frames { every, last: n };
+        let tresca = Tresca::create(&file, problem, &commit).map_err(io(path, "writing the tresca group"))?;
+        h5::attr(&tresca.group, "frame_every", every as i64).map_err(io(path, "attribute frame_every"))?;
+        let vtk =
+            VtkHdf::create(&file, &fields, frames.total(), contact).map_err(io(path, "writing the VTKHDF group"))?;
+        let mut xdmf = Xdmf::create(&file, path, &fields, contact).map_err(ioerr(path, "writing the XDMF sidecar"))?;
+        xdmf.total_frames = frames.total();
+        file.flush().map_err(io(path, "flush"))?;
+        Ok(Writer {
+            path: path.to_path_buf(),
+            file,
+            space: problem.space.clone(),
+            fields,
+            tresca,
+            vtk,
+            xdmf,
+            frames,
+            interval: opts.commit_interval,
+            buf: StepFields::default(),
+            rows: Rows::default(),
+            frame_rows: FrameRows::default(),
+            frame_steps: Vec::new(),
+            prev_slip: None,
+            completed: 0,
+            frames_done: 0,
+            last_commit: Instant::now(),
+            finished: false,
+            seconds: [0.0; 2],
+        })
+    }
+
+    /// Reopen a results file of `problem` (same scene text, time grid, solver and mesh, else an error),
+    /// drop a partial step and return the last complete step, from which `problem.run_from` continues.
+    pub fn resume(path: &Path, problem: &Problem) -> Result<(Writer, StepResult)> {
+        let file = hdf5::File::open_rw(path).map_err(io(path, "cannot open for --resume"))?;
+        let tresca = Tresca::open(&file).map_err(io(path, "not a tresca-cr results file"))?;
+        let mismatch = |what: &str| Error::Io {
+            path: path.to_path_buf(),
+            msg: format!("--resume: the file was written for a different {what}; rerun with --force to overwrite it"),
+        };
+        let g = &*tresca.group;
+        let text = h5::read_str(g, "scene").map_err(io(path, "attribute scene"))?;
+        if text != problem.scene.text {
+            return Err(mismatch("scene (the stored scene text differs)"));
+        }
+        let int = |k: &str| g.attr(k).and_then(|a| a.read_scalar::<i64>()).unwrap_or(-1);
+        if int("steps") != problem.n_steps() as i64 {
+            return Err(mismatch("number of time steps (--steps)"));
+        }
+        if int("n_edges") != problem.mesh.edges.len() as i64 || int("n_dofs") != problem.space.n_dofs as i64 {
+            return Err(mismatch("mesh (--refine)"));
+        }
+        let solver = h5::read_str(g, "solver").unwrap_or_default();
+        if solver != problem.scene.solver.method.name() {
+            return Err(mismatch(&format!("solver ({solver})")));
+        }
+        let pts =
+            tresca.group.dataset("mesh/points").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "mesh/points"))?;
+        if pts != problem.mesh.points.as_flattened() {
+            return Err(mismatch("mesh (vertex coordinates)"));
+        }
+        let contact = !problem.space.contact.is_empty();
+        let vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
+        let completed = tresca.completed().map_err(io(path, "tresca/steps completed"))?.min(tresca.min_steps());
+        if completed == 0 {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: "--resume: the file holds no complete step; rerun with --force".into(),
+            });
+        }
+        let times: Vec<f64> =
+            tresca.group.dataset("times").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "tresca/times"))?;
+        if times[..completed] != problem.scene.times[..completed] {
+            return Err(mismatch("time grid"));
+        }
+        let every = int("frame_every").max(1) as usize;
+        let frames = Frames { every, last: problem.n_steps() };
+        let frames_done = frames.before(completed);
+        if vtk.frames_stored() < frames_done {
+            return Err(Error::Io { path: path.to_path_buf(), msg: "--resume: VTKHDF frames are missing; rerun with --force".into() });
+        }
+        let frame_list: Vec<(usize, f64)> =
+            (0..completed).filter(|&n| frames.is_frame(n)).map(|n| (n, times[n])).collect();
+        let fix = || -> hdf5::Result<StepResult> {
+            tresca.truncate(completed)?;
+            vtk.truncate(frames_done)?;
+            tresca.set_completed(completed)?;
+            vtk.set_nsteps(frames_done)?;
+            tresca.set_status("running (resumed)")?;
+            tresca.read_step(problem, completed - 1)
+        };
+        let last = fix().map_err(io(path, "--resume"))?;
+        let mut xdmf =
+            Xdmf::resume(&file, path, &frame_list, contact).map_err(ioerr(path, "rewriting the XDMF sidecar"))?;
+        xdmf.total_frames = frames.total();
+        file.flush().map_err(io(path, "flush"))?;
+        let w = Writer {
+            path: path.to_path_buf(),
+            file,
+            space: problem.space.clone(),
+            fields: Fields::new(problem),
+            tresca,
+            vtk,
+            xdmf,
+            frames,
+            interval: Options::default().commit_interval,
+            buf: StepFields::default(),
+            rows: { let mut r = Rows::default(); r.reset(completed); r },
+            frame_rows: { let mut r = FrameRows::default(); r.reset(frames_done); r },
+            frame_steps: Vec::new(),
+            prev_slip: Some(last.slip.clone()),
+            completed,
+            frames_done,
+            last_commit: Instant::now(),
+            finished: false,
+            seconds: [0.0; 2],
+        };
+        Ok((w, last))
+    }
+
+    /// Number of steps committed to the file.
+    pub fn completed(&self) -> usize {
+        self.completed
+    }
+
+    /// The results file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Seconds between commits (0: every step).
+    pub fn set_commit_interval(&mut self, seconds: f64) {
+        self.interval = seconds;
+    }
+
+    /// Take step `r` (the step after the last one taken): checked for non-finite values, buffered, and
+    /// committed (see the module doc) once the commit interval has passed or at the last step.
+    pub fn write_step(&mut self, r: &StepResult) -> Result<()> {
+        let start = Instant::now();
+        let out = self.take(r);
+        let out = match out {
+            Ok(()) if self.last_commit.elapsed().as_secs_f64() >= self.interval || r.n == self.frames.last => {
+                self.commit()
+            }
+            Ok(()) => Ok(()),
+            Err(e) => {
+                // keep what was good
+                let _ = self.commit();
+                Err(e)
+            }
+        };
+        self.seconds[0] += start.elapsed().as_secs_f64();
+        out
+    }
+
+    fn take(&mut self, r: &StepResult) -> Result<()> {
+        let (path, n) = (self.path.as_path(), r.n);
+        let expected = self.completed + self.rows.count;
+        if n != expected {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: format!("step {n} handed to the writer, but the next step is {expected}"),
+            });
+        }
+        if r.u.len() != self.space.n_dofs {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: format!("step {n} carries no displacement (solved with want_u = false); every written step needs u"),
+            });
+        }
+        check_finite(path, n, "t", [&r.t])?;
+        check_finite(path, n, "u", &r.u)?;
+        check_finite(path, n, "mu", &r.mu)?;
+        check_finite(path, n, "slip", &r.slip)?;
+        check_finite(path, n, "energy/residual/wall", [&r.energy, &r.residual, &r.wall])?;
+        if let Some(e) = &r.errors {
+            check_finite(path, n, "errors", [&e.energy, &e.h1, &e.l2])?;
+        }
+        let sigma_t: Vec<f64> = r.mu.iter().zip(&self.space.contact).map(|(m, c)| -m / c.length).collect();
+        check_finite(path, n, "sigma_t", &sigma_t)?;
+        let mid = self.space.midpoint_values(&r.u);
+        if self.frames.is_frame(n) {
+            self.fields.eval(&mid, r, self.prev_slip.as_deref(), &mut self.buf);
+            let b = &self.buf;
+            for (what, v) in [
+                ("displacement", &b.displacement),
+                ("strain", &b.strain),
+                ("stress", &b.stress),
+                ("von_mises", &b.von_mises),
+                ("slip_increment", &b.slip_increment),
+            ] {
+                if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+                    return Err(Error::Io {
+                        path: path.to_path_buf(),
+                        msg: format!("step {n}: {what}[{k}] is not finite in single precision; the step was not written"),
+                    });
+                }
+            }
+            self.frame_rows.push(r.t, &self.buf);
+            self.frame_steps.push(n);
+        }
+        let dof: Vec<f64> = self.space.contact.iter().map(|c| r.u[c.dof]).collect();
+        self.rows.push(r, &mid, &sigma_t, &dof);
+        self.prev_slip = Some(r.slip.clone());
+        Ok(())
+    }
+
+    /// Write the buffered steps, mark them complete, flush, extend the XDMF text.
+    pub fn commit(&mut self) -> Result<()> {
+        if self.rows.count == 0 {
+            return Ok(());
+        }
+        let path = self.path.clone();
+        let (steps, nf) = (self.completed + self.rows.count, self.frames_done + self.frame_rows.count());
+        let write = || -> hdf5::Result<()> {
+            self.tresca.write_rows(&self.rows)?;
+            self.vtk.write_frames(&self.frame_rows)?;
+            for f in self.frames_done..nf {
+                self.xdmf.add_frame_datasets(f)?;
+            }
+            self.vtk.set_nsteps(nf)?;
+            self.tresca.set_completed(steps)
+        };
+        write().map_err(io(&path, &format!("writing steps {}..{}", self.completed, steps - 1)))?;
+        let f0 = Instant::now();
+        self.file.flush().map_err(io(&path, "flush"))?;
+        self.seconds[1] += f0.elapsed().as_secs_f64();
+        for (k, &n) in self.frame_steps.iter().enumerate() {
+            let t = self.frame_rows.times[k];
+            self.xdmf
+                .append_text(self.frames_done + k, n, t)
+                .map_err(ioerr(&self.xdmf.path.clone(), "appending to the XDMF sidecar"))?;
+        }
+        self.completed = steps;
+        self.frames_done = nf;
+        self.rows.reset(steps);
+        self.frame_rows.reset(nf);
+        self.frame_steps.clear();
+        self.last_commit = Instant::now();
+        Ok(())
+    }
+
+    /// Commit what is buffered, record why the run stopped ("completed", or the error of the failed
+    /// step) and close the file.
+    pub fn finish(mut self, status: &str) -> Result<()> {
+        self.commit()?;
+        self.finished = true;
+        let path = self.path.clone();
+        self.tresca.set_status(status).map_err(io(&path, "attribute status"))?;
+        self.file.flush().map_err(io(&path, "flush"))?;
+        Ok(())
+    }
+}
+
+impl Drop for Writer {
+    /// A writer dropped without [`Writer::finish`] (an error, a panic) still commits what it holds.
+    fn drop(&mut self) {
+        if !self.finished {
+            let _ = self.commit();
+        }
+    }
+}

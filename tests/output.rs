@@ -1,0 +1,470 @@
+//! Results file: round trip of every dataset, refusal of existing files and non-finite values,
+//! SIGKILL safety (a child process killed at random moments) and bit-identical `resume`.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+use tresca_cr::cr::Element;
+use tresca_cr::output::{sidecar, Writer};
+use tresca_cr::{Problem, Scene, StepResult};
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tresca-output-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let p = d.join(name);
+    let _ = std::fs::remove_file(&p);
+    p
+}
+
+fn example(refine: u32, steps: usize) -> Scene {
+    let mut s = common::scene("verification/cases/paper_example_5_1.toml");
+    s.set_refine(refine).unwrap();
+    s.set_steps(steps).unwrap();
+    s
+}
+
+/// Run `p`, writing every step; returns the results.
+fn run_written(p: &Problem, path: &Path) -> Vec<StepResult> {
+    let mut w = Writer::create(path, p, true).unwrap();
+    let mut out = Vec::new();
+    p.run(|r| {
+        out.push(r.clone());
+        w.write_step(r)
+    })
+    .unwrap();
+    w.finish("completed").unwrap();
+    out
+}
+
+fn f64s(f: &hdf5::File, name: &str) -> Vec<f64> {
+    f.dataset(name).unwrap_or_else(|e| panic!("{name}: {e}")).read_raw::<f64>().unwrap()
+}
+fn f32s(f: &hdf5::File, name: &str) -> Vec<f32> {
+    f.dataset(name).unwrap_or_else(|e| panic!("{name}: {e}")).read_raw::<f32>().unwrap()
+}
+fn shape(f: &hdf5::File, name: &str) -> Vec<usize> {
+    f.dataset(name).unwrap_or_else(|e| panic!("{name}: {e}")).shape()
+}
+fn attr_str(f: &hdf5::File, group: &str, name: &str) -> String {
+    f.group(group)
+        .unwrap()
+        .attr(name)
+        .unwrap()
+        .read_scalar::<hdf5::types::VarLenUnicode>()
+        .unwrap()
+        .as_str()
+        .to_string()
+}
+fn attr_i64(f: &hdf5::File, group: &str, name: &str) -> i64 {
+    f.group(group).unwrap().attr(name).unwrap().read_scalar::<i64>().unwrap()
+}
+
+/// f32 agreement relative to the array's scale.
+fn close32(a: &[f32], b: &[f64], what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}: length");
+    let scale = b.iter().fold(1e-300f64, |m, v| m.max(v.abs()));
+    for (k, (x, y)) in a.iter().zip(b).enumerate() {
+        assert!(((*x as f64) - y).abs() <= 1e-6 * scale, "{what}[{k}]: {x} vs {y}");
+    }
+}
+
+/// Every dataset of the file against the in-memory results, with the VTK fields recomputed here by
+/// evaluating the CR basis at the triangle vertices (an independent route from the writer's formula).
+fn check_file(p: &Problem, rs: &[StepResult], path: &Path) {
+    let f = hdf5::File::open(path).unwrap();
+    let (mesh, sp) = (&p.mesh, &p.space);
+    let (nt, ne, nc) = (mesh.tris.len(), mesh.edges.len(), sp.contact.len());
+    let n1 = rs.len();
+    assert_eq!(attr_i64(&f, "tresca/steps", "completed"), n1 as i64);
+    assert_eq!(attr_i64(&f, "VTKHDF/Steps", "NSteps"), n1 as i64);
+    assert_eq!(attr_str(&f, "tresca", "scene"), p.scene.text);
+    assert_eq!(attr_str(&f, "tresca", "status"), "completed");
+    assert_eq!(attr_str(&f, "tresca", "version"), env!("CARGO_PKG_VERSION"));
+    assert_eq!(attr_str(&f, "tresca", "solver"), p.scene.solver.method.name());
+    assert_eq!(f64s(&f, "tresca/mesh/points"), mesh.points.as_flattened());
+    let tris: Vec<i64> = f.dataset("tresca/mesh/triangles").unwrap().read_raw().unwrap();
+    assert_eq!(tris, mesh.tris.iter().flatten().map(|&v| v as i64).collect::<Vec<_>>());
+    assert_eq!(shape(&f, "tresca/mesh/edges"), [ne, 2]);
+    assert_eq!(shape(&f, "tresca/u"), [n1, ne, 2]);
+    let times: Vec<f64> = rs.iter().map(|r| r.t).collect();
+    assert_eq!(f64s(&f, "tresca/times"), times);
+    assert_eq!(f64s(&f, "VTKHDF/Steps/Values"), times);
+    let u = f64s(&f, "tresca/u");
+    let energy = f64s(&f, "tresca/energy");
+    let iters: Vec<i64> = f.dataset("tresca/steps/iterations").unwrap().read_raw().unwrap();
+    let res = f64s(&f, "tresca/steps/residual");
+    for (n, r) in rs.iter().enumerate() {
+        let mid = sp.midpoint_values(&r.u);
+        assert_eq!(&u[n * 2 * ne..(n + 1) * 2 * ne], mid.as_flattened(), "tresca/u step {n}");
+        assert_eq!(energy[n], r.energy);
+        assert_eq!(iters[n], r.iterations as i64);
+        assert_eq!(res[n], r.residual);
+    }
+    if nc > 0 {
+        let slip = f64s(&f, "tresca/contact/slip");
+        let sig = f64s(&f, "tresca/contact/sigma_t");
+        let mu = f64s(&f, "tresca/contact/mu");
+        let state: Vec<u8> = f.dataset("tresca/contact/state").unwrap().read_raw().unwrap();
+        let g = f64s(&f, "tresca/contact/g");
+        for (k, c) in sp.contact.iter().enumerate() {
+            assert_eq!(g[k], c.g_mean);
+        }
+        for (n, r) in rs.iter().enumerate() {
+            assert_eq!(&slip[n * nc..(n + 1) * nc], &r.slip[..]);
+            assert_eq!(&mu[n * nc..(n + 1) * nc], &r.mu[..]);
+            assert_eq!(&state[n * nc..(n + 1) * nc], &r.state[..]);
+            for k in 0..nc {
+                assert_eq!(sig[n * nc + k], -r.mu[k] / sp.contact[k].length);
+            }
+        }
+    }
+    if p.errors.is_some() {
+        let e = f64s(&f, "tresca/errors/energy");
+        let l2 = f64s(&f, "tresca/errors/l2");
+        for (n, r) in rs.iter().enumerate() {
+            assert_eq!(e[n], r.errors.unwrap().energy);
+            assert_eq!(l2[n], r.errors.unwrap().l2);
+        }
+    }
+    // VTKHDF
+    let np = 3 * nt;
+    let ncell = nt + nc;
+    assert_eq!(shape(&f, "VTKHDF/Points"), [np, 3]);
+    assert_eq!(shape(&f, "VTKHDF/Types"), [ncell]);
+    assert_eq!(shape(&f, "VTKHDF/PointData/displacement"), [n1 * np, 3]);
+    assert_eq!(shape(&f, "VTKHDF/CellData/stress"), [n1 * ncell, 6]);
+    let disp = f32s(&f, "VTKHDF/PointData/displacement");
+    let vm = f32s(&f, "VTKHDF/CellData/von_mises");
+    let stress = f32s(&f, "VTKHDF/CellData/stress");
+    let (lam, mu) = (p.scene.material.lambda(), p.scene.material.mu());
+    for (n, r) in rs.iter().enumerate() {
+        let mid = sp.midpoint_values(&r.u);
+        let mut want = Vec::new();
+        let mut want_vm = Vec::new();
+        let mut want_sxx = Vec::new();
+        for t in 0..nt {
+            let el = Element::new(mesh, t);
+            for j in 0..3 {
+                let phi = Element::phi(el.bary(el.pts[j]));
+                let mut v = [0.0; 3];
+                for i in 0..3 {
+                    let ue = mid[mesh.tri_edges[t][i]];
+                    v[0] += phi[i] * ue[0];
+                    v[1] += phi[i] * ue[1];
+                }
+                want.extend(v);
+            }
+            // stress from a finite difference of the P1 vertex values (exact for a linear field)
+            let vals: Vec<[f64; 2]> =
+                (0..3).map(|j| [want[want.len() - 9 + 3 * j], want[want.len() - 8 + 3 * j]]).collect();
+            let mut gu = [[0.0; 2]; 2];
+            for j in 0..3 {
+                for a in 0..2 {
+                    for b in 0..2 {
+                        gu[a][b] += vals[j][a] * el.grad_lambda[j][b];
+                    }
+                }
+            }
+            let tr = gu[0][0] + gu[1][1];
+            let (sxx, syy, szz, sxy) =
+                (lam * tr + 2.0 * mu * gu[0][0], lam * tr + 2.0 * mu * gu[1][1], lam * tr, mu * (gu[0][1] + gu[1][0]));
+            want_sxx.push(sxx);
+            want_vm.push(
+                (0.5 * ((sxx - syy).powi(2) + (syy - szz).powi(2) + (szz - sxx).powi(2)) + 3.0 * sxy * sxy).sqrt(),
+            );
+        }
+        close32(&disp[n * 3 * np..(n + 1) * 3 * np], &want, &format!("displacement step {n}"));
+        close32(&vm[n * ncell..n * ncell + nt], &want_vm, &format!("von_mises step {n}"));
+        let sxx: Vec<f32> = (0..nt).map(|t| stress[(n * ncell + t) * 6]).collect();
+        close32(&sxx, &want_sxx, &format!("stress xx step {n}"));
+    }
+    if nc > 0 {
+        let st = f32s(&f, "VTKHDF/CellData/sigma_t");
+        let inc = f32s(&f, "VTKHDF/CellData/slip_increment");
+        let n = n1 - 1;
+        let want: Vec<f64> = (0..nc).map(|k| -rs[n].mu[k] / sp.contact[k].length).collect();
+        close32(&st[n * ncell + nt..(n + 1) * ncell], &want, "sigma_t");
+        let want: Vec<f64> = (0..nc).map(|k| rs[n].slip[k] - rs[n - 1].slip[k]).collect();
+        close32(&inc[n * ncell + nt..(n + 1) * ncell], &want, "slip_increment");
+    }
+    // XDMF virtual datasets resolve to the same rows
+    for k in 0..n1 {
+        let v = f32s(&f, &format!("xdmf/displacement/{k:06}"));
+        assert_eq!(v, &disp[k * 3 * np..(k + 1) * 3 * np]);
+        let v = f32s(&f, &format!("xdmf/stress/{k:06}"));
+        assert_eq!(v, &stress[k * 6 * ncell..(k + 1) * 6 * ncell]);
+    }
+    let x = std::fs::read_to_string(sidecar(path)).unwrap();
+    assert_eq!(x.matches("<Grid Name=\"step_").count(), n1);
+    assert!(x.trim_end().ends_with("</Xdmf>"));
+}
+
+#[test]
+fn round_trip_example_with_contact() {
+    let p = Problem::new(example(1, 12)).unwrap();
+    let path = tmp("example.h5");
+    let rs = run_written(&p, &path);
+    check_file(&p, &rs, &path);
+}
+
+#[test]
+fn round_trip_with_exact_solution_errors() {
+    let p = Problem::new(common::scene("verification/cases/mms_stick_to_slip.toml")).unwrap();
+    let path = tmp("mms.h5");
+    let rs = run_written(&p, &path);
+    assert!(rs[1].errors.is_some());
+    check_file(&p, &rs, &path);
+}
+
+#[test]
+fn round_trip_without_contact() {
+    let p = Problem::new(common::scene("verification/cases/mms_elastic.toml")).unwrap();
+    assert!(p.space.contact.is_empty());
+    let path = tmp("elastic.h5");
+    let rs = run_written(&p, &path);
+    check_file(&p, &rs, &path);
+    let f = hdf5::File::open(&path).unwrap();
+    assert!(f.group("tresca/contact").is_err());
+}
+
+#[test]
+fn existing_file_is_refused_without_force() {
+    let p = Problem::new(example(0, 2)).unwrap();
+    let path = tmp("exists.h5");
+    std::fs::write(&path, b"keep me").unwrap();
+    let err = Writer::create(&path, &p, false).err().expect("must refuse").to_string();
+    assert!(err.contains(&path.display().to_string()) && err.contains("--force") && err.contains("--resume"), "{err}");
+    assert_eq!(std::fs::read(&path).unwrap(), b"keep me");
+    Writer::create(&path, &p, true).unwrap();
+}
+
+#[test]
+fn non_finite_values_are_refused_and_earlier_steps_survive() {
+    let p = Problem::new(example(0, 4)).unwrap();
+    let path = tmp("nan.h5");
+    let mut w = Writer::create(&path, &p, true).unwrap();
+    let r0 = p.initial().unwrap();
+    w.write_step(&r0).unwrap();
+    let mut bad = p.step(1, &r0, &mut Vec::new(), true).unwrap();
+    bad.u[3] = f64::NAN;
+    let err = w.write_step(&bad).unwrap_err().to_string();
+    assert!(err.contains("u[3]") && err.contains("not finite"), "{err}");
+    bad.u[3] = 0.0;
+    bad.mu[0] = f64::INFINITY;
+    assert!(w.write_step(&bad).is_err());
+    drop(w);
+    let f = hdf5::File::open(&path).unwrap();
+    assert_eq!(attr_i64(&f, "tresca/steps", "completed"), 1);
+    assert_eq!(shape(&f, "tresca/u")[0], 1);
+    assert!(f64s(&f, "tresca/u").iter().all(|v| v.is_finite()));
+}
+
+/// Compare two results files dataset by dataset (bitwise), except wall times and the status.
+fn same_results(a: &Path, b: &Path) {
+    let (fa, fb) = (hdf5::File::open(a).unwrap(), hdf5::File::open(b).unwrap());
+    let mut names = Vec::new();
+    fn walk(g: &hdf5::Group, prefix: &str, out: &mut Vec<String>) {
+        for m in g.member_names().unwrap() {
+            let full = format!("{prefix}/{m}");
+            if let Ok(sub) = g.group(&m) {
+                walk(&sub, &full, out);
+            } else {
+                out.push(full);
+            }
+        }
+    }
+    walk(&fa.group("/").unwrap(), "", &mut names);
+    let mut nb = Vec::new();
+    walk(&fb.group("/").unwrap(), "", &mut nb);
+    assert_eq!(names, nb, "dataset lists differ");
+    for n in names.iter().filter(|n| !n.ends_with("wall_time")) {
+        let (da, db) = (fa.dataset(n).unwrap(), fb.dataset(n).unwrap());
+        assert_eq!(da.shape(), db.shape(), "{n}");
+        let bits = |d: &hdf5::Dataset| -> Vec<u64> {
+            use hdf5::types::{FloatSize, TypeDescriptor as T};
+            match d.dtype().unwrap().to_descriptor().unwrap() {
+                T::Float(FloatSize::U8) => d.read_raw::<f64>().unwrap().iter().map(|f| f.to_bits()).collect(),
+                T::Float(FloatSize::U4) => d.read_raw::<f32>().unwrap().iter().map(|f| f.to_bits() as u64).collect(),
+                T::Unsigned(_) => d.read_raw::<u8>().unwrap().iter().map(|&f| f as u64).collect(),
+                T::Integer(_) => d.read_raw::<i64>().unwrap().iter().map(|&f| f as u64).collect(),
+                other => panic!("{n}: unexpected type {other:?}"),
+            }
+        };
+        assert!(bits(&da) == bits(&db), "{n} differs");
+    }
+    assert_eq!(
+        std::fs::read_to_string(sidecar(a)).unwrap().replace(&*a.file_name().unwrap().to_string_lossy(), "X"),
+        std::fs::read_to_string(sidecar(b)).unwrap().replace(&*b.file_name().unwrap().to_string_lossy(), "X")
+    );
+}
+
+#[test]
+fn resume_after_drop_is_bit_identical() {
+    let p = Problem::new(example(1, 24)).unwrap();
+    let full = tmp("full.h5");
+    run_written(&p, &full);
+    let part = tmp("part.h5");
+    {
+        let mut w = Writer::create(&part, &p, false).unwrap();
+        let mut k = 0;
+        let r = p.run(|r| {
+            k += 1;
+            if k > 9 {
+                return Err(tresca_cr::Error::Linear("stop".into()));
+            }
+            w.write_step(r)
+        });
+        assert!(r.is_err());
+        // dropped without finish: as after a crash between steps
+    }
+    let err = Writer::create(&part, &p, false).err().unwrap().to_string();
+    assert!(err.contains("--resume"));
+    let (mut w, last) = Writer::resume(&part, &p).unwrap();
+    assert_eq!((last.n, w.completed()), (8, 9));
+    p.run_from(last, |r| w.write_step(r)).unwrap();
+    w.finish("completed").unwrap();
+    same_results(&full, &part);
+}
+
+#[test]
+fn resume_refuses_a_different_run() {
+    let p = Problem::new(example(0, 6)).unwrap();
+    let path = tmp("other.h5");
+    run_written(&p, &path);
+    let q = Problem::new(example(0, 8)).unwrap();
+    let err = Writer::resume(&path, &q).err().unwrap().to_string();
+    assert!(err.contains("time steps"), "{err}");
+    let q = Problem::new(example(1, 6)).unwrap();
+    let err = Writer::resume(&path, &q).err().unwrap().to_string();
+    assert!(err.contains("mesh"), "{err}");
+    let mut s = example(0, 6);
+    s.text.push_str("\n# changed\n");
+    let err = Writer::resume(&path, &Problem::new(s).unwrap()).err().unwrap().to_string();
+    assert!(err.contains("scene"), "{err}");
+}
+
+/// Child side of the SIGKILL test: write a long run slowly to the file named by TRESCA_KILL_CHILD.
+#[test]
+fn kill_child_writer() {
+    let Ok(path) = std::env::var("TRESCA_KILL_CHILD") else { return };
+    let p = Problem::new(example(1, 400)).unwrap();
+    let mut w = Writer::create(Path::new(&path), &p, true).unwrap();
+    p.run(|r| {
+        std::thread::sleep(Duration::from_micros(300));
+        w.write_step(r)
+    })
+    .unwrap();
+    w.finish("completed").unwrap();
+}
+
+#[test]
+fn sigkill_at_random_moments_leaves_complete_steps_and_resume_is_bit_identical() {
+    let p = Problem::new(example(1, 400)).unwrap();
+    let full = tmp("kill_full.h5");
+    run_written(&p, &full);
+    let exe = std::env::current_exe().unwrap();
+    let mut resumed = 0;
+    for (i, ms) in [15u64, 40, 70, 110, 160, 230].iter().enumerate() {
+        let path = tmp(&format!("kill_{i}.h5"));
+        let mut child = std::process::Command::new(&exe)
+            .args(["--exact", "kill_child_writer", "--test-threads=1", "--nocapture"])
+            .env("TRESCA_KILL_CHILD", &path)
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let start = Instant::now();
+        std::thread::sleep(Duration::from_millis(*ms));
+        child.kill().unwrap(); // SIGKILL
+        child.wait().unwrap();
+        let _ = start;
+        if !path.exists() {
+            continue;
+        }
+        let Ok(f) = hdf5::File::open(&path) else { continue };
+        let done = f.group("tresca/steps").and_then(|g| g.attr("completed")).and_then(|a| a.read_scalar::<i64>());
+        let Ok(done) = done else { continue };
+        let done = done as usize;
+        let every = attr_i64(&f, "tresca", "frame_every") as usize;
+        let last = p.n_steps();
+        let frames = done.div_ceil(every) + usize::from(done > last && last % every != 0);
+        assert_eq!(attr_i64(&f, "VTKHDF/Steps", "NSteps") as usize, frames);
+        assert!(shape(&f, "tresca/u")[0] >= done);
+        // every completed step equals the uninterrupted run
+        let g = hdf5::File::open(&full).unwrap();
+        let ne = p.mesh.edges.len();
+        let (a, b) = (f64s(&f, "tresca/u"), f64s(&g, "tresca/u"));
+        assert_eq!(&a[..done * 2 * ne], &b[..done * 2 * ne], "kill {i}: completed steps differ");
+        drop(f);
+        if done == 0 {
+            continue;
+        }
+        let (mut w, last) = Writer::resume(&path, &p).unwrap();
+        assert_eq!(last.n + 1, done);
+        p.run_from(last, |r| w.write_step(r)).unwrap();
+        w.finish("completed").unwrap();
+        same_results(&full, &path);
+        resumed += 1;
+    }
+    assert!(resumed >= 3, "only {resumed} kills landed mid-run");
+}
+
+/// `cargo test --release --test output -- --ignored --nocapture timing`: the paper's finest run, with
+/// the default options, strict per-step commits, only 2 frames, and every step a frame.
+#[test]
+#[ignore]
+fn timing_example_5_1_finest() {
+    use tresca_cr::output::Options;
+    let (refine, steps) = (4u32, 640usize);
+    let t0 = Instant::now();
+    let p = Problem::new(example(refine, steps)).unwrap();
+    let setup = t0.elapsed().as_secs_f64();
+    let t4 = Instant::now();
+    p.run(|_| Ok(())).unwrap();
+    println!("refine {refine} steps {steps}: unknowns {}, set-up {setup:.3}s, solve without writer {:.3}s", p.space.n_dofs, t4.elapsed().as_secs_f64());
+    for (what, opts) in [
+        ("default (<= 51 frames, commit every 0.05 s)", Options { force: true, ..Options::default() }),
+        ("commit every step", Options { force: true, commit_interval: 0.0, ..Options::default() }),
+        ("2 frames", Options { force: true, frame_every: Some(steps), ..Options::default() }),
+        ("every step a frame", Options { force: true, frame_every: Some(1), ..Options::default() }),
+    ] {
+        let path = tmp("timing.h5");
+        let t1 = Instant::now();
+        let mut w = Writer::create_with(&path, &p, &opts).unwrap();
+        let create = t1.elapsed().as_secs_f64();
+        let t2 = Instant::now();
+        p.run(|r| w.write_step(r)).unwrap();
+        let sec = w.seconds;
+        w.finish("completed").unwrap();
+        println!(
+            "  {what}: create {create:.3}s, run+write+finish {:.3}s (write_step {:.3}s, H5Fflush {:.3}s), file {:.1} MB",
+            t2.elapsed().as_secs_f64(),
+            sec[0],
+            sec[1],
+            std::fs::metadata(&path).unwrap().len() as f64 / 1e6
+        );
+    }
+}
+
+#[test]
+#[ignore]
+fn bench_dataset_creation() {
+    let path = tmp("bench.h5");
+    let f = hdf5::File::create(&path).unwrap();
+    let g = f.create_group("x").unwrap();
+    let data = vec![0f32; 6144 * 3];
+    let t = Instant::now();
+    for k in 0..5000 {
+        let v = ndarray::ArrayView2::from_shape((6144, 3), &data).unwrap();
+        g.new_dataset_builder().with_data(&v).create(format!("{k}").as_str()).unwrap();
+        if k % 8 == 0 { f.flush().unwrap(); }
+    }
+    println!("5000 plain datasets with data: {:.3}s", t.elapsed().as_secs_f64());
+    let g = f.create_group("y").unwrap();
+    let t = Instant::now();
+    for k in 0..5000 {
+        g.new_dataset::<f32>().shape((6144, 3)).create(format!("{k}").as_str()).unwrap();
+        if k % 8 == 0 { f.flush().unwrap(); }
+    }
+    println!("5000 plain datasets without data: {:.3}s", t.elapsed().as_secs_f64());
+}
