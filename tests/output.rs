@@ -421,7 +421,11 @@ fn timing_example_5_1_finest() {
     let setup = t0.elapsed().as_secs_f64();
     let t4 = Instant::now();
     p.run(|_| Ok(())).unwrap();
-    println!("refine {refine} steps {steps}: unknowns {}, set-up {setup:.3}s, solve without writer {:.3}s", p.space.n_dofs, t4.elapsed().as_secs_f64());
+    println!(
+        "refine {refine} steps {steps}: unknowns {}, set-up {setup:.3}s, solve without writer {:.3}s",
+        p.space.n_dofs,
+        t4.elapsed().as_secs_f64()
+    );
     for (what, opts) in [
         ("default (<= 51 frames, commit every 0.05 s)", Options { force: true, ..Options::default() }),
         ("commit every step", Options { force: true, commit_interval: 0.0, ..Options::default() }),
@@ -457,14 +461,27 @@ fn bench_dataset_creation() {
     for k in 0..5000 {
         let v = ndarray::ArrayView2::from_shape((6144, 3), &data).unwrap();
         g.new_dataset_builder().with_data(&v).create(format!("{k}").as_str()).unwrap();
-        if k % 8 == 0 { f.flush().unwrap(); }
+        if k % 8 == 0 {
+            f.flush().unwrap();
+        }
     }
     println!("5000 plain datasets with data: {:.3}s", t.elapsed().as_secs_f64());
     let g = f.create_group("y").unwrap();
     let t = Instant::now();
     for k in 0..5000 {
         g.new_dataset::<f32>().shape((6144, 3)).create(format!("{k}").as_str()).unwrap();
-        if k % 8 == 0 { f.flush().unwrap(); }
+        if k % 8 == 0 {
+            f.flush().unwrap();
+        }
     }
     println!("5000 plain datasets without data: {:.3}s", t.elapsed().as_secs_f64());
+}
+
+/// Writes `$TRESCA_SAMPLE_OUT` (Example 5.1, refine 2, 160 steps) for the Python checks and pictures.
+#[test]
+#[ignore]
+fn write_sample_file() {
+    let Ok(out) = std::env::var("TRESCA_SAMPLE_OUT") else { return };
+    let p = Problem::new(example(2, 160)).unwrap();
+    run_written(&p, Path::new(&out));
 }

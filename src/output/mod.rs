@@ -217,7 +217,10 @@ impl Writer {
         let frames = Frames { every, last: problem.n_steps() };
         let frames_done = frames.before(completed);
         if vtk.frames_stored() < frames_done {
-            return Err(Error::Io { path: path.to_path_buf(), msg: "--resume: VTKHDF frames are missing; rerun with --force".into() });
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: "--resume: VTKHDF frames are missing; rerun with --force".into(),
+            });
         }
         let frame_list: Vec<(usize, f64)> =
             (0..completed).filter(|&n| frames.is_frame(n)).map(|n| (n, times[n])).collect();
@@ -245,8 +248,16 @@ impl Writer {
             frames,
             interval: Options::default().commit_interval,
             buf: StepFields::default(),
-            rows: { let mut r = Rows::default(); r.reset(completed); r },
-            frame_rows: { let mut r = FrameRows::default(); r.reset(frames_done); r },
+            rows: {
+                let mut r = Rows::default();
+                r.reset(completed);
+                r
+            },
+            frame_rows: {
+                let mut r = FrameRows::default();
+                r.reset(frames_done);
+                r
+            },
             frame_steps: Vec::new(),
             prev_slip: Some(last.slip.clone()),
             completed,
@@ -305,7 +316,9 @@ impl Writer {
         if r.u.len() != self.space.n_dofs {
             return Err(Error::Io {
                 path: path.to_path_buf(),
-                msg: format!("step {n} carries no displacement (solved with want_u = false); every written step needs u"),
+                msg: format!(
+                    "step {n} carries no displacement (solved with want_u = false); every written step needs u"
+                ),
             });
         }
         check_finite(path, n, "t", [&r.t])?;
@@ -332,7 +345,9 @@ impl Writer {
                 if let Some(k) = v.iter().position(|x| !x.is_finite()) {
                     return Err(Error::Io {
                         path: path.to_path_buf(),
-                        msg: format!("step {n}: {what}[{k}] is not finite in single precision; the step was not written"),
+                        msg: format!(
+                            "step {n}: {what}[{k}] is not finite in single precision; the step was not written"
+                        ),
                     });
                 }
             }

@@ -165,7 +165,12 @@ impl VtkHdf {
 
     /// Frames stored (the shortest series).
     pub fn frames_stored(&self) -> usize {
-        std::iter::once(&self.values).chain(std::iter::once(&self.displacement)).chain(&self.cells).map(|s| s.steps()).min().unwrap_or(0)
+        std::iter::once(&self.values)
+            .chain(std::iter::once(&self.displacement))
+            .chain(&self.cells)
+            .map(|s| s.steps())
+            .min()
+            .unwrap_or(0)
     }
 
     pub fn set_nsteps(&self, n: usize) -> hdf5::Result<()> {

@@ -1,0 +1,156 @@
+#!/usr/bin/env python3
+"""Check a tresca-cr results file through three independent readers.
+
+    .venv/bin/python scripts/check_results.py run.h5 [--xdmf run.xdmf]
+
+* VTK's ``vtkHDFReader`` (the VTKHDF view): numbers of points, cells and frames, array names, and every
+  frame's displacement / von Mises / contact arrays against values recomputed here from ``tresca/u``
+  (the CR field evaluated at triangle vertices: U(v_j) = sum_{i != j} U_{e_i} - U_{e_j}).
+* meshio's XDMF ``TimeSeriesReader`` (the sidecar): same numbers and values.
+* h5py (the ``tresca`` group): shapes of the README table, ``completed`` attribute, finiteness.
+
+Exits non-zero with one line per mismatch.
+"""
+import argparse
+import os
+import sys
+
+import h5py
+import numpy as np
+
+FAIL = []
+
+
+def check(ok, msg):
+    if not ok:
+        FAIL.append(msg)
+    return ok
+
+
+def close(a, b, what, rtol=2e-6):
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    if not check(a.shape == b.shape, f"{what}: shape {a.shape} != {b.shape}"):
+        return
+    scale = max(float(np.max(np.abs(b))) if b.size else 0.0, 1e-300)
+    err = float(np.max(np.abs(a - b))) if a.size else 0.0
+    check(err <= rtol * scale, f"{what}: max difference {err:.3e} (scale {scale:.3e})")
+
+
+def reference(g):
+    """Expected VTK arrays per step from the tresca group (f64)."""
+    tri = g["mesh/triangles"][()]
+    pts = g["mesh/points"][()]
+    edges = g["mesh/edges"][()]
+    # edge opposite local vertex i of each triangle
+    index = {tuple(sorted(e)): k for k, e in enumerate(edges)}
+    te = np.array([[index[tuple(sorted((t[(i + 1) % 3], t[(i + 2) % 3])))] for i in range(3)] for t in tri])
+    u = g["u"][()]  # (S, E, 2)
+    U = u[:, te, :]  # (S, T, 3, 2)
+    disp = U.sum(axis=2, keepdims=True) - 2.0 * U  # value at vertex j
+    # gradient of the P1 field on each triangle from vertex values
+    x = pts[tri]  # (T, 3, 2)
+    a2 = (x[:, 1, 0] - x[:, 0, 0]) * (x[:, 2, 1] - x[:, 0, 1]) - (x[:, 1, 1] - x[:, 0, 1]) * (x[:, 2, 0] - x[:, 0, 0])
+    gl = np.zeros((len(tri), 3, 2))
+    for i in range(3):
+        b, c = x[:, (i + 1) % 3], x[:, (i + 2) % 3]
+        gl[:, i, 0] = (b[:, 1] - c[:, 1]) / a2
+        gl[:, i, 1] = (c[:, 0] - b[:, 0]) / a2
+    G = np.einsum("stja,tjb->stab", disp, gl)
+    E, nu = float(g.attrs["E"]), float(g.attrs["nu"])
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    exx, eyy, exy = G[..., 0, 0], G[..., 1, 1], 0.5 * (G[..., 0, 1] + G[..., 1, 0])
+    tr = exx + eyy
+    sxx, syy, szz, sxy = lam * tr + 2 * mu * exx, lam * tr + 2 * mu * eyy, lam * tr, 2 * mu * exy
+    vm = np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2) + 3 * sxy ** 2)
+    return disp.reshape(len(u), -1, 2), vm, sxx
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[1])
+    ap.add_argument("h5")
+    ap.add_argument("--xdmf", help="sidecar (default: same stem, .xdmf)")
+    args = ap.parse_args(argv)
+    xdmf = args.xdmf or os.path.splitext(args.h5)[0] + ".xdmf"
+
+    f = h5py.File(args.h5, "r")
+    g = f["tresca"]
+    S = int(g["steps"].attrs["completed"])
+    T, E = len(g["mesh/triangles"]), len(g["mesh/edges"])
+    C = len(g["contact/edges"]) if "contact" in g else 0
+    check(g["times"].shape == (S,), f"tresca/times shape {g['times'].shape}, completed {S}")
+    check(g["u"].shape == (S, E, 2), f"tresca/u shape {g['u'].shape}")
+    for k in ("iterations", "residual", "n_stick", "n_slip", "wall_time"):
+        check(g[f"steps/{k}"].shape == (S,), f"tresca/steps/{k} shape")
+    if C:
+        for k in ("slip", "sigma_t", "state", "mu"):
+            check(g[f"contact/{k}"].shape == (S, C), f"tresca/contact/{k} shape")
+        close(g["contact/sigma_t"][()], -g["contact/mu"][()] /
+              np.linalg.norm(np.diff(g["mesh/points"][()][g["mesh/edges"][()][g["contact/edges"][()]]], axis=1)[:, 0], axis=1),
+              "sigma_t = -mu/|e|", 1e-14)
+    for name in ("u", "energy", "times"):
+        check(np.all(np.isfinite(g[name][()])), f"tresca/{name} has non-finite values")
+    every = int(g.attrs["frame_every"])
+    steps = np.arange(S)
+    frames = [n for n in steps if n % every == 0 or n == int(g.attrs["steps"])]
+    times = g["times"][()]
+    disp_ref, vm_ref, sxx_ref = reference(g)
+    P, NC = 3 * T, T + C
+    print(f"{args.h5}: {S} steps, {len(frames)} frames (every {every}), {T} triangles, {E} edges, {C} contact edges, "
+          f"status {g.attrs['status']!r}")
+
+    # --- VTK vtkHDFReader
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy as v2n
+    r = vtk.vtkHDFReader()
+    r.SetFileName(args.h5)
+    r.UpdateInformation()
+    check(r.GetNumberOfSteps() == len(frames), f"VTKHDF: {r.GetNumberOfSteps()} steps, expected {len(frames)} frames")
+    want_cells = ["cell_kind", "strain", "stress", "von_mises"] + (["sigma_t", "slip", "slip_increment", "stick_slip"] if C else [])
+    for k, n in enumerate(frames[: r.GetNumberOfSteps()]):
+        r.SetStep(k)
+        r.Update()
+        o = r.GetOutput()
+        check(o.GetNumberOfPoints() == P and o.GetNumberOfCells() == NC,
+              f"VTKHDF frame {k}: {o.GetNumberOfPoints()} points, {o.GetNumberOfCells()} cells; expected {P}, {NC}")
+        names = sorted(o.GetCellData().GetArrayName(i) for i in range(o.GetCellData().GetNumberOfArrays()))
+        check(names == sorted(want_cells), f"VTKHDF cell arrays {names}")
+        d = v2n(o.GetPointData().GetArray("displacement"))
+        close(d[:, :2], disp_ref[n], f"VTKHDF displacement frame {k} (step {n})")
+        check(np.all(d[:, 2] == 0), "VTKHDF displacement z != 0")
+        close(v2n(o.GetCellData().GetArray("von_mises"))[:T], vm_ref[n], f"VTKHDF von_mises frame {k}", 2e-5)
+        close(v2n(o.GetCellData().GetArray("stress"))[:T, 0], sxx_ref[n], f"VTKHDF stress xx frame {k}", 2e-5)
+        if C:
+            close(v2n(o.GetCellData().GetArray("sigma_t"))[T:], g["contact/sigma_t"][n], f"VTKHDF sigma_t frame {k}")
+            check(np.array_equal(v2n(o.GetCellData().GetArray("stick_slip"))[T:], g["contact/state"][n]),
+                  f"VTKHDF stick_slip frame {k}")
+        tval = r.GetOutputInformation(0).Get(vtk.vtkStreamingDemandDrivenPipeline.TIME_STEPS())
+        if k == 0 and tval is not None:
+            close(np.array(tval), times[frames], "VTKHDF time values", 1e-15)
+
+    # --- meshio XDMF time series
+    import meshio
+    with meshio.xdmf.TimeSeriesReader(xdmf) as rd:
+        points, cells = rd.read_points_cells()
+        check(len(points) == P, f"XDMF: {len(points)} points, expected {P}")
+        ncell = sum(len(c.data) for c in cells)
+        check(ncell == NC, f"XDMF: {ncell} cells, expected {NC}")
+        check(rd.num_steps == len(frames), f"XDMF: {rd.num_steps} steps, expected {len(frames)}")
+        for k in range(rd.num_steps):
+            t, pd, cd = rd.read_data(k)
+            n = frames[k]
+            check(abs(t - times[n]) <= 1e-12 * max(1.0, abs(times[n])), f"XDMF time {t} != {times[n]}")
+            close(pd["displacement"][:, :2], disp_ref[n], f"XDMF displacement frame {k}")
+            vm = np.concatenate(cd["von_mises"])
+            close(vm[:T], vm_ref[n], f"XDMF von_mises frame {k}", 2e-5)
+            check(sorted(cd) == sorted(want_cells), f"XDMF cell arrays {sorted(cd)}")
+    if FAIL:
+        print(f"FAILED ({len(FAIL)}):")
+        for m in FAIL[:50]:
+            print("  " + m)
+        return 1
+    print("OK: VTKHDF (vtkHDFReader), XDMF (meshio) and the tresca group agree")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,168 @@
+#!/usr/bin/env python3
+"""Pictures of a tresca-cr results file (reads only the ``tresca`` group, matplotlib Agg).
+
+    .venv/bin/python scripts/render.py run.h5 [--times 0.25 0.5 1.0] [-o DIR] [--field vm|u] [--scale S]
+
+For each chosen time (nearest stored step; default: quarter, half and final time) writes
+* ``DIR/deformed_<n>.png``: the deformed body (CR field as discontinuous P1 on each triangle, displacement
+  magnified by S, stated in the title; default: 10 % of the body's size over max |u|), coloured by von Mises
+  stress or |u|, with Γ_C drawn in black;
+* ``DIR/contact_<n>.png`` (when Γ_C exists): σ_τ/ḡ along Γ_C and the slip velocity Δs/Δt, with slip
+  edges shaded.
+Units are the scene's (the README's Example 5.1: mm, daN/mm², s).
+"""
+import argparse
+import os
+import sys
+
+import h5py
+import numpy as np
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
+
+
+def load(path):
+    f = h5py.File(path, "r")
+    g = f["tresca"]
+    d = {k: g[k][()] for k in ("mesh/points", "mesh/triangles", "mesh/edges", "times", "u")}
+    d["E"], d["nu"] = float(g.attrs["E"]), float(g.attrs["nu"])
+    d["title"] = str(g.attrs.get("title", "")) or os.path.basename(path)
+    if "contact" in g:
+        for k in ("edges", "tangent", "g", "slip", "sigma_t", "state"):
+            d["c_" + k] = g["contact/" + k][()]
+    return d
+
+
+def tri_edges(tri, edges):
+    index = {tuple(sorted(e)): k for k, e in enumerate(edges)}
+    return np.array([[index[tuple(sorted((t[(i + 1) % 3], t[(i + 2) % 3])))] for i in range(3)] for t in tri])
+
+
+def fields(d, n, te):
+    tri, pts = d["mesh/triangles"], d["mesh/points"]
+    U = d["u"][n][te]  # (T, 3, 2) midpoint values
+    disp = U.sum(axis=1, keepdims=True) - 2.0 * U  # vertex values of u_h|_T
+    x = pts[tri]
+    a2 = (x[:, 1, 0] - x[:, 0, 0]) * (x[:, 2, 1] - x[:, 0, 1]) - (x[:, 1, 1] - x[:, 0, 1]) * (x[:, 2, 0] - x[:, 0, 0])
+    gl = np.zeros((len(tri), 3, 2))
+    for i in range(3):
+        b, c = x[:, (i + 1) % 3], x[:, (i + 2) % 3]
+        gl[:, i] = np.stack([(b[:, 1] - c[:, 1]) / a2, (c[:, 0] - b[:, 0]) / a2], axis=1)
+    G = np.einsum("tja,tjb->tab", disp, gl)
+    E, nu = d["E"], d["nu"]
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    exx, eyy, exy = G[:, 0, 0], G[:, 1, 1], 0.5 * (G[:, 0, 1] + G[:, 1, 0])
+    tr = exx + eyy
+    sxx, syy, szz, sxy = lam * tr + 2 * mu * exx, lam * tr + 2 * mu * eyy, lam * tr, 2 * mu * exy
+    vm = np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2) + 3 * sxy ** 2)
+    return x, disp, vm
+
+
+def deformed(d, n, te, field, scale, out):
+    x, disp, vm = fields(d, n, te)
+    size = float(np.ptp(d["mesh/points"], axis=0).max())
+    umax = float(np.abs(d["u"]).max()) or 1.0
+    s = scale if scale else 0.1 * size / umax
+    y = x + s * disp
+    if field == "vm":
+        val, label = vm, "von Mises stress (plane strain) [force/length²]"
+    else:
+        val, label = np.linalg.norm(disp, axis=2).mean(axis=1), "|u| (triangle mean) [length]"
+    fig, ax = plt.subplots(figsize=(6.4, 5.6))
+    ax.add_collection(PolyCollection(x, facecolors="none", edgecolors="0.8", linewidths=0.4))
+    pc = PolyCollection(y, array=val, cmap="viridis", edgecolors="face", linewidths=0.2)
+    ax.add_collection(pc)
+    fig.colorbar(pc, ax=ax, label=label, shrink=0.85)
+    if "c_edges" in d:
+        pts = d["mesh/points"]
+        e2 = d["mesh/edges"][d["c_edges"]]
+        # deformed Γ_C from the trace of the triangle owning each edge
+        segs = []
+        tri = d["mesh/triangles"]
+        for e, (a, b) in zip(d["c_edges"], e2):
+            t = np.nonzero((te == e).any(axis=1))[0][0]
+            ja, jb = list(tri[t]).index(a), list(tri[t]).index(b)
+            segs.append([y[t, ja], y[t, jb]])
+        ax.add_collection(LineCollection(segs, colors="k", linewidths=2.0, label="Γ_C (deformed)"))
+        ax.add_collection(LineCollection(pts[e2], colors="r", linewidths=1.0, linestyles=":", label="Γ_C (reference)"))
+        ax.legend(loc="upper right", fontsize=8)
+    ax.autoscale()
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [length]")
+    ax.set_ylabel("y [length]")
+    ax.set_title(f"{d['title']}\nt = {d['times'][n]:.4g}, step {n}: deformed ×{s:.3g} (grey: reference)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+
+
+def contact(d, n, out):
+    pts, e2 = d["mesh/points"], d["mesh/edges"][d["c_edges"]]
+    mid = pts[e2].mean(axis=1)
+    tau = d["c_tangent"][0]
+    s = mid @ tau  # arclength-like coordinate along Γ_C (straight contact boundary)
+    order = np.argsort(s)
+    half = 0.5 * np.abs((pts[e2[:, 1]] - pts[e2[:, 0]]) @ tau)
+    g = d["c_g"]
+    sig = d["c_sigma_t"][n] / np.where(g > 0, g, 1.0)
+    times = d["times"]
+    if n > 0:
+        vel = (d["c_slip"][n] - d["c_slip"][n - 1]) / (times[n] - times[n - 1])
+    else:
+        vel = np.zeros_like(sig)
+    state = d["c_state"][n]
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 5.6), sharex=True)
+    for ax in (a1, a2):
+        for k in np.nonzero(state == 1)[0]:
+            ax.axvspan(s[k] - half[k], s[k] + half[k], color="tab:orange", alpha=0.25, lw=0)
+        ax.grid(alpha=0.3)
+    a1.step(s[order], sig[order], where="mid", color="tab:blue")
+    a1.plot(s[order], sig[order], ".", color="tab:blue")
+    a1.axhline(1, color="k", lw=0.8, ls="--")
+    a1.axhline(-1, color="k", lw=0.8, ls="--")
+    a1.set_ylabel("σ_τ / ḡ  [–]")
+    a1.set_ylim(-1.15, 1.15)
+    a2.step(s[order], vel[order], where="mid", color="tab:red")
+    a2.plot(s[order], vel[order], ".", color="tab:red")
+    a2.set_ylabel("slip velocity Δs/Δt [length/time]")
+    a2.set_xlabel("position along Γ_C, x·τ [length]")
+    nslip = int(state.sum())
+    a1.set_title(f"{d['title']}: Γ_C at t = {times[n]:.4g} (step {n}); shaded: slip ({nslip} of {len(state)} edges)",
+                 fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description="render a tresca-cr results file")
+    ap.add_argument("h5")
+    ap.add_argument("--times", type=float, nargs="*", help="times to draw (nearest stored step)")
+    ap.add_argument("-o", "--out", default=".", help="output directory")
+    ap.add_argument("--field", choices=["vm", "u"], default="vm", help="colour: von Mises or |u|")
+    ap.add_argument("--scale", type=float, default=0.0, help="displacement magnification (default: automatic)")
+    args = ap.parse_args(argv)
+    d = load(args.h5)
+    t = d["times"]
+    if len(t) == 0:
+        sys.exit(f"error: {args.h5} holds no complete step")
+    want = args.times if args.times else [t[0] + q * (t[-1] - t[0]) for q in (0.25, 0.5, 1.0)]
+    os.makedirs(args.out, exist_ok=True)
+    te = tri_edges(d["mesh/triangles"], d["mesh/edges"])
+    for w in want:
+        n = int(np.argmin(np.abs(t - w)))
+        p = os.path.join(args.out, f"deformed_{n:06d}.png")
+        deformed(d, n, te, args.field, args.scale, p)
+        print(p)
+        if "c_edges" in d:
+            p = os.path.join(args.out, f"contact_{n:06d}.png")
+            contact(d, n, p)
+            print(p)
+
+
+if __name__ == "__main__":
+    main()
