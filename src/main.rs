@@ -35,6 +35,9 @@ enum Cmd {
         /// Per-step solver (overrides solver.method): ssn, uzawa or pdas.
         #[arg(long)]
         solver: Option<String>,
+        /// Solver tolerance (overrides solver.tol).
+        #[arg(long)]
+        tol: Option<f64>,
         /// Print one line per step.
         #[arg(long, short)]
         verbose: bool,
@@ -54,10 +57,25 @@ enum Cmd {
         /// Per-step solver (overrides solver.method).
         #[arg(long)]
         solver: Option<String>,
+        /// Solver tolerance (overrides solver.tol).
+        #[arg(long)]
+        tol: Option<f64>,
         /// Write the table as CSV.
         #[arg(long)]
         csv: Option<PathBuf>,
     },
+}
+
+/// Apply the --solver and --tol overrides.
+fn solver_overrides(s: &mut Scene, solver: Option<String>, tol: Option<f64>) -> Result<()> {
+    if let Some(m) = solver {
+        s.solver.method = method(&m)?;
+    }
+    if let Some(t) = tol {
+        anyhow::ensure!(t.is_finite() && t > 0.0, "--tol {t}: must be a positive number");
+        s.solver.tol = t;
+    }
+    Ok(())
 }
 
 fn method(name: &str) -> Result<tresca_cr::scene::Method> {
@@ -84,7 +102,11 @@ fn study(
     let mut prev: Option<tresca_cr::study::LevelResult> = None;
     let results = run_study(&scene, levels, reference, |r| {
         let o = |f: &dyn Fn(&tresca_cr::study::LevelResult) -> Option<f64>| match (&prev, f(r)) {
-            (Some(p), Some(b)) => f(p).map(|a| format!("{:.3}", order(a, b, p.h, r.h))).unwrap_or_default(),
+            // orders against h, or against k when only the time step changes
+            (Some(p), Some(b)) => {
+                let (xa, xb) = if (p.h - r.h).abs() <= 1e-12 * r.h { (p.k, r.k) } else { (p.h, r.h) };
+                f(p).map(|a| format!("{:.3}", order(a, b, xa, xb))).unwrap_or_default()
+            }
             _ => String::new(),
         };
         let v = |x: Option<f64>| x.map(|x| format!("{x:.4e}")).unwrap_or_else(|| "-".into());
@@ -266,16 +288,14 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.cmd {
         Cmd::Check { scene, refine, steps } => load(&scene, refine, steps).and_then(check),
-        Cmd::Run { scene, refine, steps, solver, verbose, quiet } => load(&scene, refine, steps).and_then(|mut s| {
-            if let Some(m) = solver {
-                s.solver.method = method(&m)?;
-            }
-            run(s, verbose, quiet)
-        }),
-        Cmd::Study { scene, levels, reference, solver, csv } => load(&scene, None, None).and_then(|mut s| {
-            if let Some(m) = solver {
-                s.solver.method = method(&m)?;
-            }
+        Cmd::Run { scene, refine, steps, solver, tol, verbose, quiet } => {
+            load(&scene, refine, steps).and_then(|mut s| {
+                solver_overrides(&mut s, solver, tol)?;
+                run(s, verbose, quiet)
+            })
+        }
+        Cmd::Study { scene, levels, reference, solver, tol, csv } => load(&scene, None, None).and_then(|mut s| {
+            solver_overrides(&mut s, solver, tol)?;
             study(s, &levels, reference, csv)
         }),
     };

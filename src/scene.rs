@@ -470,6 +470,13 @@ impl Scene {
         Ok(())
     }
 
+    /// The number of uniform refinements of the mesh.
+    pub fn mesh_level(&self) -> u32 {
+        match &self.mesh {
+            MeshSpec::Structured { refine, .. } | MeshSpec::Gmsh { refine, .. } => *refine,
+        }
+    }
+
     /// True if the scene has a contact part.
     pub fn has_contact(&self) -> bool {
         self.parts.iter().any(|p| matches!(p.kind, PartKind::Contact(_)))
