@@ -19,6 +19,7 @@ pub mod expr;
 pub mod factor;
 pub mod mesh;
 pub mod norms;
+pub mod output;
 pub mod pdas;
 pub mod prolong;
 pub mod quadrature;

@@ -7,7 +7,7 @@ use tresca_cr::scene::PartKind;
 use tresca_cr::{Problem, Scene};
 
 #[derive(Parser)]
-#[command(name = "tresca-cr", version, about = "Quasi-static Tresca contact with stabilised Crouzeix-Raviart elements")]
+#[command(name = "tresca-cr", version = concat!(env!("CARGO_PKG_VERSION"), " (", env!("TRESCA_BUILD_COMMIT"), ")"), about = "Quasi-static Tresca contact with stabilised Crouzeix-Raviart elements")]
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,
@@ -38,6 +38,8 @@ enum Cmd {
         /// Solver tolerance (overrides solver.tol).
         #[arg(long)]
         tol: Option<f64>,
+        #[command(flatten)]
+        out: OutputArgs,
         /// Print one line per step.
         #[arg(long, short)]
         verbose: bool,
@@ -145,6 +147,26 @@ fn study(
     Ok(())
 }
 
+/// Where and how results are written.
+#[derive(clap::Args)]
+struct OutputArgs {
+    /// Results file (HDF5, with a run.xdmf sidecar); overrides the scene's [output] path.
+    #[arg(long, short = 'o')]
+    output: Option<PathBuf>,
+    /// Overwrite an existing results file.
+    #[arg(long, conflicts_with = "resume")]
+    force: bool,
+    /// Continue the run held in the results file from its last complete step.
+    #[arg(long)]
+    resume: bool,
+    /// Visualisation frame (VTKHDF/XDMF) every k steps, plus the last; default about 50 frames in all.
+    #[arg(long)]
+    frame_every: Option<usize>,
+    /// Seconds between commits (write + flush) of completed steps; 0 (default) commits every step.
+    #[arg(long, default_value_t = 0.0)]
+    commit_interval: f64,
+}
+
 fn load(path: &PathBuf, refine: Option<u32>, steps: Option<usize>) -> Result<Scene> {
     let mut scene = Scene::from_file(path)?;
     if let Some(k) = refine {
@@ -218,9 +240,33 @@ fn check(scene: Scene) -> Result<()> {
     Ok(())
 }
 
-fn run(scene: Scene, verbose: bool, quiet: bool) -> Result<()> {
+fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> {
+    use tresca_cr::output::{Options, Writer};
     let start = std::time::Instant::now();
+    let path = out.output.clone().or_else(|| scene.output.clone());
+    anyhow::ensure!(!(out.resume && path.is_none()), "--resume needs a results file: give -o FILE");
+    anyhow::ensure!(out.frame_every != Some(0), "--frame-every must be at least 1");
+    anyhow::ensure!(
+        out.commit_interval.is_finite() && out.commit_interval >= 0.0,
+        "--commit-interval must be a non-negative number of seconds"
+    );
     let problem = Problem::new(scene)?;
+    if std::env::var_os("TRESCA_GIT_COMMIT").is_none() {
+        std::env::set_var("TRESCA_GIT_COMMIT", env!("TRESCA_BUILD_COMMIT"));
+    }
+    let (mut writer, first) = match &path {
+        Some(p) if out.resume => {
+            let (mut w, last) = Writer::resume(p, &problem)?;
+            w.set_commit_interval(out.commit_interval);
+            eprintln!("resuming {} after step {} of {}", p.display(), last.n, problem.n_steps());
+            (Some(w), Some(last))
+        }
+        Some(p) => {
+            let opts = Options { force: out.force, frame_every: out.frame_every, commit_interval: out.commit_interval };
+            (Some(Writer::create_with(p, &problem, &opts)?), None)
+        }
+        None => (None, None),
+    };
     let n = problem.n_steps();
     let bar = if quiet || verbose || n < 50 {
         indicatif::ProgressBar::hidden()
@@ -230,31 +276,47 @@ fn run(scene: Scene, verbose: bool, quiet: bool) -> Result<()> {
     let mut max_err = [0.0f64; 3];
     let (mut iters, mut max_res) = (0usize, 0.0f64);
     let mut last = None;
-    problem
-        .run(|r| {
-            if let Some(e) = r.errors {
-                max_err = [max_err[0].max(e.energy), max_err[1].max(e.h1), max_err[2].max(e.l2)];
-            }
-            iters += r.iterations;
-            max_res = max_res.max(r.residual);
-            if verbose {
-                let err = r.errors.map(|e| format!("  |||e||| {:.4e}  L2 {:.4e}", e.energy, e.l2)).unwrap_or_default();
-                println!(
-                    "step {:>5} t = {:<10.6} it {:>5} res {:.2e} stick {:>4} slip {:>4}{}",
-                    r.n,
-                    r.t,
-                    r.iterations,
-                    r.residual,
-                    r.n_stick(),
-                    r.n_slip(),
-                    err
-                );
-            }
-            bar.inc(u64::from(r.n > 0));
-            last = Some(r.clone());
-            Ok(())
-        })
-        .with_context(|| "run stopped")?;
+    let on_step = |r: &tresca_cr::StepResult| -> tresca_cr::Result<()> {
+        if let Some(w) = writer.as_mut() {
+            w.write_step(r)?;
+        }
+        if let Some(e) = r.errors {
+            max_err = [max_err[0].max(e.energy), max_err[1].max(e.h1), max_err[2].max(e.l2)];
+        }
+        iters += r.iterations;
+        max_res = max_res.max(r.residual);
+        if verbose {
+            let err = r.errors.map(|e| format!("  |||e||| {:.4e}  L2 {:.4e}", e.energy, e.l2)).unwrap_or_default();
+            println!(
+                "step {:>5} t = {:<10.6} it {:>5} res {:.2e} stick {:>4} slip {:>4}{}",
+                r.n,
+                r.t,
+                r.iterations,
+                r.residual,
+                r.n_stick(),
+                r.n_slip(),
+                err
+            );
+        }
+        bar.inc(u64::from(r.n > 0));
+        last = Some(r.clone());
+        Ok(())
+    };
+    let result = match first {
+        Some(f) => problem.run_from(f, on_step),
+        None => problem.run(on_step),
+    };
+    if let Some(w) = writer {
+        let status = match &result {
+            Ok(()) => "completed".to_string(),
+            Err(e) => format!("stopped: {e}"),
+        };
+        w.finish(&status)?;
+    }
+    if let (Err(_), Some(p)) = (&result, &path) {
+        eprintln!("every completed step is in {}; its `tresca` group records why the run stopped", p.display());
+    }
+    result.with_context(|| "run stopped")?;
     bar.finish_and_clear();
     let sp = &problem.space;
     println!("unknowns {} (paper DOF {}), contact edges {}, steps {}", sp.n_dofs, sp.paper_dofs(), sp.contact.len(), n);
@@ -288,10 +350,10 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.cmd {
         Cmd::Check { scene, refine, steps } => load(&scene, refine, steps).and_then(check),
-        Cmd::Run { scene, refine, steps, solver, tol, verbose, quiet } => {
+        Cmd::Run { scene, refine, steps, solver, tol, out, verbose, quiet } => {
             load(&scene, refine, steps).and_then(|mut s| {
                 solver_overrides(&mut s, solver, tol)?;
-                run(s, verbose, quiet)
+                run(s, out, verbose, quiet)
             })
         }
         Cmd::Study { scene, levels, reference, solver, tol, csv } => load(&scene, None, None).and_then(|mut s| {

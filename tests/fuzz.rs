@@ -1,7 +1,8 @@
 //! Fuzzing (proptest): the scene parser, expression parsing/evaluation and the Gmsh reader never panic
 //! on arbitrary or mutated input — they return a value or a typed error. The number of cases is
-//! TRESCA_FUZZ_CASES (default 500 per target; `make verify` runs more). Failing inputs are kept by
-//! proptest in tests/fuzz.proptest-regressions (the regression corpus, committed).
+//! TRESCA_FUZZ_CASES (default 500 per target; `make verify` runs more). Each target prints how many
+//! inputs ran and how they ended. Inputs that once panicked are kept in `tests/fuzz_corpus/` and
+//! replayed by `corpus_replays_without_panic`.
 
 use proptest::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -50,47 +51,135 @@ fn no_panic<T>(what: &str, input: &str, f: impl FnOnce() -> T) {
     }
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig { cases: cases(), failure_persistence: None, ..ProptestConfig::default() })]
+/// Run `cases()` generated inputs through `check`, which classifies each outcome; print the counts.
+fn fuzz<S: Strategy>(name: &str, strategy: S, check: impl Fn(S::Value) -> &'static str)
+where
+    S::Value: std::fmt::Debug,
+{
+    let mut runner = proptest::test_runner::TestRunner::new(ProptestConfig {
+        cases: cases(),
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    });
+    let counts = std::cell::RefCell::new(std::collections::BTreeMap::<&'static str, usize>::new());
+    runner
+        .run(&strategy, |v| {
+            *counts.borrow_mut().entry(check(v)).or_default() += 1;
+            Ok(())
+        })
+        .unwrap();
+    let c = counts.borrow();
+    println!("fuzz {name}: {} inputs, no panic; outcomes {:?}", c.values().sum::<usize>(), *c);
+}
 
-    /// Mutated scene files are parsed, validated, set up and run without a panic.
-    #[test]
-    fn scene_parser_and_setup(edits in prop::collection::vec((0.0f64..1.0, any::<u8>(), any::<u8>()), 1..6)) {
-        let text = mutate(BASE, &edits);
+fn edits() -> impl Strategy<Value = Vec<(f64, u8, u8)>> {
+    prop::collection::vec((0.0f64..1.0, any::<u8>(), any::<u8>()), 1..6)
+}
+
+/// Mutated scene files are parsed, validated, set up and run without a panic (comment lines are
+/// stripped first so that every edit reaches the parser).
+#[test]
+fn scene_parser_and_setup() {
+    let base: String = BASE.lines().filter(|l| !l.trim_start().starts_with('#')).collect::<Vec<_>>().join("\n");
+    fuzz("scene", edits(), |e| {
+        let text = mutate(&base, &e);
+        let mut outcome = "parse error";
         no_panic("scene", &text, || {
             if let Ok(s) = Scene::from_str(&text, "fuzz.toml") {
+                outcome = "too large to run";
                 if small(&s) {
-                    if let Ok(p) = Problem::new(s) {
-                        let _ = p.run(|_| Ok(()));
-                    }
+                    outcome = match Problem::new(s) {
+                        Ok(p) => match p.run(|_| Ok(())) {
+                            Ok(()) => "ran",
+                            Err(_) => "run error",
+                        },
+                        Err(_) => "set-up error",
+                    };
                 }
             }
         });
-    }
+        outcome
+    });
+}
 
-    /// Random token strings are parsed and evaluated without a panic; values are finite or errors.
-    #[test]
-    fn expressions(tokens in prop::collection::vec(0usize..32, 0..24), x in -10.0f64..10.0, y in -10.0f64..10.0, t in 0.0f64..2.0) {
-        const TOK: [&str; 32] = ["x", "y", "t", "1", "2.5", "1e-3", "+", "-", "*", "/", "^", "(", ")", ",", "sin(", "cos(", "exp(",
-            "sqrt(", "abs(", "min(", "max(", "ln(", "PI", "E", "signum(", "tanh(", "atan2(", " ", "0", "1e308", "z", ".5"];
-        let text: String = tokens.iter().map(|&i| TOK[i]).collect();
+/// Well-formed random expressions (a small grammar) and random token soup.
+fn expression_text() -> impl Strategy<Value = String> {
+    let leaf = prop::sample::select(vec!["x", "y", "t", "0", "1", "2.5", "1e-3", "1e308", "PI", "E", ".5"])
+        .prop_map(String::from);
+    let tree = leaf.prop_recursive(5, 40, 3, |inner| {
+        prop_oneof![
+            (
+                prop::sample::select(vec!["sin", "cos", "exp", "sqrt", "abs", "ln", "tanh", "signum", "floor"]),
+                inner.clone()
+            )
+                .prop_map(|(f, a)| format!("{f}({a})")),
+            (inner.clone(), prop::sample::select(vec!["+", "-", "*", "/", "^"]), inner.clone())
+                .prop_map(|(a, o, b)| format!("({a}){o}({b})")),
+            (prop::sample::select(vec!["min", "max", "atan2"]), inner.clone(), inner.clone())
+                .prop_map(|(f, a, b)| format!("{f}({a}, {b})")),
+            inner.clone().prop_map(|a| format!("-{a}")),
+            (inner.clone(), inner).prop_map(|(a, b)| format!("{a}^{b}")),
+        ]
+    });
+    const TOK: [&str; 32] = [
+        "x", "y", "t", "1", "2.5", "1e-3", "+", "-", "*", "/", "^", "(", ")", ",", "sin(", "cos(", "exp(", "sqrt(",
+        "abs(", "min(", "max(", "ln(", "PI", "E", "signum(", "tanh(", "atan2(", " ", "0", "1e308", "z", ".5",
+    ];
+    let soup = prop::collection::vec(0usize..32, 0..24).prop_map(|t| t.iter().map(|&i| TOK[i]).collect::<String>());
+    prop_oneof![3 => tree, 1 => soup]
+}
+
+/// Random expressions are parsed and evaluated without a panic; values are finite or errors.
+#[test]
+fn expressions() {
+    let strategy = (expression_text(), -10.0f64..10.0, -10.0f64..10.0, 0.0f64..2.0);
+    fuzz("expression", strategy, |(text, x, y, t)| {
+        let mut outcome = "parse error";
         no_panic("expression", &text, || {
             if let Ok(e) = tresca_cr::expr::Expr::parse("fuzz", &text) {
-                if let Ok(v) = e.eval(x, y, t) {
-                    assert!(v.is_finite());
-                }
+                outcome = match e.eval(x, y, t) {
+                    Ok(v) => {
+                        assert!(v.is_finite());
+                        "finite value"
+                    }
+                    Err(_) => "evaluation error",
+                };
             }
         });
-    }
+        outcome
+    });
+}
 
-    /// Mutated Gmsh files are read without a panic.
-    #[test]
-    fn gmsh_reader(edits in prop::collection::vec((0.0f64..1.0, any::<u8>(), any::<u8>()), 1..8)) {
-        let text = mutate(MSH, &edits);
+/// Mutated Gmsh files are read without a panic.
+#[test]
+fn gmsh_reader() {
+    fuzz("msh", prop::collection::vec((0.0f64..1.0, any::<u8>(), any::<u8>()), 1..8), |e| {
+        let text = mutate(MSH, &e);
+        let mut outcome = "parse error";
         no_panic("msh", &text, || {
             if let Ok(raw) = tresca_cr::mesh::parse_gmsh(&text, "fuzz.msh") {
-                let _ = tresca_cr::mesh::Mesh::build(raw);
+                outcome = if tresca_cr::mesh::Mesh::build(raw).is_ok() { "valid mesh" } else { "mesh error" };
             }
         });
+        outcome
+    });
+}
+
+/// Every input that once made a reader panic is replayed and must give an error, not a panic.
+#[test]
+fn corpus_replays_without_panic() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_corpus");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let name = path.display().to_string();
+        no_panic("corpus", &name, || match path.extension().and_then(|e| e.to_str()) {
+            Some("msh") => assert!(tresca_cr::mesh::parse_gmsh(&text, &name).is_err(), "{name} parsed"),
+            Some("toml") => assert!(Scene::from_str(&text, &name).and_then(Problem::new).is_err(), "{name} accepted"),
+            _ => {}
+        });
+        n += 1;
     }
+    assert!(n >= 2, "the corpus is empty");
 }

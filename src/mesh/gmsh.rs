@@ -109,11 +109,11 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
                 }
                 for _ in 0..c[1] {
                     let v = tk.nums::<f64>(8)?;
-                    let np = v[7] as usize;
-                    if v.len() < 8 + np {
+                    let np = v[7];
+                    if !(np >= 0.0 && np.fract() == 0.0 && v.len() as f64 >= 8.0 + np) {
                         return Err(tk.err("curve entity lists fewer physical tags than it declares"));
                     }
-                    curve_phys.insert(v[0] as i64, v[8..8 + np].iter().map(|&x| x as i64).collect());
+                    curve_phys.insert(v[0] as i64, v[8..8 + np as usize].iter().map(|&x| x as i64).collect());
                 }
                 for _ in 0..c[2] + c[3] {
                     tk.line()?;
@@ -124,8 +124,9 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
                 let h = tk.nums::<usize>(4)?;
                 for _ in 0..h[0] {
                     let b = tk.nums::<i64>(4)?;
-                    let (param, count) = (b[2] != 0, b[3] as usize);
-                    let mut tags = Vec::with_capacity(count);
+                    let param = b[2] != 0;
+                    let count = usize::try_from(b[3]).map_err(|_| tk.err(format!("negative node count {}", b[3])))?;
+                    let mut tags = Vec::new();
                     for _ in 0..count {
                         tags.push(tk.nums::<i64>(1)?[0]);
                     }
@@ -150,7 +151,9 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
                 let h = tk.nums::<usize>(4)?;
                 for _ in 0..h[0] {
                     let b = tk.nums::<i64>(4)?;
-                    let (dim, entity, ty, count) = (b[0], b[1], b[2], b[3] as usize);
+                    let (dim, entity, ty) = (b[0], b[1], b[2]);
+                    let count =
+                        usize::try_from(b[3]).map_err(|_| tk.err(format!("negative element count {}", b[3])))?;
                     for _ in 0..count {
                         let e = tk.nums::<i64>(2)?;
                         match (dim, ty) {

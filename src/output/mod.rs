@@ -12,7 +12,7 @@
 //!
 //! **Crash safety.** Steps handed to [`Writer::write_step`] are committed in batches: a batch is written
 //! as soon as [`Options::commit_interval`] seconds have passed since the previous commit (default
-//! 0.05 s; 0 = every step), at the last step, and by [`Writer::finish`] / drop. A commit appends the
+//! 0: every step), at the last step, and by [`Writer::finish`] / drop. A commit appends the
 //! batch to every time-dependent (chunked, resizable) dataset, then sets `tresca/steps` attribute
 //! `completed` and `VTKHDF/Steps` attribute `NSteps`, flushes the file (H5Fflush), and only then appends
 //! the frames to `run.xdmf`. A process killed at any moment therefore leaves every committed step
@@ -64,7 +64,7 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
-        Options { force: false, frame_every: None, commit_interval: 0.05 }
+        Options { force: false, frame_every: None, commit_interval: 0.0 }
     }
 }
 
