@@ -68,6 +68,19 @@ def sympy_to_ufl(expr, x, t, key="expression"):
         return unary[expr.func](rec(expr.args[0]))
     if expr.func == sympy.atan2:
         return ufl.atan2(rec(expr.args[0]), rec(expr.args[1]))
+    if isinstance(expr, sympy.Piecewise):
+        # e.g. signum (see tresca_scene._signum); the last branch must be unconditional
+        rel = {sympy.StrictLessThan: ufl.lt, sympy.LessThan: ufl.le, sympy.StrictGreaterThan: ufl.gt,
+               sympy.GreaterThan: ufl.ge}
+        out = None
+        for val, cond in reversed(expr.args):
+            if cond is sympy.true:
+                out = rec(val)
+            elif type(cond) in rel and out is not None:
+                out = ufl.conditional(rel[type(cond)](rec(cond.args[0]), rec(cond.args[1])), rec(val), out)
+            else:
+                raise ts.SceneError(f"{key}: piecewise condition {cond} has no UFL equivalent")
+        return out
     if expr.func in (sympy.Min, sympy.Max):
         op = ufl.min_value if expr.func == sympy.Min else ufl.max_value
         out = rec(expr.args[0])

@@ -33,7 +33,8 @@ gives s = s_free - C mu and the box-constrained dual QP
 
 solved exactly (to rounding) by a primal active-set method (finite, warm-started from the previous
 step). Then r = K_r^{-1} P^T l - Z mu.  Tangential traction sigma_t,e = -mu_e / |e|; an edge slips
-(state 1) when |mu_e| = w_e (rel. 1e-9) and |s_e - s_e^{n-1}| > 1e-12 * max(|u^n|_inf, |u^{n-1}|_inf).
+(state 1) when |mu_e| >= w_e (1 - 1e-9) and |ds_e| > 1e-9 * max(|ds|_inf, |d|_inf), ds = d - C mu (the
+convention of the Rust solver, see ``classify``).
 The initial value u^0 = I_CR u0 is the edge mean of u0 by 3-point Gauss (tau component on Gamma_C).
 """
 from __future__ import annotations
@@ -85,11 +86,17 @@ def _sp():
     return _sympy
 
 
+def _signum(a):
+    """exmex's signum is Rust's f64::signum: +1 at 0 (sympy.sign(0) = 0 would disagree there)."""
+    sympy = _sp()
+    return sympy.Piecewise((-1, a < 0), (1, True))
+
+
 def parse_expression(text, key="expression"):
     """Translate an exmex expression string in x, y, t into a sympy expression.
 
     ``^`` is power; constants PI/pi, E/e; functions sin cos tan exp ln log(=ln) sqrt abs signum tanh
-    sinh cosh atan2 min max floor.  Anything else is rejected with an error naming ``key``.
+    sinh cosh atan2 min max floor.  signum(0) = 1 as in exmex (Rust's f64::signum).  Anything else is rejected with an error naming ``key``.
     """
     sympy = _sp()
     from sympy.parsing.sympy_parser import parse_expr, standard_transformations
@@ -100,7 +107,7 @@ def parse_expression(text, key="expression"):
         "x": x, "y": y, "t": t, "PI": sympy.pi, "pi": sympy.pi, "E": sympy.E, "e": sympy.E,
         "sin": sympy.sin, "cos": sympy.cos, "tan": sympy.tan, "exp": sympy.exp,
         "ln": sympy.log, "log": sympy.log, "sqrt": sympy.sqrt, "abs": sympy.Abs,
-        "signum": sympy.sign, "tanh": sympy.tanh, "sinh": sympy.sinh, "cosh": sympy.cosh,
+        "signum": _signum, "tanh": sympy.tanh, "sinh": sympy.sinh, "cosh": sympy.cosh,
         "atan2": sympy.atan2, "min": sympy.Min, "max": sympy.Max, "floor": sympy.floor,
     }
     src = text.replace("^", "**")
@@ -759,14 +766,26 @@ class StepSolver:
         disc = self.disc
         r_free = self._solve(self.P.T @ l_full)
         if len(self.ic) == 0:
-            return self.P @ r_free, dict(iterations=1, residual=0.0, mu=np.zeros(0))
+            return self.P @ r_free, dict(iterations=1, residual=0.0, mu=np.zeros(0), d=np.zeros(0), ds=np.zeros(0))
         s_old = np.sum(u_prev_full.reshape(-1, 2)[disc.contact] * disc.tangent, axis=1)
         d = r_free[self.ic] - s_old
         mu, its = box_qp(self.C, d, self.w, self.mu)
         self.mu = mu.copy()
         r = r_free - self.Z @ mu
         u = self.P @ r
-        return u, dict(iterations=its, residual=kkt_residual(self.C, d, self.w, mu), mu=mu)
+        return u, dict(iterations=its, residual=kkt_residual(self.C, d, self.w, mu), mu=mu, d=d,
+                       ds=d - self.C @ mu)
+
+
+def classify(mu, ds, d, w):
+    """Stick (0) / slip (1) per contact edge, the convention of the Rust solver (contact::classify):
+    slip when |mu_e| >= w_e (1 - 1e-9) and |ds_e| > 1e-9 max(|ds|_inf, |d|_inf), where ds = d - C mu is
+    the slip increment of the step and d = s_free - s^{n-1} the increment without friction
+    (w_e = 0: slip when |ds_e| exceeds the threshold)."""
+    if len(mu) == 0:
+        return np.zeros(0, dtype=bool)
+    scale = max(float(np.max(np.abs(ds))), float(np.max(np.abs(d))))
+    return (np.abs(mu) >= w * (1 - 1e-9)) & (np.abs(ds) > 1e-9 * scale)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -810,10 +829,7 @@ def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True):
                 u_prev = u
                 u, info = stepper.step(l, u_prev)
                 mu = info["mu"]
-                s = np.sum(u.reshape(-1, 2)[disc.contact] * disc.tangent, axis=1)
-                s_old = np.sum(u_prev.reshape(-1, 2)[disc.contact] * disc.tangent, axis=1)
-                scale = max(np.max(np.abs(u)), np.max(np.abs(u_prev)))
-                slip = (np.abs(mu) >= disc.weight * (1 - 1e-9)) & (np.abs(s - s_old) > 1e-12 * scale)
+                slip = classify(mu, info["ds"], info["d"], disc.weight)
                 res["sigma_t"][n] = -mu / disc.lengths[disc.contact]
                 res["state"][n] = slip
                 res["iterations"][n] = info["iterations"]
