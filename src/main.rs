@@ -268,6 +268,7 @@ fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> 
         None => (None, None),
     };
     let n = problem.n_steps();
+    let all = writer.is_some() || problem.scene.exact.is_some() || verbose;
     let bar = if quiet || verbose || n < 50 {
         indicatif::ProgressBar::hidden()
     } else {
@@ -302,9 +303,16 @@ fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> 
         last = Some(r.clone());
         Ok(())
     };
+    // Without a results file and without true errors, u is formed only at the last step: every step still
+    // solves the friction problem (slip, μ, stick/slip), but reconstructing u costs O(n·n_c) per step.
+    let want = |k: usize| all || k == n;
     let result = match first {
-        Some(f) => problem.run_from(f, on_step),
-        None => problem.run(on_step),
+        Some(f) => problem.run_selected(f, want, on_step),
+        None => problem.initial().and_then(|f| {
+            let mut on_step = on_step;
+            on_step(&f)?;
+            problem.run_selected(f, want, on_step)
+        }),
     };
     if let Some(w) = writer {
         let status = match &result {
