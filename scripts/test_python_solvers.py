@@ -1,6 +1,6 @@
 """Checks of the independent Python solvers (scikit-fem and dolfinx) of tresca-cr.
 
-Usage:  python scripts/test_python_solvers.py [--quick] [--no-mpi] [--write-scenes DIR]
+Usage:  python scripts/test_python_solvers.py [--quick] [--no-mpi] [--no-cases] [--write-scenes DIR]
 
 Plain script (no pytest needed); prints one line per check and exits non-zero if any fails.
 
@@ -283,6 +283,8 @@ def main():
     ap.add_argument("--quick", action="store_true", help="skip the convergence study")
     ap.add_argument("--no-mpi", action="store_true", help="skip the mpirun -n 2 checks")
     ap.add_argument("--write-scenes", metavar="DIR", help="also write the generated scenes to DIR")
+    ap.add_argument("--no-cases", action="store_true",
+                    help="skip skfem == dolfinx on verification/cases (verification/cross_check.py covers them)")
     args = ap.parse_args()
     t_start = time.perf_counter()
     check_expressions()
@@ -332,7 +334,7 @@ def main():
 
     # the repository's verification scenes (manufactured Tresca solutions), when present
     cases = os.path.join(os.path.dirname(HERE), "verification", "cases")
-    if os.path.isdir(cases):
+    if os.path.isdir(cases) and not args.no_cases:
         for fn in sorted(os.listdir(cases)):
             if not fn.endswith(".toml"):
                 continue
