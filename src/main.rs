@@ -178,6 +178,15 @@ fn load(path: &PathBuf, refine: Option<u32>, steps: Option<usize>) -> Result<Sce
     Ok(scene)
 }
 
+/// An expression for display: long generated expressions are shortened.
+fn short(text: &str) -> String {
+    if text.chars().count() <= 48 {
+        text.to_string()
+    } else {
+        format!("{}… ({} characters)", text.chars().take(40).collect::<String>(), text.chars().count())
+    }
+}
+
 fn check(scene: Scene) -> Result<()> {
     let problem = Problem::new(scene)?;
     let (s, m, sp) = (&problem.scene, &problem.mesh, &problem.space);
@@ -202,9 +211,9 @@ fn check(scene: Scene) -> Result<()> {
             PartKind::Dirichlet => "dirichlet (u = 0)".to_string(),
             PartKind::Neumann(None) => "neumann, traction free (nothing assembled)".to_string(),
             PartKind::Neumann(Some(g)) => {
-                format!("neumann, g = ({}, {})", g.0[0].text(), g.0[1].text())
+                format!("neumann, g = ({}, {})", short(g.0[0].text()), short(g.0[1].text()))
             }
-            PartKind::Contact(g) => format!("contact u.n = 0, Tresca g_a = {}", g.text()),
+            PartKind::Contact(g) => format!("contact u.n = 0, Tresca g_a = {}", short(g.text())),
         };
         println!("part       {:<10} {:>6} edges  {}", part.name, n, what);
     }

@@ -57,6 +57,8 @@ pub struct LevelResult {
     pub max_err: Option<[f64; 3]>,
     /// True errors at the final time.
     pub final_err: Option<[f64; 3]>,
+    /// max over the common nodes of the solution's discrete energy norm a_h(u, u)^{1/2}.
+    pub norm_max: f64,
     /// Consecutive-level error: max over common nodes, and at the final time.
     pub consecutive: Option<[f64; 2]>,
     /// Error against the reference run: max over common nodes, and at the final time.
@@ -130,7 +132,7 @@ fn run_level(scene: &Scene, level: Level, common: &[f64], out: &mut LevelResult)
     let start = Instant::now();
     let problem = Problem::new(s)?;
     let mut u = Vec::new();
-    let (mut max_err, mut final_err, mut iterations) = (None::<[f64; 3]>, None, 0);
+    let (mut max_err, mut final_err, mut iterations, mut norm_max) = (None::<[f64; 3]>, None, 0, 0.0f64);
     let nodes: Vec<usize> = (0..problem.scene.times.len())
         .filter(|&n| common.iter().any(|&t| (t - problem.scene.times[n]).abs() <= 1e-12 * t.abs().max(1.0)))
         .collect();
@@ -146,6 +148,7 @@ fn run_level(scene: &Scene, level: Level, common: &[f64], out: &mut LevelResult)
             final_err = Some(v);
         }
         if nodes.contains(&r.n) {
+            norm_max = norm_max.max(r.energy.max(0.0).sqrt());
             u.push(r.u.clone());
         }
         Ok(())
@@ -170,6 +173,7 @@ fn run_level(scene: &Scene, level: Level, common: &[f64], out: &mut LevelResult)
         iterations,
         max_err,
         final_err,
+        norm_max,
         consecutive: None,
         reference: None,
     };
@@ -212,7 +216,7 @@ pub fn run_study(
 }
 
 /// CSV header matching [`csv_row`].
-pub const CSV_HEADER: &str = "refine,steps,h,k,dofs,paper_dofs,wall_s,iterations,energy_max,h1_max,l2_max,energy_T,h1_T,l2_T,consecutive_max,consecutive_T,reference_max,reference_T";
+pub const CSV_HEADER: &str = "refine,steps,h,k,dofs,paper_dofs,wall_s,iterations,energy_max,h1_max,l2_max,energy_T,h1_T,l2_T,consecutive_max,consecutive_T,reference_max,reference_T,norm_max";
 
 /// One CSV row (empty fields for quantities not computed).
 pub fn csv_row(r: &LevelResult) -> String {
@@ -220,7 +224,7 @@ pub fn csv_row(r: &LevelResult) -> String {
     let m = |a: Option<[f64; 3]>, i: usize| f(a.map(|v| v[i]));
     let c = |a: Option<[f64; 2]>, i: usize| f(a.map(|v| v[i]));
     format!(
-        "{},{},{:.10e},{:.10e},{},{},{:.6},{},{},{},{},{},{},{},{},{},{},{}",
+        "{},{},{:.10e},{:.10e},{},{},{:.6},{},{},{},{},{},{},{},{},{},{},{},{:.10e}",
         r.refine,
         r.steps,
         r.h,
@@ -238,6 +242,7 @@ pub fn csv_row(r: &LevelResult) -> String {
         c(r.consecutive, 0),
         c(r.consecutive, 1),
         c(r.reference, 0),
-        c(r.reference, 1)
+        c(r.reference, 1),
+        r.norm_max
     )
 }
