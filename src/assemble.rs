@@ -14,17 +14,17 @@ use crate::expr::Vec2Expr;
 use crate::mesh::Mesh;
 use crate::quadrature::{edge_point, tri_point, GAUSS2, GAUSS3, TRI4};
 use crate::scene::{Material, PartKind, Scene};
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
 /// Add the coupling block between the midpoint values of edges a and b to the triplets:
 /// K[k, l] += Σ_cd v_k[c] block[c][d] w_l[d] over the terms of both edges.
-fn scatter(space: &CrSpace, a: usize, b: usize, block: [[f64; 2]; 2], trip: &mut Vec<Triplet<usize, usize, f64>>) {
+fn scatter(space: &CrSpace, a: usize, b: usize, block: [[f64; 2]; 2], trip: &mut Vec<(usize, usize, f64)>) {
     for (k, v) in space.edge_dof[a].terms() {
         for (l, w) in space.edge_dof[b].terms() {
             let val =
                 v[0] * (block[0][0] * w[0] + block[0][1] * w[1]) + v[1] * (block[1][0] * w[0] + block[1][1] * w[1]);
             if val != 0.0 {
-                trip.push(Triplet::new(k, l, val));
+                trip.push((k, l, val));
             }
         }
     }
@@ -95,8 +95,42 @@ pub fn stiffness(mesh: &Mesh, space: &CrSpace, mat: &Material, rho: f64) -> Resu
             }
         }
     }
-    SparseColMat::try_new_from_triplets(space.n_dofs, space.n_dofs, &trip)
-        .map_err(|e| crate::error::Error::Linear(format!("cannot build the stiffness matrix: {e:?}")))
+    Ok(csc_from_triplets(space.n_dofs, &trip))
+}
+
+/// Square CSC matrix from (row, col, value) triplets, duplicates summed: a counting sort by column,
+/// then a sort of each (short) column by row. O(nnz · log(column length)).
+pub fn csc_from_triplets(n: usize, trip: &[(usize, usize, f64)]) -> SparseColMat<usize, f64> {
+    let mut start = vec![0usize; n + 1];
+    for &(_, c, _) in trip {
+        start[c + 1] += 1;
+    }
+    for j in 0..n {
+        start[j + 1] += start[j];
+    }
+    let mut slot = start.clone();
+    let mut entries = vec![(0usize, 0.0f64); trip.len()];
+    for &(r, c, v) in trip {
+        entries[slot[c]] = (r, v);
+        slot[c] += 1;
+    }
+    let (mut col_ptr, mut row_idx, mut val) =
+        (Vec::with_capacity(n + 1), Vec::with_capacity(trip.len() / 2), Vec::with_capacity(trip.len() / 2));
+    col_ptr.push(0);
+    for j in 0..n {
+        let col = &mut entries[start[j]..start[j + 1]];
+        col.sort_unstable_by_key(|e| e.0);
+        for &(r, v) in col.iter() {
+            if row_idx.len() > col_ptr[j] && *row_idx.last().expect("nonempty column") == r {
+                *val.last_mut().expect("nonempty column") += v;
+            } else {
+                row_idx.push(r);
+                val.push(v);
+            }
+        }
+        col_ptr.push(row_idx.len());
+    }
+    SparseColMat::new(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx), val)
 }
 
 /// y = K x for a CSC matrix.

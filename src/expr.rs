@@ -153,7 +153,8 @@ fn lint(text: &str) -> std::result::Result<String, String> {
             while let Some(d) = chars.next_if(|d| d.is_alphanumeric() || *d == '_') {
                 name.push(d);
             }
-            out.push_str(&name);
+            // `pi` is accepted for exmex's `PI`
+            out.push_str(if name == "pi" { "PI" } else { &name });
             toks.push(if matches!(name.as_str(), "min" | "max" | "atan2") { Tok::Binary } else { Tok::Ident });
         } else {
             out.push(c);
@@ -321,5 +322,6 @@ mod tests {
         assert!(!Expr::parse("f", "0*x").unwrap().is_zero());
         let pi = Expr::parse("f", "PI").unwrap().constant().unwrap();
         assert!((pi - std::f64::consts::PI).abs() < 1e-15);
+        assert_eq!(Expr::parse("f", "2*pi").unwrap().constant(), Some(2.0 * std::f64::consts::PI));
     }
 }

@@ -18,6 +18,9 @@ use crate::{pdas, ssn, uzawa};
 use faer::sparse::SparseColMat;
 use std::time::Instant;
 
+/// Largest accepted condition-number estimate of K: beyond it fewer than 4 of the 16 digits survive.
+pub const MAX_CONDITION: f64 = 1e12;
+
 /// Everything assembled once per run.
 pub struct Problem {
     pub scene: Scene,
@@ -32,6 +35,8 @@ pub struct Problem {
     pub errors: Option<ErrorEvaluator>,
     /// Wall times of the set-up phases (seconds): mesh+space, assembly, factorisation, condensation.
     pub setup_times: [f64; 4],
+    /// Estimated condition number of K.
+    pub condition: f64,
 }
 
 /// What one time step produced.
@@ -80,6 +85,17 @@ impl Problem {
         let loads = Loads::new(&scene, &mesh, &space);
         let t2 = Instant::now();
         let llt = Factor::new(&k, std::env::var_os("TRESCA_SIMPLICIAL").is_some())?;
+        // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
+        // ranges) factorises without complaint but returns meaningless displacements: refuse it.
+        let kappa = llt.condition_estimate(&k, 12);
+        if !(kappa < MAX_CONDITION) {
+            return Err(Error::Linear(format!(
+                "the stiffness matrix is too ill-conditioned (condition number ≳ {kappa:.1e} > {MAX_CONDITION:.0e}; \
+                 rho = {}, E = {}, nu = {}): results would keep fewer than 4 correct digits. \
+                 Use rho of order 1 or more (without the jump term CR fails Korn's inequality)",
+                scene.rho, scene.material.e, scene.material.nu
+            )));
+        }
         let t3 = Instant::now();
         let condensed = if space.contact.is_empty() { None } else { Some(Condensed::new(&space, &llt)) };
         let basis = LoadBasis::build(&loads, &space, &scene.times, &llt)?;
@@ -88,6 +104,7 @@ impl Problem {
         let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
         Ok(Problem {
             setup_times: [d(t0, t1), d(t1, t2), d(t2, t3), d(t3, t4)],
+            condition: kappa,
             scene,
             mesh,
             space,
