@@ -6,7 +6,9 @@ SHELL := /bin/bash
 VENV  := .venv
 PY    := $(VENV)/bin/python
 BIN   := target/release/tresca-cr
-PY312 := $(shell command -v python3.12 2>/dev/null || (command -v pyenv >/dev/null && ls $$(pyenv root)/versions/3.12*/bin/python3.12 2>/dev/null | head -1))
+# Python 3.12: pyenv's build first (its shim only works when 3.12 is selected), then a system one.
+PY312 := $(shell for p in $$(pyenv root 2>/dev/null)/versions/3.12*/bin/python3.12 /usr/local/bin/python3.12 /usr/bin/python3.12; do \
+           [ -x "$$p" ] && "$$p" -c 'import sys' 2>/dev/null && echo "$$p" && break; done)
 
 .PHONY: all deps build venv test verify bench clean-out
 
