@@ -2,6 +2,7 @@
 //! SIGKILL safety (a child process killed at random moments) and bit-identical `resume`.
 
 mod common;
+use common::same_results;
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -258,45 +259,6 @@ fn non_finite_values_are_refused_and_earlier_steps_survive() {
     assert_eq!(attr_i64(&f, "tresca/steps", "completed"), 1);
     assert_eq!(shape(&f, "tresca/u")[0], 1);
     assert!(f64s(&f, "tresca/u").iter().all(|v| v.is_finite()));
-}
-
-/// Compare two results files dataset by dataset (bitwise), except wall times and the status.
-fn same_results(a: &Path, b: &Path) {
-    let (fa, fb) = (hdf5::File::open(a).unwrap(), hdf5::File::open(b).unwrap());
-    let mut names = Vec::new();
-    fn walk(g: &hdf5::Group, prefix: &str, out: &mut Vec<String>) {
-        for m in g.member_names().unwrap() {
-            let full = format!("{prefix}/{m}");
-            if let Ok(sub) = g.group(&m) {
-                walk(&sub, &full, out);
-            } else {
-                out.push(full);
-            }
-        }
-    }
-    walk(&fa.group("/").unwrap(), "", &mut names);
-    let mut nb = Vec::new();
-    walk(&fb.group("/").unwrap(), "", &mut nb);
-    assert_eq!(names, nb, "dataset lists differ");
-    for n in names.iter().filter(|n| !n.ends_with("wall_time")) {
-        let (da, db) = (fa.dataset(n).unwrap(), fb.dataset(n).unwrap());
-        assert_eq!(da.shape(), db.shape(), "{n}");
-        let bits = |d: &hdf5::Dataset| -> Vec<u64> {
-            use hdf5::types::{FloatSize, TypeDescriptor as T};
-            match d.dtype().unwrap().to_descriptor().unwrap() {
-                T::Float(FloatSize::U8) => d.read_raw::<f64>().unwrap().iter().map(|f| f.to_bits()).collect(),
-                T::Float(FloatSize::U4) => d.read_raw::<f32>().unwrap().iter().map(|f| f.to_bits() as u64).collect(),
-                T::Unsigned(_) => d.read_raw::<u8>().unwrap().iter().map(|&f| f as u64).collect(),
-                T::Integer(_) => d.read_raw::<i64>().unwrap().iter().map(|&f| f as u64).collect(),
-                other => panic!("{n}: unexpected type {other:?}"),
-            }
-        };
-        assert!(bits(&da) == bits(&db), "{n} differs");
-    }
-    assert_eq!(
-        std::fs::read_to_string(sidecar(a)).unwrap().replace(&*a.file_name().unwrap().to_string_lossy(), "X"),
-        std::fs::read_to_string(sidecar(b)).unwrap().replace(&*b.file_name().unwrap().to_string_lossy(), "X")
-    );
 }
 
 #[test]
