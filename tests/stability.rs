@@ -95,7 +95,8 @@ fn tiny_time_steps_are_harmless() {
 fn crouzeix_raviart_does_not_lock() {
     let base = text(NEAR);
     let err = |nu: f64| {
-        let t = with_line(&with_line(&base, "E ", &format!("E  = {:?}", 2.0 * (1.0 + nu))), "nu ", &format!("nu = {nu:?}"));
+        let t =
+            with_line(&with_line(&base, "E ", &format!("E  = {:?}", 2.0 * (1.0 + nu))), "nu ", &format!("nu = {nu:?}"));
         let (_, r) = run(scene_from(&t, 2, None));
         max_errors(&r).0
     };

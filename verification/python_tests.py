@@ -5,7 +5,9 @@
 1. scripts/test_python_solvers.py --quick --no-cases: expression/mesh/box-QP unit checks, patch tests,
    skfem == dolfinx on generated and example scenes, the variational inequality from the stored results,
    dolfinx serial == mpirun -n 2, bad-input messages, skfem == Rust on the example scenes;
-2. verification/cross_check.py --quick: Rust == scikit-fem == dolfinx (1e-8, identical stick/slip sets) on
+2. results file read by real clients: VTK's vtkHDFReader, meshio (XDMF) and h5py, values checked against
+   the solver's (scripts/check_results.py on a fresh Example 5.1 run);
+3. verification/cross_check.py --quick: Rust == scikit-fem == dolfinx (1e-8, identical stick/slip sets) on
    every scene of verification/cases at one mesh level, plus one mpirun -n 2 case
    (report out/cross_check_quick.md, requirements out/cross_check_quick.json).
 
@@ -29,7 +31,13 @@ def main():
     mpi = ["--no-mpi"] if args.no_mpi else []
     if not os.path.exists(os.path.join(ROOT, "target", "release", "tresca-cr")):
         sys.exit("error: target/release/tresca-cr missing (cargo build --release)")
+    os.makedirs(os.path.join(ROOT, "out"), exist_ok=True)
+    h5 = os.path.join("out", "test_clients.h5")
     steps = [
+        ("results file for the client check", [os.path.join(ROOT, "target", "release", "tresca-cr"), "run",
+                                               "verification/cases/paper_example_5_1.toml", "--refine", "2", "--steps", "160",
+                                               "-q", "-o", h5, "--force"]),
+        ("VTK / meshio / h5py read the results file", [PY, "scripts/check_results.py", h5]),
         ("Python solver checks", [PY, "scripts/test_python_solvers.py", "--quick", "--no-cases"] + mpi),
         ("cross-check Rust / scikit-fem / dolfinx", [PY, "verification/cross_check.py", "--quick",
                                                       "--json", "out/cross_check_quick.json"] + mpi),
