@@ -165,6 +165,10 @@ struct LoadTerm {
 pub struct Loads {
     terms: Vec<LoadTerm>,
     n_dofs: usize,
+    /// The unknowns any load can touch, increasing (all of them with a body force, only boundary ones
+    /// with tractions alone); `slot[k]` is the position of unknown k in it.
+    support: Vec<usize>,
+    slot: Vec<usize>,
 }
 
 impl Loads {
@@ -206,7 +210,20 @@ impl Loads {
             }
             terms.push(LoadTerm { expr: g.clone(), points });
         }
-        Loads { terms, n_dofs: space.n_dofs }
+        let mut touched = vec![false; space.n_dofs];
+        for p in terms.iter().flat_map(|t| &t.points) {
+            for &(e, _) in &p.edges {
+                for (k, _) in space.edge_dof[e].terms() {
+                    touched[k] = true;
+                }
+            }
+        }
+        let support: Vec<usize> = (0..space.n_dofs).filter(|&k| touched[k]).collect();
+        let mut slot = vec![usize::MAX; space.n_dofs];
+        for (i, &k) in support.iter().enumerate() {
+            slot[k] = i;
+        }
+        Loads { terms, n_dofs: space.n_dofs, support, slot }
     }
 
     /// True if some load depends on t.
@@ -214,20 +231,44 @@ impl Loads {
         self.terms.iter().any(|t| t.expr.depends_on_t())
     }
 
-    /// l(t) into `out` (length = number of unknowns).
-    pub fn assemble(&self, space: &CrSpace, t: f64, out: &mut Vec<f64>) -> Result<()> {
+    /// The unknowns a load can be nonzero on (increasing).
+    pub fn support(&self) -> &[usize] {
+        &self.support
+    }
+
+    /// l(t) restricted to [`Loads::support`], into `out`.
+    pub fn assemble_on_support(&self, space: &CrSpace, t: f64, out: &mut Vec<f64>) -> Result<()> {
         out.clear();
-        out.resize(self.n_dofs, 0.0);
+        out.resize(self.support.len(), 0.0);
         for term in &self.terms {
-            for p in &term.points {
-                let v = term.expr.eval(p.x[0], p.x[1], t)?;
+            // the expression values in parallel (order kept), the sums sequentially: bit-identical results
+            let values = crate::parallel::map(&term.points, |p| term.expr.eval(p.x[0], p.x[1], t));
+            for (p, v) in term.points.iter().zip(values) {
+                let v = v?;
                 for &(e, wphi) in &p.edges {
                     for (k, c) in space.edge_dof[e].terms() {
-                        out[k] += wphi * (c[0] * v[0] + c[1] * v[1]);
+                        out[self.slot[k]] += wphi * (c[0] * v[0] + c[1] * v[1]);
                     }
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Scatter values on the support into a full vector of unknowns.
+    pub fn expand(&self, on_support: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.resize(self.n_dofs, 0.0);
+        for (&k, &v) in self.support.iter().zip(on_support) {
+            out[k] = v;
+        }
+    }
+
+    /// l(t) into `out` (length = number of unknowns).
+    pub fn assemble(&self, space: &CrSpace, t: f64, out: &mut Vec<f64>) -> Result<()> {
+        let mut s = Vec::new();
+        self.assemble_on_support(space, t, &mut s)?;
+        self.expand(&s, out);
         Ok(())
     }
 }

@@ -20,6 +20,7 @@ pub mod factor;
 pub mod mesh;
 pub mod norms;
 pub mod output;
+pub mod parallel;
 pub mod pdas;
 pub mod prolong;
 pub mod quadrature;

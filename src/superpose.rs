@@ -6,6 +6,8 @@
 //! ≤ [`SPAN_TOL`] ‖l(tₙ)‖), the run stores w_j = K⁻¹b_j and coefficients cₙⱼ, and each step gets
 //! u_f = K⁻¹l(tₙ) = Σ_j cₙⱼ w_j without a triangular solve. Otherwise nothing is kept and every step
 //! assembles and solves. The basis depends only on the scene, so a resumed run computes the same numbers.
+//! The orthogonalisation works on the loads' support only (the boundary unknowns when there is no body
+//! force), so its cost is O(N · support) rather than O(N · unknowns).
 
 use crate::assemble::Loads;
 use crate::cr::CrSpace;
@@ -19,7 +21,9 @@ pub const SPAN_TOL: f64 = 1e-13;
 
 /// Orthonormal load patterns, their responses and the coefficients of every time node.
 pub struct LoadBasis {
+    /// Orthonormal patterns on the loads' support (see `Loads::support`), support indices.
     b: Vec<Vec<f64>>,
+    support: Vec<usize>,
     w: Vec<Vec<f64>>,
     coef: Vec<Vec<f64>>,
 }
@@ -35,7 +39,7 @@ impl LoadBasis {
         let mut coef = Vec::with_capacity(times.len());
         let mut l = Vec::new();
         for &t in times {
-            loads.assemble(space, t, &mut l)?;
+            loads.assemble_on_support(space, t, &mut l)?;
             let norm = dot(&l, &l).sqrt();
             let mut r = l.clone();
             let mut c = vec![0.0; b.len()];
@@ -60,12 +64,13 @@ impl LoadBasis {
         let w = b
             .iter()
             .map(|bj| {
-                let mut x = bj.clone();
+                let mut x = Vec::new();
+                loads.expand(bj, &mut x);
                 factor.solve_in_place(&mut x);
                 x
             })
             .collect();
-        Ok(Some(LoadBasis { b, w, coef }))
+        Ok(Some(LoadBasis { b, support: loads.support().to_vec(), w, coef }))
     }
 
     /// Number of load patterns.
@@ -83,7 +88,13 @@ impl LoadBasis {
 
     /// l(tₙ) = Σ_j cₙⱼ b_j.
     pub fn load(&self, n: usize, dofs: usize, out: &mut Vec<f64>) {
-        Self::combine(&self.b, &self.coef[n], dofs, out);
+        let mut on_support = Vec::new();
+        Self::combine(&self.b, &self.coef[n], self.support.len(), &mut on_support);
+        out.clear();
+        out.resize(dofs, 0.0);
+        for (&k, v) in self.support.iter().zip(on_support) {
+            out[k] = v;
+        }
     }
 
     /// Entries `idx` of K⁻¹ l(tₙ): O(rank · idx.len()).

@@ -13,8 +13,9 @@
 //! **Crash safety.** Steps handed to [`Writer::write_step`] are committed in batches: a batch is written
 //! as soon as [`Options::commit_interval`] seconds have passed since the previous commit (default
 //! 0: every step), at the last step, and by [`Writer::finish`] / drop. A commit appends the
-//! batch to every time-dependent (chunked, resizable) dataset, then sets `tresca/steps` attribute
-//! `completed` and `VTKHDF/Steps` attribute `NSteps`, flushes the file (H5Fflush), and only then appends
+//! batch to every time-dependent (chunked, resizable) dataset, flushes the file (H5Fflush), then sets
+//! `tresca/steps` attribute `completed` and `VTKHDF/Steps` attribute `NSteps`, flushes again (HDF5 may
+//! write metadata before raw data, so the counters must not share a flush with the data), and only then appends
 //! the frames to `run.xdmf`. A process killed at any moment therefore leaves every committed step
 //! readable and loses at most `commit_interval` seconds of work (a partial batch shows up only as longer
 //! series, ignored via `completed`/`NSteps`; HDF5 has no journal, so a kill *inside* H5Fflush is the one
@@ -129,10 +130,10 @@ impl Writer {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(ioerr(path, "cannot create the directory"))?;
         }
-        if path.exists() {
-            std::fs::remove_file(path).map_err(ioerr(path, "cannot remove the old file"))?;
-        }
-        let file = hdf5::File::create(path).map_err(io(path, "cannot create HDF5 file"))?;
+        // Build the file under a temporary name and rename it once its structure is flushed: a kill
+        // during creation leaves no half-made file under `path` (the open handle follows the rename).
+        let partial = PathBuf::from(format!("{}.partial", path.display()));
+        let file = hdf5::File::create(&partial).map_err(io(path, "cannot create HDF5 file"))?;
         let fields = Fields::new(problem);
         let contact = !problem.space.contact.is_empty();
         let commit = std::env::var("TRESCA_GIT_COMMIT").unwrap_or_else(|_| "unknown".into());
@@ -146,6 +147,10 @@ impl Writer {
         let mut xdmf = Xdmf::create(&file, path, &fields, contact).map_err(ioerr(path, "writing the XDMF sidecar"))?;
         xdmf.total_frames = frames.total();
         file.flush().map_err(io(path, "flush"))?;
+        if path.exists() {
+            std::fs::remove_file(path).map_err(ioerr(path, "cannot remove the old file"))?;
+        }
+        std::fs::rename(&partial, path).map_err(ioerr(path, "cannot move the new file into place"))?;
         Ok(Writer {
             path: path.to_path_buf(),
             file,
@@ -203,10 +208,12 @@ impl Writer {
         let vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
         let completed = tresca.completed().map_err(io(path, "tresca/steps completed"))?.min(tresca.min_steps());
         if completed == 0 {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: "--resume: the file holds no complete step; rerun with --force".into(),
-            });
+            // killed before step 0 was committed: nothing to keep, start the same run afresh
+            drop((vtk, tresca, file));
+            let mut w = Writer::create_with(path, problem, &Options { force: true, ..Options::default() })?;
+            let first = problem.initial()?;
+            w.write_step(&first)?;
+            return Ok((w, first));
         }
         let times: Vec<f64> =
             tresca.group.dataset("times").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "tresca/times"))?;
@@ -373,11 +380,18 @@ impl Writer {
             for f in self.frames_done..nf {
                 self.xdmf.add_frame_datasets(f)?;
             }
+            Ok(())
+        };
+        write().map_err(io(&path, &format!("writing steps {}..{}", self.completed, steps - 1)))?;
+        // The data must reach the file before the counters that declare it complete: HDF5 may write
+        // metadata (the counters) to disk before raw data, so flush in between.
+        let f0 = Instant::now();
+        self.file.flush().map_err(io(&path, "flush"))?;
+        let mark = || -> hdf5::Result<()> {
             self.vtk.set_nsteps(nf)?;
             self.tresca.set_completed(steps)
         };
-        write().map_err(io(&path, &format!("writing steps {}..{}", self.completed, steps - 1)))?;
-        let f0 = Instant::now();
+        mark().map_err(io(&path, "marking the steps complete"))?;
         self.file.flush().map_err(io(&path, "flush"))?;
         self.seconds[1] += f0.elapsed().as_secs_f64();
         for (k, &n) in self.frame_steps.iter().enumerate() {
