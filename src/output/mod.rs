@@ -32,6 +32,7 @@
 
 pub mod fields;
 mod h5;
+mod resume;
 pub mod tresca;
 pub mod vtkhdf;
 pub mod xdmf;
@@ -172,108 +173,6 @@ impl Writer {
             finished: false,
             seconds: [0.0; 2],
         })
-    }
-
-    /// Reopen a results file of `problem` (same scene text, time grid, solver and mesh, else an error),
-    /// drop a partial step and return the last complete step, from which `problem.run_from` continues.
-    pub fn resume(path: &Path, problem: &Problem) -> Result<(Writer, StepResult)> {
-        let file = hdf5::File::open_rw(path).map_err(io(path, "cannot open for --resume"))?;
-        let tresca = Tresca::open(&file).map_err(io(path, "not a tresca-cr results file"))?;
-        let mismatch = |what: &str| Error::Io {
-            path: path.to_path_buf(),
-            msg: format!("--resume: the file was written for a different {what}; rerun with --force to overwrite it"),
-        };
-        let g = &*tresca.group;
-        let text = h5::read_str(g, "scene").map_err(io(path, "attribute scene"))?;
-        if text != problem.scene.text {
-            return Err(mismatch("scene (the stored scene text differs)"));
-        }
-        let int = |k: &str| g.attr(k).and_then(|a| a.read_scalar::<i64>()).unwrap_or(-1);
-        if int("steps") != problem.n_steps() as i64 {
-            return Err(mismatch("number of time steps (--steps)"));
-        }
-        if int("n_edges") != problem.mesh.edges.len() as i64 || int("n_dofs") != problem.space.n_dofs as i64 {
-            return Err(mismatch("mesh (--refine)"));
-        }
-        let solver = h5::read_str(g, "solver").unwrap_or_default();
-        if solver != problem.scene.solver.method.name() {
-            return Err(mismatch(&format!("solver ({solver})")));
-        }
-        let pts =
-            tresca.group.dataset("mesh/points").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "mesh/points"))?;
-        if pts != problem.mesh.points.as_flattened() {
-            return Err(mismatch("mesh (vertex coordinates)"));
-        }
-        let contact = !problem.space.contact.is_empty();
-        let vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
-        let completed = tresca.completed().map_err(io(path, "tresca/steps completed"))?.min(tresca.min_steps());
-        if completed == 0 {
-            // killed before step 0 was committed: nothing to keep, start the same run afresh
-            drop((vtk, tresca, file));
-            let mut w = Writer::create_with(path, problem, &Options { force: true, ..Options::default() })?;
-            let first = problem.initial()?;
-            w.write_step(&first)?;
-            return Ok((w, first));
-        }
-        let times: Vec<f64> =
-            tresca.group.dataset("times").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "tresca/times"))?;
-        if times[..completed] != problem.scene.times[..completed] {
-            return Err(mismatch("time grid"));
-        }
-        let every = int("frame_every").max(1) as usize;
-        let frames = Frames { every, last: problem.n_steps() };
-        let frames_done = frames.before(completed);
-        if vtk.frames_stored() < frames_done {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: "--resume: VTKHDF frames are missing; rerun with --force".into(),
-            });
-        }
-        let frame_list: Vec<(usize, f64)> =
-            (0..completed).filter(|&n| frames.is_frame(n)).map(|n| (n, times[n])).collect();
-        let fix = || -> hdf5::Result<StepResult> {
-            tresca.truncate(completed)?;
-            vtk.truncate(frames_done)?;
-            tresca.set_completed(completed)?;
-            vtk.set_nsteps(frames_done)?;
-            tresca.set_status("running (resumed)")?;
-            tresca.read_step(problem, completed - 1)
-        };
-        let last = fix().map_err(io(path, "--resume"))?;
-        let mut xdmf =
-            Xdmf::resume(&file, path, &frame_list, contact).map_err(ioerr(path, "rewriting the XDMF sidecar"))?;
-        xdmf.total_frames = frames.total();
-        file.flush().map_err(io(path, "flush"))?;
-        let w = Writer {
-            path: path.to_path_buf(),
-            file,
-            space: problem.space.clone(),
-            fields: Fields::new(problem),
-            tresca,
-            vtk,
-            xdmf,
-            frames,
-            interval: Options::default().commit_interval,
-            buf: StepFields::default(),
-            rows: {
-                let mut r = Rows::default();
-                r.reset(completed);
-                r
-            },
-            frame_rows: {
-                let mut r = FrameRows::default();
-                r.reset(frames_done);
-                r
-            },
-            frame_steps: Vec::new(),
-            prev_slip: Some(last.slip.clone()),
-            completed,
-            frames_done,
-            last_commit: Instant::now(),
-            finished: false,
-            seconds: [0.0; 2],
-        };
-        Ok((w, last))
     }
 
     /// Number of steps committed to the file.
