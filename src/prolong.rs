@@ -87,9 +87,14 @@ pub fn parent_triangles(coarse: &Mesh, fine: &Mesh) -> Result<Vec<usize>> {
 
 /// P u_c on the fine space, from the coarse unknowns `u_c`.
 pub fn prolong(coarse: (&Mesh, &CrSpace), u_c: &[f64], fine: (&Mesh, &CrSpace)) -> Result<Vec<f64>> {
+    let parent = parent_triangles(coarse.0, fine.0)?;
+    Ok(prolong_with(&parent, coarse, u_c, fine))
+}
+
+/// [`prolong`] with the coarse parent of every fine triangle ([`parent_triangles`]) computed once.
+pub fn prolong_with(parent: &[usize], coarse: (&Mesh, &CrSpace), u_c: &[f64], fine: (&Mesh, &CrSpace)) -> Vec<f64> {
     let (cm, cs) = coarse;
     let (fm, fs) = fine;
-    let loc = Locator::new(cm);
     let mid = cs.midpoint_values(u_c);
     let mut u = vec![0.0; fs.n_dofs];
     for (e, dof) in fs.edge_dof.iter().enumerate() {
@@ -101,15 +106,8 @@ pub fn prolong(coarse: (&Mesh, &CrSpace), u_c: &[f64], fine: (&Mesh, &CrSpace)) 
         let mut sum = [0.0; 2];
         let mut count = 0.0;
         for t in [Some(t1), t2].into_iter().flatten() {
-            let [a, b, c] = fm.tris[t].map(|v| fm.points[v]);
-            let centroid = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
-            let (ct, _) = loc.find(centroid).ok_or_else(|| {
-                Error::mesh(
-                    &fm.source,
-                    format!("fine triangle at ({:.6}, {:.6}) lies outside the coarse mesh", centroid[0], centroid[1]),
-                )
-            })?;
-            let phi = Element::phi(loc.elements[ct].bary(m));
+            let ct = parent[t];
+            let phi = Element::phi(Element::new(cm, ct).bary(m));
             for (i, p) in phi.iter().enumerate() {
                 let v = mid[cm.tri_edges[ct][i]];
                 sum = [sum[0] + p * v[0], sum[1] + p * v[1]];
@@ -121,7 +119,7 @@ pub fn prolong(coarse: (&Mesh, &CrSpace), u_c: &[f64], fine: (&Mesh, &CrSpace)) 
             u[k] = c[0] * v[0] + c[1] * v[1];
         }
     }
-    Ok(u)
+    u
 }
 
 #[cfg(test)]

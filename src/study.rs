@@ -16,7 +16,7 @@ use crate::assemble::matvec;
 use crate::cr::Element;
 use crate::error::{Error, Result};
 use crate::norms::{gradient, strain_energy_density, ErrorEvaluator};
-use crate::prolong::{parent_triangles, prolong};
+use crate::prolong::{parent_triangles, prolong_with};
 use crate::scene::Scene;
 use crate::stepping::Problem;
 use std::time::Instant;
@@ -81,8 +81,10 @@ fn energy_norm(p: &Problem, e: &[f64]) -> f64 {
 fn difference(fine: &Kept, coarse: &Kept) -> Result<[f64; 2]> {
     let mut worst: f64 = 0.0;
     let mut last = 0.0;
+    let (c, f) = (&coarse.problem, &fine.problem);
+    let parent = parent_triangles(&c.mesh, &f.mesh)?;
     for (uf, uc) in fine.u.iter().zip(&coarse.u) {
-        let pu = prolong((&coarse.problem.mesh, &coarse.problem.space), uc, (&fine.problem.mesh, &fine.problem.space))?;
+        let pu = prolong_with(&parent, (&c.mesh, &c.space), uc, (&f.mesh, &f.space));
         let d: Vec<f64> = uf.iter().zip(&pu).map(|(a, b)| a - b).collect();
         last = energy_norm(&fine.problem, &d);
         worst = worst.max(last);
