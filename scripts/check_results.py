@@ -9,6 +9,10 @@
 * meshio's XDMF ``TimeSeriesReader`` (the sidecar): same numbers and values.
 * h5py (the ``tresca`` group): shapes of the README table, ``completed`` attribute, finiteness.
 
+Also for the file of a killed run (status ``running``): its series have room for every step of the run
+and only the first ``completed`` rows are data; every reader must still open it and see exactly the
+committed steps and frames.
+
 Exits non-zero with one line per mismatch.
 """
 import argparse
@@ -36,7 +40,7 @@ def close(a, b, what, rtol=2e-6):
     check(err <= rtol * scale, f"{what}: max difference {err:.3e} (scale {scale:.3e})")
 
 
-def reference(g):
+def reference(g, S):
     """Expected VTK arrays per step from the tresca group (f64)."""
     tri = g["mesh/triangles"][()]
     pts = g["mesh/points"][()]
@@ -44,7 +48,7 @@ def reference(g):
     # edge opposite local vertex i of each triangle
     index = {tuple(sorted(e)): k for k, e in enumerate(edges)}
     te = np.array([[index[tuple(sorted((t[(i + 1) % 3], t[(i + 2) % 3])))] for i in range(3)] for t in tri])
-    u = g["u"][()]  # (S, E, 2)
+    u = g["u"][:S]  # (S, E, 2)
     U = u[:, te, :]  # (S, T, 3, 2)
     disp = U.sum(axis=2, keepdims=True) - 2.0 * U  # value at vertex j
     # gradient of the P1 field on each triangle from vertex values
@@ -77,23 +81,27 @@ def main(argv=None):
     S = int(g["steps"].attrs["completed"])
     T, E = len(g["mesh/triangles"]), len(g["mesh/edges"])
     C = len(g["contact/edges"]) if "contact" in g else 0
-    check(g["times"].shape == (S,), f"tresca/times shape {g['times'].shape}, completed {S}")
-    check(g["u"].shape == (S, E, 2), f"tresca/u shape {g['u'].shape}")
+    # a finished or stopped run holds exactly its completed steps; a killed one ("running") has room for all
+    killed = g.attrs["status"] == "running"
+    R = int(g.attrs["steps"]) + 1 if killed else S
+    check(S <= R, f"completed {S} > steps + 1")
+    check(g["times"].shape == (R,), f"tresca/times shape {g['times'].shape}, completed {S}, rows {R}")
+    check(g["u"].shape == (R, E, 2), f"tresca/u shape {g['u'].shape}")
     for k in ("iterations", "residual", "n_stick", "n_slip", "wall_time"):
-        check(g[f"steps/{k}"].shape == (S,), f"tresca/steps/{k} shape")
+        check(g[f"steps/{k}"].shape == (R,), f"tresca/steps/{k} shape")
     if C:
         for k in ("slip", "sigma_t", "state", "mu"):
-            check(g[f"contact/{k}"].shape == (S, C), f"tresca/contact/{k} shape")
-        close(g["contact/sigma_t"][()], -g["contact/mu"][()] /
+            check(g[f"contact/{k}"].shape == (R, C), f"tresca/contact/{k} shape")
+        close(g["contact/sigma_t"][:S], -g["contact/mu"][:S] /
               np.linalg.norm(np.diff(g["mesh/points"][()][g["mesh/edges"][()][g["contact/edges"][()]]], axis=1)[:, 0], axis=1),
               "sigma_t = -mu/|e|", 1e-14)
     for name in ("u", "energy", "times"):
-        check(np.all(np.isfinite(g[name][()])), f"tresca/{name} has non-finite values")
+        check(np.all(np.isfinite(g[name][:S])), f"tresca/{name} has non-finite values")
     every = int(g.attrs["frame_every"])
     steps = np.arange(S)
     frames = [n for n in steps if n % every == 0 or n == int(g.attrs["steps"])]
-    times = g["times"][()]
-    disp_ref, vm_ref, sxx_ref = reference(g)
+    times = g["times"][:S]
+    disp_ref, vm_ref, sxx_ref = reference(g, S)
     P, NC = 3 * T, T + C
     print(f"{args.h5}: {S} steps, {len(frames)} frames (every {every}), {T} triangles, {E} edges, {C} contact edges, "
           f"status {g.attrs['status']!r}")

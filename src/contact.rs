@@ -16,6 +16,7 @@ use crate::error::Error;
 use crate::factor::Factor;
 use faer::Mat;
 use nalgebra::DMatrix;
+use std::cell::RefCell;
 
 /// Condensed operator of the contact unknowns.
 pub struct Condensed {
@@ -29,6 +30,10 @@ pub struct Condensed {
     pub c: DMatrix<f64>,
     /// Z = K⁻¹ E (column-major, n × n_c) when it fits in memory; otherwise u is recovered by a second solve.
     pub z: Option<Vec<f64>>,
+    /// The last μ given to [`Condensed::apply_friction`] and its K⁻¹Eμ: once Γ_C slips (or sticks)
+    /// everywhere μ stays the same from step to step, and K⁻¹Eμ is reused instead of recomputed
+    /// (keyed on bit-equal μ, so the result does not depend on the cache).
+    friction_cache: RefCell<(Vec<f64>, Vec<f64>)>,
 }
 
 /// Largest Z kept in memory (entries); beyond it a second triangular solve per step is cheaper in memory.
@@ -65,7 +70,7 @@ impl Condensed {
         let c = 0.5 * (&c + c.transpose());
         let w = space.contact.iter().map(|e| e.length * e.g_mean).collect();
         let g = space.contact.iter().map(|e| e.g_mean).collect();
-        Condensed { dofs, w, g, c, z }
+        Condensed { dofs, w, g, c, z, friction_cache: RefCell::new((vec![], vec![])) }
     }
 
     /// Eᵀ K⁻¹ l = Zᵀ l (requires Z).
@@ -75,27 +80,37 @@ impl Condensed {
         (0..self.dofs.len()).map(|j| z[j * n..(j + 1) * n].iter().zip(l).map(|(a, b)| a * b).sum()).collect()
     }
 
-    /// u ← u_f − K⁻¹ E μ.
+    /// u ← u_f − K⁻¹ E μ, with K⁻¹Eμ = Σ_e μ_e z_e from Z, or one pair of triangular solves without it.
     pub fn apply_friction(&self, llt: &Factor, u: &mut [f64], mu: &[f64]) {
         let n = u.len();
-        match &self.z {
-            Some(z) => {
-                for (j, &m) in mu.iter().enumerate() {
-                    if m != 0.0 {
-                        let col = &z[j * n..(j + 1) * n];
-                        u.iter_mut().zip(col).for_each(|(ui, zi)| *ui -= m * zi);
+        let mut cache = self.friction_cache.borrow_mut();
+        let (last_mu, zmu) = &mut *cache;
+        let same = last_mu.len() == mu.len()
+            && zmu.len() == n
+            && last_mu.iter().zip(mu).all(|(a, b)| a.to_bits() == b.to_bits());
+        if !same {
+            zmu.clear();
+            zmu.resize(n, 0.0);
+            match &self.z {
+                Some(z) => {
+                    for (j, &m) in mu.iter().enumerate() {
+                        if m != 0.0 {
+                            let col = &z[j * n..(j + 1) * n];
+                            zmu.iter_mut().zip(col).for_each(|(a, zi)| *a += m * zi);
+                        }
                     }
                 }
-            }
-            None => {
-                let mut b = vec![0.0; n];
-                for (j, &m) in mu.iter().enumerate() {
-                    b[self.dofs[j]] = m;
+                None => {
+                    for (j, &m) in mu.iter().enumerate() {
+                        zmu[self.dofs[j]] = m;
+                    }
+                    llt.solve_in_place(zmu);
                 }
-                llt.solve_in_place(&mut b);
-                u.iter_mut().zip(&b).for_each(|(ui, bi)| *ui -= bi);
             }
+            last_mu.clear();
+            last_mu.extend_from_slice(mu);
         }
+        u.iter_mut().zip(zmu.iter()).for_each(|(ui, a)| *ui -= a);
     }
 }
 

@@ -326,27 +326,31 @@ fn sigkill_at_random_moments_leaves_complete_steps_and_resume_is_bit_identical()
     let full = tmp("kill_full.h5");
     run_written(&p, &full);
     let exe = std::env::current_exe().unwrap();
-    let mut resumed = 0;
-    for (i, ms) in [15u64, 40, 70, 110, 160, 230].iter().enumerate() {
-        let path = tmp(&format!("kill_{i}.h5"));
-        let mut child = std::process::Command::new(&exe)
+    let child = |path: &Path| {
+        std::process::Command::new(&exe)
             .args(["--exact", "kill_child_writer", "--test-threads=1", "--nocapture"])
-            .env("TRESCA_KILL_CHILD", &path)
+            .env("TRESCA_KILL_CHILD", path)
             .stdout(std::process::Stdio::null())
             .spawn()
-            .unwrap();
-        let start = Instant::now();
-        std::thread::sleep(Duration::from_millis(*ms));
+            .unwrap()
+    };
+    // kill at fractions of the time an uninterrupted child takes, so the kills land mid-run however
+    // fast the machine and the writer are
+    let start = Instant::now();
+    assert!(child(&tmp("kill_timing.h5")).wait().unwrap().success());
+    let whole = start.elapsed();
+    let mut resumed = 0;
+    for (i, frac) in [0.2, 0.35, 0.5, 0.65, 0.8, 0.95].into_iter().enumerate() {
+        let path = tmp(&format!("kill_{i}.h5"));
+        let mut child = child(&path);
+        std::thread::sleep(whole.mul_f64(frac));
         child.kill().unwrap(); // SIGKILL
         child.wait().unwrap();
-        let _ = start;
         if !path.exists() {
-            continue;
+            continue; // killed before the file was moved into place
         }
-        let Ok(f) = hdf5::File::open(&path) else { continue };
-        let done = f.group("tresca/steps").and_then(|g| g.attr("completed")).and_then(|a| a.read_scalar::<i64>());
-        let Ok(done) = done else { continue };
-        let done = done as usize;
+        let f = hdf5::File::open(&path).unwrap_or_else(|e| panic!("kill {i}: the file must open: {e}"));
+        let done = attr_i64(&f, "tresca/steps", "completed") as usize;
         let every = attr_i64(&f, "tresca", "frame_every") as usize;
         let last = p.n_steps();
         let frames = done.div_ceil(every) + usize::from(done > last && last % every != 0);

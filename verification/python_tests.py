@@ -7,6 +7,7 @@
    dolfinx serial == mpirun -n 2, bad-input messages, skfem == Rust on the example scenes;
 2. results file read by real clients: VTK's vtkHDFReader, meshio (XDMF) and h5py, values checked against
    the solver's (scripts/check_results.py on a fresh Example 5.1 run);
+   and verification/interrupted_runs.py: the same for the files of a killed, a stopped and a resumed run;
 3. verification/cross_check.py --quick: Rust == scikit-fem == dolfinx (1e-8, identical stick/slip sets) on
    every scene of verification/cases at one mesh level, plus one mpirun -n 2 case
    (report out/cross_check_quick.md, requirements out/cross_check_quick.json).
@@ -38,6 +39,7 @@ def main():
                                                "verification/cases/paper_example_5_1.toml", "--refine", "2", "--steps", "160",
                                                "-q", "-o", h5, "--force"]),
         ("VTK / meshio / h5py read the results file", [PY, "scripts/check_results.py", h5]),
+        ("files of killed, stopped and resumed runs", [PY, "verification/interrupted_runs.py"]),
         ("Python solver checks", [PY, "scripts/test_python_solvers.py", "--quick", "--no-cases"] + mpi),
         ("cross-check Rust / scikit-fem / dolfinx", [PY, "verification/cross_check.py", "--quick",
                                                       "--json", "out/cross_check_quick.json"] + mpi),

@@ -13,14 +13,15 @@
 //! **Crash safety.** Steps handed to [`Writer::write_step`] are committed in batches: a batch is written
 //! as soon as [`Options::commit_interval`] seconds have passed since the previous commit (default
 //! 0: every step), at the last step, and by [`Writer::finish`] / drop. A commit appends the
-//! batch to every time-dependent (chunked, resizable) dataset, flushes the file (H5Fflush), then sets
-//! `tresca/steps` attribute `completed` and `VTKHDF/Steps` attribute `NSteps`, flushes again (HDF5 may
-//! write metadata before raw data, so the counters must not share a flush with the data), and only then appends
-//! the frames to `run.xdmf`. A process killed at any moment therefore leaves every committed step
-//! readable and loses at most `commit_interval` seconds of work (a partial batch shows up only as longer
-//! series, ignored via `completed`/`NSteps`; HDF5 has no journal, so a kill *inside* H5Fflush is the one
-//! window this does not cover). [`Writer::resume`]
-//! truncates a partial step and returns the last complete one; continuing from it is bit-identical to
+//! batch to every time-dependent dataset (allocated for the whole run at creation, contiguous, written
+//! straight to the kernel: [`h5::Series`]), then sets `tresca/steps` attribute `completed` and
+//! `VTKHDF/Steps` attribute `NSteps`, flushes the file (H5Fflush: only these counters are dirty
+//! metadata), and only then appends the frames to `run.xdmf`. A process killed at any moment therefore
+//! leaves every committed step readable and loses at most `commit_interval` seconds of work (rows beyond
+//! `completed`/`NSteps` hold no data; HDF5 has no journal, so a kill *inside* H5Fflush is the one
+//! window this does not cover). A run that stops (solver failure) is finished with every series cut to
+//! its completed steps. [`Writer::resume`]
+//! returns the last complete step of a file; continuing from it is bit-identical to
 //! an uninterrupted run because a step depends on the previous one only through its slip and μ, both
 //! stored exactly. Non-finite values are refused before anything of the step is written.
 //!
@@ -41,7 +42,7 @@ use crate::cr::CrSpace;
 use crate::error::{Error, Result};
 use crate::stepping::{Problem, StepResult};
 use fields::{Fields, StepFields};
-use h5::io;
+use h5::{io, Raw};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use tresca::{Rows, Tresca};
@@ -74,6 +75,8 @@ impl Default for Options {
 pub struct Writer {
     path: PathBuf,
     file: hdf5::File,
+    /// Plain handle for the direct writes of the series ([`h5::Series`]).
+    raw: Raw,
     space: CrSpace,
     fields: Fields,
     tresca: Tresca,
@@ -134,7 +137,10 @@ impl Writer {
         // Build the file under a temporary name and rename it once its structure is flushed: a kill
         // during creation leaves no half-made file under `path` (the open handle follows the rename).
         let partial = PathBuf::from(format!("{}.partial", path.display()));
-        let file = hdf5::File::create(&partial).map_err(io(path, "cannot create HDF5 file"))?;
+        let file = hdf5::File::with_options()
+            .with_fapl(h5::file_access)
+            .create(&partial)
+            .map_err(io(path, "cannot create HDF5 file"))?;
         let fields = Fields::new(problem);
         let contact = !problem.space.contact.is_empty();
         let commit = std::env::var("TRESCA_GIT_COMMIT").unwrap_or_else(|_| "unknown".into());
@@ -145,9 +151,10 @@ impl Writer {
         h5::attr(&tresca.group, "frame_every", every as i64).map_err(io(path, "attribute frame_every"))?;
         let vtk =
             VtkHdf::create(&file, &fields, frames.total(), contact).map_err(io(path, "writing the VTKHDF group"))?;
-        let mut xdmf = Xdmf::create(&file, path, &fields, contact).map_err(ioerr(path, "writing the XDMF sidecar"))?;
-        xdmf.total_frames = frames.total();
+        let xdmf = Xdmf::create(&file, path, &fields, contact, frames.total())
+            .map_err(ioerr(path, "writing the XDMF sidecar"))?;
         file.flush().map_err(io(path, "flush"))?;
+        let raw = Raw::open(&partial).map_err(ioerr(path, "cannot open the new file for writing"))?;
         if path.exists() {
             std::fs::remove_file(path).map_err(ioerr(path, "cannot remove the old file"))?;
         }
@@ -155,6 +162,7 @@ impl Writer {
         Ok(Writer {
             path: path.to_path_buf(),
             file,
+            raw,
             space: problem.space.clone(),
             fields,
             tresca,
@@ -274,18 +282,14 @@ impl Writer {
         let path = self.path.clone();
         let (steps, nf) = (self.completed + self.rows.count, self.frames_done + self.frame_rows.count());
         let write = || -> hdf5::Result<()> {
-            self.tresca.write_rows(&self.rows)?;
-            self.vtk.write_frames(&self.frame_rows)?;
-            for f in self.frames_done..nf {
-                self.xdmf.add_frame_datasets(f)?;
-            }
-            Ok(())
+            self.tresca.write_rows(&self.raw, &self.rows)?;
+            self.vtk.write_frames(&self.raw, &self.frame_rows)
         };
         write().map_err(io(&path, &format!("writing steps {}..{}", self.completed, steps - 1)))?;
-        // The data must reach the file before the counters that declare it complete: HDF5 may write
-        // metadata (the counters) to disk before raw data, so flush in between.
+        // The series data is in the kernel now (direct writes, see `h5::Series`), so the counters that
+        // declare it complete may follow in one flush. `VTKHDF/Steps/Values` grows in that same flush: it
+        // must never be longer than `NSteps` (see `vtkhdf::VtkHdf`).
         let f0 = Instant::now();
-        self.file.flush().map_err(io(&path, "flush"))?;
         let mark = || -> hdf5::Result<()> {
             self.vtk.set_nsteps(nf)?;
             self.tresca.set_completed(steps)
@@ -309,11 +313,25 @@ impl Writer {
     }
 
     /// Commit what is buffered, record why the run stopped ("completed", or the error of the failed
-    /// step) and close the file.
+    /// step) and close the file. A run that stopped early has its series cut to the completed steps.
     pub fn finish(mut self, status: &str) -> Result<()> {
+        self.close(status)
+    }
+
+    fn close(&mut self, status: &str) -> Result<()> {
         self.commit()?;
         self.finished = true;
         let path = self.path.clone();
+        if self.completed < self.frames.last + 1 {
+            // a stopped run: series of exactly the completed steps, so no reader meets unwritten rows
+            let (steps, frames) = (self.completed, self.frames_done);
+            let mut shrink = || -> hdf5::Result<()> {
+                self.tresca.set_steps(&self.raw, steps, steps)?;
+                self.vtk.set_frames(&self.raw, frames, frames)?;
+                self.xdmf.drop_frames_from(frames)
+            };
+            shrink().map_err(io(&path, "shrinking the series of a stopped run"))?;
+        }
         self.tresca.set_status(status).map_err(io(&path, "attribute status"))?;
         self.file.flush().map_err(io(&path, "flush"))?;
         Ok(())
@@ -321,10 +339,11 @@ impl Writer {
 }
 
 impl Drop for Writer {
-    /// A writer dropped without [`Writer::finish`] (an error, a panic) still commits what it holds.
+    /// A writer dropped without [`Writer::finish`] (an error, a panic) still commits what it holds and
+    /// closes the file as a stopped run.
     fn drop(&mut self) {
         if !self.finished {
-            let _ = self.commit();
+            let _ = self.close("stopped: the writer was dropped before the run finished");
         }
     }
 }

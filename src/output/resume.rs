@@ -1,4 +1,4 @@
-//! `--resume`: reopen a results file of the same run, drop a partial step, and hand back the last
+//! `--resume`: reopen a results file of the same run and hand back the last
 //! complete step so that stepping continues bit-identically (a step depends on the previous one only
 //! through its slip and μ, both stored exactly).
 
@@ -6,10 +6,14 @@ use super::*;
 
 impl Writer {
     /// Reopen a results file of `problem` (same scene text, time grid, solver and mesh, else an error),
-    /// drop a partial step and return the last complete step, from which `problem.run_from` continues.
+    /// and return the last complete step, from which `problem.run_from` continues.
     pub fn resume(path: &Path, problem: &Problem) -> Result<(Writer, StepResult)> {
-        let file = hdf5::File::open_rw(path).map_err(io(path, "cannot open for --resume"))?;
-        let tresca = Tresca::open(&file).map_err(io(path, "not a tresca-cr results file"))?;
+        let file = hdf5::File::with_options()
+            .with_fapl(h5::file_access)
+            .open_rw(path)
+            .map_err(io(path, "cannot open for --resume"))?;
+        let raw = Raw::open(path).map_err(ioerr(path, "cannot open for --resume"))?;
+        let mut tresca = Tresca::open(&file).map_err(io(path, "not a tresca-cr results file"))?;
         let mismatch = |what: &str| Error::Io {
             path: path.to_path_buf(),
             msg: format!("--resume: the file was written for a different {what}; rerun with --force to overwrite it"),
@@ -36,8 +40,8 @@ impl Writer {
             return Err(mismatch("mesh (vertex coordinates)"));
         }
         let contact = !problem.space.contact.is_empty();
-        let vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
-        let completed = tresca.completed().map_err(io(path, "tresca/steps completed"))?.min(tresca.min_steps());
+        let mut vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
+        let completed = tresca.completed().map_err(io(path, "tresca/steps completed"))?;
         if completed == 0 {
             // killed before step 0 was committed: nothing to keep, start the same run afresh
             drop((vtk, tresca, file));
@@ -54,30 +58,25 @@ impl Writer {
         let every = int("frame_every").max(1) as usize;
         let frames = Frames { every, last: problem.n_steps() };
         let frames_done = frames.before(completed);
-        if vtk.frames_stored() < frames_done {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: "--resume: VTKHDF frames are missing; rerun with --force".into(),
-            });
-        }
         let frame_list: Vec<(usize, f64)> =
             (0..completed).filter(|&n| frames.is_frame(n)).map(|n| (n, times[n])).collect();
-        let fix = || -> hdf5::Result<StepResult> {
-            tresca.truncate(completed)?;
-            vtk.truncate(frames_done)?;
+        let mut fix = || -> hdf5::Result<StepResult> {
+            // a stopped run's series were cut to its completed steps: room for the whole run again
+            tresca.set_steps(&raw, problem.n_steps() + 1, completed)?;
+            vtk.set_frames(&raw, frames.total(), frames_done)?;
             tresca.set_completed(completed)?;
             vtk.set_nsteps(frames_done)?;
             tresca.set_status("running (resumed)")?;
             tresca.read_step(problem, completed - 1)
         };
         let last = fix().map_err(io(path, "--resume"))?;
-        let mut xdmf =
-            Xdmf::resume(&file, path, &frame_list, contact).map_err(ioerr(path, "rewriting the XDMF sidecar"))?;
-        xdmf.total_frames = frames.total();
+        let xdmf = Xdmf::resume(&file, path, &frame_list, contact, frames.total())
+            .map_err(ioerr(path, "rewriting the XDMF sidecar"))?;
         file.flush().map_err(io(path, "flush"))?;
         let w = Writer {
             path: path.to_path_buf(),
             file,
+            raw,
             space: problem.space.clone(),
             fields: Fields::new(problem),
             tresca,

@@ -10,16 +10,11 @@
 //! other dataset of a step. The unknown vector of the last step is rebuilt exactly from `u` (free
 //! edges hold the two unknowns verbatim) and `contact/dof` (the one unknown of a contact edge).
 
-use super::h5::{attr, attr_str, attr_vec, put, Series};
+use super::h5::{attr, attr_str, attr_vec, put, Raw, Series};
 use crate::cr::EdgeDof;
 use crate::norms::ErrorNorms;
 use crate::stepping::{Problem, StepResult};
 use hdf5::{File, Group};
-
-/// Steps per chunk so that a chunk is about 64 KiB.
-fn chunk_steps(bytes_per_step: usize) -> usize {
-    (65536 / bytes_per_step.max(1)).clamp(1, 4096)
-}
 
 /// Rows of consecutive steps buffered for one write.
 #[derive(Default)]
@@ -105,7 +100,7 @@ impl Tresca {
         let mids: Vec<f64> = (0..mesh.edges.len()).flat_map(|e| mesh.midpoint(e)).collect();
         put(&mg, "midpoints", &[mesh.edges.len(), 2], &mids)?;
         let ne = mesh.edges.len();
-        let sc = chunk_steps(8);
+        let sc = p.n_steps() + 1;
         let sg = g.create_group("steps")?;
         let contact = if space.contact.is_empty() {
             None
@@ -117,7 +112,7 @@ impl Tresca {
             put(&cg, "normal", &[nc, 2], &c.iter().flat_map(|c| c.normal).collect::<Vec<_>>())?;
             put(&cg, "tangent", &[nc, 2], &c.iter().flat_map(|c| c.tangent).collect::<Vec<_>>())?;
             put(&cg, "g", &[nc], &c.iter().map(|c| c.g_mean).collect::<Vec<_>>())?;
-            let k = chunk_steps(8 * nc);
+            let k = sc;
             Some([
                 Series::create::<f64>(&cg, "slip", 1, &[nc], k)?,
                 Series::create::<f64>(&cg, "sigma_t", 1, &[nc], k)?,
@@ -161,7 +156,7 @@ impl Tresca {
         attr(&sg, "completed", 0i64)?;
         Ok(Tresca {
             times: Series::create::<f64>(&g, "times", 1, &[], sc)?,
-            u: Series::create::<f64>(&g, "u", 1, &[ne, 2], chunk_steps(16 * ne))?,
+            u: Series::create::<f64>(&g, "u", 1, &[ne, 2], sc)?,
             energy: Series::create::<f64>(&g, "energy", 1, &[], sc)?,
             iterations: Series::create::<i64>(&sg, "iterations", 1, &[], sc)?,
             residual: Series::create::<f64>(&sg, "residual", 1, &[], sc)?,
@@ -209,19 +204,19 @@ impl Tresca {
         })
     }
 
-    fn all(&self) -> Vec<&Series> {
+    fn all(&mut self) -> Vec<&mut Series> {
         let mut v = vec![
-            &self.times,
-            &self.u,
-            &self.energy,
-            &self.iterations,
-            &self.residual,
-            &self.n_stick,
-            &self.n_slip,
-            &self.wall,
+            &mut self.times,
+            &mut self.u,
+            &mut self.energy,
+            &mut self.iterations,
+            &mut self.residual,
+            &mut self.n_stick,
+            &mut self.n_slip,
+            &mut self.wall,
         ];
-        v.extend(self.contact.iter().flatten());
-        v.extend(self.errors.iter().flatten());
+        v.extend(self.contact.iter_mut().flatten());
+        v.extend(self.errors.iter_mut().flatten());
         v
     }
 
@@ -231,26 +226,26 @@ impl Tresca {
     }
 
     /// Append buffered rows (all series; `completed` is not changed).
-    pub fn write_rows(&self, b: &Rows) -> hdf5::Result<()> {
+    pub fn write_rows(&self, raw: &Raw, b: &Rows) -> hdf5::Result<()> {
         let (n, k) = (b.first, b.count);
-        self.times.write_steps(n, k, &b.times)?;
-        self.u.write_steps(n, k, &b.u)?;
-        self.energy.write_steps(n, k, &b.energy)?;
-        self.iterations.write_steps(n, k, &b.iterations)?;
-        self.residual.write_steps(n, k, &b.residual)?;
-        self.n_stick.write_steps(n, k, &b.n_stick)?;
-        self.n_slip.write_steps(n, k, &b.n_slip)?;
-        self.wall.write_steps(n, k, &b.wall)?;
+        self.times.write_steps(raw, n, k, &b.times)?;
+        self.u.write_steps(raw, n, k, &b.u)?;
+        self.energy.write_steps(raw, n, k, &b.energy)?;
+        self.iterations.write_steps(raw, n, k, &b.iterations)?;
+        self.residual.write_steps(raw, n, k, &b.residual)?;
+        self.n_stick.write_steps(raw, n, k, &b.n_stick)?;
+        self.n_slip.write_steps(raw, n, k, &b.n_slip)?;
+        self.wall.write_steps(raw, n, k, &b.wall)?;
         if let Some([slip, sig, state, mu, d]) = &self.contact {
-            slip.write_steps(n, k, &b.slip)?;
-            sig.write_steps(n, k, &b.sigma_t)?;
-            state.write_steps(n, k, &b.state)?;
-            mu.write_steps(n, k, &b.mu)?;
-            d.write_steps(n, k, &b.dof)?;
+            slip.write_steps(raw, n, k, &b.slip)?;
+            sig.write_steps(raw, n, k, &b.sigma_t)?;
+            state.write_steps(raw, n, k, &b.state)?;
+            mu.write_steps(raw, n, k, &b.mu)?;
+            d.write_steps(raw, n, k, &b.dof)?;
         }
         if let Some(es) = &self.errors {
             for (s, v) in es.iter().zip(&b.errors) {
-                s.write_steps(n, k, v)?;
+                s.write_steps(raw, n, k, v)?;
             }
         }
         Ok(())
@@ -261,19 +256,15 @@ impl Tresca {
         attr(&self.steps_group, "completed", count as i64)
     }
 
-    /// Drop everything beyond `steps` complete steps.
-    pub fn truncate(&self, steps: usize) -> hdf5::Result<()> {
-        for s in self.all() {
-            if s.steps() > steps {
-                s.truncate(steps)?;
-            }
-        }
-        Ok(())
+    /// Give every series room for exactly `steps` steps, keeping the first `kept` (see
+    /// [`Series::set_steps`]).
+    pub fn set_steps(&mut self, raw: &Raw, steps: usize, kept: usize) -> hdf5::Result<()> {
+        self.all().into_iter().try_for_each(|s| s.set_steps(raw, steps, kept))
     }
 
-    /// Smallest number of steps any series holds (a partial step shows up as a shorter series).
-    pub fn min_steps(&self) -> usize {
-        self.all().iter().map(|s| s.steps()).min().unwrap_or(0)
+    /// Steps every series has room for.
+    pub fn capacity(&mut self) -> usize {
+        self.all().iter().map(|s| s.capacity()).min().unwrap_or(0)
     }
 
     /// Rebuild the StepResult of stored step n (exact unknowns, μ, slip, state, statistics).

@@ -15,8 +15,8 @@
 //!   written for all frames at creation; readers only use the first `NSteps` entries.
 
 use super::fields::{Fields, StepFields, TENSOR};
-use super::h5::{attr, attr_fixed_ascii, attr_vec, put, Series};
-use hdf5::{File, Group};
+use super::h5::{attr, attr_fixed_ascii, attr_vec, put, Raw, Series};
+use hdf5::{Dataset, Extent, Extents, File, Group};
 
 /// Names of the per-step cell arrays with their components (all f32 but `stick_slip`).
 pub fn cell_arrays(contact: bool) -> Vec<(&'static str, usize)> {
@@ -78,7 +78,10 @@ impl FrameRows {
 
 pub struct VtkHdf {
     steps: Group,
-    values: Series,
+    /// `Steps/Values`, the one per-frame array whose length must equal `NSteps` at every commit: VTK
+    /// 9.7's reader corrupts its heap on a longer one (measured; a killed run's file crashed it). It is
+    /// chunked and grown frame by frame, in the same flush as `NSteps`.
+    values: Dataset,
     displacement: Series,
     /// In the order of [`cell_arrays`].
     cells: Vec<Series>,
@@ -118,14 +121,18 @@ impl VtkHdf {
             put(&cdo, name, &[m], &off(ncell))?;
             let rest: &[usize] = if nc == 1 { &[] } else { &[nc] };
             cells.push(if name == "stick_slip" {
-                Series::create::<u8>(&cd, name, ncell, rest, 1)?
+                Series::create::<u8>(&cd, name, ncell, rest, m)?
             } else {
-                Series::create::<f32>(&cd, name, ncell, rest, 1)?
+                Series::create::<f32>(&cd, name, ncell, rest, m)?
             });
         }
         Ok(VtkHdf {
-            values: Series::create::<f64>(&steps, "Values", 1, &[], 1024)?,
-            displacement: Series::create::<f32>(&pd, "displacement", np, &[3], 1)?,
+            values: steps
+                .new_dataset::<f64>()
+                .chunk(1024)
+                .shape(Extents::from(Extent::resizable(0)))
+                .create("Values")?,
+            displacement: Series::create::<f32>(&pd, "displacement", np, &[3], m)?,
             cells,
             steps,
         })
@@ -142,7 +149,7 @@ impl VtkHdf {
             .collect::<hdf5::Result<Vec<_>>>()?;
         let steps = root.group("Steps")?;
         Ok(VtkHdf {
-            values: Series::open(&steps, "Values", 1)?,
+            values: steps.dataset("Values")?,
             displacement: Series::open(&root.group("PointData")?, "displacement", np)?,
             cells,
             steps,
@@ -150,39 +157,30 @@ impl VtkHdf {
     }
 
     /// Append buffered frames (NSteps is not changed).
-    pub fn write_frames(&self, b: &FrameRows) -> hdf5::Result<()> {
+    pub fn write_frames(&self, raw: &Raw, b: &FrameRows) -> hdf5::Result<()> {
         let (f, k) = (b.first, b.count());
-        self.values.write_steps(f, k, &b.times)?;
-        self.displacement.write_steps(f, k, &b.displacement)?;
+        if k > 0 {
+            self.values.resize(f + k)?;
+            self.values.write_slice(&b.times, f..f + k)?;
+        }
+        self.displacement.write_steps(raw, f, k, &b.displacement)?;
         for (series, data) in self.cells.iter().zip(&b.cells) {
-            series.write_steps(f, k, data)?;
+            series.write_steps(raw, f, k, data)?;
         }
         if let Some(series) = self.cells.get(6) {
-            series.write_steps(f, k, &b.stick_slip)?;
+            series.write_steps(raw, f, k, &b.stick_slip)?;
         }
         Ok(())
-    }
-
-    /// Frames stored (the shortest series).
-    pub fn frames_stored(&self) -> usize {
-        std::iter::once(&self.values)
-            .chain(std::iter::once(&self.displacement))
-            .chain(&self.cells)
-            .map(|s| s.steps())
-            .min()
-            .unwrap_or(0)
     }
 
     pub fn set_nsteps(&self, n: usize) -> hdf5::Result<()> {
         attr(&self.steps, "NSteps", n as i64)
     }
 
-    pub fn truncate(&self, steps: usize) -> hdf5::Result<()> {
-        for s in std::iter::once(&self.values).chain(std::iter::once(&self.displacement)).chain(&self.cells) {
-            if s.steps() > steps {
-                s.truncate(steps)?;
-            }
-        }
-        Ok(())
+    /// Give every frame series room for exactly `frames` frames, keeping the first `kept`; `Values`
+    /// holds exactly the kept frames.
+    pub fn set_frames(&mut self, raw: &Raw, frames: usize, kept: usize) -> hdf5::Result<()> {
+        self.values.resize(kept.min(frames))?;
+        std::iter::once(&mut self.displacement).chain(&mut self.cells).try_for_each(|s| s.set_steps(raw, frames, kept))
     }
 }

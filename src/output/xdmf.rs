@@ -8,8 +8,11 @@
 //! Every grid repeats Topology and Geometry (same datasets). Strain and stress are 6-component
 //! (xx, yy, zz, xy, yz, xz) and declared `Matrix` so no reader reorders them as XDMF `Tensor6`.
 //!
-//! The text is appended per step after the HDF5 step is flushed (seeking back over the closing tags),
-//! and rewritten whole on resume, so it never names data the file does not hold.
+//! The virtual datasets of every frame of the run are created with the file, so committing a frame
+//! changes no HDF5 metadata (see `super::h5::Series`); those of frames not yet written map rows that hold
+//! no data yet, and a stopped run drops them ([`Xdmf::drop_frames_from`]). The text is appended per
+//! frame after the HDF5 step is flushed (seeking back over the closing tags), and rewritten whole on
+//! resume, so it never names data the file does not hold.
 
 use super::fields::Fields;
 use super::h5::put;
@@ -33,7 +36,7 @@ pub struct Xdmf {
     topo_len: usize,
     contact: bool,
     /// Frames of the whole run.
-    pub total_frames: usize,
+    total_frames: usize,
 }
 
 fn rows(start: usize, end: usize, rest: &[usize]) -> Selection {
@@ -58,8 +61,9 @@ fn arrays(np: usize, ncell: usize, contact: bool) -> Vec<(String, String, usize,
 }
 
 impl Xdmf {
-    /// Create `/xdmf` (topology, per-array groups) in the HDF5 file and start the text.
-    pub fn create(h5: &File, h5_path: &Path, f: &Fields, contact: bool) -> std::io::Result<Xdmf> {
+    /// Create `/xdmf` (topology, per-array groups, the virtual datasets of all `total_frames` frames) in
+    /// the HDF5 file and start the text.
+    pub fn create(h5: &File, h5_path: &Path, f: &Fields, contact: bool, total_frames: usize) -> std::io::Result<Xdmf> {
         let mk = || -> hdf5::Result<(Group, usize)> {
             let g = h5.create_group("xdmf")?;
             let mut topo = Vec::with_capacity(4 * f.n_cells());
@@ -79,33 +83,49 @@ impl Xdmf {
             Ok((g, topo.len()))
         };
         let (group, topo_len) = mk().map_err(std::io::Error::other)?;
-        Xdmf::start(h5_path, group, f.n_points(), f.n_cells(), topo_len, contact)
+        let x = Xdmf::start(h5_path, group, f.n_points(), f.n_cells(), topo_len, contact, total_frames)?;
+        (0..total_frames).try_for_each(|k| x.add_frame_datasets(k)).map_err(std::io::Error::other)?;
+        Ok(x)
     }
 
-    /// Reopen for a resumed run: drop frame datasets beyond `frames` ((step, time) of each frame) and
-    /// rewrite the text.
-    pub fn resume(h5: &File, h5_path: &Path, frames: &[(usize, f64)], contact: bool) -> std::io::Result<Xdmf> {
+    /// Reopen for a resumed run: recreate the virtual datasets a stopped run dropped and rewrite the text
+    /// for `frames` ((step, time) of each complete frame).
+    pub fn resume(
+        h5: &File,
+        h5_path: &Path,
+        frames: &[(usize, f64)],
+        contact: bool,
+        total_frames: usize,
+    ) -> std::io::Result<Xdmf> {
         let get = || -> hdf5::Result<(Group, usize, usize, usize)> {
             let g = h5.group("xdmf")?;
             let np = h5.dataset("VTKHDF/Points")?.shape()[0];
             let ncell = h5.dataset("VTKHDF/Types")?.shape()[0];
             let topo_len = g.dataset("topology")?.shape()[0];
-            for (name, ..) in arrays(0, 0, contact) {
-                let ag = g.group(&name)?;
-                for member in ag.member_names()? {
-                    if member.parse::<usize>().map_or(true, |k| k >= frames.len()) {
-                        ag.unlink(&member)?;
-                    }
-                }
-            }
             Ok((g, np, ncell, topo_len))
         };
         let (group, np, ncell, topo_len) = get().map_err(std::io::Error::other)?;
-        let mut x = Xdmf::start(h5_path, group, np, ncell, topo_len, contact)?;
+        let mut x = Xdmf::start(h5_path, group, np, ncell, topo_len, contact, total_frames)?;
+        let counts = x.groups.iter().map(|g| g.member_names().map(|m| m.len())).collect::<hdf5::Result<Vec<_>>>();
+        let present = counts.map_err(std::io::Error::other)?.into_iter().min().unwrap_or(0);
+        x.drop_frames_from(present).map_err(std::io::Error::other)?;
+        (present..total_frames).try_for_each(|k| x.add_frame_datasets(k)).map_err(std::io::Error::other)?;
         for (f, &(n, t)) in frames.iter().enumerate() {
             x.append_text(f, n, t)?;
         }
         Ok(x)
+    }
+
+    /// Remove the virtual datasets of frames `first`… (a stopped run keeps only its complete frames).
+    pub fn drop_frames_from(&self, first: usize) -> hdf5::Result<()> {
+        for g in &self.groups {
+            for member in g.member_names()? {
+                if member.parse::<usize>().map_or(true, |k| k >= first) {
+                    g.unlink(&member)?;
+                }
+            }
+        }
+        Ok(())
     }
 
     fn start(
@@ -115,6 +135,7 @@ impl Xdmf {
         ncell: usize,
         topo_len: usize,
         contact: bool,
+        total_frames: usize,
     ) -> std::io::Result<Xdmf> {
         let path = sidecar(h5_path);
         let mut file = std::fs::File::create(&path)?;
@@ -128,15 +149,15 @@ impl Xdmf {
             .collect::<hdf5::Result<Vec<_>>>()
             .map_err(std::io::Error::other)?;
         let h5_name = h5_path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        Ok(Xdmf { path, h5_name, groups, file, len: head.len() as u64, np, ncell, topo_len, contact, total_frames: 0 })
+        Ok(Xdmf { path, h5_name, groups, file, len: head.len() as u64, np, ncell, topo_len, contact, total_frames })
     }
 
-    /// Create the virtual datasets of frame n (before the HDF5 flush of that frame).
-    pub fn add_frame_datasets(&self, n: usize) -> hdf5::Result<()> {
+    /// Create the virtual datasets of frame n.
+    fn add_frame_datasets(&self, n: usize) -> hdf5::Result<()> {
         for (i, (_, src, block, nc, ty, _)) in arrays(self.np, self.ncell, self.contact).into_iter().enumerate() {
             let rest: Vec<usize> = if nc == 1 { vec![] } else { vec![nc] };
             // the source's extent at its largest: a selection of all of a smaller extent would become "all"
-            let mut src_ext = vec![self.total_frames.max(n + 1) * block];
+            let mut src_ext = vec![self.total_frames * block];
             src_ext.extend(&rest);
             let mut shape = vec![block];
             shape.extend(&rest);
