@@ -239,7 +239,8 @@ def main(argv=None):
            "`tresca-cr run verification/cases/paper_example_5_1.toml --refine k --steps 40·2^k --solver S` "
            "(solve-only) and the same with `-o out.h5 --force -q` (written in full: every step's u, contact "
            "state, statistics, ~50 VTKHDF frames, committed (written + flushed) every step, the default); "
-           "`write-batched` adds `--commit-interval 10` (commits at most every 10 s: here once at the end). "
+           "`write-batched` adds `--commit-interval 10` (commits at most every 10 s: here once at the end); "
+           "`write-all-frames` (finest level) adds `--frame-every 1`: every step also a VTKHDF/XDMF frame. "
            "The CLI prints times in whole milliseconds, so for written runs the set-up split is read from the "
            "file's `setup_times` attribute (full precision); for solve-only runs below ~10 ms it is 0/1 ms.", "",
            "| n | N | paper DOF | solver | mode | total (median) | CLI wall | per step | it/step | "
@@ -249,14 +250,17 @@ def main(argv=None):
     for k in levels:
         N = 40 * 2 ** k
         for solver in ["ssn", "uzawa"]:
-            for mode in (["solve", "write", "write-batched"] if solver == "ssn" else ["solve", "write"]):
+            modes = ["solve", "write", "write-batched"] + (["write-all-frames"] if k == max(levels) else [])
+            for mode in (modes if solver == "ssn" else ["solve", "write"]):
                 cmd = [BIN, "run", EX51, "--refine", str(k), "--steps", str(N), "--solver", solver, "-q"]
                 h5 = None
                 if mode.startswith("write"):
-                    h5 = os.path.join(tmp, f"ex51_{k}_{solver}{'' if mode == 'write' else '_b'}.h5")
+                    h5 = os.path.join(tmp, f"ex51_{k}_{solver}{'' if mode == 'write' else '_' + mode}.h5")
                     cmd += ["-o", h5, "--force"]
                 if mode == "write-batched":
                     cmd += ["--commit-interval", "10"]
+                if mode == "write-all-frames":
+                    cmd += ["--frame-every", "1"]
                 rec = Rec(cmd, R, h5=h5)
                 ex[(k, solver, mode)] = rec
                 i = rec.info
