@@ -84,14 +84,29 @@ pub fn stiffness(mesh: &Mesh, space: &CrSpace, mat: &Material, rho: f64) -> Resu
         if !is_stabilised(mesh, space, e) {
             continue;
         }
-        // (2ρμ/h_e) ∫_e [v]·[w] = 2ρμ Σ_q w_q [v](x_q)·[w](x_q)  (the weights sum to 1, ∫_e = h_e Σ_q w_q)
+        // (2ρμ/h_e) ∫_e [v]·[w] = 2ρμ Σ_q w_q [v](x_q)·[w](x_q)  (the weights sum to 1, ∫_e = h_e Σ_q w_q),
+        // summed into the local matrix M_ab of the ≤ 6 basis functions of the two triangles first (the
+        // shared edge's function appears on both sides and is merged) and scattered once.
+        let mut idx: Vec<usize> = Vec::with_capacity(6);
+        let mut m = [[0.0f64; 6]; 6];
         for (s, w) in GAUSS2 {
-            let terms = jump_terms(mesh, e, s);
-            for &(a, pa) in &terms {
-                for &(b, pb) in &terms {
-                    let c = pen * w * pa * pb;
-                    scatter(space, a, b, [[c, 0.0], [0.0, c]], &mut trip);
+            let mut p = [0.0f64; 6];
+            for (a, pa) in jump_terms(mesh, e, s) {
+                let i = idx.iter().position(|&x| x == a).unwrap_or_else(|| {
+                    idx.push(a);
+                    idx.len() - 1
+                });
+                p[i] += pa;
+            }
+            for i in 0..idx.len() {
+                for j in 0..idx.len() {
+                    m[i][j] += pen * w * p[i] * p[j];
                 }
+            }
+        }
+        for (i, &a) in idx.iter().enumerate() {
+            for (j, &b) in idx.iter().enumerate() {
+                scatter(space, a, b, [[m[i][j], 0.0], [0.0, m[i][j]]], &mut trip);
             }
         }
     }

@@ -100,6 +100,21 @@ impl Raw {
     pub fn open(path: &Path) -> std::io::Result<Raw> {
         Ok(Raw(std::fs::OpenOptions::new().write(true).open(path)?))
     }
+
+    /// All of `bytes` at byte `offset` (one `pwrite` on Unix).
+    fn write_at(&self, bytes: &[u8], offset: u64) -> std::io::Result<()> {
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::FileExt::write_all_at(&self.0, bytes, offset)
+        }
+        #[cfg(not(unix))]
+        {
+            use std::io::{Seek, SeekFrom, Write};
+            let mut f = &self.0;
+            f.seek(SeekFrom::Start(offset))?;
+            f.write_all(bytes)
+        }
+    }
 }
 
 /// File access properties of a results file: no sieve buffer, so `H5Dwrite` of contiguous datasets
@@ -192,12 +207,9 @@ impl Series {
         }
         let bytes: &[u8] = bytemuck::cast_slice(data);
         match self.direct {
-            Some((offset, row)) if bytes.len() == count * row && T::type_descriptor() == self.dtype => {
-                use std::os::unix::fs::FileExt;
-                raw.0
-                    .write_all_at(bytes, offset + (first * row) as u64)
-                    .map_err(|e| hdf5::Error::from(format!("{}: {e}", name())))
-            }
+            Some((offset, row)) if bytes.len() == count * row && T::type_descriptor() == self.dtype => raw
+                .write_at(bytes, offset + (first * row) as u64)
+                .map_err(|e| hdf5::Error::from(format!("{}: {e}", name()))),
             _ => {
                 let mut shape = vec![count * self.block];
                 shape.extend(&self.rest);
