@@ -317,6 +317,12 @@ def results_clients():
     print(p.stdout[-2000:])
     require("O1-clients", "VTK (vtkHDFReader), meshio (XDMF) and h5py shall open the results file and read the solver's values",
             p.returncode == 0, (p.stdout.strip().splitlines() or ["(no output)"])[-1][:200], " ".join(chk), "scripts/check_results.py")
+    chk = [PY, "verification/interrupted_runs.py"]
+    p = subprocess.run(chk, cwd=ROOT, capture_output=True, text=True)
+    print(p.stdout[-3000:])
+    require("O2-interrupted", "the files of a killed, a stopped and a resumed run shall open in VTK, meshio and h5py, "
+            "each showing exactly its committed steps", p.returncode == 0,
+            (p.stdout.strip().splitlines() or ["(no output)"])[-1][:200], " ".join(chk), "verification/interrupted_runs.py")
 
 
 def cross_check(quick):
