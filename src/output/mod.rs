@@ -155,10 +155,13 @@ impl Writer {
             .map_err(ioerr(path, "writing the XDMF sidecar"))?;
         file.flush().map_err(io(path, "flush"))?;
         let raw = Raw::open(&partial).map_err(ioerr(path, "cannot open the new file for writing"))?;
-        if path.exists() {
-            std::fs::remove_file(path).map_err(ioerr(path, "cannot remove the old file"))?;
-        }
+        // rename() replaces an old file atomically; freeing its blocks (tens of ms for a large file) is
+        // left to a background thread that holds it open across the rename and closes it.
+        let old = std::fs::File::open(path).ok();
         std::fs::rename(&partial, path).map_err(ioerr(path, "cannot move the new file into place"))?;
+        if let Some(old) = old {
+            std::thread::spawn(move || drop(old));
+        }
         Ok(Writer {
             path: path.to_path_buf(),
             file,
