@@ -1,10 +1,25 @@
-//! Factorise once, solve many times: the sparse Cholesky factor K = L Lᵀ of the stiffness (faer, AMD
-//! ordering), kept for the whole run. Every step and every friction iteration only performs the pair of
+//! Factorise once, solve many times: the sparse Cholesky factor K = P L Lᵀ Pᵀ of the stiffness (faer,
+//! supernodal), kept for the whole run. Every step and every friction iteration only performs the pair of
 //! triangular solves L Lᵀ x = b, with a scratch buffer allocated once. Sequential: the per-step solves
 //! of a 2D problem are too small to profit from threads, and sequential kernels keep runs bit-identical.
+//!
+//! Fill-reducing ordering P: nested dissection (METIS_NodeND) for large K, AMD (faer's) below
+//! [`ND_MIN_SIZE`] unknowns. Why: on a 2D mesh nested dissection gives the asymptotically optimal fill,
+//! O(n log n) entries and O(n^1.5) flops, with a smaller constant than AMD: on the 1.57M-unknown
+//! benchmark it cuts nnz(L) by 30 % and the factorisation flops by 58 % (1.14e12 → 4.8e11), which
+//! halves the numeric phase. But METIS itself costs O(n log n) with a large constant (≈ 11 s there), so
+//! on small meshes AMD (cheap, and then the factorisation takes a second or less) is faster overall.
+//! METIS orders the graph of K with consecutive coupled unknowns (i, i+1) merged into one weighted vertex:
+//! the two displacement components of an edge are numbered consecutively and are coupled, so this halves
+//! the graph (and METIS's time) with nnz(L) within 1 % of ordering the full graph; the merging is only a
+//! heuristic for speed, the result is a valid permutation whatever the numbering. Deterministic: a fixed seed
+//! and calls serialised by a lock (METIS draws from the C library's global `rand`), so the same K always
+//! gets the same ordering, hence bit-identical results. If METIS cannot be used (tiny or edgeless graphs,
+//! indices beyond i32, an error) the ordering falls back to AMD: the ordering only affects speed.
 
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
 };
@@ -12,6 +27,7 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::SparseColMat;
 use faer::{Conj, MatMut, Par, Side};
 use std::cell::RefCell;
+use std::sync::Mutex;
 
 /// The Cholesky factor of an SPD sparse matrix.
 pub struct Factor {
@@ -25,6 +41,11 @@ impl Factor {
     /// Factorise the SPD matrix `k` (lower triangle read). `simplicial` forces the simplicial kernel,
     /// otherwise faer chooses (supernodal for larger fill).
     pub fn new(k: &SparseColMat<usize, f64>, simplicial: bool) -> Result<Factor> {
+        Factor::with_ordering(k, simplicial, k.nrows() >= ND_MIN_SIZE)
+    }
+
+    /// As [`Factor::new`], with nested dissection tried (`nested`) or AMD.
+    fn with_ordering(k: &SparseColMat<usize, f64>, simplicial: bool, nested: bool) -> Result<Factor> {
         let n = k.nrows();
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: if simplicial {
@@ -34,8 +55,14 @@ impl Factor {
             },
             ..Default::default()
         };
-        let symbolic = factorize_symbolic_cholesky(k.symbolic(), Side::Lower, SymmetricOrdering::Amd, params)
+        let nd = if nested { nested_dissection(k) } else { None };
+        let ordering = match &nd {
+            Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, n)),
+            None => SymmetricOrdering::Amd,
+        };
+        let symbolic = factorize_symbolic_cholesky(k.symbolic(), Side::Lower, ordering, params)
             .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))?;
+        drop(nd);
         let mut values = vec![0.0; symbolic.len_val()];
         let mut buf = MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
             .map_err(|_| Error::Linear("out of memory for the Cholesky factorisation".into()))?;
@@ -106,5 +133,219 @@ impl Factor {
         let llt = LltRef::new(&self.symbolic, &self.values);
         let mut buf = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(x.ncols(), Par::Seq));
         llt.solve_in_place_with_conj(Conj::No, x, Par::Seq, MemStack::new(&mut buf));
+    }
+}
+
+/// Below this many unknowns K is ordered by AMD: METIS's own cost would exceed what its better ordering
+/// saves in the numeric factorisation (measured on the benchmark: AMD wins at 98k unknowns, the two are
+/// even around 400k, nested dissection wins by a third of the set-up at 1.57M).
+pub const ND_MIN_SIZE: usize = 200_000;
+
+/// Fixed METIS seed: the ordering, hence every result, is reproducible.
+const ND_SEED: i32 = 42;
+
+/// Serialises METIS calls: its random choices come from the C library's global `rand` state, reseeded at
+/// each call, so concurrent calls (parallel tests) would interleave their draws and break determinism.
+static METIS_LOCK: Mutex<()> = Mutex::new(());
+
+/// Nested-dissection ordering (forward, inverse) of the graph of K by METIS_NodeND, or `None` when
+/// METIS cannot be used: the caller then falls back to AMD.
+fn nested_dissection(k: &SparseColMat<usize, f64>) -> Option<(Vec<usize>, Vec<usize>)> {
+    let n = k.nrows();
+    let (col_ptr, row_idx) = (k.symbolic().col_ptr(), k.symbolic().row_idx());
+    let coupled = |i: usize, j: usize| {
+        row_idx[col_ptr[i]..col_ptr[i + 1]].contains(&j) || row_idx[col_ptr[j]..col_ptr[j + 1]].contains(&i)
+    };
+    // Vertices of METIS's graph: groups first[g]..first[g + 1] of one unknown, or of two consecutive
+    // coupled ones (both components of an edge's displacement).
+    let mut group = vec![0usize; n];
+    let mut first = Vec::with_capacity(n / 2 + 2);
+    let mut i = 0;
+    while i < n {
+        group[i] = first.len();
+        first.push(i);
+        if i + 1 < n && coupled(i, i + 1) {
+            group[i + 1] = group[i];
+            i += 2;
+        } else {
+            i += 1;
+        }
+    }
+    let ng = first.len();
+    first.push(n);
+    // Symmetric adjacency of the groups, without self loops, from whichever triangle(s) K stores.
+    let mut deg = vec![0usize; ng];
+    for j in 0..n {
+        for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+            if group[i] != group[j] {
+                deg[group[i]] += 1;
+                deg[group[j]] += 1;
+            }
+        }
+    }
+    let mut start = vec![0usize; ng + 1];
+    for g in 0..ng {
+        start[g + 1] = start[g] + deg[g];
+    }
+    drop(deg);
+    let mut adj = vec![0u32; start[ng]];
+    let mut fill = start[..ng].to_vec();
+    for j in 0..n {
+        for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+            let (gi, gj) = (group[i], group[j]);
+            if gi != gj {
+                adj[fill[gi]] = gj as u32;
+                fill[gi] += 1;
+                adj[fill[gj]] = gi as u32;
+                fill[gj] += 1;
+            }
+        }
+    }
+    drop(fill);
+    let mut xadj: Vec<i32> = Vec::with_capacity(ng + 1);
+    let mut adjncy: Vec<i32> = Vec::new();
+    xadj.push(0);
+    for g in 0..ng {
+        let row = &mut adj[start[g]..start[g + 1]];
+        row.sort_unstable();
+        let mut last = u32::MAX;
+        for &h in row.iter() {
+            if h != last {
+                adjncy.push(i32::try_from(h).ok()?);
+                last = h;
+            }
+        }
+        xadj.push(i32::try_from(adjncy.len()).ok()?);
+    }
+    drop(adj);
+    if adjncy.is_empty() {
+        return None;
+    }
+    let mut vwgt: Vec<i32> = (0..ng).map(|g| (first[g + 1] - first[g]) as i32).collect();
+    let mut options = [0i32; metis_sys::METIS_NOPTIONS as usize];
+    let mut nvtxs = i32::try_from(ng).ok()?;
+    let (mut perm, mut iperm) = (vec![0i32; ng], vec![0i32; ng]);
+    let status = {
+        let _guard = METIS_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+        // SAFETY: `options` has METIS_NOPTIONS entries; xadj has ng + 1 entries, adjncy xadj[ng] (all
+        // in 0..ng, no self loops, symmetric), vwgt, perm and iperm ng each. METIS reads the graph and
+        // options and writes only perm and iperm.
+        unsafe {
+            metis_sys::METIS_SetDefaultOptions(options.as_mut_ptr());
+            options[metis_sys::moptions_et_METIS_OPTION_SEED as usize] = ND_SEED;
+            options[metis_sys::moptions_et_METIS_OPTION_NUMBERING as usize] = 0;
+            metis_sys::METIS_NodeND(
+                &mut nvtxs,
+                xadj.as_mut_ptr(),
+                adjncy.as_mut_ptr(),
+                vwgt.as_mut_ptr(),
+                options.as_mut_ptr(),
+                perm.as_mut_ptr(),
+                iperm.as_mut_ptr(),
+            )
+        }
+    };
+    if status != metis_sys::rstatus_et_METIS_OK {
+        return None;
+    }
+    // METIS: perm[new] = old. Expand each group into its unknowns, in order.
+    let mut fwd = Vec::with_capacity(n);
+    for &g in &perm {
+        let g = usize::try_from(g).ok().filter(|&g| g < ng)?;
+        fwd.extend(first[g]..first[g + 1]);
+    }
+    let mut inv = vec![usize::MAX; n];
+    for (new, &old) in fwd.iter().enumerate() {
+        inv[old] = new;
+    }
+    if fwd.len() != n || inv.contains(&usize::MAX) {
+        return None;
+    }
+    Some((fwd, inv))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assemble::{csc_from_triplets, matvec};
+
+    /// Plane-elasticity-like test matrix: a 2D grid (m × m nodes) Laplacian, two coupled unknowns per node
+    /// (numbered consecutively), shifted to be SPD.
+    fn grid(m: usize) -> SparseColMat<usize, f64> {
+        let node = |i: usize, j: usize| i * m + j;
+        let mut t = Vec::new();
+        for i in 0..m {
+            for j in 0..m {
+                let a = node(i, j);
+                for c in 0..2 {
+                    t.push((2 * a + c, 2 * a + c, 4.5));
+                }
+                t.push((2 * a, 2 * a + 1, 0.25));
+                t.push((2 * a + 1, 2 * a, 0.25));
+                for (di, dj) in [(0, 1), (1, 0)] {
+                    if i + di < m && j + dj < m {
+                        let b = node(i + di, j + dj);
+                        for c in 0..2 {
+                            t.push((2 * a + c, 2 * b + c, -1.0));
+                            t.push((2 * b + c, 2 * a + c, -1.0));
+                        }
+                    }
+                }
+            }
+        }
+        csc_from_triplets(2 * m * m, &t)
+    }
+
+    fn residual(k: &SparseColMat<usize, f64>, f: &Factor) -> f64 {
+        let n = k.nrows();
+        let b: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+        let mut x = b.clone();
+        f.solve_in_place(&mut x);
+        let mut r = vec![0.0; n];
+        matvec(k, &x, &mut r);
+        r.iter().zip(&b).map(|(r, b)| (r - b).abs()).fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn nested_dissection_orders_and_solves() {
+        let k = grid(40);
+        let (fwd, inv) = nested_dissection(&k).expect("METIS ordering");
+        assert!(fwd.iter().enumerate().all(|(new, &old)| inv[old] == new));
+        for simplicial in [false, true] {
+            let nd = Factor::with_ordering(&k, simplicial, true).unwrap();
+            let amd = Factor::with_ordering(&k, simplicial, false).unwrap();
+            assert!(residual(&k, &nd) < 1e-12 && residual(&k, &amd) < 1e-12);
+        }
+    }
+
+    #[test]
+    fn nested_dissection_is_deterministic_across_threads() {
+        let k = grid(30);
+        let reference = nested_dissection(&k).unwrap();
+        let runs: Vec<_> = std::thread::scope(|s| {
+            let h: Vec<_> = (0..4).map(|_| s.spawn(|| nested_dissection(&k).unwrap())).collect();
+            h.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        assert!(runs.iter().all(|r| *r == reference));
+    }
+
+    #[test]
+    fn degenerate_graphs_fall_back_to_amd() {
+        let diag = |n: usize| csc_from_triplets(n, &(0..n).map(|i| (i, i, 2.0)).collect::<Vec<_>>());
+        for n in [0, 1, 2, 5] {
+            assert!(nested_dissection(&diag(n)).is_none());
+            let f = Factor::with_ordering(&diag(n), false, true).unwrap();
+            assert!(residual(&diag(n), &f) < 1e-15);
+        }
+        // One coupled pair: a single METIS vertex, no edges.
+        let pair = csc_from_triplets(2, &[(0, 0, 2.0), (1, 1, 2.0), (0, 1, 1.0), (1, 0, 1.0)]);
+        assert!(nested_dissection(&pair).is_none());
+        assert!(residual(&pair, &Factor::with_ordering(&pair, false, true).unwrap()) < 1e-15);
+        // Three unknowns: METIS on a 2-vertex graph.
+        let three = csc_from_triplets(
+            3,
+            &[(0, 0, 4.0), (1, 1, 4.0), (2, 2, 4.0), (1, 2, 1.0), (2, 1, 1.0), (0, 2, 1.0), (2, 0, 1.0)],
+        );
+        assert!(residual(&three, &Factor::with_ordering(&three, false, true).unwrap()) < 1e-14);
     }
 }
