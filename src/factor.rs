@@ -3,19 +3,20 @@
 //! triangular solves L Lᵀ x = b, with a scratch buffer allocated once. Sequential: the per-step solves
 //! of a 2D problem are too small to profit from threads, and sequential kernels keep runs bit-identical.
 //!
-//! Fill-reducing ordering P: nested dissection (METIS_NodeND) for large K, AMD (faer's) below
-//! [`ND_MIN_SIZE`] unknowns. Why: on a 2D mesh nested dissection gives the asymptotically optimal fill,
-//! O(n log n) entries and O(n^1.5) flops, with a smaller constant than AMD: on the 1.57M-unknown
-//! benchmark it cuts nnz(L) by 30 % and the factorisation flops by 58 % (1.14e12 → 4.8e11), which
-//! halves the numeric phase. But METIS itself costs O(n log n) with a large constant (≈ 11 s there), so
-//! on small meshes AMD (cheap, and then the factorisation takes a second or less) is faster overall.
-//! METIS orders the graph of K with consecutive coupled unknowns (i, i+1) merged into one weighted vertex:
-//! the two displacement components of an edge are numbered consecutively and are coupled, so this halves
-//! the graph (and METIS's time) with nnz(L) within 1 % of ordering the full graph; the merging is only a
-//! heuristic for speed, the result is a valid permutation whatever the numbering. Deterministic: a fixed seed
-//! and calls serialised by a lock (METIS draws from the C library's global `rand`), so the same K always
-//! gets the same ordering, hence bit-identical results. If METIS cannot be used (tiny or edgeless graphs,
-//! indices beyond i32, an error) the ordering falls back to AMD: the ordering only affects speed.
+//! Fill-reducing ordering P: nested dissection (METIS_NodeND) for K of [`ND_MIN_SIZE`] unknowns or
+//! more, AMD (faer's) below. Why: the factorisation is flop-bound, and on a 2D mesh nested dissection
+//! gives the asymptotically optimal fill, O(n log n) entries and O(n^1.5) flops, with a smaller constant
+//! than AMD: on the 1.57M-unknown benchmark nnz(L) drops from 613M to 462M and the flops from 1.14e12 to
+//! about 5e11, so the numeric phase halves (≈ 60 s → 29 s). But METIS itself takes ≈ 11 s there and
+//! ≈ 2.5 s at 394k unknowns, where it loses overall to AMD (the set-up was 40 % slower), hence the size
+//! threshold. METIS orders the graph of K with consecutive coupled unknowns (i, i+1) merged into one
+//! weighted vertex: the two displacement components of an edge are numbered consecutively and are
+//! coupled, so this halves the graph (and METIS's time) with nnz(L) within 1 % of ordering the full
+//! graph; the merging is only a heuristic for speed, the result is a valid permutation whatever the
+//! numbering. Deterministic: adjacency lists sorted, a fixed seed, and calls serialised by a lock (METIS
+//! draws from the C library's global `rand`), so the same K always gets the same ordering, hence
+//! bit-identical results. If METIS cannot be used (tiny or edgeless graphs, indices beyond i32, an
+//! error) the ordering falls back to AMD: the ordering only affects speed.
 
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -137,9 +138,9 @@ impl Factor {
 }
 
 /// Below this many unknowns K is ordered by AMD: METIS's own cost would exceed what its better ordering
-/// saves in the numeric factorisation (measured on the benchmark: AMD wins at 98k unknowns, the two are
-/// even around 400k, nested dissection wins by a third of the set-up at 1.57M).
-pub const ND_MIN_SIZE: usize = 200_000;
+/// saves in the numeric factorisation (benchmark, medians of 3: at 394k unknowns the set-up took 12.3 s
+/// with METIS against 8.7 s with AMD; at 1.57M, 64 s against 73 s).
+pub const ND_MIN_SIZE: usize = 1_000_000;
 
 /// Fixed METIS seed: the ordering, hence every result, is reproducible.
 const ND_SEED: i32 = 42;
