@@ -79,35 +79,48 @@ impl Factor {
         Ok(Factor { symbolic, values, scratch: RefCell::new(scratch), n })
     }
 
-    /// Estimate of the 2-norm condition number λ_max/λ_min of K: `iters` steps of power iteration on K
-    /// (matrix products) and of inverse iteration (solves with the factor), from a fixed start vector so
-    /// the estimate is deterministic. Both are lower bounds that converge from below; the huge gaps of a
-    /// nearly singular K show up within a few iterations.
+    /// Estimate of the 2-norm condition number λ_max/λ_min of K from the Rayleigh quotients vᵀKv of
+    /// power iteration (`iters` matrix products) and vᵀK⁻¹v of inverse iteration (solves with the
+    /// factor), from a fixed start vector so the estimate is deterministic. Both quotients are lower
+    /// bounds of λ_max and 1/λ_min that converge from below, twice as fast as the norm ratios (error
+    /// ~ (λ₂/λ₁)^{2k}). The inverse iteration stops once its quotient changes by less than 1e-3
+    /// relative (at least 3, at most `iters` solves): each solve streams the whole factor (1.4 s at
+    /// 1.57M unknowns), and the huge gap of a nearly singular K shows up within a few iterations.
     pub fn condition_estimate(&self, k: &SparseColMat<usize, f64>, iters: usize) -> f64 {
         let n = self.n;
         if n == 0 {
             return 1.0;
         }
         let start: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 104729) as f64 / 104729.0).collect();
-        let normalise = |v: &mut Vec<f64>| {
+        let normalise = |v: &mut [f64]| {
             let s = v.iter().map(|x| x * x).sum::<f64>().sqrt();
             v.iter_mut().for_each(|x| *x /= s);
-            s
         };
-        let (mut hi, mut lo_inv) = (0.0, 0.0);
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
         let mut v = start.clone();
         normalise(&mut v);
         let mut w = vec![0.0; n];
+        let mut hi = 0.0f64;
         for _ in 0..iters {
             crate::assemble::matvec(k, &v, &mut w);
+            hi = hi.max(dot(&v, &w));
             std::mem::swap(&mut v, &mut w);
-            hi = normalise(&mut v);
+            normalise(&mut v);
         }
         let mut v = start;
         normalise(&mut v);
-        for _ in 0..iters {
-            self.solve_in_place(&mut v);
-            lo_inv = normalise(&mut v);
+        let mut lo_inv = 0.0f64;
+        for it in 0..iters.max(1) {
+            w.copy_from_slice(&v);
+            self.solve_in_place(&mut w);
+            let q = dot(&v, &w);
+            let settled = it >= 2 && (q - lo_inv).abs() <= 1e-3 * q;
+            lo_inv = lo_inv.max(q);
+            std::mem::swap(&mut v, &mut w);
+            normalise(&mut v);
+            if settled {
+                break;
+            }
         }
         hi * lo_inv
     }
