@@ -60,7 +60,8 @@ pub fn attr_fixed_ascii<const N: usize>(loc: &Location, name: &str, v: &str) -> 
     loc.new_attr::<FixedAscii<N>>().create(name)?.write_scalar(&s)
 }
 
-fn rows(start: usize, end: usize, rest: &[usize]) -> Selection {
+/// Selection of rows start..end (all of the other dimensions `rest`).
+pub fn rows(start: usize, end: usize, rest: &[usize]) -> Selection {
     let mut dims = vec![SliceOrIndex::SliceTo { start, step: 1, end, block: 1 }];
     dims.extend(rest.iter().map(|&r| SliceOrIndex::SliceTo { start: 0, step: 1, end: r, block: 1 }));
     Selection::from(Hyperslab::from(dims))
@@ -177,11 +178,6 @@ impl Series {
     /// Open an existing series.
     pub fn open(g: &Group, name: &str, block: usize) -> hdf5::Result<Series> {
         Series::wrap(g.dataset(name)?, block)
-    }
-
-    /// Number of steps the dataset has room for.
-    pub fn capacity(&self) -> usize {
-        self.capacity
     }
 
     /// Write steps first..first+count; `data` holds count · block · Π rest values of the dataset's

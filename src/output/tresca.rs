@@ -112,13 +112,12 @@ impl Tresca {
             put(&cg, "normal", &[nc, 2], &c.iter().flat_map(|c| c.normal).collect::<Vec<_>>())?;
             put(&cg, "tangent", &[nc, 2], &c.iter().flat_map(|c| c.tangent).collect::<Vec<_>>())?;
             put(&cg, "g", &[nc], &c.iter().map(|c| c.g_mean).collect::<Vec<_>>())?;
-            let k = sc;
             Some([
-                Series::create::<f64>(&cg, "slip", 1, &[nc], k)?,
-                Series::create::<f64>(&cg, "sigma_t", 1, &[nc], k)?,
-                Series::create::<u8>(&cg, "state", 1, &[nc], k)?,
-                Series::create::<f64>(&cg, "mu", 1, &[nc], k)?,
-                Series::create::<f64>(&cg, "dof", 1, &[nc], k)?,
+                Series::create::<f64>(&cg, "slip", 1, &[nc], sc)?,
+                Series::create::<f64>(&cg, "sigma_t", 1, &[nc], sc)?,
+                Series::create::<u8>(&cg, "state", 1, &[nc], sc)?,
+                Series::create::<f64>(&cg, "mu", 1, &[nc], sc)?,
+                Series::create::<f64>(&cg, "dof", 1, &[nc], sc)?,
             ])
         };
         let errors = if p.errors.is_some() {
@@ -260,11 +259,6 @@ impl Tresca {
     /// [`Series::set_steps`]).
     pub fn set_steps(&mut self, raw: &Raw, steps: usize, kept: usize) -> hdf5::Result<()> {
         self.all().into_iter().try_for_each(|s| s.set_steps(raw, steps, kept))
-    }
-
-    /// Steps every series has room for.
-    pub fn capacity(&mut self) -> usize {
-        self.all().iter().map(|s| s.capacity()).min().unwrap_or(0)
     }
 
     /// Rebuild the StepResult of stored step n (exact unknowns, μ, slip, state, statistics).

@@ -15,9 +15,9 @@
 //! resume, so it never names data the file does not hold.
 
 use super::fields::Fields;
-use super::h5::put;
+use super::h5::{put, rows};
 use super::vtkhdf::cell_arrays;
-use hdf5::{File, Group, Hyperslab, Selection, SliceOrIndex};
+use hdf5::{File, Group};
 use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
@@ -37,12 +37,6 @@ pub struct Xdmf {
     contact: bool,
     /// Frames of the whole run.
     total_frames: usize,
-}
-
-fn rows(start: usize, end: usize, rest: &[usize]) -> Selection {
-    let mut d = vec![SliceOrIndex::SliceTo { start, step: 1, end, block: 1 }];
-    d.extend(rest.iter().map(|&r| SliceOrIndex::SliceTo { start: 0, step: 1, end: r, block: 1 }));
-    Selection::from(Hyperslab::from(d))
 }
 
 /// The XDMF path of a results file: same stem, extension `xdmf`.
