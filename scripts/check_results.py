@@ -11,7 +11,8 @@
 
 Also for the file of a killed run (status ``running``): its series have room for every step of the run
 and only the first ``completed`` rows are data; every reader must still open it and see exactly the
-committed steps and frames.
+committed steps and frames. tresca-cr moves a file under its name only at its first commit, so a file
+without a committed step is reported as an error.
 
 Exits non-zero with one line per mismatch.
 """
@@ -66,7 +67,7 @@ def reference(g, S):
     tr = exx + eyy
     sxx, syy, szz, sxy = lam * tr + 2 * mu * exx, lam * tr + 2 * mu * eyy, lam * tr, 2 * mu * exy
     vm = np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2) + 3 * sxy ** 2)
-    return disp.reshape(len(u), -1, 2), vm, sxx
+    return disp.reshape(len(u), 3 * len(tri), 2), vm, sxx
 
 
 def main(argv=None):
@@ -81,6 +82,9 @@ def main(argv=None):
     S = int(g["steps"].attrs["completed"])
     T, E = len(g["mesh/triangles"]), len(g["mesh/edges"])
     C = len(g["contact/edges"]) if "contact" in g else 0
+    if not check(S >= 1, "no committed step: tresca-cr never leaves such a file under its name"):
+        print(f"FAILED: {args.h5}: {FAIL[0]}")
+        return 1
     # a finished or stopped run holds exactly its completed steps; a killed one ("running") has room for all
     killed = g.attrs["status"] == "running"
     R = int(g.attrs["steps"]) + 1 if killed else S

@@ -332,15 +332,25 @@ fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> 
             problem.run_selected(f, want, on_step)
         }),
     };
+    let mut committed = 0;
     if let Some(w) = writer {
         let status = match &result {
             Ok(()) => "completed".to_string(),
             Err(e) => format!("stopped: {e}"),
         };
-        w.finish(&status)?;
+        committed = w.finish(&status)?;
     }
-    if let (Err(_), Some(p)) = (&result, &path) {
-        eprintln!("every completed step is in {}; its `tresca` group records why the run stopped", p.display());
+    match (&result, &path) {
+        (Err(_), Some(p)) if committed == 0 => {
+            eprintln!(
+                "no step was committed, so no results file was written (an existing {} is left as it was)",
+                p.display()
+            )
+        }
+        (Err(_), Some(p)) => {
+            eprintln!("every completed step is in {}; its `tresca` group records why the run stopped", p.display())
+        }
+        _ => {}
     }
     result.with_context(|| "run stopped")?;
     bar.finish_and_clear();

@@ -134,7 +134,9 @@ fn bad_scenes_fail_cleanly() {
 }
 
 /// A `run -o` killed with SIGKILL at several moments leaves a file holding every completed step, and
-/// `--resume` then ends bit-identical to an uninterrupted run.
+/// `--resume` then ends bit-identical to an uninterrupted run. The kills land at fractions of the step
+/// phase of an uninterrupted run (from the moment its file appears under its name, i.e. after step 0
+/// is committed, to its end), so they fall mid-run however fast the machine is.
 #[test]
 fn sigkill_then_resume_is_bit_identical() {
     let scene = root("verification/cases/paper_example_5_1.toml");
@@ -144,20 +146,29 @@ fn sigkill_then_resume_is_bit_identical() {
             .map(|s| s.to_string())
             .collect()
     };
+    // poll until `out` exists (the run's first commit) or the child ends
+    let wait_for = |out: &Path, child: &mut std::process::Child| {
+        while !out.exists() && child.try_wait().unwrap().is_none() {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+    };
     let full = tmp("kill_full.h5");
-    let o = bin().args(args(&full)).arg("--force").output().unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
+    let start = std::time::Instant::now();
+    let mut child = bin().args(args(&full)).spawn().unwrap();
+    wait_for(&full, &mut child);
+    let appeared = start.elapsed();
+    assert!(child.wait().unwrap().success());
+    let phase = start.elapsed() - appeared;
     let mut killed_mid_run = 0;
-    for (i, delay_ms) in [40u64, 150, 400].into_iter().enumerate() {
+    for (i, frac) in [0.1, 0.5, 0.9].into_iter().enumerate() {
         let out = tmp(&format!("kill_{i}.h5"));
-        let mut child = bin().args(args(&out)).arg("--force").spawn().unwrap();
-        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let mut child = bin().args(args(&out)).spawn().unwrap();
+        wait_for(&out, &mut child);
+        std::thread::sleep(phase.mul_f64(frac));
         let finished = child.try_wait().unwrap().is_some();
         let _ = child.kill(); // SIGKILL on Unix
         let _ = child.wait();
-        if !out.exists() {
-            continue; // killed before the file was created: nothing to check
-        }
+        assert!(out.exists(), "kill {i}: the run's file is not under its name after its first commit");
         // every committed step is readable and equal to the uninterrupted run's
         let f = hdf5::File::open(&out).expect("a killed run's file opens");
         let done = f.group("tresca/steps").unwrap().attr("completed").unwrap().read_scalar::<i64>().unwrap() as usize;

@@ -261,6 +261,32 @@ fn non_finite_values_are_refused_and_earlier_steps_survive() {
     assert!(f64s(&f, "tresca/u").iter().all(|v| v.is_finite()));
 }
 
+/// A new file is moved under its name only at its first commit: a run that fails at step 0 (or is
+/// killed before it) leaves an old results file and its sidecar byte for byte as they were, and
+/// neither a file without a step nor `.partial` leftovers.
+#[test]
+fn a_run_that_commits_nothing_replaces_nothing() {
+    let p = Problem::new(example(0, 4)).unwrap();
+    let path = tmp("keep.h5");
+    run_written(&p, &path);
+    let xdmf = tresca_cr::output::sidecar(&path);
+    let (h5_before, xdmf_before) = (std::fs::read(&path).unwrap(), std::fs::read(&xdmf).unwrap());
+    let mut w = Writer::create(&path, &p, true).unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), h5_before, "created, nothing committed: old file in place");
+    let mut bad = p.initial().unwrap();
+    bad.u[0] = f64::NAN;
+    assert!(w.write_step(&bad).is_err());
+    w.finish("stopped: step 0").unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), h5_before);
+    assert_eq!(std::fs::read(&xdmf).unwrap(), xdmf_before);
+    let dir: Vec<_> = std::fs::read_dir(path.parent().unwrap())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("keep.") && n.ends_with(".partial"))
+        .collect();
+    assert!(dir.is_empty(), "leftovers {dir:?}");
+}
+
 #[test]
 fn resume_after_drop_is_bit_identical() {
     let p = Problem::new(example(1, 24)).unwrap();

@@ -5,11 +5,16 @@
 Requirement: the file of a run that was killed (SIGKILL, status "running"), of a run that stopped on a
 solver failure (status "stopped: ..."), and of a killed run finished with --resume, each opens in VTK's
 vtkHDFReader, meshio's XDMF reader and h5py, and each reader sees exactly the committed steps and frames
-with the solver's values (scripts/check_results.py). Found necessary: VTK 9.7's reader corrupts its heap
-when `Steps/Values` is longer than `NSteps`, which a killed run's file once had.
+with the solver's values (scripts/check_results.py). A run killed while it builds a new file over a
+complete one (--force) leaves the old pair run.h5 + run.xdmf readable and unchanged. Found necessary:
+VTK 9.7's reader corrupts its heap when `Steps/Values` is longer than `NSteps`, which a killed run's
+file once had; and run.xdmf was once truncated before the new run.h5 was in place (CI caught a kill in
+that window: a complete old run.h5 beside an empty XDMF collection).
 
-The kill lands mid-run: the uninterrupted run is timed first and the kill comes at half that time; the
-check fails if the killed file is complete or holds no step (then the kill missed the run).
+Kill timing does not depend on how fast the machine is: each attempt starts from no file, waits until the
+run's file appears under its final name (set-up and file creation done), then kills at a fraction of the
+step phase measured on an uninterrupted run. The check fails if the killed file is complete or holds no
+step (the kill missed the step phase), after retries that move the kill towards the middle.
 """
 import os
 import signal
@@ -42,31 +47,76 @@ def state(h5):
         return int(f["tresca/steps"].attrs["completed"]), str(f["tresca"].attrs["status"]), int(f["tresca"].attrs["steps"])
 
 
+def clear(h5):
+    for p in (h5, h5 + ".partial", h5[:-3] + ".xdmf", h5[:-3] + ".xdmf.partial"):
+        if os.path.exists(p):
+            os.remove(p)
+
+
+def wait_for(path, p, limit=120.0):
+    """Poll (1 ms) until `path` exists or the process `p` ends; return the time waited."""
+    t = time.perf_counter()
+    while not os.path.exists(path) and p.poll() is None and time.perf_counter() - t < limit:
+        time.sleep(0.001)
+    return time.perf_counter() - t
+
+
 def main():
     out = os.path.join(ROOT, "out", "interrupted")
     os.makedirs(out, exist_ok=True)
     run = [BIN, "run", EX51, "--refine", "3", "--steps", "2000", "-q"]
 
-    # 1. killed mid-run, then resumed
+    # 1. killed in the step phase, then resumed
     h5 = os.path.join(out, "killed.h5")
+    clear(h5)
     t = time.perf_counter()
-    subprocess.run(run + ["-o", h5, "--force"], check=True, capture_output=True)
-    whole = time.perf_counter() - t
-    for attempt in range(5):
-        p = subprocess.Popen(run + ["-o", h5, "--force"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        time.sleep(whole * 0.5)
+    p = subprocess.Popen(run + ["-o", h5], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    wait_for(h5, p)
+    setup = time.perf_counter() - t
+    p.wait()
+    phase = time.perf_counter() - t - setup  # steps after the file is in place
+    frac = 0.5
+    for attempt in range(6):
+        clear(h5)
+        p = subprocess.Popen(run + ["-o", h5], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        wait_for(h5, p)
+        time.sleep(frac * phase)
         p.send_signal(signal.SIGKILL)
         p.wait()
         done, status, n = state(h5)
+        print(f"      attempt {attempt}: kill {frac:.2f} x {phase * 1e3:.0f} ms into the step phase: "
+              f"{done} of {n + 1} steps committed, status {status!r}", flush=True)
         if 0 < done < n + 1 and status == "running":
             break
-        whole *= 1.5 if done == 0 else 0.7  # missed the run: retry with the kill later / earlier
+        frac = frac / 2 if done == n + 1 else min(0.5 * (1 + frac), 0.95)  # too late / too early
     check(0 < done < n + 1 and status == "running", f"killed run: {done} of {n + 1} steps committed, status {status!r}")
     clients(h5, "killed run")
     r = subprocess.run(run + ["-o", h5, "--resume"], capture_output=True, text=True)
     done, status, n = state(h5)
     check(r.returncode == 0 and done == n + 1 and status == "completed", f"resumed run: {done} steps, status {status!r}")
     clients(h5, "resumed run")
+
+    # 1b. killed while creating a new file over the complete one: the old pair stays as it was.
+    # --frame-every 1 makes creation long (8 virtual datasets per frame, 2001 frames).
+    with open(h5, "rb") as f:
+        before = f.read()
+    with open(h5[:-3] + ".xdmf", "rb") as f:
+        before_x = f.read()
+    p = subprocess.Popen(run + ["-o", h5, "--force", "--frame-every", "1"],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    wait_for(h5 + ".partial", p)
+    time.sleep(0.05)
+    building = os.path.exists(h5 + ".partial")
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    with open(h5, "rb") as f:
+        same = f.read() == before
+    with open(h5[:-3] + ".xdmf", "rb") as f:
+        same_x = f.read() == before_x
+    check(building and same and same_x,
+          f"killed while building a new file: new file still under .partial {building}, old run.h5 unchanged {same}, "
+          f"old run.xdmf unchanged {same_x}")
+    clients(h5, "old file after a kill during creation")
 
     # 2. stopped on a solver failure at step 1
     scene = os.path.join(out, "fail.toml")

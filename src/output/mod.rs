@@ -16,7 +16,11 @@
 //! batch to every time-dependent dataset (allocated for the whole run at creation, contiguous, written
 //! straight to the kernel: [`h5::Series`]), then sets `tresca/steps` attribute `completed` and
 //! `VTKHDF/Steps` attribute `NSteps`, flushes the file (H5Fflush: only these counters are dirty
-//! metadata), and only then appends the frames to `run.xdmf`. A process killed at any moment therefore
+//! metadata), and only then appends the frames to `run.xdmf`. A new file is built as `run.h5.partial` +
+//! `run.xdmf.partial` and both are renamed into place at the first commit (a run that commits nothing
+//! removes them), so a file under its name always holds at least step 0, and a run killed before that
+//! leaves an old pair as it was (the two renames follow each other; only between them does a new `run.h5` sit beside
+//! the old `run.xdmf`). A process killed at any moment therefore
 //! leaves every committed step readable and loses at most `commit_interval` seconds of work (rows beyond
 //! `completed`/`NSteps` hold no data; HDF5 has no journal, so a kill *inside* H5Fflush is the one
 //! window this does not cover). A run that stops (solver failure) is finished with every series cut to
@@ -95,8 +99,17 @@ pub struct Writer {
     frames_done: usize,
     last_commit: Instant,
     finished: bool,
+    /// A new file still under `run.h5.partial`: moved into place at its first commit ([`Writer::publish`]).
+    pending: Option<Pending>,
     /// Seconds spent in write_step (all of it) and in H5Fflush alone.
     pub seconds: [f64; 2],
+}
+
+/// A created file not yet under its name, and the old file it will replace (held open so its blocks are
+/// freed by a background thread, not by the rename).
+struct Pending {
+    partial: PathBuf,
+    old: Option<std::fs::File>,
 }
 
 fn ioerr(path: &Path, what: &'static str) -> impl FnOnce(std::io::Error) -> Error {
@@ -134,8 +147,8 @@ impl Writer {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(ioerr(path, "cannot create the directory"))?;
         }
-        // Build the file under a temporary name and rename it once its structure is flushed: a kill
-        // during creation leaves no half-made file under `path` (the open handle follows the rename).
+        // Build the file under a temporary name, renamed at its first commit (`publish`): a kill before
+        // that leaves no half-made file under `path` and an old file as it was (the handles follow the rename).
         let partial = PathBuf::from(format!("{}.partial", path.display()));
         let file = hdf5::File::with_options()
             .with_fapl(h5::file_access)
@@ -155,13 +168,7 @@ impl Writer {
             .map_err(ioerr(path, "writing the XDMF sidecar"))?;
         file.flush().map_err(io(path, "flush"))?;
         let raw = Raw::open(&partial).map_err(ioerr(path, "cannot open the new file for writing"))?;
-        // rename() replaces an old file atomically; freeing its blocks (tens of ms for a large file) is
-        // left to a background thread that holds it open across the rename and closes it.
-        let old = std::fs::File::open(path).ok();
-        std::fs::rename(&partial, path).map_err(ioerr(path, "cannot move the new file into place"))?;
-        if let Some(old) = old {
-            std::thread::spawn(move || drop(old));
-        }
+        let pending = Some(Pending { old: std::fs::File::open(path).ok(), partial });
         Ok(Writer {
             path: path.to_path_buf(),
             file,
@@ -182,8 +189,23 @@ impl Writer {
             frames_done: 0,
             last_commit: Instant::now(),
             finished: false,
+            pending,
             seconds: [0.0; 2],
         })
+    }
+
+    /// Move a new file and its sidecar into place (`rename`, atomic for each; the old file's blocks
+    /// are freed by a background thread). Done at the first commit, so a run killed or failing before
+    /// its step 0 is on disk leaves an old pair as it was and no file without a step.
+    fn publish(&mut self) -> Result<()> {
+        if let Some(Pending { partial, old }) = self.pending.take() {
+            std::fs::rename(&partial, &self.path).map_err(ioerr(&self.path, "cannot move the new file into place"))?;
+            if let Some(old) = old {
+                std::thread::spawn(move || drop(old));
+            }
+            self.xdmf.publish().map_err(ioerr(&self.path, "cannot move the XDMF sidecar into place"))?;
+        }
+        Ok(())
     }
 
     /// Number of steps committed to the file.
@@ -306,6 +328,7 @@ impl Writer {
                 .append_text(self.frames_done + k, n, t)
                 .map_err(ioerr(&self.xdmf.path.clone(), "appending to the XDMF sidecar"))?;
         }
+        self.publish()?;
         self.completed = steps;
         self.frames_done = nf;
         self.rows.reset(steps);
@@ -317,14 +340,24 @@ impl Writer {
 
     /// Commit what is buffered, record why the run stopped ("completed", or the error of the failed
     /// step) and close the file. A run that stopped early has its series cut to the completed steps.
-    pub fn finish(mut self, status: &str) -> Result<()> {
-        self.close(status)
+    /// Returns the number of steps in the file (0: no file was written, see [`Writer::publish`]).
+    pub fn finish(mut self, status: &str) -> Result<usize> {
+        self.close(status)?;
+        Ok(self.completed)
     }
 
     fn close(&mut self, status: &str) -> Result<()> {
         self.commit()?;
         self.finished = true;
         let path = self.path.clone();
+        if self.completed == 0 {
+            // nothing committed (the run failed at step 0): no results file replaces an old one
+            if let Some(Pending { partial, .. }) = self.pending.take() {
+                let _ = std::fs::remove_file(partial);
+                self.xdmf.discard();
+            }
+            return Ok(());
+        }
         if self.completed < self.frames.last + 1 {
             // a stopped run: series of exactly the completed steps, so no reader meets unwritten rows
             let (steps, frames) = (self.completed, self.frames_done);
@@ -337,7 +370,7 @@ impl Writer {
         }
         self.tresca.set_status(status).map_err(io(&path, "attribute status"))?;
         self.file.flush().map_err(io(&path, "flush"))?;
-        Ok(())
+        self.publish()
     }
 }
 

@@ -73,6 +73,7 @@ impl Writer {
         let xdmf = Xdmf::resume(&file, path, &frame_list, contact, frames.total())
             .map_err(ioerr(path, "rewriting the XDMF sidecar"))?;
         file.flush().map_err(io(path, "flush"))?;
+        xdmf.publish().map_err(ioerr(path, "cannot move the XDMF sidecar into place"))?;
         let w = Writer {
             path: path.to_path_buf(),
             file,
@@ -101,6 +102,7 @@ impl Writer {
             frames_done,
             last_commit: Instant::now(),
             finished: false,
+            pending: None,
             seconds: [0.0; 2],
         };
         Ok((w, last))

@@ -13,6 +13,12 @@
 //! no data yet, and a stopped run drops them ([`Xdmf::drop_frames_from`]). The text is appended per
 //! frame after the HDF5 step is flushed (seeking back over the closing tags), and rewritten whole on
 //! resume, so it never names data the file does not hold.
+//!
+//! The text is started under `run.xdmf.partial` and moved into place by [`Xdmf::publish`] only once
+//! `run.h5` is in place (after its own rename on create, after the flush on resume): a run killed while
+//! it builds a new file therefore leaves the old pair `run.h5` + `run.xdmf` as they were. (Found by
+//! `verification/interrupted_runs.py` on CI: truncating `run.xdmf` at creation, before the HDF5 rename,
+//! left a complete old `run.h5` beside an empty collection that meshio refuses.)
 
 use super::fields::Fields;
 use super::h5::{put, rows};
@@ -25,6 +31,8 @@ const TAIL: &str = "    </Grid>\n  </Domain>\n</Xdmf>\n";
 
 pub struct Xdmf {
     pub path: PathBuf,
+    /// Where the text is written until [`Xdmf::publish`] moves it to `path`.
+    partial: PathBuf,
     h5_name: String,
     /// One group per array of [`arrays`].
     groups: Vec<Group>,
@@ -132,7 +140,8 @@ impl Xdmf {
         total_frames: usize,
     ) -> std::io::Result<Xdmf> {
         let path = sidecar(h5_path);
-        let mut file = std::fs::File::create(&path)?;
+        let partial = PathBuf::from(format!("{}.partial", path.display()));
+        let mut file = std::fs::File::create(&partial)?;
         let head = "<?xml version=\"1.0\"?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n    \
                     <Grid Name=\"tresca\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
         file.write_all(head.as_bytes())?;
@@ -143,7 +152,30 @@ impl Xdmf {
             .collect::<hdf5::Result<Vec<_>>>()
             .map_err(std::io::Error::other)?;
         let h5_name = h5_path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        Ok(Xdmf { path, h5_name, groups, file, len: head.len() as u64, np, ncell, topo_len, contact, total_frames })
+        Ok(Xdmf {
+            path,
+            partial,
+            h5_name,
+            groups,
+            file,
+            len: head.len() as u64,
+            np,
+            ncell,
+            topo_len,
+            contact,
+            total_frames,
+        })
+    }
+
+    /// Move the text from `run.xdmf.partial` to `run.xdmf` (atomically replacing an old sidecar); the
+    /// open handle follows the rename, so later frames are appended to the published file.
+    pub fn publish(&self) -> std::io::Result<()> {
+        std::fs::rename(&self.partial, &self.path)
+    }
+
+    /// Remove an unpublished text (its run committed nothing).
+    pub fn discard(&self) {
+        let _ = std::fs::remove_file(&self.partial);
     }
 
     /// Create the virtual datasets of frame n.
