@@ -321,7 +321,8 @@ def results_clients():
     p = subprocess.run(chk, cwd=ROOT, capture_output=True, text=True)
     print(p.stdout[-3000:])
     require("O2-interrupted", "the files of a killed, a stopped and a resumed run shall open in VTK, meshio and h5py, "
-            "each showing exactly its committed steps", p.returncode == 0,
+            "each showing exactly its committed steps; a run killed while building a new file over a "
+            "complete one shall leave the old run.h5 and run.xdmf unchanged", p.returncode == 0,
             (p.stdout.strip().splitlines() or ["(no output)"])[-1][:200], " ".join(chk), "verification/interrupted_runs.py")
 
 
