@@ -191,6 +191,10 @@ def classify(dso, sym):
                       ("from_triplets", "sparse matrix from triplets (assembly)"), ("scatter", "assembly"),
                       ("assemble", "assembly"), ("sort", "assembly (triplet sort)"),
                       ("cholesky", "Cholesky (symbolic+numeric+solves)"), ("amd", "Cholesky (symbolic+numeric+solves)"),
+                      # Factor::with_ordering: faer's numeric factorisation inlined into it
+                      ("factor::", "Cholesky (symbolic+numeric+solves)"),
+                      ("pulp::", "faer SIMD kernels (pulp: factorisation updates, triangular solves)"),
+                      ("matvec", "sparse K·v (condition estimate, energies)"),
                       ("llt", "Cholesky (symbolic+numeric+solves)"), ("gemm", "dense kernels (gemm, condensation)"),
                       ("exmex", "expression evaluation"), ("output", "results writer (Rust side)"),
                       ("hdf5", "HDF5 library"), ("ssn", "friction QP (ssn/uzawa)"), ("uzawa", "friction QP (ssn/uzawa)"),
