@@ -106,6 +106,21 @@ fn output_options_are_checked() {
     let o = run(&["run", &scene, "--steps", "0"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("time.steps"), "{}", stderr(&o));
+    // --resume of a run killed before its first commit: only `.partial` exists, and the message says so
+    let missing = tmp("never_committed.h5");
+    let o = run(&["run", &scene, "-o", missing.to_str().unwrap(), "--resume"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("no results file to --resume"), "{}", stderr(&o));
+    assert!(!stderr(&o).contains(".partial"), "{}", stderr(&o));
+    std::fs::write(tmp("never_committed.h5.partial"), b"unfinished").unwrap();
+    let o = run(&["run", &scene, "-o", missing.to_str().unwrap(), "--resume"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("before committing step 0") && stderr(&o).contains("without --resume"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!missing.exists());
 }
 
 /// Bad scenes give exit status 1 and a message naming the file — never a panic.

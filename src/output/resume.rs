@@ -8,6 +8,15 @@ impl Writer {
     /// Reopen a results file of `problem` (same scene text, time grid, solver and mesh, else an error),
     /// and return the last complete step, from which `problem.run_from` continues.
     pub fn resume(path: &Path, problem: &Problem) -> Result<(Writer, StepResult)> {
+        if !path.exists() {
+            let partial = PathBuf::from(format!("{}.partial", path.display()));
+            let why = if partial.exists() {
+                "; its run stopped before committing step 0 (only a .partial file exists, holding no step): run it again without --resume"
+            } else {
+                ""
+            };
+            return Err(Error::Io { path: path.to_path_buf(), msg: format!("no results file to --resume{why}") });
+        }
         let file = hdf5::File::with_options()
             .with_fapl(h5::file_access)
             .open_rw(path)
