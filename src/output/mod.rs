@@ -16,11 +16,11 @@
 //! batch to every time-dependent dataset (allocated for the whole run at creation, contiguous, written
 //! straight to the kernel: [`h5::Series`]), then sets `tresca/steps` attribute `completed` and
 //! `VTKHDF/Steps` attribute `NSteps`, flushes the file (H5Fflush: only these counters are dirty
-//! metadata), and only then appends the frames to `run.xdmf`. A new file is built as `run.h5.partial` +
-//! `run.xdmf.partial` and both are renamed into place at the first commit (a run that commits nothing
-//! removes them), so a file under its name always holds at least step 0, and a run killed before that
-//! leaves an old pair as it was (the two renames follow each other; only between them does a new `run.h5` sit beside
-//! the old `run.xdmf`). A process killed at any moment therefore
+//! metadata), and only then appends the frames to `run.xdmf`. A new file is built as `run.h5.partial`
+//! and `run.xdmf.partial`, both renamed into place at the first commit (a run that commits
+//! nothing removes them), so a file under its name always holds at least step 0, and a run killed
+//! before that leaves an old pair as it was (the two renames follow each other; only between them does
+//! a new `run.h5` sit beside the old `run.xdmf`). A process killed at any moment therefore
 //! leaves every committed step readable and loses at most `commit_interval` seconds of work (rows beyond
 //! `completed`/`NSteps` hold no data; HDF5 has no journal, so a kill *inside* H5Fflush is the one
 //! window this does not cover). A run that stops (solver failure) is finished with every series cut to
