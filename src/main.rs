@@ -332,25 +332,16 @@ fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> 
             problem.run_selected(f, want, on_step)
         }),
     };
-    let mut committed = 0;
-    if let Some(w) = writer {
-        let status = match &result {
-            Ok(()) => "completed".to_string(),
-            Err(e) => format!("stopped: {e}"),
-        };
-        committed = w.finish(&status)?;
-    }
-    match (&result, &path) {
-        (Err(_), Some(p)) if committed == 0 => {
-            eprintln!(
-                "no step was committed, so no results file was written (an existing {} is left as it was)",
-                p.display()
-            )
+    let status = result.as_ref().map_or_else(|e| format!("stopped: {e}"), |()| "completed".to_string());
+    let committed = writer.map(|w| w.finish(&status)).transpose()?;
+    if let (Err(_), Some(p)) = (&result, &path) {
+        let p = p.display();
+        match committed {
+            Some(0) => {
+                eprintln!("no step was committed, so no results file was written (an existing {p} is left as it was)")
+            }
+            _ => eprintln!("every completed step is in {p}; its `tresca` group records why the run stopped"),
         }
-        (Err(_), Some(p)) => {
-            eprintln!("every completed step is in {}; its `tresca` group records why the run stopped", p.display())
-        }
-        _ => {}
     }
     result.with_context(|| "run stopped")?;
     bar.finish_and_clear();

@@ -106,21 +106,22 @@ fn output_options_are_checked() {
     let o = run(&["run", &scene, "--steps", "0"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("time.steps"), "{}", stderr(&o));
-    // --resume of a run killed before its first commit: only `.partial` exists, and the message says so
+    // --resume of a file that does not exist is refused, and writes nothing
     let missing = tmp("never_committed.h5");
     let o = run(&["run", &scene, "-o", missing.to_str().unwrap(), "--resume"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("no results file to --resume"), "{}", stderr(&o));
-    assert!(!stderr(&o).contains(".partial"), "{}", stderr(&o));
-    std::fs::write(tmp("never_committed.h5.partial"), b"unfinished").unwrap();
-    let o = run(&["run", &scene, "-o", missing.to_str().unwrap(), "--resume"]);
-    assert_eq!(o.status.code(), Some(1));
-    assert!(
-        stderr(&o).contains("before committing step 0") && stderr(&o).contains("without --resume"),
-        "{}",
-        stderr(&o)
-    );
     assert!(!missing.exists());
+    // ... unless the run was killed before its first commit (only `.partial` exists): then it starts the
+    // same run afresh, and the result equals an uninterrupted run's
+    let partial = tmp("never_committed.h5.partial");
+    std::fs::write(&partial, b"unfinished").unwrap();
+    let o = run(&["run", &scene, "-o", missing.to_str().unwrap(), "--resume", "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(missing.exists() && !partial.exists());
+    let full = tmp("uninterrupted.h5");
+    assert!(run(&["run", &scene, "-o", full.to_str().unwrap(), "-q"]).status.success());
+    common::same_results(&full, &missing);
 }
 
 /// Bad scenes give exit status 1 and a message naming the file — never a panic.

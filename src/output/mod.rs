@@ -112,6 +112,13 @@ struct Pending {
     old: Option<std::fs::File>,
 }
 
+/// `path` with `.partial` appended: where a new file (or sidecar) is built before it is moved into place.
+fn partial_path(path: &Path) -> PathBuf {
+    let mut s = path.as_os_str().to_owned();
+    s.push(".partial");
+    PathBuf::from(s)
+}
+
 fn ioerr(path: &Path, what: &'static str) -> impl FnOnce(std::io::Error) -> Error {
     let path = path.to_path_buf();
     move |e| Error::Io { path, msg: format!("{what}: {e}") }
@@ -149,7 +156,7 @@ impl Writer {
         }
         // Build the file under a temporary name, renamed at its first commit (`publish`): a kill before
         // that leaves no half-made file under `path` and an old file as it was (the handles follow the rename).
-        let partial = PathBuf::from(format!("{}.partial", path.display()));
+        let partial = partial_path(path);
         let file = hdf5::File::with_options()
             .with_fapl(h5::file_access)
             .create(&partial)

@@ -9,13 +9,11 @@ impl Writer {
     /// and return the last complete step, from which `problem.run_from` continues.
     pub fn resume(path: &Path, problem: &Problem) -> Result<(Writer, StepResult)> {
         if !path.exists() {
-            let partial = PathBuf::from(format!("{}.partial", path.display()));
-            let why = if partial.exists() {
-                "; its run stopped before committing step 0 (only a .partial file exists, holding no step): run it again without --resume"
-            } else {
-                ""
-            };
-            return Err(Error::Io { path: path.to_path_buf(), msg: format!("no results file to --resume{why}") });
+            if partial_path(path).exists() {
+                // killed before step 0 was committed (only `.partial` exists): start the same run afresh
+                return Writer::afresh(path, problem);
+            }
+            return Err(Error::Io { path: path.to_path_buf(), msg: "no results file to --resume".into() });
         }
         let file = hdf5::File::with_options()
             .with_fapl(h5::file_access)
@@ -52,12 +50,9 @@ impl Writer {
         let mut vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
         let completed = tresca.completed().map_err(io(path, "tresca/steps completed"))?;
         if completed == 0 {
-            // killed before step 0 was committed: nothing to keep, start the same run afresh
+            // a file without a step (written by a version that moved files into place before step 0)
             drop((vtk, tresca, file));
-            let mut w = Writer::create_with(path, problem, &Options { force: true, ..Options::default() })?;
-            let first = problem.initial()?;
-            w.write_step(&first)?;
-            return Ok((w, first));
+            return Writer::afresh(path, problem);
         }
         let times: Vec<f64> =
             tresca.group.dataset("times").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "tresca/times"))?;
@@ -115,5 +110,13 @@ impl Writer {
             seconds: [0.0; 2],
         };
         Ok((w, last))
+    }
+
+    /// `--resume` with nothing to keep: the same run from step 0, in a new file.
+    fn afresh(path: &Path, problem: &Problem) -> Result<(Writer, StepResult)> {
+        let mut w = Writer::create_with(path, problem, &Options { force: true, ..Options::default() })?;
+        let first = problem.initial()?;
+        w.write_step(&first)?;
+        Ok((w, first))
     }
 }

@@ -140,7 +140,7 @@ impl Xdmf {
         total_frames: usize,
     ) -> std::io::Result<Xdmf> {
         let path = sidecar(h5_path);
-        let partial = PathBuf::from(format!("{}.partial", path.display()));
+        let partial = super::partial_path(&path);
         let mut file = std::fs::File::create(&partial)?;
         let head = "<?xml version=\"1.0\"?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n    \
                     <Grid Name=\"tresca\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
