@@ -1,4 +1,4 @@
-//! The `tresca-cr` command line: `check`, `run`. Library errors become messages and exit codes here.
+//! The `tresca-cr` command line: `check`, `run`, `study`. Library errors become messages and exit codes here.
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
@@ -95,8 +95,8 @@ fn study(
     reference: Option<tresca_cr::study::Level>,
     csv: Option<PathBuf>,
 ) -> Result<()> {
+    use tresca_cr::study::orders::observed_order;
     use tresca_cr::study::{csv_row, run_study, CSV_HEADER};
-    let order = |a: f64, b: f64, ha: f64, hb: f64| (a / b).ln() / (ha / hb).ln();
     println!(
         "{:>3} {:>6} {:>9} {:>9} {:>8} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>8}",
         "ref", "steps", "h", "k", "DOF", "energy", "ord", "L2", "ord", "consec(T)", "ord", "vs ref(T)", "ord", "wall s"
@@ -107,13 +107,13 @@ fn study(
             // orders against h, or against k when only the time step changes
             (Some(p), Some(b)) => {
                 let (xa, xb) = if (p.h - r.h).abs() <= 1e-12 * r.h { (p.k, r.k) } else { (p.h, r.h) };
-                f(p).map(|a| format!("{:.3}", order(a, b, xa, xb))).unwrap_or_default()
+                f(p).map(|a| format!("{:.3}", observed_order(a, b, xa, xb))).unwrap_or_default()
             }
             _ => String::new(),
         };
         let v = |x: Option<f64>| x.map(|x| format!("{x:.4e}")).unwrap_or_else(|| "-".into());
-        let en = |r: &tresca_cr::study::LevelResult| r.max_err.map(|e| e[0]);
-        let l2 = |r: &tresca_cr::study::LevelResult| r.max_err.map(|e| e[2]);
+        let en = |r: &tresca_cr::study::LevelResult| r.max_err.map(|e| e.energy);
+        let l2 = |r: &tresca_cr::study::LevelResult| r.max_err.map(|e| e.l2);
         let co = |r: &tresca_cr::study::LevelResult| r.consecutive.map(|e| e[1]);
         let rf = |r: &tresca_cr::study::LevelResult| r.reference.map(|e| e[1]);
         println!(
@@ -209,10 +209,7 @@ fn check(scene: Scene) -> Result<()> {
     );
     println!(
         "material   E = {}, nu = {} (plane strain: lambda = {:.6e}, mu = {:.6e})",
-        s.material.e,
-        s.material.nu,
-        s.material.lambda(),
-        s.material.mu()
+        s.material.e, s.material.nu, problem.law.lam, problem.law.mu
     );
     for (p, part) in s.parts.iter().enumerate() {
         let n = sp.edge_part.iter().filter(|&&q| q == Some(p)).count();
@@ -259,7 +256,7 @@ fn check(scene: Scene) -> Result<()> {
 }
 
 fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> {
-    use tresca_cr::output::{Options, Writer};
+    use tresca_cr::output::{Options, Run, Writer};
     let start = std::time::Instant::now();
     let path = out.output.clone().or_else(|| scene.output.clone());
     anyhow::ensure!(!(out.resume && path.is_none()), "--resume needs a results file: give -o FILE");
@@ -269,19 +266,20 @@ fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> 
         "--commit-interval must be a non-negative number of seconds"
     );
     let problem = Problem::new(scene)?;
-    if std::env::var_os("TRESCA_GIT_COMMIT").is_none() {
-        std::env::set_var("TRESCA_GIT_COMMIT", env!("TRESCA_BUILD_COMMIT"));
-    }
+    let info = Run::of(&problem);
     let (mut writer, first) = match &path {
         Some(p) if out.resume => {
-            let (mut w, last) = Writer::resume(p, &problem)?;
+            let (mut w, last) = Writer::resume(p, &info)?;
             w.set_commit_interval(out.commit_interval);
-            eprintln!("resuming {} after step {} of {}", p.display(), last.n, problem.n_steps());
-            (Some(w), Some(last))
+            match &last {
+                Some(l) => eprintln!("resuming {} after step {} of {}", p.display(), l.n, problem.n_steps()),
+                None => eprintln!("{}: no step was committed before; running from step 0", p.display()),
+            }
+            (Some(w), last)
         }
         Some(p) => {
             let opts = Options { force: out.force, frame_every: out.frame_every, commit_interval: out.commit_interval };
-            (Some(Writer::create_with(p, &problem, &opts)?), None)
+            (Some(Writer::create_with(p, &info, &opts)?), None)
         }
         None => (None, None),
     };
@@ -292,7 +290,7 @@ fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> 
     } else {
         indicatif::ProgressBar::new(n as u64)
     };
-    let mut max_err = [0.0f64; 3];
+    let mut max_err = tresca_cr::fem::norms::ErrorNorms::default();
     let (mut iters, mut max_res) = (0usize, 0.0f64);
     let mut last = None;
     let on_step = |r: &tresca_cr::StepResult| -> tresca_cr::Result<()> {
@@ -300,7 +298,7 @@ fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> 
             w.write_step(r)?;
         }
         if let Some(e) = r.errors {
-            max_err = [max_err[0].max(e.energy), max_err[1].max(e.h1), max_err[2].max(e.l2)];
+            max_err = max_err.max(e);
         }
         iters += r.iterations;
         max_res = max_res.max(r.residual);
@@ -347,10 +345,10 @@ fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> 
     bar.finish_and_clear();
     let sp = &problem.space;
     println!("unknowns {} (paper DOF {}), contact edges {}, steps {}", sp.n_dofs, sp.paper_dofs(), sp.contact.len(), n);
-    let st = problem.setup_times;
+    let st = problem.setup;
     println!(
         "set-up: mesh {:.3}s, assembly {:.3}s, factorisation {:.3}s, condensation {:.3}s",
-        st[0], st[1], st[2], st[3]
+        st.space, st.assembly, st.factorisation, st.condensation
     );
     println!(
         "solver {}: {} iterations in all, max residual {:.2e}; wall time {:.3}s",
@@ -367,7 +365,7 @@ fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> 
     if problem.scene.exact.is_some() {
         println!(
             "max over time nodes: energy error {:.6e}, H1 error {:.6e}, L2 error {:.6e}",
-            max_err[0], max_err[1], max_err[2]
+            max_err.energy, max_err.h1, max_err.l2
         );
     }
     Ok(())

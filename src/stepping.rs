@@ -1,20 +1,23 @@
-//! Backward Euler in time: set-up once (mesh, space, K factored once, loads, condensed contact operator),
-//! then for n = 1..N solve
+//! Backward Euler in time: set-up once (mesh, space, K assembled and factored once, loads, the
+//! condensed friction operator), then for n = 1..N
 //!   uⁿ = argmin ½a_h(v,v) − (lⁿ,v) + j_h(v − uⁿ⁻¹),   u⁰ = I_CR u₀,
-//! by u_f = K⁻¹lⁿ, the condensed friction QP on Γ_C (`contact`, solved by `ssn`, `uzawa` or `pdas`),
-//! and uⁿ = u_f − K⁻¹Eμ. Without Γ_C a step is one pair of triangular solves. Each completed step is
-//! handed to a callback (the writer), so nothing is lost if a later step fails.
+//! in two calls, as the README describes a step: the free response u_f = K⁻¹lⁿ with its contact trace
+//! s_f (`solve::free`), then the friction problem on Γ_C for d = s_f − sⁿ⁻¹ (`friction`), and
+//! uⁿ = u_f − K⁻¹Eμ. Without Γ_C a step is the free response alone. Each completed step is handed to a
+//! callback (the writer), so nothing is lost if a later step fails.
 
-use crate::assemble::{matvec, stiffness, Loads};
-use crate::contact::{classify, Condensed, FrictionSolution, Qp};
-use crate::cr::CrSpace;
 use crate::error::{Error, Result};
-use crate::factor::Factor;
+use crate::fem::assemble::stiffness;
+use crate::fem::elasticity::Elasticity;
+use crate::fem::loads::Loads;
+use crate::fem::norms::{ErrorEvaluator, ErrorNorms};
+use crate::fem::space::CrSpace;
+use crate::friction::{EdgeState, Friction};
 use crate::mesh::Mesh;
-use crate::norms::{ErrorEvaluator, ErrorNorms};
-use crate::scene::{Method, Scene};
-use crate::superpose::LoadBasis;
-use crate::{pdas, ssn, uzawa};
+use crate::scene::Scene;
+use crate::solve::factor::Factor;
+use crate::solve::free::{Free, FreeResponse};
+use crate::sparse::{dot, energy};
 use faer::sparse::SparseColMat;
 use std::time::Instant;
 
@@ -26,17 +29,36 @@ pub struct Problem {
     pub scene: Scene,
     pub mesh: Mesh,
     pub space: CrSpace,
-    pub k: SparseColMat<usize, f64>,
-    pub llt: Factor,
-    pub loads: Loads,
-    /// Superposition of load patterns, when the loads span few of them (see `superpose`).
-    pub basis: Option<LoadBasis>,
-    pub condensed: Option<Condensed>,
+    pub law: Elasticity,
+    /// K, the matrix of a_h on V_h.
+    pub stiffness: SparseColMat<usize, f64>,
+    /// u_f = K⁻¹lⁿ and its contact trace; owns the factor of K.
+    pub free: FreeResponse,
+    /// The friction problem on Γ_C (`None` without Γ_C: plain elasticity).
+    pub friction: Option<Friction>,
+    /// True errors (when the scene gives `[exact]`).
     pub errors: Option<ErrorEvaluator>,
-    /// Wall times of the set-up phases (seconds): mesh+space, assembly, factorisation, condensation.
-    pub setup_times: [f64; 4],
-    /// Estimated condition number of K.
-    pub condition: f64,
+    pub setup: SetupTimes,
+}
+
+/// Wall times of the set-up phases (seconds).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SetupTimes {
+    /// Mesh binding and numbering of V_h.
+    pub space: f64,
+    /// K and the load quadrature.
+    pub assembly: f64,
+    /// Cholesky factorisation of K and its condition estimate.
+    pub factorisation: f64,
+    /// C = EᵀK⁻¹E (and Z) and the load superposition.
+    pub condensation: f64,
+}
+
+impl SetupTimes {
+    /// In the order written to results files: space, assembly, factorisation, condensation.
+    pub fn as_array(&self) -> [f64; 4] {
+        [self.space, self.assembly, self.factorisation, self.condensation]
+    }
 }
 
 /// What one time step produced.
@@ -50,8 +72,7 @@ pub struct StepResult {
     pub mu: Vec<f64>,
     /// Tangential displacement s_e per contact edge.
     pub slip: Vec<f64>,
-    /// 0 stick, 1 slip.
-    pub state: Vec<u8>,
+    pub state: Vec<EdgeState>,
     pub iterations: usize,
     pub residual: f64,
     /// a_h(uⁿ, uⁿ).
@@ -62,7 +83,7 @@ pub struct StepResult {
 
 impl StepResult {
     pub fn n_slip(&self) -> usize {
-        self.state.iter().filter(|&&s| s == 1).count()
+        self.state.iter().filter(|&&s| s == EdgeState::Slip).count()
     }
     pub fn n_stick(&self) -> usize {
         self.state.len() - self.n_slip()
@@ -81,13 +102,14 @@ impl Problem {
         let t0 = Instant::now();
         let space = CrSpace::new(&mesh, &scene.parts)?;
         let t1 = Instant::now();
-        let k = stiffness(&mesh, &space, &scene.material, scene.rho)?;
+        let law = Elasticity::new(&scene.material);
+        let stiffness = stiffness(&mesh, &space, &law, scene.rho);
         let loads = Loads::new(&scene, &mesh, &space);
         let t2 = Instant::now();
-        let llt = Factor::new(&k, std::env::var_os("TRESCA_SIMPLICIAL").is_some())?;
+        let factor = Factor::new(&stiffness)?;
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
         // ranges) factorises without complaint but returns meaningless displacements: refuse it.
-        let kappa = llt.condition_estimate(&k, 12);
+        let kappa = factor.condition_estimate(&stiffness, 12);
         if !(kappa < MAX_CONDITION) {
             return Err(Error::Linear(format!(
                 "the stiffness matrix is too ill-conditioned (condition number ≳ {kappa:.1e} > {MAX_CONDITION:.0e}; \
@@ -97,22 +119,25 @@ impl Problem {
             )));
         }
         let t3 = Instant::now();
-        let condensed = if space.contact.is_empty() { None } else { Some(Condensed::new(&space, &llt)) };
-        let basis = LoadBasis::build(&loads, &space, &scene.times, &llt)?;
+        let (free, c) = FreeResponse::new(factor, loads, &space, &scene.times)?;
+        let friction = c.map(|c| Friction::new(&space, c, scene.solver));
         let t4 = Instant::now();
-        let errors = scene.exact.as_ref().map(|_| ErrorEvaluator::new(&mesh, &space, &scene.material, scene.rho));
+        let errors = scene.exact.as_ref().map(|_| ErrorEvaluator::new(&mesh, &space, &law, scene.rho));
         let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
         Ok(Problem {
-            setup_times: [d(t0, t1), d(t1, t2), d(t2, t3), d(t3, t4)],
-            condition: kappa,
+            setup: SetupTimes {
+                space: d(t0, t1),
+                assembly: d(t1, t2),
+                factorisation: d(t2, t3),
+                condensation: d(t3, t4),
+            },
             scene,
             mesh,
             space,
-            k,
-            llt,
-            loads,
-            basis,
-            condensed,
+            law,
+            stiffness,
+            free,
+            friction,
             errors,
         })
     }
@@ -131,16 +156,14 @@ impl Problem {
         };
         let nc = self.space.contact.len();
         let slip = self.space.contact.iter().map(|c| u[c.dof]).collect();
-        let mut ku = vec![0.0; u.len()];
-        matvec(&self.k, &u, &mut ku);
-        let energy = u.iter().zip(&ku).map(|(a, b)| a * b).sum();
+        let energy = energy(&self.stiffness, &u);
         let r = StepResult {
             n: 0,
             t,
             u,
             mu: vec![0.0; nc],
             slip,
-            state: vec![0; nc],
+            state: vec![EdgeState::Stick; nc],
             iterations: 0,
             residual: 0.0,
             energy,
@@ -172,32 +195,10 @@ impl Problem {
     pub fn step(&self, n: usize, prev: &StepResult, load: &mut Vec<f64>, want_u: bool) -> Result<StepResult> {
         let start = Instant::now();
         let t = self.scene.times[n];
-        let dofs = self.space.n_dofs;
-        let mut u = Vec::new();
-        // u_f = K⁻¹ l(t) where needed; its contact trace s_f always
-        let s_free: Vec<f64> = match (&self.basis, &self.condensed) {
-            (Some(b), cd) => {
-                if want_u || cd.is_none() {
-                    b.load(n, dofs, load);
-                    b.response(n, dofs, &mut u);
-                }
-                cd.as_ref().map(|c| b.response_at(n, &c.dofs)).unwrap_or_default()
-            }
-            (None, cd) => {
-                self.loads.assemble(&self.space, t, load)?;
-                match cd {
-                    Some(c) if !want_u && c.z.is_some() => c.trace_of_solution(load),
-                    _ => {
-                        u.extend_from_slice(load);
-                        self.llt.solve_in_place(&mut u);
-                        cd.as_ref().map(|c| c.dofs.iter().map(|&k| u[k]).collect()).unwrap_or_default()
-                    }
-                }
-            }
-        };
-        let Some(cd) = &self.condensed else {
+        let Free { mut u, trace } = self.free.at(n, t, want_u, load)?;
+        let Some(friction) = &self.friction else {
             // a_h(u, u) = (l, u)
-            let energy = load.iter().zip(&u).map(|(a, b)| a * b).sum();
+            let energy = dot(load, &u);
             let r = StepResult {
                 n,
                 t,
@@ -213,33 +214,15 @@ impl Problem {
             };
             return self.finish(r);
         };
-        let d: Vec<f64> = s_free.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
-        let qp = Qp { c: &cd.c, d: &d, w: &cd.w };
-        let s = &self.scene.solver;
-        let sol: Result<FrictionSolution> = match s.method {
-            Method::Ssn => ssn::solve(&qp, &prev.mu, s.tol, s.max_iter()),
-            Method::Pdas => pdas::solve(&qp, &prev.mu, s.tol, s.max_iter()),
-            Method::Uzawa => {
-                let rho = if s.uzawa_step > 0.0 { s.uzawa_step } else { uzawa::auto_step(&qp, &cd.g) };
-                uzawa::solve(&qp, &cd.g, &prev.mu, rho, s.tol, s.max_iter())
-            }
-        };
-        let sol = sol.map_err(|e| match e {
-            Error::NotConverged { solver, iterations, residual, tol, .. } => {
-                Error::NotConverged { step: n, time: t, solver, iterations, residual, tol }
-            }
-            other => other,
-        })?;
+        let d: Vec<f64> = trace.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
+        let sol = friction.solve(&d, &prev.mu, n, t)?;
         // s = s_f − Cμ
-        let ds = qp.slip_increment(&sol.mu);
-        let slip: Vec<f64> = prev.slip.iter().zip(&ds).map(|(a, b)| a + b).collect();
-        let state = classify(&qp, &sol.mu, &ds);
+        let slip: Vec<f64> = prev.slip.iter().zip(&sol.slip_increment).map(|(a, b)| a + b).collect();
         let mut energy = f64::NAN;
         if want_u {
-            cd.apply_friction(&self.llt, &mut u, &sol.mu);
+            self.free.subtract_friction(&mut u, &sol.mu);
             // a_h(u, u) = (l, u) − Σ_e μ_e s_e, since K u = l − Eμ
-            let load_work: f64 = load.iter().zip(&u).map(|(a, b)| a * b).sum();
-            energy = load_work - sol.mu.iter().zip(&slip).map(|(m, s)| m * s).sum::<f64>();
+            energy = dot(load, &u) - dot(&sol.mu, &slip);
         }
         let r = StepResult {
             n,
@@ -247,7 +230,7 @@ impl Problem {
             u,
             mu: sol.mu,
             slip,
-            state,
+            state: sol.state,
             iterations: sol.iterations,
             residual: sol.residual,
             energy,

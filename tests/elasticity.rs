@@ -2,10 +2,12 @@
 
 mod common;
 use common::*;
-use tresca_cr::assemble::{matvec, stiffness};
-use tresca_cr::cr::CrSpace;
+use tresca_cr::fem::assemble::stiffness;
+use tresca_cr::fem::elasticity::Elasticity;
+use tresca_cr::fem::space::CrSpace;
 use tresca_cr::mesh::{Mesh, RawMesh};
 use tresca_cr::scene::{Part, PartKind};
+use tresca_cr::sparse::matvec;
 use tresca_cr::{Problem, Scene};
 
 /// Affine field u = (a x, b x) (zero on x = 0) with σ constant; tractions σn on the other sides.
@@ -125,7 +127,7 @@ fn rigid_motions_are_in_the_kernel_and_clamping_makes_k_spd() {
         .map(|n| Part { name: n.to_string(), kind: PartKind::Neumann(None) })
         .collect();
     let space = CrSpace::new(&mesh, &free).unwrap();
-    let k = stiffness(&mesh, &space, &mat, 10.0).unwrap();
+    let k = stiffness(&mesh, &space, &Elasticity::new(&mat), 10.0);
     let norm_k = k.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
     for r in [|_x: f64, _y: f64| [1.0, 0.0], |_x, _y| [0.0, 1.0], |x: f64, y: f64| [-y, x]] {
         let u: Vec<f64> = (0..mesh.edges.len()).flat_map(|e| r(mesh.midpoint(e)[0], mesh.midpoint(e)[1])).collect();
@@ -144,7 +146,7 @@ fn rigid_motions_are_in_the_kernel_and_clamping_makes_k_spd() {
     let mut clamped = free.clone();
     clamped[3].kind = PartKind::Dirichlet;
     let space = CrSpace::new(&mesh, &clamped).unwrap();
-    let k = stiffness(&mesh, &space, &mat, 10.0).unwrap();
+    let k = stiffness(&mesh, &space, &Elasticity::new(&mat), 10.0);
     let n = space.n_dofs;
     let mut dense = nalgebra::DMatrix::<f64>::zeros(n, n);
     for j in 0..n {

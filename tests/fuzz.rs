@@ -136,7 +136,7 @@ fn expressions() {
     fuzz("expression", strategy, |(text, x, y, t)| {
         let mut outcome = "parse error";
         no_panic("expression", &text, || {
-            if let Ok(e) = tresca_cr::expr::Expr::parse("fuzz", &text) {
+            if let Ok(e) = tresca_cr::scene::expr::Expr::parse("fuzz", &text) {
                 outcome = match e.eval(x, y, t) {
                     Ok(v) => {
                         assert!(v.is_finite());

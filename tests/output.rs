@@ -6,8 +6,8 @@ use common::same_results;
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-use tresca_cr::cr::Element;
-use tresca_cr::output::{sidecar, Writer};
+use tresca_cr::fem::space::Element;
+use tresca_cr::output::{sidecar, Run, Writer};
 use tresca_cr::{Problem, Scene, StepResult};
 
 fn tmp(name: &str) -> PathBuf {
@@ -27,7 +27,7 @@ fn example(refine: u32, steps: usize) -> Scene {
 
 /// Run `p`, writing every step; returns the results.
 fn run_written(p: &Problem, path: &Path) -> Vec<StepResult> {
-    let mut w = Writer::create(path, p, true).unwrap();
+    let mut w = Writer::create(path, &Run::of(&p), true).unwrap();
     let mut out = Vec::new();
     p.run(|r| {
         out.push(r.clone());
@@ -114,7 +114,7 @@ fn check_file(p: &Problem, rs: &[StepResult], path: &Path) {
         for (n, r) in rs.iter().enumerate() {
             assert_eq!(&slip[n * nc..(n + 1) * nc], &r.slip[..]);
             assert_eq!(&mu[n * nc..(n + 1) * nc], &r.mu[..]);
-            assert_eq!(&state[n * nc..(n + 1) * nc], &r.state[..]);
+            assert!(state[n * nc..(n + 1) * nc].iter().zip(&r.state).all(|(a, b)| *a == *b as u8));
             for k in 0..nc {
                 assert_eq!(sig[n * nc + k], -r.mu[k] / sp.contact[k].length);
             }
@@ -138,7 +138,7 @@ fn check_file(p: &Problem, rs: &[StepResult], path: &Path) {
     let disp = f32s(&f, "VTKHDF/PointData/displacement");
     let vm = f32s(&f, "VTKHDF/CellData/von_mises");
     let stress = f32s(&f, "VTKHDF/CellData/stress");
-    let (lam, mu) = (p.scene.material.lambda(), p.scene.material.mu());
+    let (lam, mu) = (p.law.lam, p.law.mu);
     for (n, r) in rs.iter().enumerate() {
         let mid = sp.midpoint_values(&r.u);
         let mut want = Vec::new();
@@ -234,17 +234,17 @@ fn existing_file_is_refused_without_force() {
     let p = Problem::new(example(0, 2)).unwrap();
     let path = tmp("exists.h5");
     std::fs::write(&path, b"keep me").unwrap();
-    let err = Writer::create(&path, &p, false).err().expect("must refuse").to_string();
+    let err = Writer::create(&path, &Run::of(&p), false).err().expect("must refuse").to_string();
     assert!(err.contains(&path.display().to_string()) && err.contains("--force") && err.contains("--resume"), "{err}");
     assert_eq!(std::fs::read(&path).unwrap(), b"keep me");
-    Writer::create(&path, &p, true).unwrap();
+    Writer::create(&path, &Run::of(&p), true).unwrap();
 }
 
 #[test]
 fn non_finite_values_are_refused_and_earlier_steps_survive() {
     let p = Problem::new(example(0, 4)).unwrap();
     let path = tmp("nan.h5");
-    let mut w = Writer::create(&path, &p, true).unwrap();
+    let mut w = Writer::create(&path, &Run::of(&p), true).unwrap();
     let r0 = p.initial().unwrap();
     w.write_step(&r0).unwrap();
     let mut bad = p.step(1, &r0, &mut Vec::new(), true).unwrap();
@@ -271,7 +271,7 @@ fn a_run_that_commits_nothing_replaces_nothing() {
     run_written(&p, &path);
     let xdmf = tresca_cr::output::sidecar(&path);
     let (h5_before, xdmf_before) = (std::fs::read(&path).unwrap(), std::fs::read(&xdmf).unwrap());
-    let mut w = Writer::create(&path, &p, true).unwrap();
+    let mut w = Writer::create(&path, &Run::of(&p), true).unwrap();
     assert_eq!(std::fs::read(&path).unwrap(), h5_before, "created, nothing committed: old file in place");
     let mut bad = p.initial().unwrap();
     bad.u[0] = f64::NAN;
@@ -294,7 +294,7 @@ fn resume_after_drop_is_bit_identical() {
     run_written(&p, &full);
     let part = tmp("part.h5");
     {
-        let mut w = Writer::create(&part, &p, false).unwrap();
+        let mut w = Writer::create(&part, &Run::of(&p), false).unwrap();
         let mut k = 0;
         let r = p.run(|r| {
             k += 1;
@@ -306,9 +306,10 @@ fn resume_after_drop_is_bit_identical() {
         assert!(r.is_err());
         // dropped without finish: as after a crash between steps
     }
-    let err = Writer::create(&part, &p, false).err().unwrap().to_string();
+    let err = Writer::create(&part, &Run::of(&p), false).err().unwrap().to_string();
     assert!(err.contains("--resume"));
-    let (mut w, last) = Writer::resume(&part, &p).unwrap();
+    let (mut w, last) = Writer::resume(&part, &Run::of(&p)).unwrap();
+    let last = last.expect("a committed step");
     assert_eq!((last.n, w.completed()), (8, 9));
     p.run_from(last, |r| w.write_step(r)).unwrap();
     w.finish("completed").unwrap();
@@ -321,14 +322,14 @@ fn resume_refuses_a_different_run() {
     let path = tmp("other.h5");
     run_written(&p, &path);
     let q = Problem::new(example(0, 8)).unwrap();
-    let err = Writer::resume(&path, &q).err().unwrap().to_string();
+    let err = Writer::resume(&path, &Run::of(&q)).err().unwrap().to_string();
     assert!(err.contains("time steps"), "{err}");
     let q = Problem::new(example(1, 6)).unwrap();
-    let err = Writer::resume(&path, &q).err().unwrap().to_string();
+    let err = Writer::resume(&path, &Run::of(&q)).err().unwrap().to_string();
     assert!(err.contains("mesh"), "{err}");
     let mut s = example(0, 6);
     s.text.push_str("\n# changed\n");
-    let err = Writer::resume(&path, &Problem::new(s).unwrap()).err().unwrap().to_string();
+    let err = Writer::resume(&path, &Run::of(&Problem::new(s).unwrap())).err().unwrap().to_string();
     assert!(err.contains("scene"), "{err}");
 }
 
@@ -337,7 +338,7 @@ fn resume_refuses_a_different_run() {
 fn kill_child_writer() {
     let Ok(path) = std::env::var("TRESCA_KILL_CHILD") else { return };
     let p = Problem::new(example(1, 400)).unwrap();
-    let mut w = Writer::create(Path::new(&path), &p, true).unwrap();
+    let mut w = Writer::create(Path::new(&path), &Run::of(&p), true).unwrap();
     p.run(|r| {
         std::thread::sleep(Duration::from_micros(300));
         w.write_step(r)
@@ -391,7 +392,8 @@ fn sigkill_at_random_moments_leaves_complete_steps_and_resume_is_bit_identical()
         if done == 0 {
             continue;
         }
-        let (mut w, last) = Writer::resume(&path, &p).unwrap();
+        let (mut w, last) = Writer::resume(&path, &Run::of(&p)).unwrap();
+        let last = last.expect("a committed step");
         assert_eq!(last.n + 1, done);
         p.run_from(last, |r| w.write_step(r)).unwrap();
         w.finish("completed").unwrap();
@@ -426,7 +428,7 @@ fn timing_example_5_1_finest() {
     ] {
         let path = tmp("timing.h5");
         let t1 = Instant::now();
-        let mut w = Writer::create_with(&path, &p, &opts).unwrap();
+        let mut w = Writer::create_with(&path, &Run::of(&p), &opts).unwrap();
         let create = t1.elapsed().as_secs_f64();
         let t2 = Instant::now();
         p.run(|r| w.write_step(r)).unwrap();

@@ -11,11 +11,31 @@ mod refine;
 mod structured;
 
 use crate::error::{Error, Result};
-use crate::scene::{MeshSpec, Part};
+use serde::Deserialize;
 use std::collections::HashMap;
+use std::path::PathBuf;
 
 pub use gmsh::parse as parse_gmsh;
 pub use structured::generate as structured_raw;
+
+/// Direction of the diagonal splitting each structured cell.
+#[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
+#[serde(rename_all = "lowercase")]
+pub enum Diagonal {
+    /// Cell (i, j) split along p(i, j)–p(i+1, j+1).
+    First,
+    /// Cell (i, j) split along p(i+1, j)–p(i, j+1).
+    Second,
+}
+
+/// Where the mesh comes from.
+#[derive(Clone, Debug)]
+pub enum MeshSpec {
+    /// Quadrilateral c0 c1 c2 c3 (counter-clockwise), n × m cells, each split by one diagonal.
+    Structured { corners: [[f64; 2]; 4], cells: [usize; 2], diagonal: Diagonal, refine: u32 },
+    /// Gmsh 4.1 ASCII file, `refine` red refinements.
+    Gmsh { path: PathBuf, refine: u32 },
+}
 
 /// Mesh data before topology is built: points, triangles and tagged boundary edges.
 #[derive(Clone, Debug)]
@@ -195,12 +215,12 @@ impl Mesh {
         })
     }
 
-    /// Scene part index of every boundary edge (`None` for interior edges). Every boundary edge must be
-    /// in a declared part, and every declared part must have edges.
-    pub fn bind_parts(&self, parts: &[Part]) -> Result<Vec<Option<usize>>> {
+    /// Index in `parts` (the scene's boundary part names) of every boundary edge (`None` for interior
+    /// edges). Every boundary edge must be in a declared part, and every declared part must have edges.
+    pub fn bind_parts(&self, parts: &[&str]) -> Result<Vec<Option<usize>>> {
         let src = self.source.as_str();
         let tag_to_part: Vec<Option<usize>> =
-            self.tag_names.iter().map(|n| parts.iter().position(|p| &p.name == n)).collect();
+            self.tag_names.iter().map(|n| parts.iter().position(|p| p == n)).collect();
         let mut out = vec![None; self.edges.len()];
         let mut count = vec![0usize; parts.len()];
         for e in 0..self.edges.len() {
@@ -228,7 +248,7 @@ impl Mesh {
                 let known = self.tag_names.join(", ");
                 return Err(Error::mesh(
                     src,
-                    format!("scene part `{}` has no boundary edges in the mesh (mesh parts: {known})", p.name),
+                    format!("scene part `{p}` has no boundary edges in the mesh (mesh parts: {known})"),
                 ));
             }
         }
@@ -278,7 +298,6 @@ impl Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Diagonal;
 
     fn square(n: usize) -> Mesh {
         let c = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]];

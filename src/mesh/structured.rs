@@ -2,9 +2,8 @@
 //! p(i, j) = bilinear image of (i/n, j/m), and each cell is split by one diagonal, all parallel.
 //! Sides are tagged `bottom` (c0→c1), `right` (c1→c2), `top` (c2→c3), `left` (c3→c0).
 
-use super::{area2, RawMesh};
+use super::{area2, Diagonal, RawMesh};
 use crate::error::{Error, Result};
-use crate::scene::Diagonal;
 
 /// Generate the n × m mesh.
 pub fn generate(c: &[[f64; 2]; 4], [n, m]: [usize; 2], diagonal: Diagonal) -> Result<RawMesh> {

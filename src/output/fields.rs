@@ -15,8 +15,10 @@
 //! Contact cell arrays (zero on triangles): `sigma_t` = σ_τ·τ_e = −μ_e/|e|, `slip` = u_τ(m_e),
 //! `slip_increment` = sⁿ − sⁿ⁻¹ (0 at step 0), `stick_slip` = 0 stick, 1 slip.
 
-use crate::cr::Element;
-use crate::stepping::{Problem, StepResult};
+use super::Run;
+use crate::fem::elasticity::{von_mises, Elasticity};
+use crate::fem::space::Element;
+use crate::stepping::StepResult;
 
 /// Components of the strain and stress arrays.
 pub const TENSOR: usize = 6;
@@ -35,14 +37,13 @@ pub struct Fields {
     pub cell_kind: Vec<u8>,
     /// tri_edges of every triangle.
     tri_edges: Vec<[usize; 3]>,
-    /// ∇φ_i of every triangle.
-    grad_phi: Vec<[[f64; 2]; 3]>,
+    /// Element geometry of every triangle.
+    elements: Vec<Element>,
     /// Triangle of each contact edge.
     contact_tri: Vec<usize>,
     /// |e| of each contact edge.
     contact_len: Vec<f64>,
-    lam: f64,
-    mu: f64,
+    law: Elasticity,
 }
 
 /// One step's cell and point arrays (f32, as written).
@@ -59,19 +60,18 @@ pub struct StepFields {
 }
 
 impl Fields {
-    pub fn new(p: &Problem) -> Fields {
-        let (mesh, space) = (&p.mesh, &p.space);
+    pub fn new(p: &Run) -> Fields {
+        let (mesh, space) = (p.mesh, p.space);
         let nt = mesh.tris.len();
         let nc = space.contact.len();
         let mut points = Vec::with_capacity(3 * nt);
-        let mut grad_phi = Vec::with_capacity(nt);
+        let mut elements = Vec::with_capacity(nt);
         for (t, tri) in mesh.tris.iter().enumerate() {
             for &v in tri {
                 let x = mesh.points[v];
                 points.push([x[0], x[1], 0.0]);
             }
-            let el = Element::new(mesh, t);
-            grad_phi.push([el.grad_phi(0), el.grad_phi(1), el.grad_phi(2)]);
+            elements.push(Element::new(mesh, t));
         }
         let mut connectivity: Vec<i64> = (0..3 * nt as i64).collect();
         let mut types = vec![5u8; nt];
@@ -98,11 +98,10 @@ impl Fields {
             offsets,
             cell_kind,
             tri_edges: mesh.tri_edges.clone(),
-            grad_phi,
+            elements,
             contact_tri,
             contact_len,
-            lam: p.scene.material.lambda(),
-            mu: p.scene.material.mu(),
+            law: p.law,
         }
     }
 
@@ -130,28 +129,17 @@ impl Fields {
         out.strain.reserve(TENSOR * ncell);
         out.stress.reserve(TENSOR * ncell);
         out.von_mises.reserve(ncell);
-        let (lam, mu) = (self.lam, self.mu);
-        for (te, gp) in self.tri_edges.iter().zip(&self.grad_phi) {
+        for (te, el) in self.tri_edges.iter().zip(&self.elements) {
             let u = te.map(|e| mid[e]);
             let s = [u[0][0] + u[1][0] + u[2][0], u[0][1] + u[1][1] + u[2][1]];
             for uj in &u {
                 out.displacement.extend_from_slice(&[(s[0] - 2.0 * uj[0]) as f32, (s[1] - 2.0 * uj[1]) as f32, 0.0]);
             }
-            let mut g = [[0.0; 2]; 2];
-            for (ui, gi) in u.iter().zip(gp) {
-                for a in 0..2 {
-                    for b in 0..2 {
-                        g[a][b] += ui[a] * gi[b];
-                    }
-                }
-            }
-            let (exx, eyy, exy) = (g[0][0], g[1][1], 0.5 * (g[0][1] + g[1][0]));
-            let tr = exx + eyy;
-            let (sxx, syy, szz, sxy) = (lam * tr + 2.0 * mu * exx, lam * tr + 2.0 * mu * eyy, lam * tr, 2.0 * mu * exy);
+            let ss = self.law.strain_stress(el.gradient(u));
+            let ([exx, eyy, exy], [sxx, syy, szz, sxy]) = (ss.strain, ss.stress);
             out.strain.extend_from_slice(&[exx as f32, eyy as f32, 0.0, exy as f32, 0.0, 0.0]);
             out.stress.extend_from_slice(&[sxx as f32, syy as f32, szz as f32, sxy as f32, 0.0, 0.0]);
-            let vm = (0.5 * ((sxx - syy).powi(2) + (syy - szz).powi(2) + (szz - sxx).powi(2)) + 3.0 * sxy * sxy).sqrt();
-            out.von_mises.push(vm as f32);
+            out.von_mises.push(von_mises(ss.stress) as f32);
         }
         for &t in &self.contact_tri {
             out.strain.extend_from_within(TENSOR * t..TENSOR * (t + 1));
@@ -171,7 +159,7 @@ impl Fields {
             out.sigma_t.push((-r.mu[k] / self.contact_len[k]) as f32);
             out.slip.push(r.slip[k] as f32);
             out.slip_increment.push(prev_slip.map_or(0.0, |p| r.slip[k] - p[k]) as f32);
-            out.stick_slip.push(r.state[k]);
+            out.stick_slip.push(r.state[k] as u8);
         }
     }
 }

@@ -30,7 +30,7 @@
 //! stored exactly. Non-finite values are refused before anything of the step is written.
 //!
 //! Attributes of `/tresca`: `scene` (full text), `scene_path`, `title`, `version` (crate),
-//! `git_commit` (environment variable `TRESCA_GIT_COMMIT` at run time, else "unknown"), `solver`, `tol`,
+//! `git_commit` (of the build, from `build.rs`), `solver`, `tol`,
 //! `max_iter`, `uzawa_step`, `rho`, `E`, `nu`, `steps` (N), `n_edges`, `n_contact`, `n_dofs`,
 //! `paper_dofs`, `h`, `setup_times` (4 wall times, s), `status` ("running", then what
 //! [`Writer::finish`] records: "completed" or the error of the failed step).
@@ -42,9 +42,12 @@ pub mod tresca;
 pub mod vtkhdf;
 pub mod xdmf;
 
-use crate::cr::CrSpace;
 use crate::error::{Error, Result};
-use crate::stepping::{Problem, StepResult};
+use crate::fem::elasticity::Elasticity;
+use crate::fem::space::CrSpace;
+use crate::mesh::Mesh;
+use crate::scene::Scene;
+use crate::stepping::{Problem, SetupTimes, StepResult};
 use fields::{Fields, StepFields};
 use h5::{io, Raw};
 use std::path::{Path, PathBuf};
@@ -73,6 +76,62 @@ impl Default for Options {
     fn default() -> Self {
         Options { force: false, frame_every: None, commit_interval: 0.0 }
     }
+}
+
+/// What a results file records about a run besides its steps.
+#[derive(Clone, Copy, Debug)]
+pub struct RunMeta {
+    /// Crate version.
+    pub version: &'static str,
+    /// Git commit of the build (`build.rs`; "-dirty" when the tree had changes).
+    pub commit: &'static str,
+    pub setup: SetupTimes,
+    /// True errors are computed (the scene gives `[exact]`).
+    pub true_errors: bool,
+}
+
+/// What the writer needs of a run: the discretisation it writes (scene with the solver settings in
+/// force, mesh, space, law) and the run's metadata.
+#[derive(Clone, Copy)]
+pub struct Run<'a> {
+    pub scene: &'a Scene,
+    pub mesh: &'a Mesh,
+    pub space: &'a CrSpace,
+    pub law: Elasticity,
+    pub meta: RunMeta,
+}
+
+impl<'a> Run<'a> {
+    /// The run of `p` with this build's version and commit.
+    pub fn of(p: &'a Problem) -> Run<'a> {
+        Run {
+            scene: &p.scene,
+            mesh: &p.mesh,
+            space: &p.space,
+            law: p.law,
+            meta: RunMeta {
+                version: env!("CARGO_PKG_VERSION"),
+                commit: env!("TRESCA_BUILD_COMMIT"),
+                setup: p.setup,
+                true_errors: p.errors.is_some(),
+            },
+        }
+    }
+
+    /// Number of time steps N.
+    pub fn n_steps(&self) -> usize {
+        self.scene.times.len() - 1
+    }
+}
+
+/// The open parts of a results file, new or resumed.
+struct Opened {
+    file: hdf5::File,
+    raw: Raw,
+    tresca: Tresca,
+    vtk: VtkHdf,
+    xdmf: Xdmf,
+    frames: Frames,
 }
 
 /// Appends the steps of a run to a results file.
@@ -137,12 +196,12 @@ fn check_finite<'a>(path: &Path, n: usize, what: &str, v: impl IntoIterator<Item
 impl Writer {
     /// Create `path` (and `run.xdmf` next to it) with mesh, static data and attributes. An existing file
     /// is refused unless `force`.
-    pub fn create(path: &Path, problem: &Problem, force: bool) -> Result<Writer> {
-        Writer::create_with(path, problem, &Options { force, ..Options::default() })
+    pub fn create(path: &Path, run: &Run, force: bool) -> Result<Writer> {
+        Writer::create_with(path, run, &Options { force, ..Options::default() })
     }
 
     /// [`Writer::create`] with all options.
-    pub fn create_with(path: &Path, problem: &Problem, opts: &Options) -> Result<Writer> {
+    pub fn create_with(path: &Path, run: &Run, opts: &Options) -> Result<Writer> {
         if path.exists() && !opts.force {
             return Err(Error::Io {
                 path: path.to_path_buf(),
@@ -161,13 +220,12 @@ impl Writer {
             .with_fapl(h5::file_access)
             .create(&partial)
             .map_err(io(path, "cannot create HDF5 file"))?;
-        let fields = Fields::new(problem);
-        let contact = !problem.space.contact.is_empty();
-        let commit = std::env::var("TRESCA_GIT_COMMIT").unwrap_or_else(|_| "unknown".into());
-        let n = problem.n_steps();
+        let fields = Fields::new(run);
+        let contact = !run.space.contact.is_empty();
+        let n = run.n_steps();
         let every = opts.frame_every.unwrap_or(n.div_ceil(AUTO_FRAMES - 1)).max(1);
         let frames = Frames { every, last: n };
-        let tresca = Tresca::create(&file, problem, &commit).map_err(io(path, "writing the tresca group"))?;
+        let tresca = Tresca::create(&file, run).map_err(io(path, "writing the tresca group"))?;
         h5::attr(&tresca.group, "frame_every", every as i64).map_err(io(path, "attribute frame_every"))?;
         let vtk =
             VtkHdf::create(&file, &fields, frames.total(), contact).map_err(io(path, "writing the VTKHDF group"))?;
@@ -176,29 +234,50 @@ impl Writer {
         file.flush().map_err(io(path, "flush"))?;
         let raw = Raw::open(&partial).map_err(ioerr(path, "cannot open the new file for writing"))?;
         let pending = Some(Pending { old: std::fs::File::open(path).ok(), partial });
-        Ok(Writer {
+        let mut w = Writer::from_opened(path, run, fields, Opened { file, raw, tresca, vtk, xdmf, frames }, 0, None);
+        w.interval = opts.commit_interval;
+        w.pending = pending;
+        Ok(w)
+    }
+
+    /// The writer of an open file whose first `completed` steps are committed (the last one's slip
+    /// `prev_slip`), committing every step until told otherwise.
+    fn from_opened(
+        path: &Path,
+        run: &Run,
+        fields: Fields,
+        o: Opened,
+        completed: usize,
+        prev_slip: Option<Vec<f64>>,
+    ) -> Writer {
+        let frames_done = o.frames.before(completed);
+        let mut rows = Rows::default();
+        rows.reset(completed);
+        let mut frame_rows = FrameRows::default();
+        frame_rows.reset(frames_done);
+        Writer {
             path: path.to_path_buf(),
-            file,
-            raw,
-            space: problem.space.clone(),
+            file: o.file,
+            raw: o.raw,
+            space: run.space.clone(),
             fields,
-            tresca,
-            vtk,
-            xdmf,
-            frames,
-            interval: opts.commit_interval,
+            tresca: o.tresca,
+            vtk: o.vtk,
+            xdmf: o.xdmf,
+            frames: o.frames,
+            interval: Options::default().commit_interval,
             buf: StepFields::default(),
-            rows: Rows::default(),
-            frame_rows: FrameRows::default(),
+            rows,
+            frame_rows,
             frame_steps: Vec::new(),
-            prev_slip: None,
-            completed: 0,
-            frames_done: 0,
+            prev_slip,
+            completed,
+            frames_done,
             last_commit: Instant::now(),
             finished: false,
-            pending,
+            pending: None,
             seconds: [0.0; 2],
-        })
+        }
     }
 
     /// Move a new file and its sidecar into place (`rename`, atomic for each; the old file's blocks

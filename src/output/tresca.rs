@@ -11,9 +11,11 @@
 //! edges hold the two unknowns verbatim) and `contact/dof` (the one unknown of a contact edge).
 
 use super::h5::{attr, attr_str, attr_vec, put, Raw, Series};
-use crate::cr::EdgeDof;
-use crate::norms::ErrorNorms;
-use crate::stepping::{Problem, StepResult};
+use super::Run;
+use crate::fem::norms::ErrorNorms;
+use crate::fem::space::{CrSpace, EdgeDof};
+use crate::friction::EdgeState;
+use crate::stepping::StepResult;
 use hdf5::{File, Group};
 
 /// Rows of consecutive steps buffered for one write.
@@ -50,7 +52,7 @@ impl Rows {
         self.wall.push(r.wall);
         self.slip.extend_from_slice(&r.slip);
         self.sigma_t.extend_from_slice(sigma_t);
-        self.state.extend_from_slice(&r.state);
+        self.state.extend(r.state.iter().map(|&s| s as u8));
         self.mu.extend_from_slice(&r.mu);
         self.dof.extend_from_slice(dof);
         if let Some(e) = &r.errors {
@@ -87,9 +89,9 @@ const SCALARS: [&str; 6] = ["times", "energy", "steps/iterations", "steps/residu
 
 impl Tresca {
     /// Create the group with static data, attributes and empty series.
-    pub fn create(file: &File, p: &Problem, git_commit: &str) -> hdf5::Result<Tresca> {
+    pub fn create(file: &File, p: &Run) -> hdf5::Result<Tresca> {
         let g = file.create_group("tresca")?;
-        let (mesh, space, s) = (&p.mesh, &p.space, &p.scene);
+        let (mesh, space, s) = (p.mesh, p.space, p.scene);
         let mg = g.create_group("mesh")?;
         let pts: Vec<f64> = mesh.points.iter().flatten().copied().collect();
         put(&mg, "points", &[mesh.points.len(), 2], &pts)?;
@@ -120,7 +122,7 @@ impl Tresca {
                 Series::create::<f64>(&cg, "dof", 1, &[nc], sc)?,
             ])
         };
-        let errors = if p.errors.is_some() {
+        let errors = if p.meta.true_errors {
             let eg = g.create_group("errors")?;
             Some([
                 Series::create::<f64>(&eg, "energy", 1, &[], sc)?,
@@ -134,8 +136,8 @@ impl Tresca {
         attr_str(loc, "scene", &s.text)?;
         attr_str(loc, "scene_path", &s.file)?;
         attr_str(loc, "title", &s.title)?;
-        attr_str(loc, "version", env!("CARGO_PKG_VERSION"))?;
-        attr_str(loc, "git_commit", git_commit)?;
+        attr_str(loc, "version", p.meta.version)?;
+        attr_str(loc, "git_commit", p.meta.commit)?;
         attr_str(loc, "solver", s.solver.method.name())?;
         attr(loc, "tol", s.solver.tol)?;
         attr(loc, "max_iter", s.solver.max_iter() as i64)?;
@@ -149,7 +151,7 @@ impl Tresca {
         attr(loc, "n_dofs", space.n_dofs as i64)?;
         attr(loc, "paper_dofs", space.paper_dofs() as i64)?;
         attr(loc, "h", mesh.h_max())?;
-        attr_vec(loc, "setup_times", &p.setup_times)?;
+        attr_vec(loc, "setup_times", &p.meta.setup.as_array())?;
         attr_str(loc, "setup_times_meaning", "mesh+space, assembly, factorisation, condensation (s)")?;
         attr_str(loc, "status", "running")?;
         attr(&sg, "completed", 0i64)?;
@@ -262,11 +264,11 @@ impl Tresca {
     }
 
     /// Rebuild the StepResult of stored step n (exact unknowns, μ, slip, state, statistics).
-    pub fn read_step(&self, p: &Problem, n: usize) -> hdf5::Result<StepResult> {
+    pub fn read_step(&self, space: &CrSpace, n: usize) -> hdf5::Result<StepResult> {
         let t = self.times.read::<f64>(n)?[0];
         let mid = self.u.read::<f64>(n)?;
-        let mut u = vec![0.0; p.space.n_dofs];
-        for (e, d) in p.space.edge_dof.iter().enumerate() {
+        let mut u = vec![0.0; space.n_dofs];
+        for (e, d) in space.edge_dof.iter().enumerate() {
             if let EdgeDof::Free([a, b]) = d {
                 u[*a] = mid[2 * e];
                 u[*b] = mid[2 * e + 1];
@@ -275,9 +277,13 @@ impl Tresca {
         let (mut mu, mut slip, mut state) = (vec![], vec![], vec![]);
         if let Some([sl, _, st, m, d]) = &self.contact {
             slip = sl.read::<f64>(n)?;
-            state = st.read::<u8>(n)?;
+            state = st
+                .read::<u8>(n)?
+                .into_iter()
+                .map(|s| if s == 1 { EdgeState::Slip } else { EdgeState::Stick })
+                .collect();
             mu = m.read::<f64>(n)?;
-            for (c, s) in p.space.contact.iter().zip(&d.read::<f64>(n)?) {
+            for (c, s) in space.contact.iter().zip(&d.read::<f64>(n)?) {
                 u[c.dof] = *s;
             }
         }

@@ -6,31 +6,15 @@
 //! Only what the scene declares is modelled: no contact part means plain elasticity.
 
 use crate::error::{Error, Result};
-use crate::expr::{Expr, Vec2Expr};
+use expr::{Expr, Vec2Expr};
+pub mod expr;
 mod raw;
 
 use raw::*;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
-/// Direction of the diagonal splitting each structured cell.
-#[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
-#[serde(rename_all = "lowercase")]
-pub enum Diagonal {
-    /// Cell (i, j) split along p(i, j)–p(i+1, j+1).
-    First,
-    /// Cell (i, j) split along p(i+1, j)–p(i, j+1).
-    Second,
-}
-
-/// Where the mesh comes from.
-#[derive(Clone, Debug)]
-pub enum MeshSpec {
-    /// Quadrilateral c0 c1 c2 c3 (counter-clockwise), n × m cells, each split by one diagonal.
-    Structured { corners: [[f64; 2]; 4], cells: [usize; 2], diagonal: Diagonal, refine: u32 },
-    /// Gmsh 4.1 ASCII file, `refine` red refinements.
-    Gmsh { path: PathBuf, refine: u32 },
-}
+pub use crate::mesh::{Diagonal, MeshSpec};
 
 /// What a boundary part imposes.
 #[derive(Clone, Debug)]
@@ -40,7 +24,43 @@ pub enum PartKind {
     /// Traction g(x, y, t); `None` is traction free (nothing assembled).
     Neumann(Option<Vec2Expr>),
     /// Bilateral contact u·n = 0 with Tresca bound g_a(x, y).
-    Contact(Expr),
+    Contact(FrictionBound),
+}
+
+/// Tresca's bound g_a(x, y) ≥ 0 of a contact part. It must not depend on t (checked when the scene is
+/// read) and must not be negative, which [`FrictionBound::at`] checks wherever it is evaluated (a
+/// constant bound is checked when the scene is read).
+#[derive(Clone, Debug)]
+pub struct FrictionBound(Expr);
+
+impl FrictionBound {
+    /// Parse the bound of scene key `key` in file `file`.
+    pub fn parse(file: &str, key: &str, text: &str) -> Result<FrictionBound> {
+        let g = FrictionBound(Expr::parse(key, text)?);
+        if g.0.depends_on_t() {
+            return Err(Error::scene(file, key, "the friction bound must not depend on t"));
+        }
+        if let Some(c) = g.0.constant() {
+            if c < 0.0 {
+                return Err(Error::scene(file, key, format!("must be >= 0, got {c}")));
+            }
+        }
+        Ok(g)
+    }
+
+    /// g_a(x, y), refused with the point when negative.
+    pub fn at(&self, x: f64, y: f64) -> Result<f64> {
+        let v = self.0.eval(x, y, 0.0)?;
+        if v < 0.0 {
+            return Err(self.0.error(format!("negative friction bound {v:e} near ({x:.6}, {y:.6})")));
+        }
+        Ok(v)
+    }
+
+    /// The expression text.
+    pub fn text(&self) -> &str {
+        self.0.text()
+    }
 }
 
 /// A named boundary part.
@@ -55,17 +75,6 @@ pub struct Part {
 pub struct Material {
     pub e: f64,
     pub nu: f64,
-}
-
-impl Material {
-    /// Lamé λ = Eν/((1+ν)(1−2ν)).
-    pub fn lambda(&self) -> f64 {
-        self.e * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
-    }
-    /// Shear modulus μ = E/(2(1+ν)).
-    pub fn mu(&self) -> f64 {
-        self.e / (2.0 * (1.0 + self.nu))
-    }
 }
 
 /// Per-step friction solver.
@@ -237,16 +246,7 @@ impl Scene {
                 RawKind::Contact => {
                     let text =
                         b.g_a.as_deref().ok_or_else(|| Error::scene(file, key("g_a"), "contact part needs g_a"))?;
-                    let g = Expr::parse(&key("g_a"), text)?;
-                    if g.depends_on_t() {
-                        return Err(Error::scene(file, key("g_a"), "the friction bound must not depend on t"));
-                    }
-                    if let Some(c) = g.constant() {
-                        if c < 0.0 {
-                            return Err(Error::scene(file, key("g_a"), format!("must be >= 0, got {c}")));
-                        }
-                    }
-                    PartKind::Contact(g)
+                    PartKind::Contact(FrictionBound::parse(file, &key("g_a"), text)?)
                 }
             };
             parts.push(Part { name: b.name.clone(), kind });

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 #[serde(deny_unknown_fields)]
 pub(super) struct RawScene {
     pub(super) title: Option<String>,
-    pub(super) mesh: RawMesh,
+    pub(super) mesh: RawMeshTable,
     pub(super) material: RawMaterial,
     pub(super) boundary: Vec<RawBoundary>,
     pub(super) loads: Option<RawLoads>,
@@ -23,7 +23,7 @@ pub(super) struct RawScene {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-pub(super) struct RawMesh {
+pub(super) struct RawMeshTable {
     pub(super) corners: Option<[[f64; 2]; 4]>,
     pub(super) cells: Option<[usize; 2]>,
     pub(super) diagonal: Option<Diagonal>,

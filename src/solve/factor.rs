@@ -24,7 +24,6 @@ use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
 };
-use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::SparseColMat;
 use faer::{Conj, MatMut, Par, Side};
 use std::cell::RefCell;
@@ -39,23 +38,16 @@ pub struct Factor {
 }
 
 impl Factor {
-    /// Factorise the SPD matrix `k` (lower triangle read). `simplicial` forces the simplicial kernel,
-    /// otherwise faer chooses (supernodal for larger fill).
-    pub fn new(k: &SparseColMat<usize, f64>, simplicial: bool) -> Result<Factor> {
-        Factor::with_ordering(k, simplicial, k.nrows() >= ND_MIN_SIZE)
+    /// Factorise the SPD matrix `k` (lower triangle read); faer chooses the simplicial or supernodal
+    /// kernel (supernodal for larger fill).
+    pub fn new(k: &SparseColMat<usize, f64>) -> Result<Factor> {
+        Factor::with_ordering(k, k.nrows() >= ND_MIN_SIZE)
     }
 
     /// As [`Factor::new`], with nested dissection tried (`nested`) or AMD.
-    fn with_ordering(k: &SparseColMat<usize, f64>, simplicial: bool, nested: bool) -> Result<Factor> {
+    fn with_ordering(k: &SparseColMat<usize, f64>, nested: bool) -> Result<Factor> {
         let n = k.nrows();
-        let params = CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: if simplicial {
-                SupernodalThreshold::FORCE_SIMPLICIAL
-            } else {
-                SupernodalThreshold::AUTO
-            },
-            ..Default::default()
-        };
+        let params = CholeskySymbolicParams::default();
         let nd = if nested { nested_dissection(k) } else { None };
         let ordering = match &nd {
             Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, n)),
@@ -102,7 +94,7 @@ impl Factor {
         let mut w = vec![0.0; n];
         let mut hi = 0.0f64;
         for _ in 0..iters {
-            crate::assemble::matvec(k, &v, &mut w);
+            crate::sparse::matvec(k, &v, &mut w);
             hi = hi.max(dot(&v, &w));
             std::mem::swap(&mut v, &mut w);
             normalise(&mut v);
@@ -123,11 +115,6 @@ impl Factor {
             }
         }
         hi * lo_inv
-    }
-
-    /// Number of nonzeros of L.
-    pub fn nnz(&self) -> usize {
-        self.values.len()
     }
 
     /// x ← K⁻¹ x for one vector.
@@ -281,7 +268,7 @@ fn nested_dissection(k: &SparseColMat<usize, f64>) -> Option<(Vec<usize>, Vec<us
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assemble::{csc_from_triplets, matvec};
+    use crate::sparse::{csc_from_triplets, matvec};
 
     /// Plane-elasticity-like test matrix: a 2D grid (m × m nodes) Laplacian, two coupled unknowns per node
     /// (numbered consecutively), shifted to be SPD.
@@ -325,11 +312,9 @@ mod tests {
         let k = grid(40);
         let (fwd, inv) = nested_dissection(&k).expect("METIS ordering");
         assert!(fwd.iter().enumerate().all(|(new, &old)| inv[old] == new));
-        for simplicial in [false, true] {
-            let nd = Factor::with_ordering(&k, simplicial, true).unwrap();
-            let amd = Factor::with_ordering(&k, simplicial, false).unwrap();
-            assert!(residual(&k, &nd) < 1e-12 && residual(&k, &amd) < 1e-12);
-        }
+        let nd = Factor::with_ordering(&k, true).unwrap();
+        let amd = Factor::with_ordering(&k, false).unwrap();
+        assert!(residual(&k, &nd) < 1e-12 && residual(&k, &amd) < 1e-12);
     }
 
     #[test]
@@ -348,18 +333,18 @@ mod tests {
         let diag = |n: usize| csc_from_triplets(n, &(0..n).map(|i| (i, i, 2.0)).collect::<Vec<_>>());
         for n in [0, 1, 2, 5] {
             assert!(nested_dissection(&diag(n)).is_none());
-            let f = Factor::with_ordering(&diag(n), false, true).unwrap();
+            let f = Factor::with_ordering(&diag(n), true).unwrap();
             assert!(residual(&diag(n), &f) < 1e-15);
         }
         // One coupled pair: a single METIS vertex, no edges.
         let pair = csc_from_triplets(2, &[(0, 0, 2.0), (1, 1, 2.0), (0, 1, 1.0), (1, 0, 1.0)]);
         assert!(nested_dissection(&pair).is_none());
-        assert!(residual(&pair, &Factor::with_ordering(&pair, false, true).unwrap()) < 1e-15);
+        assert!(residual(&pair, &Factor::with_ordering(&pair, true).unwrap()) < 1e-15);
         // Three unknowns: METIS on a 2-vertex graph.
         let three = csc_from_triplets(
             3,
             &[(0, 0, 4.0), (1, 1, 4.0), (2, 2, 4.0), (1, 2, 1.0), (2, 1, 1.0), (0, 2, 1.0), (2, 0, 1.0)],
         );
-        assert!(residual(&three, &Factor::with_ordering(&three, false, true).unwrap()) < 1e-14);
+        assert!(residual(&three, &Factor::with_ordering(&three, true).unwrap()) < 1e-14);
     }
 }

@@ -69,6 +69,11 @@ impl Expr {
         &self.text
     }
 
+    /// An error about this expression (its scene key and text).
+    pub fn error(&self, msg: String) -> Error {
+        Error::Expr { key: self.key.clone(), expr: self.text.clone(), msg }
+    }
+
     /// Evaluate at (x, y, t); a non-finite value is an error.
     pub fn eval(&self, x: f64, y: f64, t: f64) -> Result<f64> {
         if let Some(c) = self.constant {
@@ -243,11 +248,6 @@ impl Vec2Expr {
     /// Parse two component strings; `key` names the scene entry.
     pub fn parse(key: &str, comps: &[String; 2]) -> Result<Self> {
         Ok(Vec2Expr([Expr::parse(&format!("{key}[0]"), &comps[0])?, Expr::parse(&format!("{key}[1]"), &comps[1])?]))
-    }
-    /// The zero vector.
-    pub fn zero() -> Self {
-        let z = Expr::parse("0", "0").expect("literal zero parses");
-        Vec2Expr([z.clone(), z])
     }
     /// Evaluate both components.
     pub fn eval(&self, x: f64, y: f64, t: f64) -> Result<[f64; 2]> {

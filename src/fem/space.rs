@@ -10,10 +10,10 @@
 //!
 //! The interpolant I_CR takes edge means (3-point Gauss), which commute with time derivatives.
 
+use super::quadrature::{edge_point, GAUSS3};
 use crate::error::Result;
-use crate::expr::Vec2Expr;
 use crate::mesh::Mesh;
-use crate::quadrature::{edge_point, GAUSS3};
+use crate::scene::expr::Vec2Expr;
 use crate::scene::{Part, PartKind};
 
 /// Geometry of one triangle: constant barycentric gradients.
@@ -56,6 +56,20 @@ impl Element {
     /// φ_i at barycentric point l.
     pub fn phi(l: [f64; 3]) -> [f64; 3] {
         l.map(|li| 1.0 - 2.0 * li)
+    }
+
+    /// Constant gradient G[c][d] = ∂u_c/∂x_d of the CR field with midpoint values u_i on edge i.
+    pub fn gradient(&self, u: [[f64; 2]; 3]) -> [[f64; 2]; 2] {
+        let mut g = [[0.0; 2]; 2];
+        for (i, ui) in u.iter().enumerate() {
+            let gp = self.grad_phi(i);
+            for c in 0..2 {
+                for d in 0..2 {
+                    g[c][d] += ui[c] * gp[d];
+                }
+            }
+        }
+        g
     }
 }
 
@@ -106,7 +120,8 @@ pub struct CrSpace {
 impl CrSpace {
     /// Number the unknowns: two per free edge, one per contact edge, none on Dirichlet edges.
     pub fn new(mesh: &Mesh, parts: &[Part]) -> Result<CrSpace> {
-        let edge_part = mesh.bind_parts(parts)?;
+        let names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
+        let edge_part = mesh.bind_parts(&names)?;
         let mut edge_dof = Vec::with_capacity(mesh.edges.len());
         let mut contact = Vec::new();
         let mut n = 0;
@@ -123,20 +138,9 @@ impl CrSpace {
                     let tangent = [-normal[1], normal[0]];
                     let [a, b] = mesh.edges[e].map(|v| mesh.points[v]);
                     let mut g_mean = 0.0;
-                    let mut g_min = f64::INFINITY;
                     for (s, w) in GAUSS3 {
                         let x = edge_point(a, b, s);
-                        let gv = g.eval(x[0], x[1], 0.0)?;
-                        g_mean += w * gv;
-                        g_min = g_min.min(gv);
-                    }
-                    if g_min < 0.0 {
-                        let m = mesh.midpoint(e);
-                        return Err(crate::error::Error::Expr {
-                            key: format!("boundary ({}).g_a", parts[edge_part[e].expect("bound")].name),
-                            expr: g.text().to_string(),
-                            msg: format!("negative friction bound near ({:.6}, {:.6})", m[0], m[1]),
-                        });
+                        g_mean += w * g.at(x[0], x[1])?;
                     }
                     contact.push(ContactEdge { edge: e, dof: n, normal, tangent, length: mesh.edge_length(e), g_mean });
                     n += 1;
@@ -149,6 +153,11 @@ impl CrSpace {
             });
         }
         Ok(CrSpace { edge_dof, edge_part, n_dofs: n, contact, n_dirichlet })
+    }
+
+    /// True if edge e carries the stabilisation (interior or Dirichlet).
+    pub fn is_stabilised(&self, mesh: &Mesh, e: usize) -> bool {
+        mesh.edge_tris[e].1.is_some() || self.edge_dof[e] == EdgeDof::Fixed
     }
 
     /// The paper's DOF count: 2 · (edges − Dirichlet edges) (contact normal components included).
@@ -184,6 +193,24 @@ impl CrSpace {
         }
         Ok(u)
     }
+}
+
+/// The jump of the CR basis across edge e at parameter s: (edge, signed basis value) for both sides.
+pub fn jump_terms(mesh: &Mesh, e: usize, s: f64) -> Vec<(usize, f64)> {
+    let [a, b] = mesh.edges[e].map(|v| mesh.points[v]);
+    let x = edge_point(a, b, s);
+    let (t1, t2) = mesh.edge_tris[e];
+    let mut out = Vec::with_capacity(6);
+    for (t, sign) in [(Some(t1), 1.0), (t2, -1.0)] {
+        if let Some(t) = t {
+            let el = Element::new(mesh, t);
+            let phi = Element::phi(el.bary(x));
+            for i in 0..3 {
+                out.push((mesh.tri_edges[t][i], sign * phi[i]));
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]

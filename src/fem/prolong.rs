@@ -7,7 +7,7 @@
 //! Coarse triangles are found by a bucket grid over their bounding boxes (fine triangle centroids lie
 //! strictly inside one coarse triangle when the meshes are nested).
 
-use crate::cr::{CrSpace, Element};
+use super::space::{CrSpace, Element};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 

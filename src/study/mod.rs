@@ -12,13 +12,15 @@
 //! difference is measured in that mesh's discrete energy norm a_h(u_ref − u_l, u_ref − u_l)^{1/2}.
 //! For the consecutive error |||·||| is the discrete energy norm a_h(·,·)^{1/2} of the finer level.
 
-use crate::assemble::matvec;
-use crate::cr::Element;
+pub mod orders;
+
 use crate::error::{Error, Result};
-use crate::norms::{gradient, strain_energy_density, ErrorEvaluator};
-use crate::prolong::{parent_triangles, prolong_with};
+use crate::fem::norms::{ErrorEvaluator, ErrorNorms};
+use crate::fem::prolong::{parent_triangles, prolong_with};
+use crate::fem::space::Element;
 use crate::scene::Scene;
-use crate::stepping::Problem;
+use crate::sparse::energy;
+use crate::stepping::{Problem, StepResult};
 use std::time::Instant;
 
 /// A level: uniform refinements and number of uniform time steps.
@@ -53,10 +55,10 @@ pub struct LevelResult {
     pub paper_dofs: usize,
     pub wall: f64,
     pub iterations: usize,
-    /// True errors, max over time nodes: energy, H¹, L².
-    pub max_err: Option<[f64; 3]>,
+    /// True errors, max over time nodes.
+    pub max_err: Option<ErrorNorms>,
     /// True errors at the final time.
-    pub final_err: Option<[f64; 3]>,
+    pub final_err: Option<ErrorNorms>,
     /// max over the common nodes of the solution's discrete energy norm a_h(u, u)^{1/2}.
     pub norm_max: f64,
     /// Consecutive-level error: max over common nodes, and at the final time.
@@ -71,10 +73,9 @@ struct Kept {
     u: Vec<Vec<f64>>,
 }
 
+/// a_h(e, e)^{1/2} on the unknowns of `p`.
 fn energy_norm(p: &Problem, e: &[f64]) -> f64 {
-    let mut ke = vec![0.0; e.len()];
-    matvec(&p.k, e, &mut ke);
-    e.iter().zip(&ke).map(|(a, b)| a * b).sum::<f64>().max(0.0).sqrt()
+    energy(&p.stiffness, e).max(0.0).sqrt()
 }
 
 /// ‖u_fine − P u_coarse‖ at every common node: (max, final).
@@ -105,8 +106,7 @@ fn reference_error(rf: &Kept, lv: &Kept) -> Result<[f64; 2]> {
         return Ok([worst, last]);
     }
     let parent = parent_triangles(&lp.mesh, &rp.mesh)?;
-    let mat = &lp.scene.material;
-    let jumps = ErrorEvaluator::new(&lp.mesh, &lp.space, mat, lp.scene.rho);
+    let jumps = ErrorEvaluator::new(&lp.mesh, &lp.space, &lp.law, lp.scene.rho);
     let (rel, lel): (Vec<Element>, Vec<Element>) = (
         (0..rp.mesh.tris.len()).map(|t| Element::new(&rp.mesh, t)).collect(),
         (0..lp.mesh.tris.len()).map(|t| Element::new(&lp.mesh, t)).collect(),
@@ -116,10 +116,11 @@ fn reference_error(rf: &Kept, lv: &Kept) -> Result<[f64; 2]> {
         let (mr, ml) = (rp.space.midpoint_values(ur), lp.space.midpoint_values(ul));
         let mut en = jumps.jump_energy(&ml);
         for (t, el) in rel.iter().enumerate() {
-            let gr = gradient(&rp.mesh, el, t, &mr);
-            let gl = gradient(&lp.mesh, &lel[parent[t]], parent[t], &ml);
+            let gr = el.gradient(rp.mesh.tri_edges[t].map(|e| mr[e]));
+            let pt = parent[t];
+            let gl = lel[pt].gradient(lp.mesh.tri_edges[pt].map(|e| ml[e]));
             let d = [[gr[0][0] - gl[0][0], gr[0][1] - gl[0][1]], [gr[1][0] - gl[1][0], gr[1][1] - gl[1][1]]];
-            en += el.area * strain_energy_density(d, mat.lambda(), mat.mu());
+            en += el.area * lp.law.energy_density(d);
         }
         last = en.max(0.0).sqrt();
         worst = worst.max(last);
@@ -134,20 +135,16 @@ fn run_level(scene: &Scene, level: Level, common: &[f64], out: &mut LevelResult)
     let start = Instant::now();
     let problem = Problem::new(s)?;
     let mut u = Vec::new();
-    let (mut max_err, mut final_err, mut iterations, mut norm_max) = (None::<[f64; 3]>, None, 0, 0.0f64);
+    let (mut max_err, mut final_err, mut iterations, mut norm_max) = (None::<ErrorNorms>, None, 0, 0.0f64);
     let nodes: Vec<usize> = (0..problem.scene.times.len())
         .filter(|&n| common.iter().any(|&t| (t - problem.scene.times[n]).abs() <= 1e-12 * t.abs().max(1.0)))
         .collect();
     let first = problem.initial()?;
-    let mut on_step = |r: &crate::stepping::StepResult| -> Result<()> {
+    let mut on_step = |r: &StepResult| -> Result<()> {
         iterations += r.iterations;
         if let Some(e) = r.errors {
-            let v = [e.energy, e.h1, e.l2];
-            max_err = Some(match max_err {
-                Some(m) => [m[0].max(v[0]), m[1].max(v[1]), m[2].max(v[2])],
-                None => v,
-            });
-            final_err = Some(v);
+            max_err = Some(max_err.map_or(e, |m: ErrorNorms| m.max(e)));
+            final_err = Some(e);
         }
         if nodes.contains(&r.n) {
             norm_max = norm_max.max(r.energy.max(0.0).sqrt());
@@ -223,7 +220,7 @@ pub const CSV_HEADER: &str = "refine,steps,h,k,dofs,paper_dofs,wall_s,iterations
 /// One CSV row (empty fields for quantities not computed).
 pub fn csv_row(r: &LevelResult) -> String {
     let f = |v: Option<f64>| v.map(|x| format!("{x:.10e}")).unwrap_or_default();
-    let m = |a: Option<[f64; 3]>, i: usize| f(a.map(|v| v[i]));
+    let m = |a: Option<ErrorNorms>, i: usize| f(a.map(|v| [v.energy, v.h1, v.l2][i]));
     let c = |a: Option<[f64; 2]>, i: usize| f(a.map(|v| v[i]));
     format!(
         "{},{},{:.10e},{:.10e},{},{},{:.6},{},{},{},{},{},{},{},{},{},{},{},{:.10e}",

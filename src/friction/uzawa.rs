@@ -6,8 +6,7 @@
 //! The iteration converges for 0 < ρ̃ < 2/λ_max(M), M = (GW)^{1/2} C (GW)^{1/2}, G = diag(ḡ), W = diag(w);
 //! `step = 0` chooses ρ̃ = 1/λ_max(M) (power iteration).
 
-use crate::contact::{not_converged, FrictionSolution, Qp};
-use crate::error::Result;
+use super::{stalled, Qp, Solved};
 
 /// ρ̃ = 1/λ_max((GW)^{1/2} C (GW)^{1/2}) by power iteration.
 pub fn auto_step(qp: &Qp, g: &[f64]) -> f64 {
@@ -34,7 +33,7 @@ pub fn auto_step(qp: &Qp, g: &[f64]) -> f64 {
 }
 
 /// Uzawa from the warm start `mu0` with step `rho` (the paper's ρ̃).
-pub fn solve(qp: &Qp, g: &[f64], mu0: &[f64], rho: f64, tol: f64, max_iter: usize) -> Result<FrictionSolution> {
+pub fn solve(qp: &Qp, g: &[f64], mu0: &[f64], rho: f64, tol: f64, max_iter: usize) -> Solved {
     let n = qp.d.len();
     let mut lam: Vec<f64> =
         (0..n).map(|e| if qp.w[e] > 0.0 { (mu0[e] / qp.w[e]).clamp(-1.0, 1.0) } else { 0.0 }).collect();
@@ -53,9 +52,9 @@ pub fn solve(qp: &Qp, g: &[f64], mu0: &[f64], rho: f64, tol: f64, max_iter: usiz
             break;
         }
         if diff < tol {
-            let ds = qp.slip_increment(&mu);
-            return Ok(FrictionSolution { residual: qp.residual(&mu, &ds), mu, iterations: it });
+            let res = qp.residual(&mu, &qp.slip_increment(&mu));
+            return Ok((mu, it, res));
         }
     }
-    Err(not_converged("uzawa", max_iter, diff, tol))
+    Err(stalled("uzawa", max_iter, diff))
 }

@@ -9,10 +9,10 @@
 //! The orthogonalisation works on the loads' support only (the boundary unknowns when there is no body
 //! force), so its cost is O(N · support) rather than O(N · unknowns).
 
-use crate::assemble::Loads;
-use crate::cr::CrSpace;
+use super::factor::Factor;
 use crate::error::Result;
-use crate::factor::Factor;
+use crate::fem::loads::Loads;
+use crate::sparse::dot;
 
 /// Largest number of load patterns handled by superposition.
 pub const MAX_RANK: usize = 4;
@@ -24,22 +24,19 @@ pub struct LoadBasis {
     /// Orthonormal patterns on the loads' support (see `Loads::support`), support indices.
     b: Vec<Vec<f64>>,
     support: Vec<usize>,
-    w: Vec<Vec<f64>>,
+    /// Responses K⁻¹b_j on all unknowns.
+    responses: Vec<Vec<f64>>,
     coef: Vec<Vec<f64>>,
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 impl LoadBasis {
     /// Try to build the basis; `None` if the loads need more than [`MAX_RANK`] patterns.
-    pub fn build(loads: &Loads, space: &CrSpace, times: &[f64], factor: &Factor) -> Result<Option<LoadBasis>> {
+    pub fn build(loads: &Loads, times: &[f64], factor: &Factor) -> Result<Option<LoadBasis>> {
         let mut b: Vec<Vec<f64>> = Vec::new();
         let mut coef = Vec::with_capacity(times.len());
         let mut l = Vec::new();
         for &t in times {
-            loads.assemble_on_support(space, t, &mut l)?;
+            loads.assemble_on_support(t, &mut l)?;
             let norm = dot(&l, &l).sqrt();
             let mut r = l.clone();
             let mut c = vec![0.0; b.len()];
@@ -61,7 +58,7 @@ impl LoadBasis {
             }
             coef.push(c);
         }
-        let w = b
+        let responses = b
             .iter()
             .map(|bj| {
                 let mut x = Vec::new();
@@ -70,12 +67,7 @@ impl LoadBasis {
                 x
             })
             .collect();
-        Ok(Some(LoadBasis { b, support: loads.support().to_vec(), w, coef }))
-    }
-
-    /// Number of load patterns.
-    pub fn rank(&self) -> usize {
-        self.b.len()
+        Ok(Some(LoadBasis { b, support: loads.support().to_vec(), responses, coef }))
     }
 
     fn combine(vs: &[Vec<f64>], c: &[f64], n: usize, out: &mut Vec<f64>) {
@@ -99,11 +91,11 @@ impl LoadBasis {
 
     /// Entries `idx` of K⁻¹ l(tₙ): O(rank · idx.len()).
     pub fn response_at(&self, n: usize, idx: &[usize]) -> Vec<f64> {
-        idx.iter().map(|&k| self.w.iter().zip(&self.coef[n]).map(|(w, c)| c * w[k]).sum()).collect()
+        idx.iter().map(|&k| self.responses.iter().zip(&self.coef[n]).map(|(w, c)| c * w[k]).sum()).collect()
     }
 
     /// K⁻¹ l(tₙ) = Σ_j cₙⱼ w_j.
     pub fn response(&self, n: usize, dofs: usize, out: &mut Vec<f64>) {
-        Self::combine(&self.w, &self.coef[n], dofs, out);
+        Self::combine(&self.responses, &self.coef[n], dofs, out);
     }
 }

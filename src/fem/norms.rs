@@ -6,12 +6,12 @@
 //!
 //! by the degree-4 triangle rule and the exact 2-point edge rule.
 
-use crate::assemble::{is_stabilised, jump_terms};
-use crate::cr::{CrSpace, Element};
+use super::elasticity::Elasticity;
+use super::quadrature::{tri_point, GAUSS2, TRI4};
+use super::space::{jump_terms, CrSpace, Element};
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::quadrature::{tri_point, GAUSS2, TRI4};
-use crate::scene::{Exact, Material};
+use crate::scene::Exact;
 
 /// The three error norms at one time.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -21,25 +21,11 @@ pub struct ErrorNorms {
     pub l2: f64,
 }
 
-/// Constant gradient of the CR field with midpoint values `mid` on triangle t: g[c][d] = ∂u_c/∂x_d.
-pub fn gradient(mesh: &Mesh, el: &Element, t: usize, mid: &[[f64; 2]]) -> [[f64; 2]; 2] {
-    let mut g = [[0.0; 2]; 2];
-    for i in 0..3 {
-        let (u, gp) = (mid[mesh.tri_edges[t][i]], el.grad_phi(i));
-        for c in 0..2 {
-            for d in 0..2 {
-                g[c][d] += u[c] * gp[d];
-            }
-        }
+impl ErrorNorms {
+    /// Componentwise maximum.
+    pub fn max(self, o: ErrorNorms) -> ErrorNorms {
+        ErrorNorms { energy: self.energy.max(o.energy), h1: self.h1.max(o.h1), l2: self.l2.max(o.l2) }
     }
-    g
-}
-
-/// σ(v):ε(v) for a constant displacement gradient g.
-pub fn strain_energy_density(g: [[f64; 2]; 2], lam: f64, mu: f64) -> f64 {
-    let e01 = 0.5 * (g[0][1] + g[1][0]);
-    let tr = g[0][0] + g[1][1];
-    lam * tr * tr + 2.0 * mu * (g[0][0] * g[0][0] + 2.0 * e01 * e01 + g[1][1] * g[1][1])
 }
 
 /// Precomputed geometry for repeated error evaluation.
@@ -47,23 +33,22 @@ pub struct ErrorEvaluator {
     elements: Vec<Element>,
     /// Per stabilised edge and Gauss point: weight · 2ρμ and the jump terms.
     jumps: Vec<(f64, Vec<(usize, f64)>)>,
-    lam: f64,
-    mu: f64,
+    law: Elasticity,
 }
 
 impl ErrorEvaluator {
-    pub fn new(mesh: &Mesh, space: &CrSpace, mat: &Material, rho: f64) -> Self {
+    pub fn new(mesh: &Mesh, space: &CrSpace, law: &Elasticity, rho: f64) -> Self {
         let elements = (0..mesh.tris.len()).map(|t| Element::new(mesh, t)).collect();
-        let pen = 2.0 * rho * mat.mu();
+        let pen = 2.0 * rho * law.mu;
         let mut jumps = Vec::new();
         for e in 0..mesh.edges.len() {
-            if is_stabilised(mesh, space, e) {
+            if space.is_stabilised(mesh, e) {
                 for (s, w) in GAUSS2 {
                     jumps.push((pen * w, jump_terms(mesh, e, s)));
                 }
             }
         }
-        ErrorEvaluator { elements, jumps, lam: mat.lambda(), mu: mat.mu() }
+        ErrorEvaluator { elements, jumps, law: *law }
     }
 
     /// Errors of the CR field with midpoint values `mid` against `exact` at time t.
@@ -87,7 +72,7 @@ impl ErrorEvaluator {
         let el = &self.elements[k];
         let (mut en, mut h1, mut l2) = (0.0f64, 0.0f64, 0.0f64);
         let ue = mesh.tri_edges[k].map(|e| mid[e]);
-        let gh = gradient(mesh, el, k, mid);
+        let gh = el.gradient(ue);
         for (l, w) in TRI4 {
             let x = tri_point(el.pts, l);
             let phi = Element::phi(l);
@@ -103,7 +88,7 @@ impl ErrorEvaluator {
                     g[c][d] = exact.grad[c][d].eval(x[0], x[1], t)? - gh[c][d];
                 }
             }
-            en += wt * strain_energy_density(g, self.lam, self.mu);
+            en += wt * self.law.energy_density(g);
             h1 += wt * (g[0][0] * g[0][0] + g[0][1] * g[0][1] + g[1][0] * g[1][0] + g[1][1] * g[1][1]);
         }
         Ok([en, h1, l2])

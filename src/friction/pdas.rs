@@ -4,13 +4,12 @@
 //! i.e. C_SS μ_S = d_S − C_{S,slip} μ_slip. Because C is not an M-matrix this can cycle between active
 //! sets; a repeated set is reported as non-convergence instead of iterating on.
 
-use crate::contact::{not_converged, FrictionSolution, Qp};
-use crate::error::Result;
+use super::{stalled, Qp, Solved};
 use nalgebra::{DMatrix, DVector};
 use std::collections::HashSet;
 
 /// Solve the QP by plain PDAS from `mu0`.
-pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<FrictionSolution> {
+pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Solved {
     let n = qp.d.len();
     let mut mu = mu0.to_vec();
     let mut seen: HashSet<Vec<i8>> = HashSet::new();
@@ -19,7 +18,7 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
         let feasible = (0..n).all(|e| mu[e].abs() <= qp.w[e] * (1.0 + 1e-14));
         let res = if feasible { qp.residual(&mu, &ds) } else { f64::INFINITY };
         if res <= tol {
-            return Ok(FrictionSolution { mu, iterations: it, residual: res });
+            return Ok((mu, it, res));
         }
         let set: Vec<i8> = (0..n)
             .map(|e| {
@@ -33,12 +32,9 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
                 }
             })
             .collect();
-        if std::env::var_os("TRESCA_DEBUG_PDAS").is_some() {
-            eprintln!("pdas it {it}: residual {res:.3e} set {set:?}");
-        }
         if it == max_iter || !seen.insert(set.clone()) {
             let what = if it == max_iter { "pdas" } else { "pdas (cycling: an active set repeated)" };
-            return Err(not_converged(what, it, res, tol));
+            return Err(stalled(what, it, res));
         }
         let stick: Vec<usize> = (0..n).filter(|&e| set[e] == 0).collect();
         for e in 0..n {
@@ -54,8 +50,7 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
                     .iter()
                     .map(|&i| qp.d[i] - (0..n).filter(|&j| set[j] != 0).map(|j| qp.c[(i, j)] * mu[j]).sum::<f64>()),
             );
-            let sol =
-                css.cholesky().ok_or_else(|| not_converged("pdas (singular stick block)", it, res, tol))?.solve(&rhs);
+            let sol = css.cholesky().ok_or_else(|| stalled("pdas (singular stick block)", it, res))?.solve(&rhs);
             for (k, &e) in stick.iter().enumerate() {
                 mu[e] = sol[k];
             }

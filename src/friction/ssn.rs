@@ -7,15 +7,14 @@
 //! primal–dual active-set iteration can, see `pdas`); once the active set is identified the full Newton
 //! step is accepted and the iteration terminates at the exact solution (residual at rounding level).
 
-use crate::contact::{not_converged, FrictionSolution, Qp};
-use crate::error::Result;
+use super::{stalled, Qp, Solved};
 use nalgebra::{DMatrix, DVector};
 
 /// Armijo sufficient-decrease constant.
 const SIGMA: f64 = 1e-4;
 
 /// Solve the QP from the warm start `mu0` to natural residual ≤ tol.
-pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<FrictionSolution> {
+pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Solved {
     let n = qp.d.len();
     let mut mu: Vec<f64> = (0..n).map(|e| qp.project(e, mu0[e])).collect();
     let fscale = qp.force_scale();
@@ -23,10 +22,10 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
         let ds = qp.slip_increment(&mu);
         let res = qp.residual(&mu, &ds);
         if res <= tol {
-            return Ok(FrictionSolution { mu, iterations: it, residual: res });
+            return Ok((mu, it, res));
         }
         if it == max_iter {
-            return Err(not_converged("ssn", it, res, tol));
+            return Err(stalled("ssn", it, res));
         }
         let g: Vec<f64> = ds.iter().map(|v| -v).collect();
         // ε-active set (Bertsekas 1982): ε = min(ε₀, ‖μ − P(μ − D⁻¹g)‖)
@@ -44,9 +43,8 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
         if !free.is_empty() {
             let cff = DMatrix::from_fn(free.len(), free.len(), |i, j| qp.c[(free[i], free[j])]);
             let rhs = DVector::from_iterator(free.len(), free.iter().map(|&e| -g[e]));
-            let chol = cff
-                .cholesky()
-                .ok_or_else(|| not_converged("ssn (condensed operator not positive definite)", it, res, tol))?;
+            let chol =
+                cff.cholesky().ok_or_else(|| stalled("ssn (condensed operator not positive definite)", it, res))?;
             let pf = chol.solve(&rhs);
             for (k, &e) in free.iter().enumerate() {
                 p[e] = pf[k];
@@ -71,7 +69,7 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Result<Friction
             alpha *= 0.5;
         }
         if !accepted {
-            return Err(not_converged("ssn (line search failed)", it, res, tol));
+            return Err(stalled("ssn (line search failed)", it, res));
         }
     }
     unreachable!("the loop returns at it == max_iter")

@@ -1,0 +1,171 @@
+//! The friction problem of one time step, condensed onto the Γ_C unknowns.
+//!
+//! With K the stiffness on V_h (factored once), E the injection of the contact unknowns s (one tangential
+//! displacement per Γ_C edge), l the load and s_old the previous step's s, a step solves
+//!   K u = l − E μ,   μ_e ∈ w_e ∂|·|(s_e − s_old,e),   w_e = |e| ḡ_e,
+//! (μ is the friction force on edge e; the tangential traction is σ_τ·τ_e = −μ_e/|e|). Writing
+//! u_f = K⁻¹l, C = Eᵀ K⁻¹ E (dense, SPD, n_c × n_c) and d = Eᵀu_f − s_old, the slip increment is
+//! Δs = d − Cμ and μ solves the box-constrained dual QP
+//!   min_μ q(μ) = ½ μᵀCμ − dᵀμ   subject to |μ_e| ≤ w_e,
+//! whose KKT conditions are exactly Tresca's law on every edge. The natural residual
+//!   r(μ) = max_e |μ_e − P_e(μ_e + Δs_e / C_ee)| / F,   F = max_e min(w_e, |d_e|/C_ee),
+//! vanishes exactly at the solution and is what every solver reports.
+
+pub mod pdas;
+pub mod ssn;
+pub mod uzawa;
+
+use crate::error::{Error, Result};
+use crate::fem::space::CrSpace;
+use crate::scene::{Method, SolverSettings};
+use nalgebra::DMatrix;
+
+/// The friction problem of a run: C, the weights and the per-step solver.
+pub struct Friction {
+    /// C = Eᵀ K⁻¹ E.
+    c: DMatrix<f64>,
+    /// Friction weights w_e = |e| ḡ_e.
+    w: Vec<f64>,
+    /// ḡ_e, the mean of g_a over edge e (Uzawa's c_τ).
+    g_mean: Vec<f64>,
+    settings: SolverSettings,
+}
+
+/// What a step's friction solve produced.
+#[derive(Clone, Debug)]
+pub struct FrictionSolution {
+    /// Friction force per contact edge.
+    pub mu: Vec<f64>,
+    /// Δs = d − Cμ.
+    pub slip_increment: Vec<f64>,
+    pub state: Vec<EdgeState>,
+    pub iterations: usize,
+    pub residual: f64,
+}
+
+/// Stick or slip of one contact edge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum EdgeState {
+    Stick = 0,
+    Slip = 1,
+}
+
+/// A per-step solver that stopped short of the tolerance: which (and why), after how many iterations,
+/// at what residual. [`Friction::solve`] turns it into [`Error::NotConverged`] with the step and time.
+#[derive(Clone, Debug)]
+pub struct Stalled {
+    pub solver: &'static str,
+    pub iterations: usize,
+    pub residual: f64,
+}
+
+impl Friction {
+    /// The problem on the contact edges of `space` with operator `c` (see `solve::condense`).
+    pub fn new(space: &CrSpace, c: DMatrix<f64>, settings: SolverSettings) -> Friction {
+        let w = space.contact.iter().map(|e| e.length * e.g_mean).collect();
+        let g_mean = space.contact.iter().map(|e| e.g_mean).collect();
+        Friction { c, w, g_mean, settings }
+    }
+
+    /// Solve step n (time t) with d = s_f − s_old from the warm start μ₀ with the scene's method, to
+    /// natural residual ≤ tol.
+    pub fn solve(&self, d: &[f64], mu0: &[f64], n: usize, t: f64) -> Result<FrictionSolution> {
+        let qp = Qp { c: &self.c, d, w: &self.w };
+        let s = &self.settings;
+        let sol = match s.method {
+            Method::Ssn => ssn::solve(&qp, mu0, s.tol, s.max_iter()),
+            Method::Pdas => pdas::solve(&qp, mu0, s.tol, s.max_iter()),
+            Method::Uzawa => {
+                let rho = if s.uzawa_step > 0.0 { s.uzawa_step } else { uzawa::auto_step(&qp, &self.g_mean) };
+                uzawa::solve(&qp, &self.g_mean, mu0, rho, s.tol, s.max_iter())
+            }
+        };
+        let (mu, iterations, residual) = sol.map_err(|e| Error::NotConverged {
+            step: n,
+            time: t,
+            solver: e.solver,
+            iterations: e.iterations,
+            residual: e.residual,
+            tol: s.tol,
+        })?;
+        let slip_increment = qp.slip_increment(&mu);
+        let state = classify(&qp, &mu, &slip_increment);
+        Ok(FrictionSolution { mu, slip_increment, state, iterations, residual })
+    }
+}
+
+/// A solver's result: (μ, iterations, residual).
+pub type Solved = std::result::Result<(Vec<f64>, usize, f64), Stalled>;
+
+/// One step's dual QP: min ½μᵀCμ − dᵀμ, |μ_e| ≤ w_e.
+pub struct Qp<'a> {
+    pub c: &'a DMatrix<f64>,
+    pub d: &'a [f64],
+    pub w: &'a [f64],
+}
+
+impl Qp<'_> {
+    /// Slip increment Δs = d − Cμ.
+    pub fn slip_increment(&self, mu: &[f64]) -> Vec<f64> {
+        let n = self.d.len();
+        let mut ds = self.d.to_vec();
+        for j in 0..n {
+            let m = mu[j];
+            if m != 0.0 {
+                let col = self.c.column(j);
+                for i in 0..n {
+                    ds[i] -= col[i] * m;
+                }
+            }
+        }
+        ds
+    }
+
+    /// Projection onto [−w_e, w_e].
+    pub fn project(&self, e: usize, v: f64) -> f64 {
+        v.clamp(-self.w[e], self.w[e])
+    }
+
+    /// Force scale F = max_e min(w_e, |d_e|/C_ee): the size of the friction forces of this step (all-stick
+    /// forces are about |d|/C_ee, all-slip forces are w). Residuals are relative to it, so a huge bound
+    /// (g_a → ∞) does not make every iterate look converged.
+    pub fn force_scale(&self) -> f64 {
+        (0..self.d.len()).map(|e| self.w[e].min(self.d[e].abs() / self.c[(e, e)])).fold(0.0, f64::max)
+    }
+
+    /// Natural residual r(μ) = max_e |μ_e − P_e(μ_e + Δs_e/C_ee)| / F, given Δs (see module doc).
+    pub fn residual(&self, mu: &[f64], ds: &[f64]) -> f64 {
+        let mut r: f64 = 0.0;
+        for e in 0..mu.len() {
+            r = r.max((mu[e] - self.project(e, mu[e] + ds[e] / self.c[(e, e)])).abs());
+        }
+        if r == 0.0 {
+            0.0
+        } else {
+            r / self.force_scale().max(f64::MIN_POSITIVE)
+        }
+    }
+}
+
+/// Stick or slip per edge: slip when the bound is reached and the increment is nonzero.
+pub fn classify(qp: &Qp, mu: &[f64], ds: &[f64]) -> Vec<EdgeState> {
+    let scale = ds.iter().chain(qp.d).fold(0.0f64, |a, v| a.max(v.abs()));
+    mu.iter()
+        .zip(ds)
+        .zip(qp.w)
+        .map(|((m, s), w)| {
+            if *w > 0.0 && m.abs() >= w * (1.0 - 1e-9) && s.abs() > 1e-9 * scale || *w == 0.0 && s.abs() > 1e-9 * scale
+            {
+                EdgeState::Slip
+            } else {
+                EdgeState::Stick
+            }
+        })
+        .collect()
+}
+
+/// A solver stopped at `iterations` with `residual`.
+pub fn stalled(solver: &'static str, iterations: usize, residual: f64) -> Stalled {
+    Stalled { solver, iterations, residual }
+}

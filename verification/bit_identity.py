@@ -1,0 +1,122 @@
+"""Bit-identity check for refactors: a refactor changes no number.
+
+Usage:
+    python verification/bit_identity.py run DIR [--bin PATH]     # write every case's results into DIR
+    python verification/bit_identity.py compare DIR_A DIR_B     # compare them dataset by dataset
+
+`run` solves every scene of ``verification/cases/`` (at its own refine and steps, and at one finer level)
+and the paper's Example 5.1 levels of Tables 5.1/5.2 (refine k, N = 40·2^k, k = 0..4), plus every runnable
+scene of ``tests/scenes/`` and ``scripts/scenes/``, with the SSN, Uzawa and PDAS solvers where the scene
+has contact. `compare` reads every dataset and attribute under ``/tresca`` and ``/VTKHDF`` with h5py and requires the
+bytes to be equal, except what is not a number of the method: wall times (``steps/wall_time``,
+``setup_times``), the build (``version``, ``git_commit``). It prints one line per file and exits non-zero
+if any value differs.
+"""
+import argparse
+import glob
+import os
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# not numbers of the method: they change from run to run or build to build
+VOLATILE = {"steps/wall_time", "setup_times", "version", "git_commit"}
+
+
+def runs():
+    """(name, scene, extra CLI arguments) of every run compared."""
+    out = []
+    for scene in sorted(glob.glob(os.path.join(ROOT, "verification", "cases", "*.toml"))):
+        name = os.path.splitext(os.path.basename(scene))[0]
+        out.append((name, scene, []))
+        out.append((name + "_r1", scene, ["--refine", "1"]))
+    paper = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
+    for k in range(5):
+        out.append((f"paper_{k}", paper, ["--refine", str(k), "--steps", str(40 * 2**k)]))
+    for solver in ("uzawa", "pdas"):
+        out.append((f"paper_2_{solver}", paper, ["--refine", "2", "--steps", "160", "--solver", solver]))
+        front = os.path.join(ROOT, "verification", "cases", "mms_front.toml")
+        out.append((f"mms_front_{solver}", front, ["--solver", solver]))
+    for scene in sorted(glob.glob(os.path.join(ROOT, "tests", "scenes", "*.toml"))
+                        + glob.glob(os.path.join(ROOT, "scripts", "scenes", "*.toml"))):
+        out.append((os.path.splitext(os.path.basename(scene))[0], scene, []))
+    return out
+
+
+def cmd_run(args):
+    os.makedirs(args.dir, exist_ok=True)
+    failed = 0
+    for name, scene, extra in runs():
+        path = os.path.join(args.dir, name + ".h5")
+        p = subprocess.run([args.bin, "run", scene, "-o", path, "--force", "-q", *extra],
+                           capture_output=True, text=True, cwd=ROOT)
+        status = "ok" if p.returncode == 0 else f"exit {p.returncode}: {p.stderr.strip()[-200:]}"
+        failed += p.returncode != 0
+        print(f"{name:28s} {status}")
+    return 0 if failed == 0 else 1
+
+
+def items(f):
+    """{path: bytes-comparable value} of every dataset and attribute under /tresca and /VTKHDF."""
+    out = {}
+    for group in ("tresca", "VTKHDF"):
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                out[f"{group}/{name}"] = obj[()]
+            for k, v in obj.attrs.items():
+                out[f"{group}/{name}@{k}"] = v
+
+        g = f[group]
+        for k, v in g.attrs.items():
+            out[f"{group}@{k}"] = v
+        g.visititems(visit)
+    return out
+
+
+def same(a, b):
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        a, b = np.asarray(a), np.asarray(b)
+        return a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()
+    return a == b
+
+
+def cmd_compare(args):
+    bad = 0
+    files = sorted(os.path.basename(p) for p in glob.glob(os.path.join(args.a, "*.h5")))
+    missing = sorted(set(os.path.basename(p) for p in glob.glob(os.path.join(args.b, "*.h5"))) ^ set(files))
+    for name in missing:
+        print(f"{name:28s} MISSING in one directory")
+        bad += 1
+    for name in files:
+        pb = os.path.join(args.b, name)
+        if not os.path.exists(pb):
+            continue
+        with h5py.File(os.path.join(args.a, name), "r") as fa, h5py.File(pb, "r") as fb:
+            ia, ib = items(fa), items(fb)
+        keys = sorted(k for k in set(ia) | set(ib)
+                      if k.split("@")[-1] not in VOLATILE and k.split("@")[0].removeprefix("tresca/") not in VOLATILE)
+        diff = [k for k in keys if k not in ia or k not in ib or not same(ia[k], ib[k])]
+        print(f"{name:28s} {len(keys):3d} items  {'identical' if not diff else 'DIFFER: ' + ', '.join(diff[:6])}")
+        bad += bool(diff)
+    print(f"{len(files)} files, {bad} differ")
+    return 0 if bad == 0 else 1
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run")
+    r.add_argument("dir")
+    r.add_argument("--bin", default=os.path.join(ROOT, "target", "release", "tresca-cr"))
+    c = sub.add_parser("compare")
+    c.add_argument("a")
+    c.add_argument("b")
+    args = ap.parse_args()
+    sys.exit(cmd_run(args) if args.cmd == "run" else cmd_compare(args))
+
+
+if __name__ == "__main__":
+    main()
