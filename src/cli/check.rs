@@ -1,0 +1,73 @@
+//! `tresca-cr check`: validate a scene, set it up, and print what it will model.
+
+use anyhow::Result;
+use tresca_cr::scene::PartKind;
+use tresca_cr::{Problem, Scene};
+
+/// An expression for display: long generated expressions are shortened.
+fn short(text: &str) -> String {
+    if text.chars().count() <= 48 {
+        text.to_string()
+    } else {
+        format!("{}… ({} characters)", text.chars().take(40).collect::<String>(), text.chars().count())
+    }
+}
+
+pub fn check(scene: Scene) -> Result<()> {
+    let problem = Problem::new(scene)?;
+    let (s, m, sp) = (&problem.scene, &problem.mesh, &problem.space);
+    println!("scene      {} ({})", s.file, if s.title.is_empty() { "untitled" } else { &s.title });
+    println!(
+        "mesh       {} vertices, {} triangles, {} edges, h = {:.4e}",
+        m.points.len(),
+        m.tris.len(),
+        m.edges.len(),
+        m.h_max()
+    );
+    println!(
+        "material   E = {}, nu = {} (plane strain: lambda = {:.6e}, mu = {:.6e})",
+        s.material.e, s.material.nu, problem.law.lam, problem.law.mu
+    );
+    for (p, part) in s.parts.iter().enumerate() {
+        let n = sp.edge_part.iter().filter(|&&q| q == Some(p)).count();
+        let what = match &part.kind {
+            PartKind::Dirichlet => "dirichlet (u = 0)".to_string(),
+            PartKind::Neumann(None) => "neumann, traction free (nothing assembled)".to_string(),
+            PartKind::Neumann(Some(g)) => {
+                format!("neumann, g = ({}, {})", short(g.0[0].text()), short(g.0[1].text()))
+            }
+            PartKind::Contact(g) => format!("contact u.n = 0, Tresca g_a = {}", short(g.text())),
+        };
+        println!("part       {:<10} {:>6} edges  {}", part.name, n, what);
+    }
+    println!(
+        "unknowns   {} (paper's count 2(edges - Dirichlet edges) = {}), {} contact unknowns",
+        sp.n_dofs,
+        sp.paper_dofs(),
+        sp.contact.len()
+    );
+    let stab = format!("jump stabilisation (rho = {})", s.rho);
+    let mut terms = vec!["elastic stiffness", stab.as_str()];
+    if s.f.is_some() {
+        terms.push("body force");
+    }
+    if s.parts.iter().any(|p| matches!(p.kind, PartKind::Neumann(Some(_)))) {
+        terms.push("Neumann traction");
+    }
+    if s.has_contact() {
+        terms.push("Tresca friction (condensed on contact unknowns)");
+    } else {
+        terms.push("no contact: plain elasticity");
+    }
+    println!("assembled  {}", terms.join(", "));
+    println!(
+        "time       {} steps on [{}, {}]{}",
+        problem.n_steps(),
+        s.times[0],
+        s.times.last().unwrap_or(&0.0),
+        if s.uniform_time { " (uniform)" } else { "" }
+    );
+    println!("solver     {} (tol {:.1e}, max_iter {})", s.solver.method.name(), s.solver.tol, s.solver.max_iter());
+    println!("exact      {}", if s.exact.is_some() { "given: true errors computed" } else { "none" });
+    Ok(())
+}

@@ -1,0 +1,5 @@
+//! The subcommands of the command line, one file each.
+
+pub mod check;
+pub mod run;
+pub mod study;
