@@ -226,6 +226,7 @@ impl Series {
             D::Float(FloatSize::U8) => self.rewrite::<f64>(raw, steps, kept),
             D::Float(FloatSize::U4) => self.rewrite::<f32>(raw, steps, kept),
             D::Integer(IntSize::U8) => self.rewrite::<i64>(raw, steps, kept),
+            D::Unsigned(IntSize::U8) => self.rewrite::<u64>(raw, steps, kept),
             D::Unsigned(IntSize::U1) => self.rewrite::<u8>(raw, steps, kept),
             other => Err(hdf5::Error::from(format!("{}: unexpected series type {other:?}", self.ds.name()))),
         }
@@ -246,6 +247,28 @@ impl Series {
         let ds = create_contiguous::<T>(&file, &path, &shape)?;
         *self = Series::wrap(ds, self.block)?;
         self.write_steps(raw, 0, keep, &data)
+    }
+
+    /// The first `count` steps.
+    pub fn read_steps<T: H5Type>(&self, count: usize) -> hdf5::Result<Vec<T>> {
+        let a = self.ds.read_slice::<T, _, IxDyn>(rows(0, count * self.block, &self.rest))?;
+        Ok(a.into_raw_vec_and_offset().0)
+    }
+
+    /// The first `count` steps as the little-endian bytes of the stored type.
+    pub fn read_bytes(&self, count: usize) -> hdf5::Result<Vec<u8>> {
+        use hdf5::types::{FloatSize, IntSize, TypeDescriptor as D};
+        fn b<T: H5Type + bytemuck::Pod>(s: &Series, count: usize) -> hdf5::Result<Vec<u8>> {
+            Ok(bytemuck::cast_slice(&s.read_steps::<T>(count)?).to_vec())
+        }
+        match self.dtype {
+            D::Float(FloatSize::U8) => b::<f64>(self, count),
+            D::Float(FloatSize::U4) => b::<f32>(self, count),
+            D::Integer(IntSize::U8) => b::<i64>(self, count),
+            D::Unsigned(IntSize::U8) => b::<u64>(self, count),
+            D::Unsigned(IntSize::U1) => b::<u8>(self, count),
+            ref other => Err(hdf5::Error::from(format!("{}: unexpected series type {other:?}", self.ds.name()))),
+        }
     }
 
     /// Read step n.

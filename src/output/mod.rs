@@ -37,6 +37,7 @@
 
 pub mod fields;
 mod h5;
+mod lock;
 mod resume;
 pub mod tresca;
 pub mod vtkhdf;
@@ -56,6 +57,7 @@ use tresca::{Rows, Tresca};
 use vtkhdf::{FrameRows, Frames, VtkHdf};
 use xdmf::Xdmf;
 
+pub use lock::{lock_path, OutputLock};
 pub use xdmf::sidecar;
 
 /// Default upper bound on the number of visualisation frames.
@@ -162,6 +164,8 @@ pub struct Writer {
     pending: Option<Pending>,
     /// Seconds spent in write_step (all of it) and in H5Fflush alone.
     pub seconds: [f64; 2],
+    /// The exclusive ownership of the path ([`OutputLock`]); last, so it is released after the file closes.
+    lock: Option<OutputLock>,
 }
 
 /// A created file not yet under its name, and the old file it will replace (held open so its blocks are
@@ -202,6 +206,16 @@ impl Writer {
 
     /// [`Writer::create`] with all options.
     pub fn create_with(path: &Path, run: &Run, opts: &Options) -> Result<Writer> {
+        Writer::create_locked(OutputLock::acquire(path)?, run, opts)
+    }
+
+    /// [`Writer::create_with`] on the path of a lock already taken.
+    pub fn create_locked(lock: OutputLock, run: &Run, opts: &Options) -> Result<Writer> {
+        let path = lock.target().to_path_buf();
+        let path = path.as_path();
+        if path.is_dir() {
+            return Err(Error::Io { path: path.to_path_buf(), msg: "is a directory, not a results file".into() });
+        }
         if path.exists() && !opts.force {
             return Err(Error::Io {
                 path: path.to_path_buf(),
@@ -237,6 +251,7 @@ impl Writer {
         let mut w = Writer::from_opened(path, run, fields, Opened { file, raw, tresca, vtk, xdmf, frames }, 0, None);
         w.interval = opts.commit_interval;
         w.pending = pending;
+        w.lock = Some(lock);
         Ok(w)
     }
 
@@ -277,6 +292,7 @@ impl Writer {
             finished: false,
             pending: None,
             seconds: [0.0; 2],
+            lock: None,
         }
     }
 

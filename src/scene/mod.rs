@@ -7,6 +7,7 @@
 
 use crate::error::{Error, Result};
 use expr::{Expr, Vec2Expr};
+pub mod budget;
 pub mod expr;
 mod raw;
 
@@ -161,6 +162,22 @@ fn positive_finite(file: &str, key: &str, v: f64) -> Result<f64> {
     }
 }
 
+/// Longest accepted expression (characters). The longest generated expression of the repository has
+/// ~3,000; parsing time and memory grow faster than the length (10 MB took over a minute and 3.6 GB).
+pub const MAX_EXPR_CHARS: usize = 100_000;
+
+/// Refuse expressions longer than [`MAX_EXPR_CHARS`] before they reach the parser.
+fn sized<'a, const K: usize>(file: &str, key: &str, texts: &'a [String; K]) -> Result<&'a [String; K]> {
+    match texts.iter().map(|t| t.len()).max() {
+        Some(n) if n > MAX_EXPR_CHARS => Err(Error::scene(
+            file,
+            key,
+            format!("an expression of {n} characters is longer than the {MAX_EXPR_CHARS} accepted"),
+        )),
+        _ => Ok(texts),
+    }
+}
+
 fn nonzero(v: Option<Vec2Expr>) -> Option<Vec2Expr> {
     v.filter(|e| !e.is_zero())
 }
@@ -240,12 +257,13 @@ impl Scene {
             let kind = match b.kind {
                 RawKind::Dirichlet => PartKind::Dirichlet,
                 RawKind::Neumann => PartKind::Neumann(match &b.traction {
-                    Some(g) => nonzero(Some(Vec2Expr::parse(&key("traction"), g)?)),
+                    Some(g) => nonzero(Some(Vec2Expr::parse(&key("traction"), sized(file, &key("traction"), g)?)?)),
                     None => None,
                 }),
                 RawKind::Contact => {
                     let text =
                         b.g_a.as_deref().ok_or_else(|| Error::scene(file, key("g_a"), "contact part needs g_a"))?;
+                    sized(file, &key("g_a"), &[text.to_string()])?;
                     PartKind::Contact(FrictionBound::parse(file, &key("g_a"), text)?)
                 }
             };
@@ -259,12 +277,12 @@ impl Scene {
             ));
         }
         let f = match raw.loads.and_then(|l| l.f) {
-            Some(f) => nonzero(Some(Vec2Expr::parse("loads.f", &f)?)),
+            Some(f) => nonzero(Some(Vec2Expr::parse("loads.f", sized(file, "loads.f", &f)?)?)),
             None => None,
         };
         let u0 = match raw.initial.and_then(|l| l.u0) {
             Some(u) => {
-                let u = Vec2Expr::parse("initial.u0", &u)?;
+                let u = Vec2Expr::parse("initial.u0", sized(file, "initial.u0", &u)?)?;
                 if u.depends_on_t() {
                     return Err(Error::scene(file, "initial.u0", "must not depend on t"));
                 }
@@ -323,6 +341,10 @@ impl Scene {
         };
         let exact = match raw.exact {
             Some(x) => {
+                sized(file, "exact.u", &x.u)?;
+                for row in &x.grad {
+                    sized(file, "exact.grad", row)?;
+                }
                 let g = |i: usize, j: usize| Expr::parse(&format!("exact.grad[{i}][{j}]"), &x.grad[i][j]);
                 Some(Exact { u: Vec2Expr::parse("exact.u", &x.u)?, grad: [[g(0, 0)?, g(0, 1)?], [g(1, 0)?, g(1, 1)?]] })
             }
@@ -389,7 +411,22 @@ fn uniform_times(file: &str, t: f64, n: usize) -> Result<Vec<f64>> {
     if n == 0 {
         return Err(Error::scene(file, "time.steps", "must be at least 1"));
     }
-    Ok((0..=n).map(|k| t * k as f64 / n as f64).collect())
+    // refuse before allocating: a step costs at least its time node and load coefficients in memory
+    let need = (n as u64).saturating_add(1).saturating_mul(64);
+    let have = budget::available_memory();
+    let mut times = Vec::new();
+    if have.is_some_and(|h| need > h) || times.try_reserve_exact(n.saturating_add(1)).is_err() {
+        return Err(Error::scene(
+            file,
+            "time.steps",
+            format!(
+                "{n} steps need about {} of memory for their time nodes alone, more than this machine has",
+                crate::error::human(need)
+            ),
+        ));
+    }
+    times.extend((0..=n).map(|k| t * k as f64 / n as f64));
+    Ok(times)
 }
 
 fn line_of(text: &str, byte: usize) -> usize {
