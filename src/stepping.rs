@@ -181,6 +181,14 @@ impl Problem {
                 r.n
             )));
         }
+        if !r.u.is_empty() && !r.energy.is_finite() {
+            let umax = r.u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            return Err(Error::Linear(format!(
+                "step {}: the energy a_h(u, u) overflows f64 (max |u| = {umax:.3e}): the loads are too large for \
+                 the answer to be representable; u is linear in the loads, u₀ and g_a together, so scale them down",
+                r.n
+            )));
+        }
         if let (Some(ev), Some(ex), false) = (&self.errors, &self.scene.exact, r.u.is_empty() && self.space.n_dofs > 0)
         {
             r.errors = Some(ev.errors(&self.mesh, ex, &self.space.midpoint_values(&r.u), r.t)?);

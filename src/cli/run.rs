@@ -132,6 +132,12 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
             problem.run_selected(f, want, on_step)
         }),
     };
+    if let Some(z) = problem.friction.as_ref().map(|f| f.zeroed_steps()).filter(|&z| z > 0) {
+        note!(
+            "note: at {z} steps the friction bound g_a was below the rounding of the load (its effect on the slip \
+             under 1e-17 of the free slip) and was treated as zero: those steps are frictionless"
+        );
+    }
     let status = result.as_ref().map_or_else(|e| format!("stopped: {e}"), |()| "completed".to_string());
     let committed = writer.map(|w| w.finish(&status)).transpose()?;
     if let (Err(_), Some(p)) = (&result, &path) {

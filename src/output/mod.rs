@@ -387,7 +387,8 @@ impl Writer {
                     return Err(Error::Io {
                         path: path.to_path_buf(),
                         msg: format!(
-                            "step {n}: {what}[{k}] is not finite in single precision; the step was not written"
+                            "step {n}: {what}[{k}] exceeds the single-precision range (3.4e38) of the VTKHDF/XDMF \
+                             views; the step was not written (u is linear in the loads, u₀ and g_a: scale them down)"
                         ),
                     });
                 }
