@@ -289,3 +289,48 @@ fn misleading_messages_are_fixed() {
     assert!(stderr(&o).contains("characters is longer than"), "{}", stderr(&o));
     assert!(start.elapsed().as_secs() < 5);
 }
+
+/// Issue 18.7: an ill-conditioned K names its likely cause (slivers here, at rho = 10), a mesh of size
+/// 1e-150 runs (it used to be called "inverted"), one whose areas leave the normal range is refused
+/// saying so, and a piece of the mesh without a Dirichlet edge is found.
+#[test]
+fn mesh_messages_name_the_cause() {
+    let corners = "corners  = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]";
+    let thin = scene_with("thin.toml", corners, "corners = [[0.0, 0.0], [4e6, 0.0], [4e6, 4.0], [0.0, 4.0]]");
+    let o = run(&["check", &thin]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("ill-conditioned") && stderr(&o).contains("aspect ratio up to 1.0e6"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!stderr(&o).contains("Use rho of order 1"), "{}", stderr(&o));
+    let small = |f: &str| format!("corners = [[0.0, 0.0], [{f}, 0.0], [{f}, {f}], [0.0, {f}]]");
+    let tiny = scene_with("tiny.toml", corners, &small("4e-150"));
+    let o = run(&["run", &tiny, "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let tinier = scene_with("tinier.toml", corners, &small("4e-160"));
+    let o = run(&["check", &tinier]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("beyond the normal range of f64") && !stderr(&o).contains("inverted"),
+        "{}",
+        stderr(&o)
+    );
+    // two disjoint squares, only the first clamped: the second floats
+    let c = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let a = tresca_cr::mesh::structured_raw(&c, [2, 2], tresca_cr::scene::Diagonal::First).unwrap();
+    let c2 = c.map(|p| [p[0] + 5.0, p[1]]);
+    let b = tresca_cr::mesh::structured_raw(&c2, [2, 2], tresca_cr::scene::Diagonal::First).unwrap();
+    let mut raw = a.clone();
+    let np = raw.points.len();
+    raw.points.extend(&b.points);
+    raw.tris.extend(b.tris.iter().map(|t| t.map(|v| v + np)));
+    raw.tagged.extend(b.tagged.iter().map(|&([p, q], tag)| ([p + np, q + np], tag)));
+    let mesh = tresca_cr::mesh::Mesh::build(raw).unwrap();
+    let left = mesh.tag_names.iter().position(|n| n == "left").unwrap();
+    let clamped = |e: usize| mesh.edge_tag[e] == Some(left) && mesh.midpoint(e)[0] < 2.0;
+    let p = mesh.floating_piece(clamped).expect("the second square floats");
+    assert!(p[0] >= 5.0, "{p:?}");
+    assert_eq!(mesh.floating_piece(|e| mesh.edge_tag[e] == Some(left)), None);
+}

@@ -107,6 +107,16 @@ impl Mesh {
             let a2 = area2(a, b, c);
             let scale =
                 [(a, b), (b, c), (c, a)].iter().map(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1])).fold(0.0, f64::max);
+            if scale > 0.0 && scale * scale < 1e4 * f64::MIN_POSITIVE {
+                return Err(Error::mesh(
+                    src,
+                    format!(
+                        "triangle {k} at ({:e}, {:e}) has edges of {scale:.1e}: its area is beyond the normal range of f64; \
+                         give the mesh in larger units (the answer scales with them)",
+                        a[0], a[1]
+                    ),
+                ));
+            }
             if !(a2.abs() > 1e-12 * scale * scale) {
                 return Err(Error::mesh(
                     src,
@@ -157,7 +167,8 @@ impl Mesh {
                 };
                 let s1 = area2(a, b, raw.points[opp(t1)]);
                 let s2 = area2(a, b, raw.points[opp(t2)]);
-                if s1 * s2 >= 0.0 {
+                // signs, not the product s1·s2, which underflows to 0 on a mesh of size ~1e-150
+                if s1 == 0.0 || s2 == 0.0 || (s1 > 0.0) == (s2 > 0.0) {
                     return Err(Error::mesh(
                         src,
                         format!(
@@ -287,6 +298,47 @@ impl Mesh {
     pub fn area(&self, t: usize) -> f64 {
         let [a, b, c] = self.tris[t].map(|v| self.points[v]);
         0.5 * area2(a, b, c)
+    }
+    /// A point of the first piece of the mesh (triangles connected through edges) none of whose edges
+    /// satisfies `fixed`: such a piece floats (rigid motions free). For the messages of an ill-conditioned K.
+    pub fn floating_piece(&self, fixed: impl Fn(usize) -> bool) -> Option<[f64; 2]> {
+        let mut piece = vec![usize::MAX; self.tris.len()];
+        for start in 0..self.tris.len() {
+            if piece[start] != usize::MAX {
+                continue;
+            }
+            let (mut stack, mut held) = (vec![start], false);
+            piece[start] = start;
+            while let Some(t) = stack.pop() {
+                for &e in &self.tri_edges[t] {
+                    held |= fixed(e);
+                    let (a, b) = self.edge_tris[e];
+                    for n in [Some(a), b].into_iter().flatten() {
+                        if piece[n] == usize::MAX {
+                            piece[n] = start;
+                            stack.push(n);
+                        }
+                    }
+                }
+            }
+            if !held {
+                return Some(self.points[self.tris[start][0]]);
+            }
+        }
+        None
+    }
+
+    /// The largest aspect ratio (longest edge / height on it) of a triangle, and where.
+    pub fn worst_aspect(&self) -> (f64, [f64; 2]) {
+        let mut worst = (0.0, [0.0; 2]);
+        for (t, tri) in self.tris.iter().enumerate() {
+            let l = self.tri_edges[t].iter().map(|&e| self.edge_length(e)).fold(0.0, f64::max);
+            let r = l * l / (2.0 * self.area(t)).max(f64::MIN_POSITIVE);
+            if r > worst.0 {
+                worst = (r, self.points[tri[0]]);
+            }
+        }
+        worst
     }
 
     /// Largest edge length (the mesh size h).
