@@ -10,6 +10,9 @@ use expr::{Expr, Vec2Expr};
 pub mod budget;
 pub mod expr;
 mod raw;
+mod values;
+pub use values::MAX_EXPR_CHARS;
+use values::{line_of, positive_finite, sized, uniform_times};
 
 use raw::*;
 use serde::Deserialize;
@@ -152,30 +155,6 @@ pub struct Scene {
     pub solver: SolverSettings,
     pub exact: Option<Exact>,
     pub output: Option<PathBuf>,
-}
-
-fn positive_finite(file: &str, key: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(Error::scene(file, key, format!("must be a positive finite number, got {v}")))
-    }
-}
-
-/// Longest accepted expression (characters). The longest generated expression of the repository has
-/// ~3,000; parsing time and memory grow faster than the length (10 MB took over a minute and 3.6 GB).
-pub const MAX_EXPR_CHARS: usize = 100_000;
-
-/// Refuse expressions longer than [`MAX_EXPR_CHARS`] before they reach the parser.
-fn sized<'a, const K: usize>(file: &str, key: &str, texts: &'a [String; K]) -> Result<&'a [String; K]> {
-    match texts.iter().map(|t| t.len()).max() {
-        Some(n) if n > MAX_EXPR_CHARS => Err(Error::scene(
-            file,
-            key,
-            format!("an expression of {n} characters is longer than the {MAX_EXPR_CHARS} accepted"),
-        )),
-        _ => Ok(texts),
-    }
 }
 
 fn nonzero(v: Option<Vec2Expr>) -> Option<Vec2Expr> {
@@ -405,30 +384,4 @@ impl Scene {
     pub fn has_contact(&self) -> bool {
         self.parts.iter().any(|p| matches!(p.kind, PartKind::Contact(_)))
     }
-}
-
-fn uniform_times(file: &str, t: f64, n: usize) -> Result<Vec<f64>> {
-    if n == 0 {
-        return Err(Error::scene(file, "time.steps", "must be at least 1"));
-    }
-    // refuse before allocating: a step costs at least its time node and load coefficients in memory
-    let need = (n as u64).saturating_add(1).saturating_mul(64);
-    let have = budget::available_memory();
-    let mut times = Vec::new();
-    if have.is_some_and(|h| need > h) || times.try_reserve_exact(n.saturating_add(1)).is_err() {
-        return Err(Error::scene(
-            file,
-            "time.steps",
-            format!(
-                "{n} steps need about {} of memory for their time nodes alone, more than this machine has",
-                crate::error::human(need)
-            ),
-        ));
-    }
-    times.extend((0..=n).map(|k| t * k as f64 / n as f64));
-    Ok(times)
-}
-
-fn line_of(text: &str, byte: usize) -> usize {
-    text[..byte.min(text.len())].matches('\n').count() + 1
 }
