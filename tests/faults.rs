@@ -334,3 +334,16 @@ fn mesh_messages_name_the_cause() {
     assert!(p[0] >= 5.0, "{p:?}");
     assert_eq!(mesh.floating_piece(|e| mesh.edge_tag[e] == Some(left)), None);
 }
+
+/// Issue 18.1: a lock file left by a process that died (no `flock` held: the kernel drops the locks of a
+/// dead process) does not block the next run, which takes it over and removes it at its end.
+#[test]
+fn a_stale_lock_is_taken_over() {
+    let out = tmp("stale.h5");
+    let lock = tresca_cr::output::lock_path(&out);
+    std::fs::write(&lock, "4194303 (a run that was killed)").unwrap();
+    let o = run(&["run", &root(BASE), "-q", "-o", out.to_str().unwrap(), "--steps", "8"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_complete(&out, 8);
+    assert!(!lock.exists());
+}
