@@ -95,10 +95,17 @@ CHECKSUMMED = ["times", "u", "energy", "steps/iterations", "steps/residual", "st
 
 def first_bad_step(g, S):
     """The first of the S committed steps whose rows do not match tresca/steps/checksum (None: all match)."""
-    parts = [np.ascontiguousarray(g[k][:S]).reshape(S, -1).view(np.uint8) for k in CHECKSUMMED if k in g]
-    sums = xxh64_rows(np.concatenate(parts, axis=1))
-    bad = np.nonzero(sums != g["steps/checksum"][:S])[0]
-    return int(bad[0]) if len(bad) else None
+    names = [k for k in CHECKSUMMED if k in g]
+    per_step = sum(g[k].dtype.itemsize * int(np.prod(g[k].shape[1:])) for k in names)
+    block = max(1, (64 << 20) // max(per_step, 1))  # steps per read: about 64 MB
+    stored = g["steps/checksum"][:S]
+    for a in range(0, S, block):
+        b = min(S, a + block)
+        parts = [np.ascontiguousarray(g[k][a:b]).reshape(b - a, -1).view(np.uint8) for k in names]
+        bad = np.nonzero(xxh64_rows(np.concatenate(parts, axis=1)) != stored[a:b])[0]
+        if len(bad):
+            return a + int(bad[0])
+    return None
 
 
 def reference(g, S):

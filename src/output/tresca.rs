@@ -270,13 +270,23 @@ impl Tresca {
     /// error if the file has no checksums.
     pub fn first_corrupt_step(&mut self, completed: usize) -> hdf5::Result<Option<usize>> {
         let stored: Vec<u64> = match &self.checksum {
-            Some(c) => c.read_steps::<u64>(completed)?,
+            Some(c) => c.read_steps::<u64>(0, completed)?,
             None => return Err(hdf5::Error::from("the file has no step checksums (written before they were added)")),
         };
-        let bytes = self.all().iter().map(|s| s.read_bytes(completed)).collect::<hdf5::Result<Vec<_>>>()?;
-        let views: Vec<&[u8]> = bytes.iter().map(|b| &b[..]).collect();
-        let sums = step_checksums(&views, completed);
-        Ok(sums.iter().zip(&stored).position(|(a, b)| a != b))
+        // blocks of steps of about 64 MB, so that a file larger than memory is verified too
+        let series = self.all();
+        let per_step = series.iter().map(|s| s.step_bytes()).sum::<usize>().max(1);
+        let block = ((64 << 20) / per_step).max(1);
+        for first in (0..completed).step_by(block) {
+            let count = block.min(completed - first);
+            let bytes = series.iter().map(|s| s.read_bytes(first, count)).collect::<hdf5::Result<Vec<_>>>()?;
+            let views: Vec<&[u8]> = bytes.iter().map(|b| &b[..]).collect();
+            let sums = step_checksums(&views, count);
+            if let Some(k) = sums.iter().zip(&stored[first..]).position(|(a, b)| a != b) {
+                return Ok(Some(first + k));
+            }
+        }
+        Ok(None)
     }
 
     /// The `completed` attribute.
