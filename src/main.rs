@@ -153,7 +153,9 @@ fn main() {
         }
         Cmd::Run { scene, refine, steps, solver, tol, out, verbose, quiet, limits } => {
             let target = out.output.clone().or_else(|| Scene::from_file(&scene).ok().and_then(|s| s.output));
-            load(&scene, refine, steps, limits, target.as_deref()).and_then(|(mut s, _)| {
+            // a resumed run's file already holds its disk space: only memory is checked then
+            let new_file = target.as_deref().filter(|_| !out.resume);
+            load(&scene, refine, steps, limits, new_file).and_then(|(mut s, _)| {
                 solver_overrides(&mut s, solver, tol)?;
                 cli::run::run(s, out, verbose, quiet)
             })
