@@ -6,14 +6,19 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use common::{bin, root, stderr};
+use common::{bin, fork_guard, root, spawn, stderr};
 
 fn tmp(name: &str) -> PathBuf {
     common::tmp_in("tresca-cli", name)
 }
 
 fn run(args: &[&str]) -> Output {
-    bin().args(args).output().unwrap()
+    spawn(bin().args(args)).wait_with_output().unwrap()
+}
+
+fn same_results(a: &Path, b: &Path) {
+    let _g = fork_guard();
+    common::same_results(a, b);
 }
 
 /// The same scene and binary shall give bit-identical results files (wall times aside).
@@ -36,7 +41,7 @@ fn results_files_are_deterministic() {
             ]);
             assert!(o.status.success(), "{}", stderr(&o));
         }
-        common::same_results(&a, &b);
+        same_results(&a, &b);
     }
 }
 
@@ -55,6 +60,7 @@ fn solver_failure_keeps_completed_steps_and_records_why() {
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     let e = stderr(&o);
     assert!(e.contains("step 1") && e.contains("did not converge in 50 iterations") && e.contains("residual"), "{e}");
+    let _g = fork_guard();
     let f = hdf5::File::open(&out).unwrap();
     let completed = f.group("tresca/steps").unwrap().attr("completed").unwrap().read_scalar::<i64>().unwrap();
     assert_eq!(completed, 1, "step 0 completed, step 1 failed");
@@ -109,7 +115,7 @@ fn output_options_are_checked() {
     assert!(missing.exists() && !partial.exists());
     let full = tmp("uninterrupted.h5");
     assert!(run(&["run", &scene, "-o", full.to_str().unwrap(), "-q"]).status.success());
-    common::same_results(&full, &missing);
+    same_results(&full, &missing);
 }
 
 /// Bad scenes give exit status 1 and a message naming the file — never a panic.
@@ -158,7 +164,7 @@ fn sigkill_then_resume_is_bit_identical() {
     };
     let full = tmp("kill_full.h5");
     let start = std::time::Instant::now();
-    let mut child = bin().args(args(&full)).spawn().unwrap();
+    let mut child = spawn(bin().args(args(&full)).stdout(std::process::Stdio::null()));
     wait_for(&full, &mut child);
     let appeared = start.elapsed();
     assert!(child.wait().unwrap().success());
@@ -166,7 +172,7 @@ fn sigkill_then_resume_is_bit_identical() {
     let mut killed_mid_run = 0;
     for (i, frac) in [0.1, 0.5, 0.9].into_iter().enumerate() {
         let out = tmp(&format!("kill_{i}.h5"));
-        let mut child = bin().args(args(&out)).spawn().unwrap();
+        let mut child = spawn(bin().args(args(&out)));
         wait_for(&out, &mut child);
         std::thread::sleep(phase.mul_f64(frac));
         let finished = child.try_wait().unwrap().is_some();
@@ -174,6 +180,7 @@ fn sigkill_then_resume_is_bit_identical() {
         let _ = child.wait();
         assert!(out.exists(), "kill {i}: the run's file is not under its name after its first commit");
         // every committed step is readable and equal to the uninterrupted run's
+        let held = fork_guard();
         let f = hdf5::File::open(&out).expect("a killed run's file opens");
         let done = f.group("tresca/steps").unwrap().attr("completed").unwrap().read_scalar::<i64>().unwrap() as usize;
         let g = hdf5::File::open(&full).unwrap();
@@ -187,13 +194,14 @@ fn sigkill_then_resume_is_bit_identical() {
             uk[..done * per].iter().zip(&uf[..done * per]).all(|(a, b)| a.to_bits() == b.to_bits()),
             "kill {i}: committed steps differ"
         );
-        drop(f);
+        drop((f, g));
+        drop(held);
         if !finished && done < 1501 {
             killed_mid_run += 1;
         }
-        let o = bin().args(args(&out)).arg("--resume").output().unwrap();
+        let o = spawn(bin().args(args(&out)).arg("--resume")).wait_with_output().unwrap();
         assert!(o.status.success(), "resume {i}: {}", stderr(&o));
-        common::same_results(&full, &out);
+        same_results(&full, &out);
     }
     assert!(killed_mid_run >= 1, "no kill landed in the middle of the run; lengthen it");
 }

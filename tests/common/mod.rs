@@ -142,3 +142,18 @@ pub fn root(p: &str) -> String {
 pub fn stderr(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
+
+/// Held while this process has an HDF5 file open and while it starts a child: HDF5 opens files without
+/// O_CLOEXEC and locks them, so a child forked by another test thread meanwhile would inherit the
+/// descriptor, and its lock, for its whole life (a `--resume` then fails with "unable to lock file").
+pub static FORK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+pub fn fork_guard() -> std::sync::MutexGuard<'static, ()> {
+    FORK.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Start `cmd` (stdout and stderr piped) under [`FORK`].
+pub fn spawn(cmd: &mut std::process::Command) -> std::process::Child {
+    let _g = fork_guard();
+    cmd.stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap()
+}
