@@ -169,3 +169,6 @@ pub fn classify(qp: &Qp, mu: &[f64], ds: &[f64]) -> Vec<EdgeState> {
 pub fn stalled(solver: &'static str, iterations: usize, residual: f64) -> Stalled {
     Stalled { solver, iterations, residual }
 }
+
+#[cfg(test)]
+mod tests;

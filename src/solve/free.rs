@@ -76,6 +76,11 @@ impl FreeResponse {
         &self.factor
     }
 
+    /// True if the loads are superposed from a few patterns (no assembly or solve per step).
+    pub fn superposed(&self) -> bool {
+        self.basis.is_some()
+    }
+
     /// The load functional.
     pub fn loads(&self) -> &Loads {
         &self.loads
