@@ -302,8 +302,16 @@ def main():
             os.makedirs(args.write_scenes, exist_ok=True)
             with open(os.path.join(args.write_scenes, f"{name}.toml"), "w") as fh:
                 fh.write(text)
-    for name in ("example51", "cyclic", "trapezoid"):
-        paths[name] = os.path.join(HERE, "scenes", f"{name}.toml")
+    cases = os.path.join(os.path.dirname(HERE), "verification", "cases")
+    for name in ("cyclic", "trapezoid"):
+        paths[name] = os.path.join(cases, f"{name}.toml")
+    # Example 5.1 on the paper's n = 8 mesh (refine 2 of its 2 x 2 cells), as a scene of its own
+    with open(os.path.join(cases, "paper_example_5_1.toml")) as fh:
+        ex51 = fh.read().replace("cells = [2, 2]", "cells = [8, 8]")
+    assert "cells = [8, 8]" in ex51, "paper_example_5_1.toml changed: update this generator"
+    paths["example51"] = os.path.join(tmp, "example51.toml")
+    with open(paths["example51"], "w") as fh:
+        fh.write(ex51)
 
     import h5py
     # patch tests and cross-checks

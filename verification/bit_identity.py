@@ -5,8 +5,7 @@ Usage:
     python verification/bit_identity.py compare DIR_A DIR_B     # compare them dataset by dataset
 
 `run` solves every scene of ``verification/cases/`` (at its own refine and steps, and at one finer level)
-and the paper's Example 5.1 levels of Tables 5.1/5.2 (refine k, N = 40·2^k, k = 0..4), plus every runnable
-scene of ``tests/scenes/`` and ``scripts/scenes/``, with the SSN, Uzawa and PDAS solvers where the scene
+and the paper's Example 5.1 levels of Tables 5.1/5.2 (refine k, N = 40·2^k, k = 0..4),  with the SSN, Uzawa and PDAS solvers where the scene
 has contact. `compare` reads every dataset and attribute under ``/tresca`` and ``/VTKHDF`` with h5py and requires the
 bytes to be equal, except what is not a number of the method: wall times (``steps/wall_time``,
 ``setup_times``), the build (``version``, ``git_commit``). It prints one line per file and exits non-zero
@@ -40,9 +39,6 @@ def runs():
         out.append((f"paper_2_{solver}", paper, ["--refine", "2", "--steps", "160", "--solver", solver]))
         front = os.path.join(ROOT, "verification", "cases", "mms_front.toml")
         out.append((f"mms_front_{solver}", front, ["--solver", solver]))
-    for scene in sorted(glob.glob(os.path.join(ROOT, "tests", "scenes", "*.toml"))
-                        + glob.glob(os.path.join(ROOT, "scripts", "scenes", "*.toml"))):
-        out.append((os.path.splitext(os.path.basename(scene))[0], scene, []))
     return out
 
 

@@ -366,9 +366,9 @@ def main():
     os.makedirs(REF, exist_ok=True)
     studies = {
         "elastic": lambda: (
-            h_study("E1-rect", "tests/scenes/elastic_rect.toml", "h_elastic_rect", [(k, 1) for k in range(2, 7)], 1, 2,
+            h_study("E1-rect", "verification/cases/elastic_rect.toml", "h_elastic_rect", [(k, 1) for k in range(2, 7)], 1, 2,
                     "the CR solver shall converge on a smooth elasticity problem (rectangle)"),
-            h_study("E2-rotated", "tests/scenes/elastic_rotated.toml", "h_elastic_rotated", [(k, 1) for k in range(2, 7)], 1, 2,
+            h_study("E2-rotated", "verification/cases/elastic_rotated.toml", "h_elastic_rotated", [(k, 1) for k in range(2, 7)], 1, 2,
                     "the CR solver shall converge on a smooth elasticity problem (rotated square)")),
         "front": lambda: h_study("C1-front", "verification/cases/mms_front.toml", "h_mms_front",
                                  [(k, 64) for k in range(0, 4 if args.quick else 5)], 1, 2,
