@@ -1,7 +1,7 @@
 //! Convergence studies: one scene run at a list of levels (refinement, number of steps), with
 //!
 //! * true errors when the scene has an exact solution (max over time nodes and at the final time),
-//! * the paper's consecutive-level error |||u_l − P u_{l−1}||| on level l (P: `prolong`),
+//! * the paper's consecutive-level error |||u_l − P u_{l−1}||| on level l (P: `fem::prolong`),
 //! * the error against a finer reference run u_ref, the true error with u replaced by u_ref:
 //!   |||u_ref − u_l|||² = Σ_{T ∈ reference mesh} ∫_T σ(u_ref − u_l):ε(u_ref − u_l) + Σ_{e ∈ E_l⁰} (2ρμ/h_e) ∫_e |[u_l]|²
 //!   (u_l is linear on each reference triangle of nested meshes; the exact u has no jumps),
