@@ -21,9 +21,11 @@ Wadhawan), but nothing of size O(mesh) is held by one rank:
   removed by ``zeroRowsColumns`` (unit diagonal, zero right-hand side).  u = R r.
 * Factorisation.  K_r is factored once by MUMPS Cholesky through PETSc (``--ksp mumps``, the default),
   or used by CG + GAMG (``--ksp cg-gamg``, rtol 1e-13; for the measured comparison only).
-* Contact condensation.  Only the contact unknowns are gathered: C = E^T K_r^{-1} E (n_c x n_c) is
-  built by multi-right-hand-side solves ``MatMatSolve`` with the distributed factor, in blocks of
-  ``--rhs-block`` columns (dense n x block; only the n_c contact rows of each result are gathered).
+* Contact condensation.  Only the contact unknowns are gathered: C = E^T K_r^{-1} E (n_c x n_c) is the
+  contact block of K_r^{-1}, computed by MUMPS as selected entries of the inverse (ICNTL(30), PETSc's
+  MatMumpsGetInverseTranspose through ctypes: petsc4py does not wrap it), delivered to rank 0; no dense
+  n x n_c block exists.  (``--condense matsolve``: blocked multi-right-hand-side MatMatSolve instead,
+  ``--rhs-block`` columns at a time; measured 2-3x more memory and 100x more time at 1.6M unknowns.)
   Per step: u_f = K_r^{-1} l^n (distributed), d = E^T u_f - s^{n-1} gathered to rank 0 (n_c numbers),
   the friction problem solved there by the project's exact box-QP step (``tresca_scene.box_qp``),
   mu broadcast, u^n = u_f - K_r^{-1} E mu (distributed).
@@ -41,6 +43,7 @@ Edges are numbered by dolfinx's global CR dof-block numbering (owned ranges in r
 numbering depends on the number of ranks; tools match edges by midpoint coordinates (scripts/compare.py).
 """
 import argparse
+import ctypes
 import json
 import math
 import os
@@ -81,6 +84,40 @@ def agree(comm, msg):
 
 def peak_mb():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def rss_mb():
+    """Current resident memory of this process (MB)."""
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2 ** 20
+
+
+MEMLOG = False
+
+
+def memlog(comm, what):
+    """With --mem-log: every rank's current and peak RSS after a set-up stage (collective)."""
+    if MEMLOG:
+        v = comm.gather((rss_mb(), peak_mb()), root=0)
+        if comm.rank == 0:
+            print(f"[mem] {what}: " + ", ".join(f"r{i} {a:.0f}/{b:.0f}" for i, (a, b) in enumerate(v)) + " MB (now/peak)",
+                  flush=True)
+
+
+_LIB = None
+
+
+def _petsc_lib():
+    """The wheel's libpetsc through ctypes, for the two calls petsc4py does not wrap."""
+    global _LIB
+    if _LIB is None:
+        _LIB = ctypes.CDLL(str(dolfinx.fem.petsc.get_petsc_lib()))
+        for name in ("MatProductClear", "MatMumpsGetInverseTranspose"):
+            f = getattr(_LIB, name)
+            f.restype = ctypes.c_int
+        _LIB.MatProductClear.argtypes = [ctypes.c_void_p]
+        _LIB.MatMumpsGetInverseTranspose.argtypes = [ctypes.c_void_p, ctypes.c_void_p]
+    return _LIB
 
 
 def local_range(rank, n, size):
@@ -200,8 +237,10 @@ class Problem:
         self.times_setup = {}
         self.mem_setup = {}
         tic = time.perf_counter()
+        memlog(comm, "start")
         msh, bf, side = gmsh_mesh(comm, scene) if "file" in scene.mesh else structured_mesh(comm, scene)
         self.msh = msh
+        memlog(comm, "mesh created")
         top = msh.topology
         for d0, d1 in ((2, 1), (1, 0), (2, 0), (0, 2)):
             top.create_connectivity(d0, d1)
@@ -324,8 +363,11 @@ class Problem:
         a_h = ufl.inner(sigma(u), eps(v)) * dx0 + 2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(u), ufl.jump(v)) * dS2
         if ids["dirichlet"]:
             a_h = a_h + pen * ufl.inner(u, v) * ds(ids["dirichlet"], metadata={"quadrature_degree": 3})
-        K = dolfinx.fem.petsc.assemble_matrix(fem.form(a_h))
+        a_form = fem.form(a_h)
+        memlog(comm, "a_h compiled")
+        K = dolfinx.fem.petsc.assemble_matrix(a_form)
         K.assemble()
+        memlog(comm, "K assembled")
         # rotation R: owned rows, identity except [tau n] on contact edges
         nloc = 2 * self.nb_own
         gb = 2 * self.b0
@@ -349,6 +391,11 @@ class Problem:
         self.R.assemble()
         Kr = K.PtAP(self.R)
         K.destroy()
+        # PtAP keeps its intermediate products for a later re-use (the size of K again in parallel);
+        # there is none, so free them (MatProductClear is not wrapped by petsc4py)
+        _petsc_lib().MatProductClear(ctypes.c_void_p(Kr.handle))
+        del a_form
+        memlog(comm, "K_r = R^T K R")
         cons = np.concatenate([2 * self.dir_lb, 2 * self.dir_lb + 1, 2 * self.con_lb + 1]) + gb
         self.cons_local = np.sort(cons - gb)
         Kr.zeroRowsColumns(np.sort(cons).astype(PETSc.IntType), diag=1.0)
@@ -386,6 +433,7 @@ class Problem:
             self.err_forms = [fem.form(el), fem.form(ufl.inner(G, G) * dx4),
                               fem.form(ufl.inner(ue - self.uh, ue - self.uh) * dx4)]
         self.times_setup["assembly"] = time.perf_counter() - tic
+        memlog(comm, "loads and error forms compiled")
         self.mem_setup["assembly"] = peak_mb()
 
         # factorisation / solver
@@ -407,7 +455,6 @@ class Problem:
             else:
                 F.setMumpsIcntl(28, 1)      # sequential analysis on the host
                 F.setMumpsIcntl(7, 5)       # METIS nested dissection
-            F.setMumpsIcntl(14, 40)         # workspace relaxation (%)
         else:
             ksp.setType("cg")
             ksp.getPC().setType("gamg")
@@ -430,7 +477,16 @@ class Problem:
             opts["tresca_pc_gamg_threshold"] = 0.01
         ksp.setFromOptions()
         ksp.setUp()
+        self.mumps = {}
+        if args.ksp == "mumps":
+            F = ksp.getPC().getFactorMatrix()
+            e29 = F.getMumpsInfog(29)       # entries in the factor (negative: millions)
+            self.mumps = {"factor_entries": float(-e29 * 1e6 if e29 < 0 else e29),
+                          "flops": float(F.getMumpsRinfog(3)),
+                          "mem_max_rank_mb": int(F.getMumpsInfog(21)), "mem_total_mb": int(F.getMumpsInfog(22)),
+                          "ordering": int(F.getMumpsInfog(7))}
         self.times_setup["factorisation"] = time.perf_counter() - tic
+        memlog(comm, "factorised")
         self.mem_setup["factorisation"] = peak_mb()
         self.n_solves = 0
         self.ksp_its = []
@@ -446,6 +502,7 @@ class Problem:
         tic = time.perf_counter()
         self.C = self._condense(log)
         self.times_setup["condensation"] = time.perf_counter() - tic
+        memlog(comm, "C built")
         self.mem_setup["condensation"] = peak_mb()
 
     def solve(self, b, x):
@@ -468,6 +525,8 @@ class Problem:
             return np.zeros((0, 0)) if comm.rank == 0 else None
         Cm = np.zeros((nc, nc)) if comm.rank == 0 else None
         my = 2 * self.con_lb
+        if self.args.ksp == "mumps" and self.args.condense == "inverse":
+            return self._condense_inverse()
         if self.args.ksp == "mumps":
             nb = max(1, min(nc, self.args.rhs_block))
             F = self.ksp.getPC().getFactorMatrix()
@@ -505,6 +564,46 @@ class Problem:
                 if comm.rank == 0:
                     Cm[:, k] = col
         return 0.5 * (Cm + Cm.T) if comm.rank == 0 else None
+
+    def _condense_inverse(self):
+        """C = the contact block of K_r^{-1}, computed by MUMPS as selected entries of the inverse
+        (ICNTL(30), PETSc's MatMumpsGetInverseTranspose, which petsc4py does not wrap: called through
+        ctypes on the wheel's libpetsc).  The requested pattern (n_c x n_c entries) lives on rank 0,
+        which receives the entries; no dense n x n_c block is formed."""
+        comm, nc = self.comm, self.n_c
+        F = self.ksp.getPC().getFactorMatrix()
+        N = self.Kr.getSize()[0]
+        if comm.rank == 0:
+            idx = (2 * self.C_edges).astype(PETSc.IntType)          # sorted
+            counts = np.zeros(N, PETSc.IntType)
+            counts[idx] = nc
+            indptr = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
+            cols = np.tile(idx, nc).astype(PETSc.IntType)
+            vals = np.ones(nc * nc)
+            sizes = ((N, N), (N, N))
+        else:
+            indptr, cols, vals = np.zeros(1, PETSc.IntType), np.zeros(0, PETSc.IntType), np.zeros(0)
+            sizes = ((0, N), (0, N))
+        S = PETSc.Mat().createAIJ(sizes, csr=(indptr, cols, vals), comm=comm)
+        S.assemble()
+        keep = {k: F.getMumpsIcntl(k) for k in (20, 21, 30)}
+        ierr = _petsc_lib().MatMumpsGetInverseTranspose(ctypes.c_void_p(F.handle), ctypes.c_void_p(S.handle))
+        for k, v in keep.items():                 # back to ordinary solves
+            F.setMumpsIcntl(k, v)
+        if comm.allreduce(ierr, op=MPI.MAX):
+            raise RuntimeError(f"MatMumpsGetInverseTranspose failed (PETSc error {ierr})")
+        self.n_solves += nc
+        Cm = None
+        if comm.rank == 0:
+            ip, jj, vv = S.getValuesCSR()
+            Cm = np.empty((nc, nc))
+            for k, i in enumerate(idx):
+                if not np.array_equal(jj[ip[i]:ip[i + 1]], idx):
+                    raise RuntimeError("MatMumpsGetInverseTranspose changed the requested pattern")
+                Cm[k] = vv[ip[i]:ip[i + 1]]
+            Cm = 0.5 * (Cm + Cm.T)
+        S.destroy()
+        return Cm
 
     def load(self, t):
         """l_r = R^T l(t) with the constrained entries zero (into self.rhs)."""
@@ -634,11 +733,16 @@ def main(argv=None):
                     help="linear solver for K_r: MUMPS Cholesky (default) or CG + GAMG (rtol 1e-13)")
     ap.add_argument("--mumps-analysis", choices=("sequential", "parallel"), default="sequential",
                     help="MUMPS analysis: METIS on the host (default) or PT-Scotch in parallel")
+    ap.add_argument("--condense", choices=("inverse", "matsolve"), default="inverse",
+                    help="MUMPS: C from selected entries of K_r^-1 (ICNTL(30), default) or from blocked MatMatSolve")
     ap.add_argument("--rhs-block", type=int, default=32,
                     help="right-hand sides per MatMatSolve when building C (memory: 2 x n x block doubles)")
     ap.add_argument("--frame-every", type=int, default=None,
                     help="visualisation frame every k steps (default: about 50 frames; 0 = none)")
+    ap.add_argument("--mem-log", action="store_true", help="print every rank's RSS after each set-up stage")
     args = ap.parse_args(argv)
+    global MEMLOG
+    MEMLOG = args.mem_log
     t_start = time.perf_counter()
     log = (lambda *a: print(*a, flush=True)) if comm.rank == 0 and not args.quiet else (lambda *a: None)
     try:
@@ -755,7 +859,7 @@ def main(argv=None):
                  "setup_times": json.dumps(prob.times_setup),
                  "step_time_median": float(np.median(step_times[1:])) if N else 0.0,
                  "peak_rss_mb": np.array(peaks), "setup_peak_rss_mb": json.dumps(mem_setup),
-                 "linear_solver": args.ksp, "linear_solves": prob.n_solves,
+                 "mumps": json.dumps(prob.mumps), "linear_solver": args.ksp, "linear_solves": prob.n_solves,
                  "ksp_iterations_max": int(max(prob.ksp_its)) if prob.ksp_its else 0}
         write_main(out, prob, res, writer.dir, sizes, attrs)
         log(f"dolfinx distributed ({comm.size} rank{'s' if comm.size > 1 else ''}): {2 * prob.nb_glob} unknowns, "

@@ -1,0 +1,392 @@
+"""The distributed dolfinx + PETSc/MUMPS route (issue 16): agreement (D1) and memory spreading (D2).
+
+    .venv/bin/python verification/distributed.py [--memory] [--bin target/release/tresca-cr]
+                                                 [--json out/distributed.json] [--md reference/distributed.md]
+
+D1 (quick, < 3 min): every cross-check scene (verification/cases/*.toml and the generated expression
+scenes of verification/cross_check.py) at its quick level is solved by the Rust binary and by
+scripts/dolfinx_distributed.py under `mpirun -n 1`, `-n 2` and `-n 3` (3 is oversubscribed on 2 cores);
+each distributed run is compared with the Rust run by scripts/compare.py: DOF vectors, energies, σ_τ and
+true errors within 1e-8 relative at every time node, identical stick/slip sets.
+
+D2 (--memory, ~6 min): Example 5.1 at refine 8 (1,574,912 unknowns, 512 contact edges, 3 steps) under
+`mpirun -n 1` and `-n 2`, each rank wrapped in `/usr/bin/time -f "RSS %M"`: the peak resident memory of
+the largest rank at -n 2 must be at most 0.6 x the -n 1 peak; the two runs must agree to 1e-8.  Set-up
+and per-step times and the MUMPS statistics (factor entries, flops) are recorded, and they feed the
+scaling model written into the report.  Without --memory the last D2 measurement
+(reference/distributed_memory.json) is reported as such, not re-measured.
+
+Prints PASS/FAIL per requirement with the measured numbers, writes the requirement list (JSON, merged by
+verification/run_all.py) and reference/distributed.md, and exits 1 if a requirement fails.
+"""
+import argparse
+import datetime
+import json
+import math
+import os
+import re
+import shlex
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+sys.path.insert(0, os.path.join(ROOT, "verification"))
+import compare  # noqa: E402
+import cross_check  # noqa: E402  (scenes, quick levels)
+
+PY = sys.executable
+MPIRUN = os.path.join(os.path.dirname(PY), "mpirun")
+SCRIPT = os.path.join(ROOT, "scripts", "dolfinx_distributed.py")
+MEM_JSON = os.path.join(ROOT, "reference", "distributed_memory.json")
+# Agreement tolerance: the same 1e-8 as the cross-check (X…): far above the rounding of two direct
+# solvers on these condition numbers (observed ~1e-13) and far below any discretisation effect.
+TOL = 1e-8
+# Memory: the issue's bound: the largest rank at -n 2 holds at most 60 % of the -n 1 peak (perfect
+# spreading would give 50 % plus the per-process constant of Python, dolfinx and PETSc, ~0.2 GB).
+MEM_RATIO = 0.6
+RANKS = (1, 2, 3)
+BIG = dict(case="paper_example_5_1", refine=8, steps=3)
+
+
+def rel(p):
+    return os.path.relpath(p, ROOT) if os.path.isabs(p) and p.startswith(ROOT) else p
+
+
+def cmdline(cmd):
+    return " ".join(shlex.quote(rel(c)) for c in cmd)
+
+
+def run(cmd, timeout=None):
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=timeout)
+    return p, time.perf_counter() - t0
+
+
+def dist_cmd(scene, out, refine, steps, ranks, timed=False, extra=()):
+    base = [SCRIPT, scene, "-o", out, "-q", "--refine", str(refine)] + (["--steps", str(steps)] if steps else [])
+    pre = [MPIRUN, "-n", str(ranks)]
+    if timed:
+        pre += ["/usr/bin/time", "-f", "RSS %M KB wall %e s"]
+    return pre + [PY] + base + list(extra)
+
+
+def attrs(path):
+    with h5py.File(path, "r") as f:
+        return dict(f["tresca"].attrs)
+
+
+def agreement(binary, work):
+    """D1: rows (case, refine, steps, ranks, compare result or error)."""
+    plan = dict(cross_check.QUICK)
+    on_disk = sorted(f[:-5] for f in os.listdir(cross_check.CASES_DIR) if f.endswith(".toml"))
+    for name in on_disk:
+        plan.setdefault(name, ((0,), None))
+    scenes = {n: os.path.join(cross_check.CASES_DIR, f"{n}.toml") for n in on_disk}
+    scenes.update(cross_check.generated_scenes(work))
+    rows, commands = [], []
+    for name, (levels, steps) in plan.items():
+        k = levels[0]
+        tag = f"{name}_r{k}" + (f"_n{steps}" if steps else "")
+        rs = os.path.join(work, f"{tag}_rust.h5")
+        cmd = [binary, "run", scenes[name], "-o", rs, "--force", "-q", "--refine", str(k)] + \
+              (["--steps", str(steps)] if steps else [])
+        p, _ = run(cmd)
+        commands.append(cmdline(cmd))
+        if p.returncode != 0:
+            rows.append(dict(case=name, refine=k, steps=steps, ranks="all", r=None,
+                             err=f"rust failed: {(p.stderr or p.stdout).strip()[-300:]}"))
+            continue
+        for n in RANKS:
+            out = os.path.join(work, f"{tag}_dist_np{n}.h5")
+            cmd = dist_cmd(scenes[name], out, k, steps, n)
+            p, wall = run(cmd)
+            commands.append(cmdline(cmd))
+            if p.returncode != 0:
+                rows.append(dict(case=name, refine=k, steps=steps, ranks=n, r=None, wall=wall,
+                                 err=f"distributed -n {n} failed: {(p.stderr or p.stdout).strip()[-300:]}"))
+            else:
+                try:
+                    r = compare.compare_files(rs, out)
+                    rows.append(dict(case=name, refine=k, steps=r["n_times"] - 1, ranks=n, r=r, wall=wall, err=None))
+                except compare.CompareError as e:
+                    rows.append(dict(case=name, refine=k, steps=steps, ranks=n, r=None, wall=wall, err=str(e)))
+                commands.append(f".venv/bin/python scripts/compare.py {rel(rs)} {rel(out)} --strict-flags")
+            row = rows[-1]
+            print(f"  [{'PASS' if row_ok(row) else 'FAIL'}] {tag} -n {n}: {fmt(row)}", flush=True)
+    return rows, commands
+
+
+def row_ok(row):
+    r = row.get("r")
+    return r is not None and max(r["du"], r["dE"], r["dsig"], r["derr"]) <= TOL and r["flags"] == 0
+
+
+def fmt(row):
+    r = row.get("r")
+    if r is None:
+        return row.get("err") or "not comparable"
+    s = f"du {r['du']:.1e}, dE {r['dE']:.1e}, dsig {r['dsig']:.1e}"
+    if r["has_errors"]:
+        s += f", derr {r['derr']:.1e}"
+    return s + f", flags {r['flags']}"
+
+
+def parse_rss(stderr):
+    """Per-rank peak RSS (MB) from the `/usr/bin/time -f "RSS %M KB ..."` lines, one per rank."""
+    return [int(m) / 1024.0 for m in re.findall(r"RSS (\d+) KB", stderr)]
+
+
+def memory(work, binary, with_rust):
+    """D2: the big case at -n 1 and -n 2; returns a dict of measurements."""
+    scene = os.path.join(cross_check.CASES_DIR, f"{BIG['case']}.toml")
+    meas = dict(case=BIG["case"], refine=BIG["refine"], steps=BIG["steps"], runs={}, commands=[],
+                date=datetime.date.today().isoformat())
+    for n in (1, 2):
+        out = os.path.join(work, f"big_np{n}.h5")
+        cmd = dist_cmd(scene, out, BIG["refine"], BIG["steps"], n, timed=True, extra=["--frame-every", "0"])
+        print(f"  running {cmdline(cmd)}", flush=True)
+        p, wall = run(cmd)
+        meas["commands"].append(cmdline(cmd))
+        if p.returncode != 0:
+            meas["runs"][str(n)] = dict(error=(p.stderr or p.stdout).strip()[-400:])
+            print(f"  -n {n} FAILED: {meas['runs'][str(n)]['error']}", flush=True)
+            continue
+        a = attrs(out)
+        rss = parse_rss(p.stderr)
+        meas["runs"][str(n)] = dict(
+            wall=wall, rss_time_mb=rss, rss_self_mb=[float(x) for x in np.atleast_1d(a["peak_rss_mb"])],
+            setup_time=float(a["setup_time"]), setup_times=json.loads(a["setup_times"]),
+            setup_peak_mb=json.loads(a["setup_peak_rss_mb"]), step_median=float(a["step_time_median"]),
+            total=float(a["total_time"]), unknowns=int(a["n_dofs"]), n_contact=int(a["n_contact"]),
+            mumps=json.loads(a["mumps"]), file=rel(out))
+        print(f"  -n {n}: RSS per rank {', '.join(f'{x:.0f}' for x in rss)} MB; set-up {a['setup_time']:.1f} s, "
+              f"step {a['step_time_median']:.2f} s", flush=True)
+    if all(str(n) in meas["runs"] and "error" not in meas["runs"][str(n)] for n in (1, 2)):
+        r = compare.compare_files(os.path.join(work, "big_np1.h5"), os.path.join(work, "big_np2.h5"))
+        meas["agree_1_2"] = dict(du=r["du"], dE=r["dE"], dsig=r["dsig"], flags=r["flags"])
+        meas["commands"].append(f".venv/bin/python scripts/compare.py {rel(os.path.join(work, 'big_np1.h5'))} "
+                                f"{rel(os.path.join(work, 'big_np2.h5'))} --strict-flags")
+    if with_rust:
+        rs = os.path.join(work, "big_rust.h5")
+        cmd = ["/usr/bin/time", "-f", "RSS %M KB wall %e s", binary, "run", scene, "-o", rs, "--force", "-q",
+               "--refine", str(BIG["refine"]), "--steps", str(BIG["steps"]), "--frame-every", str(BIG["steps"])]
+        print(f"  running {cmdline(cmd)}", flush=True)
+        p, wall = run(cmd)
+        meas["commands"].append(cmdline(cmd))
+        if p.returncode == 0:
+            rss = parse_rss(p.stderr)
+            meas["rust"] = dict(wall=wall, rss_mb=rss[0] if rss else None)
+            r = compare.compare_files(rs, os.path.join(work, "big_np2.h5"))
+            meas["rust"]["agree_np2"] = dict(du=r["du"], dE=r["dE"], dsig=r["dsig"], flags=r["flags"])
+            os.remove(rs)
+    return meas
+
+
+# --------------------------------------------------------------------------------------------------
+# scaling model
+# --------------------------------------------------------------------------------------------------
+def scaling_model(meas):
+    """Per-rank memory and times for 1e7 and 1e8 unknowns on 16..256 ranks, from the -n 1/-n 2 data.
+
+    Assumptions (stated in the report): structured 2D meshes, contact on one side (n_c ~ sqrt(n/6));
+    nested-dissection factor entries ∝ n log2 n, factor flops ∝ n^1.5, solve work per right-hand side
+    ∝ factor entries; per-rank memory = constant per process (measured intercept of the 1- and 2-rank
+    peaks) + distributed part / P x imbalance 1.3 (MUMPS' separator tree is not perfectly balanced);
+    time = measured 1-rank time x growth / (P x parallel efficiency 0.5); the friction step on rank 0
+    is O(n_c^3) dense per active-set iteration, counted separately.
+    """
+    r1, r2 = meas["runs"]["1"], meas["runs"]["2"]
+    n0 = r1["unknowns"]
+    m1, m2 = max(r1["rss_time_mb"]), max(r2["rss_time_mb"])
+    # m(P) = c + D/P  ->  D = 2 (m1 - m2), c = m1 - D   (two points, two unknowns)
+    D = 2.0 * (m1 - m2)
+    c = m1 - D
+    st1 = r1["setup_times"]
+    t_fact1 = st1["factorisation"]
+    t_cond1 = st1["condensation"]
+    t_step1 = r1["step_median"]
+    nc0 = r1["n_contact"]
+    rows = []
+    for n in (1e7, 1e8):
+        g_mem = (n / n0) * (math.log2(n) / math.log2(n0))
+        g_flop = (n / n0) ** 1.5
+        nc = math.sqrt(n / 6.0)
+        g_cond = (nc / nc0) * g_mem          # n_c right-hand sides, each ∝ factor entries
+        C_mb = nc * nc * 8 / 2 ** 20
+        for P in (16, 32, 64, 128, 256):
+            mem = c + D * g_mem / P * 1.3 + C_mb
+            rows.append(dict(n=n, P=P, mem_gb=mem / 1024, fact_s=t_fact1 * g_flop / (P * 0.5),
+                             cond_s=t_cond1 * g_cond / (P * 0.5), step_s=t_step1 * g_mem / (P * 0.5),
+                             nc=nc, C_mb=C_mb))
+    return dict(c_mb=c, D_mb=D, rows=rows, n0=n0)
+
+
+# --------------------------------------------------------------------------------------------------
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--memory", action="store_true", help="also run D2 (1.57M unknowns at -n 1 and -n 2, ~6 min)")
+    ap.add_argument("--with-rust", action="store_true", help="with --memory: also run the Rust binary on the big case")
+    ap.add_argument("--bin", default=os.path.join(ROOT, "target", "release", "tresca-cr"),
+                    help="the Rust binary (default target/release/tresca-cr)")
+    ap.add_argument("--json", default=os.path.join(ROOT, "out", "distributed.json"), help="requirement list")
+    ap.add_argument("--md", default=os.path.join(ROOT, "reference", "distributed.md"), help="Markdown report")
+    ap.add_argument("--work", default=os.path.join(ROOT, "out", "distributed"), help="directory for results files")
+    args = ap.parse_args(argv)
+    if not os.path.exists(args.bin):
+        sys.exit(f"error: Rust binary {args.bin} missing (cargo build --release, or give --bin)")
+    if not os.path.exists(MPIRUN):
+        sys.exit(f"error: {MPIRUN} missing (the venv's mpich wheel provides it)")
+    os.makedirs(args.work, exist_ok=True)
+    t_start = time.perf_counter()
+    reqs = []
+    self_cmd = ".venv/bin/python verification/distributed.py"
+
+    print("D1: agreement with the Rust solver at -n 1, 2, 3", flush=True)
+    rows, commands = agreement(args.bin, args.work)
+    t_d1 = time.perf_counter() - t_start
+    nfail = sum(not row_ok(r) for r in rows)
+    worst = {k: max((r["r"][k] for r in rows if r.get("r")), default=float("nan")) for k in ("du", "dE", "dsig", "derr")}
+    d1_ok = nfail == 0 and len(rows) > 0
+    d1_meas = (f"{len(rows) - nfail}/{len(rows)} runs agree; worst du {worst['du']:.1e}, dE {worst['dE']:.1e}, "
+               f"dsig {worst['dsig']:.1e}, derr {worst['derr']:.1e}; {t_d1:.0f} s")
+    if nfail:
+        d1_meas += "; failing: " + "; ".join(f"{r['case']} -n {r['ranks']}: {fmt(r)}" for r in rows if not row_ok(r))[:400]
+    reqs.append(dict(id="D1-distributed-agree",
+                     statement=(f"the distributed dolfinx/PETSc route under mpirun -n 1, 2 and 3 shall agree with the Rust "
+                                f"solver on every cross-check scene (quick level) within {TOL:g} relative in u, energy, σ_τ and "
+                                f"true errors at every time node, with identical stick/slip sets"),
+                     passed=d1_ok, measured=d1_meas, command=self_cmd, reference="reference/distributed.md"))
+    print(f"[{'PASS' if d1_ok else 'FAIL'}] D1: {d1_meas}", flush=True)
+
+    meas = None
+    if args.memory:
+        print("D2: memory at -n 1 and -n 2", flush=True)
+        meas = memory(args.work, args.bin, args.with_rust)
+        ok_runs = all(str(n) in meas["runs"] and "error" not in meas["runs"][str(n)] for n in (1, 2))
+        if ok_runs:
+            meas["model"] = scaling_model(meas)
+        with open(MEM_JSON, "w") as f:
+            json.dump(meas, f, indent=1)
+    elif os.path.exists(MEM_JSON):
+        with open(MEM_JSON) as f:
+            meas = json.load(f)
+    if meas is not None:
+        ok_runs = all(str(n) in meas["runs"] and "error" not in meas["runs"][str(n)] for n in (1, 2))
+        if ok_runs:
+            m1 = max(meas["runs"]["1"]["rss_time_mb"])
+            m2 = max(meas["runs"]["2"]["rss_time_mb"])
+            ag = meas.get("agree_1_2", {})
+            agree_ok = ag and max(ag["du"], ag["dE"], ag["dsig"]) <= TOL and ag["flags"] == 0
+            big_ok = meas["runs"]["1"]["unknowns"] >= 10 ** 6
+            ok = m2 <= MEM_RATIO * m1 and agree_ok and big_ok
+            d2_meas = (f"{meas['runs']['1']['unknowns']} unknowns: peak RSS -n 1 {m1:.0f} MB, -n 2 largest rank {m2:.0f} MB "
+                       f"(ratio {m2 / m1:.2f}); -n 1 vs -n 2 du {ag.get('du', float('nan')):.1e}, flags {ag.get('flags')}")
+        else:
+            ok = False
+            d2_meas = "; ".join(f"-n {n}: {r.get('error', 'ok')}" for n, r in meas["runs"].items())
+        if not args.memory:
+            d2_meas += f" (measured {meas['date']}, not re-run: give --memory)"
+        reqs.append(dict(id="D2-distributed-memory",
+                         statement=(f"on ≥ 10⁶ unknowns the peak resident memory of the largest rank at mpirun -n 2 shall be at "
+                                    f"most {MEM_RATIO} × the -n 1 peak, the two runs agreeing within {TOL:g}"),
+                         passed=bool(ok), measured=d2_meas, command=self_cmd + " --memory", reference="reference/distributed.md"))
+        print(f"[{'PASS' if ok else 'FAIL'}] D2: {d2_meas}", flush=True)
+
+    # ------------------------------------------------------------------ report
+    total = time.perf_counter() - t_start
+    md = ["<!-- generated by verification/distributed.py -->",
+          "# The distributed route: dolfinx + PETSc/MUMPS (issue 16)", "",
+          f"`{self_cmd}{' --memory' if args.memory else ''}` — {sum(r['passed'] for r in reqs)}/{len(reqs)} "
+          f"requirements passed, {total:.0f} s.", "",
+          "| id | passed | measured |", "|---|---|---|"]
+    md += [f"| {r['id']} | {'PASS' if r['passed'] else 'FAIL'} | {r['measured']} |" for r in reqs]
+    md += ["", "## D1: agreement with the Rust solver", "",
+           "`scripts/dolfinx_distributed.py` under `mpirun -n P` against `tresca-cr run` on the cross-check scenes at their "
+           "quick level (verification/cross_check.py QUICK). Max over the time nodes; du, dE, derr relative; dsig relative to "
+           "max ḡ; flags = differing stick/slip states summed over the nodes. Tolerance 1e-8.", "",
+           "| case | refine | N | ranks | du | dE | dsig | derr | flags | wall s | ok |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for row in rows:
+        r = row.get("r")
+        if r is None:
+            md.append(f"| {row['case']} | {row['refine']} | {row['steps'] or '–'} | {row['ranks']} | – | – | – | – | – | – | FAIL: "
+                      f"{(row.get('err') or '')[:120]} |")
+            continue
+        derr = f"{r['derr']:.1e}" if r["has_errors"] else "–"
+        md.append(f"| {row['case']} | {row['refine']} | {row['steps']} | {row['ranks']} | {r['du']:.1e} | {r['dE']:.1e} | "
+                  f"{r['dsig']:.1e} | {derr} | {r['flags']} | {row['wall']:.1f} | {'PASS' if row_ok(row) else 'FAIL'} |")
+    if meas is not None and all(str(n) in meas["runs"] and "error" not in meas["runs"][str(n)] for n in (1, 2)):
+        md += memory_tables(meas, args.memory)
+    md += ["", "## Commands (D1)", "", "Run from the repository root:", "", "```"] + commands + ["```", ""]
+    os.makedirs(os.path.dirname(os.path.abspath(args.md)), exist_ok=True)
+    with open(args.md, "w") as f:
+        f.write("\n".join(md))
+    os.makedirs(os.path.dirname(os.path.abspath(args.json)), exist_ok=True)
+    with open(args.json, "w") as f:
+        json.dump(reqs, f, indent=1, ensure_ascii=False)
+    print(f"wrote {rel(os.path.abspath(args.md))} and {rel(os.path.abspath(args.json))}")
+    return 0 if all(r["passed"] for r in reqs) else 1
+
+
+def memory_tables(meas, fresh):
+    r1, r2 = meas["runs"]["1"], meas["runs"]["2"]
+    md = ["", "## D2: memory and time at 1 and 2 ranks", "",
+          f"Example 5.1 (`verification/cases/{meas['case']}.toml`) at refine {meas['refine']}: {r1['unknowns']:,} unknowns, "
+          f"{r1['n_contact']} contact edges, {meas['steps']} steps, no visualisation frames. Measured {meas['date']}"
+          f"{'' if fresh else ' (not re-run by this invocation; `--memory` re-measures)'}; the machine has 2 cores and "
+          "other jobs may run beside it, so times vary by ~1.5×.", "",
+          "Peak resident memory per rank, from `/usr/bin/time -f \"RSS %M\"` around each rank's process (one line per "
+          "rank) and, beside it, the process's own `getrusage` maximum (the same quantity, recorded in the results file):", "",
+          "| ranks | rank | peak RSS (time) MB | peak RSS (getrusage) MB | after mesh | after assembly | after factorisation | after C |",
+          "|---|---|---|---|---|---|---|---|"]
+    for n, r in (("1", r1), ("2", r2)):
+        for k, (a, b) in enumerate(zip(r["rss_time_mb"], r["rss_self_mb"])):
+            sp = r["setup_peak_mb"][k] if k < len(r["setup_peak_mb"]) else {}
+            md.append(f"| {n} | {k} | {a:.0f} | {b:.0f} | {sp.get('mesh', 0):.0f} | {sp.get('assembly', 0):.0f} | "
+                      f"{sp.get('factorisation', 0):.0f} | {sp.get('condensation', 0):.0f} |")
+    m1, m2 = max(r1["rss_time_mb"]), max(r2["rss_time_mb"])
+    md += ["", f"Largest rank at -n 2 / -n 1: {m2:.0f} / {m1:.0f} MB = **{m2 / m1:.2f}** (required ≤ {MEM_RATIO}).", "",
+           "| ranks | set-up s | mesh | assembly + JIT | factorisation (MUMPS) | C (n_c solves) | per step (median) | whole run | MUMPS factor entries | MUMPS flops | MUMPS memory max rank / total MB |",
+           "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for n, r in (("1", r1), ("2", r2)):
+        st, mu = r["setup_times"], r["mumps"]
+        md.append(f"| {n} | {r['setup_time']:.1f} | {st['mesh']:.1f} | {st['assembly']:.1f} | {st['factorisation']:.1f} | "
+                  f"{st['condensation']:.1f} | {r['step_median']:.2f} | {r['wall']:.1f} | {mu.get('factor_entries', 0):.3g} | "
+                  f"{mu.get('flops', 0):.3g} | {mu.get('mem_max_rank_mb')} / {mu.get('mem_total_mb')} |")
+    ag = meas.get("agree_1_2")
+    if ag:
+        md += ["", f"-n 1 vs -n 2 on this case: du {ag['du']:.1e}, dE {ag['dE']:.1e}, dsig {ag['dsig']:.1e}, flags {ag['flags']}."]
+    if meas.get("rust"):
+        ru = meas["rust"]
+        a = ru.get("agree_np2", {})
+        md += [f"Rust binary on the same case: peak RSS {ru['rss_mb']:.0f} MB, {ru['wall']:.1f} s whole run; vs -n 2: "
+               f"du {a.get('du', float('nan')):.1e}, dE {a.get('dE', float('nan')):.1e}, dsig {a.get('dsig', float('nan')):.1e}, "
+               f"flags {a.get('flags')}."]
+    md += ["", "Commands:", "", "```"] + meas["commands"] + ["```"]
+    mo = meas.get("model")
+    if mo:
+        md += ["", "## Scaling model (an estimate, not a measurement)", "",
+               f"From the two measured points: per-rank peak m(P) = c + D/P with c = {mo['c_mb']:.0f} MB (per-process constant: "
+               f"Python, dolfinx, PETSc, MPI, plus what does not spread) and D = {mo['D_mb']:.0f} MB (what spreads) at "
+               f"n₀ = {mo['n0']:,} unknowns. Assumptions: structured 2D meshes with contact on one side, n_c ≈ √(n/6) "
+               "contact edges; nested-dissection factor entries (and solve work per right-hand side) ∝ n log₂ n, factorisation "
+               "flops ∝ n^1.5 (2D nested dissection); the distributed part grows like the factor and is split over P ranks "
+               "with a load imbalance of 1.3; times scale from the 1-rank measurement with parallel efficiency 0.5 (MUMPS on "
+               "a cluster network, not measured here); the dense C (n_c² doubles) sits on rank 0. The condensation C costs "
+               "n_c solves, so it grows like n^1.5 log n and overtakes the factorisation; the friction step on rank 0 is "
+               "a dense active-set solve, O(n_c³) per iteration (n_c = 4,100 at 10⁸: ~2·10¹¹ flop, tens of seconds "
+               "per iteration) — beyond ~10⁸ unknowns the contact problem itself needs a distributed solver.", "",
+               "| unknowns | ranks | n_c | per-rank peak GB | factorisation s | C (n_c solves) s | per step s | C on rank 0 MB |",
+               "|---|---|---|---|---|---|---|---|"]
+        for r in mo["rows"]:
+            md.append(f"| {r['n']:.0e} | {r['P']} | {r['nc']:.0f} | {r['mem_gb']:.1f} | {r['fact_s']:.0f} | {r['cond_s']:.0f} | "
+                      f"{r['step_s']:.1f} | {r['C_mb']:.0f} |")
+    return md
+
+
+if __name__ == "__main__":
+    sys.exit(main())
