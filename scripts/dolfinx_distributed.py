@@ -438,53 +438,29 @@ class Problem:
 
         # factorisation / solver
         tic = time.perf_counter()
-        self.ksp = ksp = PETSc.KSP().create(comm)
-        ksp.setOptionsPrefix("tresca_")
-        ksp.setOperators(Kr)
-        opts = PETSc.Options()
-        if args.ksp == "mumps":
-            ksp.setType("preonly")
-            pc = ksp.getPC()
-            pc.setType("cholesky")
-            pc.setFactorSolverType("mumps")
-            pc.setFactorSetUpSolverType()
-            F = pc.getFactorMatrix()
-            if args.mumps_analysis == "parallel":
-                F.setMumpsIcntl(28, 2)      # parallel analysis
-                F.setMumpsIcntl(29, 1)      # PT-Scotch (the MUMPS of the wheel has no ParMETIS)
-            else:
-                F.setMumpsIcntl(28, 1)      # sequential analysis on the host
-                F.setMumpsIcntl(7, 5)       # METIS nested dissection
-        else:
-            ksp.setType("cg")
-            ksp.getPC().setType("gamg")
-            ksp.setTolerances(rtol=1e-13, atol=0.0, max_it=10000)
-            ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
-            # near null space: rigid motions in the rotated unknowns, constrained entries zero
-            xy = self.midpoints
-            modes = []
-            for fx, fy in ((np.ones(len(xy)), np.zeros(len(xy))), (np.zeros(len(xy)), np.ones(len(xy))),
-                           (-xy[:, 1], xy[:, 0])):
-                vv = np.stack([fx, fy], 1)
-                vv[self.con_lb] = np.stack([np.sum(vv[self.con_lb] * self.tangent, 1), np.zeros(len(self.con_lb))], 1)
-                vv = vv.ravel()
-                vv[self.cons_local] = 0.0
-                w = Kr.createVecRight()
-                w.array[:] = vv
-                modes.append(w)
-            nsp = PETSc.NullSpace().create(vectors=modes, comm=comm)
-            Kr.setNearNullSpace(nsp)
-            opts["tresca_pc_gamg_threshold"] = 0.01
-        ksp.setFromOptions()
-        ksp.setUp()
+        # MUMPS' workspace is sized from its analysis estimate + ICNTL(14) %; with parallel dynamic
+        # scheduling the estimate can fall short (INFOG(1) = -9, seen intermittently on a tiny mesh at
+        # 3 ranks): then factorise again with a larger relaxation, as the MUMPS guide advises
+        for relax in (30, 100, 400):
+            ksp, info = self._factorise(Kr, args, relax)
+            if args.ksp != "mumps" or info[0] not in (-8, -9, -11, -12, -13, -14, -15, -17, -20):
+                break
+            if comm.rank == 0:
+                print(f"note: MUMPS workspace too small (INFOG(1) = {info[0]}) with ICNTL(14) = {relax} %; "
+                      "factorising again", file=sys.stderr, flush=True)
+            ksp.destroy()
+        self.ksp = ksp
         self.mumps = {}
         if args.ksp == "mumps":
             F = ksp.getPC().getFactorMatrix()
+            if info[0] < 0:      # PETSc records a failed MUMPS factorisation without raising
+                raise RuntimeError(f"MUMPS factorisation failed: INFOG(1) = {info[0]}, INFOG(2) = {info[1]} "
+                                   "(see the MUMPS users' guide)")
             e29 = F.getMumpsInfog(29)       # entries in the factor (negative: millions)
             self.mumps = {"factor_entries": float(-e29 * 1e6 if e29 < 0 else e29),
                           "flops": float(F.getMumpsRinfog(3)),
                           "mem_max_rank_mb": int(F.getMumpsInfog(21)), "mem_total_mb": int(F.getMumpsInfog(22)),
-                          "ordering": int(F.getMumpsInfog(7))}
+                          "ordering": int(F.getMumpsInfog(7)), "icntl14": relax}
         self.times_setup["factorisation"] = time.perf_counter() - tic
         memlog(comm, "factorised")
         self.mem_setup["factorisation"] = peak_mb()
@@ -504,6 +480,54 @@ class Problem:
         self.times_setup["condensation"] = time.perf_counter() - tic
         memlog(comm, "C built")
         self.mem_setup["condensation"] = peak_mb()
+
+    def _factorise(self, Kr, args, relax):
+        """KSP on K_r: MUMPS Cholesky (set up = factorised) or CG + GAMG.  Returns (ksp, MUMPS INFOG(1:2))."""
+        comm = self.comm
+        ksp = PETSc.KSP().create(comm)
+        ksp.setOptionsPrefix("tresca_")
+        ksp.setOperators(Kr)
+        opts = PETSc.Options()
+        info = (0, 0)
+        if args.ksp == "mumps":
+            ksp.setType("preonly")
+            pc = ksp.getPC()
+            pc.setType("cholesky")
+            pc.setFactorSolverType("mumps")
+            pc.setFactorSetUpSolverType()
+            F = pc.getFactorMatrix()
+            if args.mumps_analysis == "parallel":
+                F.setMumpsIcntl(28, 2)      # parallel analysis
+                F.setMumpsIcntl(29, 1)      # PT-Scotch (the MUMPS of the wheel has no ParMETIS)
+            else:
+                F.setMumpsIcntl(28, 1)      # sequential analysis on the host
+                F.setMumpsIcntl(7, 5)       # METIS nested dissection
+            F.setMumpsIcntl(14, relax)      # workspace relaxation (%)
+            ksp.setFromOptions()
+            ksp.setUp()
+            info = (F.getMumpsInfog(1), F.getMumpsInfog(2))
+        else:
+            ksp.setType("cg")
+            ksp.getPC().setType("gamg")
+            ksp.setTolerances(rtol=1e-13, atol=0.0, max_it=10000)
+            ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
+            # near null space: rigid motions in the rotated unknowns, constrained entries zero
+            xy = self.midpoints
+            modes = []
+            for fx, fy in ((np.ones(len(xy)), np.zeros(len(xy))), (np.zeros(len(xy)), np.ones(len(xy))),
+                           (-xy[:, 1], xy[:, 0])):
+                vv = np.stack([fx, fy], 1)
+                vv[self.con_lb] = np.stack([np.sum(vv[self.con_lb] * self.tangent, 1), np.zeros(len(self.con_lb))], 1)
+                vv = vv.ravel()
+                vv[self.cons_local] = 0.0
+                w = Kr.createVecRight()
+                w.array[:] = vv
+                modes.append(w)
+            Kr.setNearNullSpace(PETSc.NullSpace().create(vectors=modes, comm=comm))
+            opts["tresca_pc_gamg_threshold"] = 0.01
+            ksp.setFromOptions()
+            ksp.setUp()
+        return ksp, info
 
     def solve(self, b, x):
         self.ksp.solve(b, x)
@@ -525,6 +549,7 @@ class Problem:
             return np.zeros((0, 0)) if comm.rank == 0 else None
         Cm = np.zeros((nc, nc)) if comm.rank == 0 else None
         my = 2 * self.con_lb
+        self.condense_path = self.args.condense if self.args.ksp == "mumps" else "ksp"
         if self.args.ksp == "mumps" and self.args.condense == "inverse":
             return self._condense_inverse()
         if self.args.ksp == "mumps":
@@ -588,10 +613,12 @@ class Problem:
         S.assemble()
         keep = {k: F.getMumpsIcntl(k) for k in (20, 21, 30)}
         ierr = _petsc_lib().MatMumpsGetInverseTranspose(ctypes.c_void_p(F.handle), ctypes.c_void_p(S.handle))
+        info = (F.getMumpsInfog(1), F.getMumpsInfog(2), F.getMumpsInfo(1), F.getMumpsInfo(2))
         for k, v in keep.items():                 # back to ordinary solves
             F.setMumpsIcntl(k, v)
         if comm.allreduce(ierr, op=MPI.MAX):
-            raise RuntimeError(f"MatMumpsGetInverseTranspose failed (PETSc error {ierr})")
+            raise RuntimeError(f"MatMumpsGetInverseTranspose failed (PETSc error {ierr}; MUMPS INFOG(1:2), "
+                               f"INFO(1:2) on rank {comm.rank}: {info}; local rows {self.Kr.getLocalSize()[0]}, contact {len(self.con_lb)})")
         self.n_solves += nc
         Cm = None
         if comm.rank == 0:
@@ -859,7 +886,7 @@ def main(argv=None):
                  "setup_times": json.dumps(prob.times_setup),
                  "step_time_median": float(np.median(step_times[1:])) if N else 0.0,
                  "peak_rss_mb": np.array(peaks), "setup_peak_rss_mb": json.dumps(mem_setup),
-                 "mumps": json.dumps(prob.mumps), "linear_solver": args.ksp, "linear_solves": prob.n_solves,
+                 "mumps": json.dumps(prob.mumps), "linear_solver": args.ksp, "condensation": prob.condense_path, "linear_solves": prob.n_solves,
                  "ksp_iterations_max": int(max(prob.ksp_its)) if prob.ksp_its else 0}
         write_main(out, prob, res, writer.dir, sizes, attrs)
         log(f"dolfinx distributed ({comm.size} rank{'s' if comm.size > 1 else ''}): {2 * prob.nb_glob} unknowns, "
