@@ -545,6 +545,7 @@ class Problem:
 
     def _condense(self, log):
         comm, nc = self.comm, self.n_c
+        self.condense_path = "none (no contact edges)"
         if nc == 0:
             return np.zeros((0, 0)) if comm.rank == 0 else None
         Cm = np.zeros((nc, nc)) if comm.rank == 0 else None

@@ -4,7 +4,8 @@
                                                  [--json out/distributed.json] [--md reference/distributed.md]
 
 D1 (quick, < 3 min): every cross-check scene (verification/cases/*.toml and the generated expression
-scenes of verification/cross_check.py) at its quick level is solved by the Rust binary and by
+scenes of verification/cross_check.py) at its quick level, plus a Gmsh scene (tests/scenes/lshape.msh,
+refine 1, contact on its floor), is solved by the Rust binary and by
 scripts/dolfinx_distributed.py under `mpirun -n 1`, `-n 2` and `-n 3` (3 is oversubscribed on 2 cores);
 each distributed run is compared with the Rust run by scripts/compare.py: DOF vectors, energies, σ_τ and
 true errors within 1e-8 relative at every time node, identical stick/slip sets.
@@ -53,6 +54,29 @@ RANKS = (1, 2, 3)
 BIG = dict(case="paper_example_5_1", refine=8, steps=3)
 
 
+GMSH_SCENE = """title = "L-shape Gmsh mesh (tests/scenes/lshape.msh) with Tresca contact on its floor (verification/distributed.py)"
+[mesh]
+file = "{msh}"
+[material]
+E = 200.0
+nu = 0.3
+[[boundary]]
+name = "clamp"
+kind = "dirichlet"
+[[boundary]]
+name = "loaded"
+kind = "neumann"
+traction = ["0.02*t", "-0.03*t*x"]
+[[boundary]]
+name = "floor"
+kind = "contact"
+g_a = "0.001*(1+x)"
+[time]
+T = 1.0
+steps = 8
+"""
+
+
 def rel(p):
     return os.path.relpath(p, ROOT) if os.path.isabs(p) and p.startswith(ROOT) else p
 
@@ -88,6 +112,11 @@ def agreement(binary, work):
         plan.setdefault(name, ((0,), None))
     scenes = {n: os.path.join(cross_check.CASES_DIR, f"{n}.toml") for n in on_disk}
     scenes.update(cross_check.generated_scenes(work))
+    # plus a Gmsh scene (the distributed script reads Gmsh files on rank 0 and distributes them)
+    scenes["gmsh_lshape"] = os.path.join(work, "gmsh_lshape.toml")
+    with open(scenes["gmsh_lshape"], "w") as f:
+        f.write(GMSH_SCENE.format(msh=os.path.join(ROOT, "tests", "scenes", "lshape.msh")))
+    plan["gmsh_lshape"] = ((1,), None)
     rows, commands = [], []
     for name, (levels, steps) in plan.items():
         k = levels[0]
