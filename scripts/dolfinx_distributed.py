@@ -70,6 +70,18 @@ from dolfinx_solve import sympy_to_ufl, vec_to_ufl  # noqa: E402  (the sympy -> 
 SIDES = ("bottom", "right", "top", "left")
 
 
+def _abort_on_error(exc_type, exc, tb):
+    """An uncaught exception on one rank would leave the others waiting in a collective call forever
+    (and MPI_Finalize waiting for them): print it and abort the whole job."""
+    sys.__excepthook__(exc_type, exc, tb)
+    sys.stderr.flush()
+    MPI.COMM_WORLD.Abort(1)
+
+
+if MPI.COMM_WORLD.size > 1:
+    sys.excepthook = _abort_on_error
+
+
 class Fail(Exception):
     """Bad input found on some rank; every rank stops with the message."""
 
@@ -237,6 +249,7 @@ class Problem:
         self.times_setup = {}
         self.mem_setup = {}
         tic = time.perf_counter()
+        self.mem_setup["start"] = peak_mb()        # imports: Python, dolfinx, PETSc, MPI
         memlog(comm, "start")
         msh, bf, side = gmsh_mesh(comm, scene) if "file" in scene.mesh else structured_mesh(comm, scene)
         self.msh = msh
