@@ -182,7 +182,7 @@ def memory(work, binary, with_rust):
     """D2: the big case at -n 1 and -n 2; returns a dict of measurements."""
     scene = os.path.join(cross_check.CASES_DIR, f"{BIG['case']}.toml")
     meas = dict(case=BIG["case"], refine=BIG["refine"], steps=BIG["steps"], runs={}, commands=[],
-                date=datetime.date.today().isoformat())
+                date=datetime.date.today().isoformat(), load_before=os.getloadavg()[1])
     for n in (1, 2):
         out = os.path.join(work, f"big_np{n}.h5")
         cmd = dist_cmd(scene, out, BIG["refine"], BIG["steps"], n, timed=True, extra=["--frame-every", "0"])
@@ -437,7 +437,9 @@ def memory_tables(meas, fresh):
           f"Example 5.1 (`verification/cases/{meas['case']}.toml`) at refine {meas['refine']}: {r1['unknowns']:,} unknowns, "
           f"{r1['n_contact']} contact edges, {meas['steps']} steps, no visualisation frames. Measured {meas['date']}"
           f"{'' if fresh else ' (not re-run by this invocation; `--memory` re-measures)'}; the machine has 2 cores and "
-          "other jobs may run beside it, so times vary by ~1.5×.", "",
+          "other jobs may run beside it, so times vary" +
+          (f" (5-minute load average {meas['load_before']:.1f} when D2 started)." if "load_before" in meas else ".") +
+          " Memory does not depend on the load.", "",
           "Peak resident memory per rank, from `/usr/bin/time -f \"RSS %M\"` around each rank's process (one line per "
           "rank) and, beside it, the process's own `getrusage` maximum (the same quantity, recorded in the results file):", "",
           "| ranks | rank | peak RSS (time) MB | peak RSS (getrusage) MB | after mesh | after assembly | after factorisation | after C |",
