@@ -348,7 +348,8 @@ def cross_check(quick):
 def distributed(quick):
     """The distributed dolfinx/PETSc route (issue 16): D1 agreement at -n 1, 2, 3; D2 memory (full run only)."""
     out = os.path.join(ROOT, "out", "distributed.json")
-    cmd = [PY, "verification/distributed.py", "--json", out, "--bin", BIN] + ([] if quick else ["--memory"])
+    cmd = [PY, "verification/distributed.py", "--json", out, "--bin", BIN] + \
+        (["--md", os.path.join(ROOT, "out", "distributed_quick.md")] if quick else ["--memory"])
     p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
     print(p.stdout[-3000:])
     import json
