@@ -326,6 +326,20 @@ def results_clients():
             (p.stdout.strip().splitlines() or ["(no output)"])[-1][:200], " ".join(chk), "verification/interrupted_runs.py")
 
 
+def paraview():
+    """Debian's ParaView (installed by `make paraview`) on finished, killed and resumed runs (issue 17)."""
+    cmd = [PY, "verification/paraview_check.py"]
+    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    print(p.stdout[-3000:])
+    lines = p.stdout.strip().splitlines() or ["(no output)"]
+    version = next((l for l in lines if l.startswith("ParaView:")), "ParaView: ?")
+    pictures = [l.split("picture ")[1][:120] for l in lines if "picture out/" in l]
+    require("V1-paraview", "ParaView's XDMFReader, Xdmf3ReaderS and Xdmf3ReaderT shall open the files of a finished, a killed and a "
+            "resumed run as body and contact-line blocks with /tresca's values at two times, and scripts/paraview_view.py shall "
+            "render a picture showing the body and the contact line", p.returncode == 0,
+            f"{version}; {lines[-1][:80]}; " + "; ".join(pictures)[:300], " ".join(cmd[1:]), "out/paraview/*.png")
+
+
 def cross_check(quick):
     out = os.path.join(ROOT, "out", "cross_check.json")
     script = os.path.join(ROOT, "verification", "cross_check.py")
@@ -399,6 +413,7 @@ def main():
         "joint": lambda: joint_study(args.quick),
         "paper": lambda: paper_tables(args.quick),
         "clients": results_clients,
+        "paraview": paraview,
         "stability": stability,
         "cross": lambda: cross_check(args.quick),
         "distributed": lambda: distributed(args.quick),
