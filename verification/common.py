@@ -12,6 +12,7 @@ two (symmetric; 0 for two zero vectors); ``rel_to(a, ref)`` is relative to the r
 """
 import math
 import os
+import shlex
 import subprocess
 import sys
 import time
@@ -46,6 +47,11 @@ def short_path(p):
     """``p`` relative to the repository root when it lies inside it (for printed commands)."""
     p = str(p)
     return os.path.relpath(p, ROOT) if os.path.isabs(p) and p.startswith(ROOT) else p
+
+
+def cmdline(cmd):
+    """A command as a copyable shell line, with paths inside the repository made relative."""
+    return " ".join(shlex.quote(short_path(c)) for c in cmd)
 
 
 def observed_order(e_a, e_b, x_a, x_b):

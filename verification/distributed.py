@@ -4,7 +4,7 @@
                                                  [--json out/distributed.json] [--md reference/distributed.md]
 
 D1 (quick, < 3 min): every cross-check scene (verification/cases/*.toml and the generated expression
-scenes of verification/cross_check.py) at its quick level, plus a Gmsh scene (tests/scenes/lshape.msh,
+scenes of verification/cross_check.py) at its quick level, plus a Gmsh scene (verification/cases/lshape.msh,
 refine 1, contact on its floor), is solved by the Rust binary and by
 scripts/dolfinx_distributed.py under `mpirun -n 1`, `-n 2` and `-n 3` (3 is oversubscribed on 2 cores);
 each distributed run is compared with the Rust run by scripts/compare.py: DOF vectors, energies, σ_τ and
@@ -26,7 +26,6 @@ import json
 import math
 import os
 import re
-import shlex
 import subprocess
 import sys
 import time
@@ -34,14 +33,15 @@ import time
 import h5py
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-sys.path.insert(0, os.path.join(ROOT, "verification"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import MPIRUN, PY, ROOT, SCRIPTS, case  # noqa: E402
+from common import cmdline  # noqa: E402
+from common import short_path as rel  # noqa: E402
+
+sys.path.insert(0, SCRIPTS)
 import compare  # noqa: E402
 import cross_check  # noqa: E402  (scenes, quick levels)
 
-PY = sys.executable
-MPIRUN = os.path.join(os.path.dirname(PY), "mpirun")
 SCRIPT = os.path.join(ROOT, "scripts", "dolfinx_distributed.py")
 MEM_JSON = os.path.join(ROOT, "reference", "distributed_memory.json")
 SOLVER_JSON = os.path.join(ROOT, "reference", "distributed_solvers.json")
@@ -56,7 +56,7 @@ RANKS = (1, 2, 3)
 BIG = dict(case="paper_example_5_1", refine=8, steps=3)
 
 
-GMSH_SCENE = """title = "L-shape Gmsh mesh (tests/scenes/lshape.msh) with Tresca contact on its floor (verification/distributed.py)"
+GMSH_SCENE = """title = "L-shape Gmsh mesh (verification/cases/lshape.msh) with Tresca contact on its floor (verification/distributed.py)"
 [mesh]
 file = "{msh}"
 [material]
@@ -77,14 +77,6 @@ g_a = "0.001*(1+x)"
 T = 1.0
 steps = 8
 """
-
-
-def rel(p):
-    return os.path.relpath(p, ROOT) if os.path.isabs(p) and p.startswith(ROOT) else p
-
-
-def cmdline(cmd):
-    return " ".join(shlex.quote(rel(c)) for c in cmd)
 
 
 def run(cmd, timeout=600):
@@ -123,7 +115,7 @@ def agreement(binary, work):
     # plus a Gmsh scene (the distributed script reads Gmsh files on rank 0 and distributes them)
     scenes["gmsh_lshape"] = os.path.join(work, "gmsh_lshape.toml")
     with open(scenes["gmsh_lshape"], "w") as f:
-        f.write(GMSH_SCENE.format(msh=os.path.join(ROOT, "tests", "scenes", "lshape.msh")))
+        f.write(GMSH_SCENE.format(msh=case("lshape")[:-5] + ".msh"))
     plan["gmsh_lshape"] = ((1,), None)
     rows, commands = [], []
     for name, (levels, steps) in plan.items():
