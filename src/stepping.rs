@@ -106,7 +106,9 @@ impl Problem {
         let stiffness = stiffness(&mesh, &space, &law, scene.rho);
         let loads = Loads::new(&scene, &mesh, &space);
         let t2 = Instant::now();
-        let factor = Factor::new(&stiffness)?;
+        // contact unknowns last: the condensation then comes from the factor (solve::condense)
+        let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
+        let factor = Factor::with_last(&stiffness, &contact)?;
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
         // ranges) factorises without complaint but returns meaningless displacements: refuse it.
         let kappa = factor.condition_estimate(&stiffness, 12);

@@ -55,7 +55,7 @@ impl FreeResponse {
         let (c, z) = if contact_dofs.is_empty() {
             (None, None)
         } else {
-            let Condensation { c, z } = condense(&contact_dofs, &factor, n);
+            let Condensation { c, z } = condense(&contact_dofs, &factor, n)?;
             (Some(c), z)
         };
         let basis = LoadBasis::build(&loads, times, &factor)?;

@@ -268,6 +268,36 @@ mod tests {
     }
 
     #[test]
+    fn symbolic_operators_mirror_exmex() {
+        assert_eq!(sym::sym_ops_signature(), sym::float_ops_signature());
+    }
+
+    #[test]
+    fn compiled_matches_point_and_interpreted_evaluation() {
+        // integer powers (positive, negative, zero), shared subterms, t-only parts, constant outputs
+        let texts = ["x^3*y^-2 + (x^3)*t", "(1-y)^2*max(t-1/3, 0) + cos(x)*(1-y)^2", "t^2 + 1", "x", "2.5"];
+        let exprs: Vec<Expr> = texts.iter().map(|s| Expr::parse("k", s).unwrap()).collect();
+        let set = ExprSet::new(&exprs.iter().collect::<Vec<_>>());
+        let pts: Vec<[f64; 2]> = (0..100).map(|i| [0.1 + i as f64 * 0.37, 0.5 + (i % 7) as f64]).collect();
+        let mut out = Vec::new();
+        set.eval(&pts, 0.75, &mut out).unwrap();
+        for (i, p) in pts.iter().enumerate() {
+            for (k, e) in exprs.iter().enumerate() {
+                let v = out[i * exprs.len() + k];
+                // batch and point evaluation perform the same operations: bit-identical
+                assert_eq!(v.to_bits(), e.eval(p[0], p[1], 0.75).unwrap().to_bits(), "{}", texts[k]);
+                // products for integer powers: a few roundings, far below 1e-14 relative
+                let r = e.interpreted().unwrap().eval(p[0], p[1], 0.75);
+                assert!((v - r).abs() <= 1e-14 * r.abs(), "{}: {v} vs {r}", texts[k]);
+            }
+        }
+        // a non-finite value names the expression and the first point that has one
+        let bad = ExprSet::new(&[&exprs[0], &Expr::parse("g", "1/(x-0.47)").unwrap()]);
+        let e = bad.eval(&pts, 0.0, &mut out).unwrap_err().to_string();
+        assert!(e.contains("1/(x-0.47)") && e.contains("value inf at (x=0.47"), "{e}");
+    }
+
+    #[test]
     fn constants_and_zero_detection() {
         assert!(Expr::parse("f", "0").unwrap().is_zero());
         assert!(!Expr::parse("f", "0*x").unwrap().is_zero());

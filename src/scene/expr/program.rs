@@ -324,17 +324,17 @@ impl Program {
                 regs[SLOT_X as usize][l] = p[0];
                 regs[SLOT_Y as usize][l] = p[1];
             }
+            let r = regs.as_mut_ptr();
             for ins in &self.instrs {
-                match *ins {
-                    Instr::Un(f, d, a) => {
-                        let a = regs[a as usize];
-                        let d = &mut regs[d as usize];
-                        un_lanes(f, &a, d);
-                    }
-                    Instr::Bin(f, d, a, c) => {
-                        let (a, c) = (regs[a as usize], regs[c as usize]);
-                        let d = &mut regs[d as usize];
-                        bin_lanes(f, &a, &c, d);
+                // SAFETY: every slot index is < n_slots = regs.len() (assigned in `Program::new`), and an
+                // instruction's destination slot is taken while its operands still hold theirs, so it
+                // differs from both: the mutable and the shared references never overlap.
+                unsafe {
+                    match *ins {
+                        Instr::Un(f, d, a) => un_lanes(f, &*r.add(a as usize), &mut *r.add(d as usize)),
+                        Instr::Bin(f, d, a, c) => {
+                            bin_lanes(f, &*r.add(a as usize), &*r.add(c as usize), &mut *r.add(d as usize))
+                        }
                     }
                 }
             }

@@ -219,21 +219,27 @@ impl MakeOperators<Sym> for SymOps {
     }
 }
 
+/// An operator's symbol, (priority, commutative) if binary, whether unary, its value if a constant.
+pub type Signature = (String, Option<(i64, bool)>, bool, Option<f64>);
+
 /// The operator table exmex parses with, for the test that [`SymOps`] mirrors it.
-pub fn float_ops_signature() -> Vec<(String, Option<i64>, bool, Option<f64>)> {
+pub fn float_ops_signature() -> Vec<Signature> {
     signature(&FloatOpsFactory::<f64>::make(), |v| *v)
 }
 
 /// [`SymOps`]'s table in the same form.
-pub fn sym_ops_signature() -> Vec<(String, Option<i64>, bool, Option<f64>)> {
+pub fn sym_ops_signature() -> Vec<Signature> {
     signature(&SymOps::make(), |v| match v {
         Sym::Num(v) => *v,
         _ => f64::NAN,
     })
 }
 
-fn signature<T: Clone>(ops: &[Operator<'_, T>], num: impl Fn(&T) -> f64) -> Vec<(String, Option<i64>, bool, Option<f64>)> {
+fn signature<T: Clone>(ops: &[Operator<'_, T>], num: impl Fn(&T) -> f64) -> Vec<Signature> {
     ops.iter()
-        .map(|o| (o.repr().to_string(), o.bin().ok().map(|b| b.prio), o.has_unary(), o.constant().map(|c| num(&c))))
+        .map(|o| {
+            let bin = o.bin().ok().map(|b| (b.prio, b.is_commutative));
+            (o.repr().to_string(), bin, o.has_unary(), o.constant().map(|c| num(&c)))
+        })
         .collect()
 }
