@@ -21,8 +21,9 @@
 //! Unknowns ordered last ([`Factor::with_last`], the contact unknowns): with K's permuted form
 //! [K_oo K_ol; K_lo K_ll] = L Lᵀ, the trailing block of L satisfies L_ll L_llᵀ = K_ll − K_lo K_oo⁻¹ K_ol,
 //! the Schur complement, whose inverse is the block (K⁻¹)_ll. So the condensed operator comes from the
-//! factor without any solve ([`Factor::last_block`]), and K⁻¹E needs only the backward half
-//! ([`Factor::backward_solve_many`]): L⁻¹E = [0; L_ll⁻¹], since L is lower triangular. Moving a few
+//! factor without any solve ([`Factor::last_block`]), and since L⁻¹E = [0; L_ll⁻¹] (L lower
+//! triangular) a step can split its solve into the halves [`Factor::forward_solve`] and
+//! [`Factor::backward_solve`] and add the friction force in between (`solve::free`). Moving a few
 //! boundary unknowns to the end of a fill-reducing ordering changes the fill little (they act as one
 //! more separator). The supernodal kernel is always used: it exposes the triangular halves and the
 //! trailing block.
@@ -148,22 +149,39 @@ impl Factor {
         Ok(l)
     }
 
-    /// X ← P L⁻ᵀ X for a block of right-hand sides given in the factor's (permuted) order: the backward
-    /// half of a solve, with the result in the unknowns' order.
-    pub fn backward_solve_many(&self, mut x: MatMut<'_, f64>) -> Result<()> {
+    /// x ← L⁻¹ Pᵀx: the forward half of a solve, the result in the factor's (permuted) order, where
+    /// the unknowns ordered last occupy the last positions.
+    pub fn forward_solve(&self, x: &mut [f64]) -> Result<()> {
         let llt = self.supernodal().ok_or_else(|| Error::Linear("the factor is not supernodal".into()))?;
-        let mut buf = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(x.ncols(), Par::Seq))
-            .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
-        llt.l_transpose_solve_with_conj(Conj::No, x.as_mut(), Par::Seq, MemStack::new(&mut buf));
-        let mut col = vec![0.0; self.n];
-        for j in 0..x.ncols() {
-            for (new, &old) in self.fwd.iter().enumerate() {
-                col[old] = x[(new, j)];
-            }
-            for (i, v) in col.iter().enumerate() {
-                x[(i, j)] = *v;
-            }
+        let mut y: Vec<f64> = self.fwd.iter().map(|&old| x[old]).collect();
+        let mut buf = self.scratch.borrow_mut();
+        llt.l_solve_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut y, self.n, 1),
+            Par::Seq,
+            MemStack::new(&mut buf),
+        );
+        x.copy_from_slice(&y);
+        Ok(())
+    }
+
+    /// y ← P L⁻ᵀ y: the backward half of a solve, from the factor's order to the unknowns' order.
+    pub fn backward_solve(&self, y: &mut [f64]) -> Result<()> {
+        let llt = self.supernodal().ok_or_else(|| Error::Linear("the factor is not supernodal".into()))?;
+        {
+            let mut buf = self.scratch.borrow_mut();
+            llt.l_transpose_solve_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(y, self.n, 1),
+                Par::Seq,
+                MemStack::new(&mut buf),
+            );
         }
+        let mut x = vec![0.0; self.n];
+        for (new, &old) in self.fwd.iter().enumerate() {
+            x[old] = y[new];
+        }
+        y.copy_from_slice(&x);
         Ok(())
     }
 
