@@ -45,8 +45,8 @@ enum Key {
 /// One varying instruction: `dst ← op(a, b)` on slots.
 #[derive(Clone, Copy, Debug)]
 enum Instr {
-    Un(Un, u16, u16),
-    Bin(Bin, u16, u16, u16),
+    Un(Un, u32, u32),
+    Bin(Bin, u32, u32, u32),
 }
 
 /// A compiled program with one or more outputs.
@@ -58,14 +58,14 @@ pub struct Program {
     /// The varying instructions in order.
     instrs: Vec<Instr>,
     /// (slot, node) of every uniform node a varying instruction reads.
-    broadcast: Vec<(u16, u32)>,
+    broadcast: Vec<(u32, u32)>,
     n_slots: usize,
     /// Per output: its node and, if varying, its slot.
-    outputs: Vec<(u32, Option<u16>)>,
+    outputs: Vec<(u32, Option<u32>)>,
 }
 
-const SLOT_X: u16 = 0;
-const SLOT_Y: u16 = 1;
+const SLOT_X: u32 = 0;
+const SLOT_Y: u32 = 1;
 
 struct Builder {
     nodes: Vec<Op>,
@@ -191,16 +191,16 @@ impl Program {
         for &o in &out_nodes {
             last[o as usize] = usize::MAX;
         }
-        let mut slot = vec![u16::MAX; nodes.len()];
+        let mut slot = vec![u32::MAX; nodes.len()];
         slot[0] = SLOT_X;
         slot[1] = SLOT_Y;
         let mut n_slots = 2usize;
-        let mut free: Vec<u16> = Vec::new();
+        let mut free: Vec<u32> = Vec::new();
         let mut broadcast = Vec::new();
-        let mut take = |free: &mut Vec<u16>| {
+        let mut take = |free: &mut Vec<u32>| {
             free.pop().unwrap_or_else(|| {
                 n_slots += 1;
-                (n_slots - 1) as u16
+                (n_slots - 1) as u32
             })
         };
         // uniform nodes read by varying ones (or outputs) get a broadcast slot for the whole call
@@ -211,7 +211,7 @@ impl Program {
                 _ => &[],
             };
             for &r in reads {
-                if !varying[r as usize] && slot[r as usize] == u16::MAX {
+                if !varying[r as usize] && slot[r as usize] == u32::MAX {
                     slot[r as usize] = take(&mut free);
                     broadcast.push((slot[r as usize], r));
                 }
@@ -224,7 +224,7 @@ impl Program {
             }
             let dst = take(&mut free);
             slot[i] = dst;
-            let release = |r: u32, free: &mut Vec<u16>| {
+            let release = |r: u32, free: &mut Vec<u32>| {
                 if varying[r as usize] && last[r as usize] == i && r > 1 {
                     free.push(slot[r as usize]);
                 }
