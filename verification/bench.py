@@ -180,9 +180,9 @@ def floor_scene(tmp):
     return path
 
 
-def perf_profile(cmd, tmp, label):
+def perf_profile(cmd, tmp, label, freq=20000):
     data = os.path.join(tmp, f"perf_{label}.data")
-    p = subprocess.run(["perf", "record", "-F", "20000", "-g", "-o", data, "--"] + cmd,
+    p = subprocess.run(["perf", "record", "-F", str(freq), "-g", "-o", data, "--"] + cmd,
                        capture_output=True, text=True, cwd=ROOT)
     if p.returncode != 0:
         return None, p.stderr[-500:]
@@ -594,9 +594,9 @@ def mms_section(args, R, tmp, md, csvrows):
     # profile of mms_stop refine 5
     if not args.no_perf and shutil.which("perf"):
         label, scene, extra, _ = MMS_RUNS[0]
-        lines, groups = perf_profile([BIN, "run", os.path.join(ROOT, scene)] + extra + ["-q"], tmp, "mms_stop")
+        lines, groups = perf_profile([BIN, "run", os.path.join(ROOT, scene)] + extra + ["-q"], tmp, "mms_stop", freq=2000)
         if lines is not None:
-            md += [f"### Profile: {label}", "", "Grouped self time (`perf record -F 20000 -g`; all threads):", "",
+            md += [f"### Profile: {label}", "", "Grouped self time (`perf record -F 2000 -g`; all threads):", "",
                    "| share | where |", "|---|---|"]
             for g, pc in sorted(groups.items(), key=lambda kv: -kv[1]):
                 if pc >= 0.5:
