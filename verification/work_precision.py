@@ -218,8 +218,7 @@ def conclusions(rows):
             q = math.log(a["error"] / b["error"]) / math.log(b["dofs"] / a["dofs"])
             out.append(f"* {case}, h family (N = {b['steps']}): from {a['dofs']} to {b['dofs']} DOF the cost grows as "
                        f"DOF^{p:.2f} ({a['cpu'] * 1e3:.0f} → {b['cpu'] * 1e3:.0f} ms CPU) while the energy error falls as "
-                       f"DOF^-{q:.2f}: the method's own cost (factorisation once, a solve pair and an O(n_c²) friction "
-                       "solve per step), no longer the evaluation of the data.")
+                       f"DOF^-{q:.2f}.")
         if len(k) >= 2:
             a, b = k[0], k[-1]
             per = (b["cpu"] - a["cpu"]) / (b["steps"] - a["steps"])
