@@ -124,7 +124,7 @@ impl Problem {
         let (free, c) = FreeResponse::new(factor, loads, &space, &scene.times)?;
         let friction = c.map(|c| Friction::new(&space, c, scene.solver));
         let t4 = Instant::now();
-        let errors = scene.exact.as_ref().map(|_| ErrorEvaluator::new(&mesh, &space, &law, scene.rho));
+        let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(x));
         let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
         Ok(Problem {
             setup: SetupTimes {

@@ -47,10 +47,14 @@ fn compiled_agrees_with_interpreter_on_all_cases() {
         for (key, text) in found {
             let e = Expr::parse(&key, &text).unwrap();
             let set = ExprSet::new(&[&e]);
+            let bound = set.clone().bind(pts.clone());
             let reference = e.interpreted().unwrap();
-            let mut compiled = Vec::new();
+            let (mut compiled, mut from_bound) = (Vec::new(), Vec::new());
             for &t in &scene.times {
                 set.eval(&pts, t, &mut compiled).unwrap();
+                // the spatial parts cached at binding: the same operations, so the same bits
+                bound.eval(t, &mut from_bound).unwrap();
+                assert!(compiled.iter().zip(&from_bound).all(|(a, b)| a.to_bits() == b.to_bits()), "{key} `{text}`");
                 let exact: Vec<f64> = pts.iter().map(|p| reference.eval(p[0], p[1], t)).collect();
                 // relative to the expression's size over the mesh at this time: these expressions are
                 // sums of terms of that size, so a change of a few ulps in one term (integer powers as

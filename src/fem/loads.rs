@@ -7,7 +7,7 @@ use super::quadrature::{edge_point, tri_point, GAUSS3, TRI4};
 use super::space::{CrSpace, Element};
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::scene::expr::{ExprSet, Vec2Expr};
+use crate::scene::expr::{BoundSet, ExprSet, Vec2Expr};
 use crate::scene::{PartKind, Scene};
 
 /// A quadrature point of a load term: position, and the (edge, weight · φ) pairs it feeds.
@@ -28,9 +28,8 @@ struct Scatter {
 /// Precomputed quadrature for one vector load (body force or one Neumann part).
 #[derive(Clone, Debug)]
 struct LoadTerm {
-    /// Both components, compiled together.
-    expr: ExprSet,
-    points: Vec<[f64; 2]>,
+    /// Both components, compiled together and bound to the quadrature points.
+    expr: BoundSet,
     /// The contributions of point i: `scatter[first[i]..first[i + 1]]`.
     first: Vec<usize>,
     scatter: Vec<Scatter>,
@@ -110,7 +109,7 @@ impl Loads {
                     first.push(scatter.len());
                 }
                 let points = pts.iter().map(|p| p.x).collect();
-                LoadTerm { expr: ExprSet::new(&[&e.0[0], &e.0[1]]), points, first, scatter }
+                LoadTerm { expr: ExprSet::new(&[&e.0[0], &e.0[1]]).bind(points), first, scatter }
             })
             .collect();
         Loads { terms, n_dofs: space.n_dofs, support }
@@ -128,7 +127,7 @@ impl Loads {
         let mut values = Vec::new();
         for term in &self.terms {
             // the expression values in parallel batches, the sums sequentially: bit-identical results
-            term.expr.eval(&term.points, t, &mut values)?;
+            term.expr.eval(t, &mut values)?;
             for (i, v) in values.chunks_exact(2).enumerate() {
                 for s in &term.scatter[term.first[i]..term.first[i + 1]] {
                     out[s.slot] += s.w * (s.c[0] * v[0] + s.c[1] * v[1]);

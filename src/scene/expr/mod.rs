@@ -182,12 +182,45 @@ impl ExprSet {
     /// Every expression at every point at time t, point-major (`out[i * len + k]`). A non-finite value
     /// is an error naming the expression and the point (the first point in order that has one).
     pub fn eval(&self, points: &[[f64; 2]], t: f64, out: &mut Vec<f64>) -> Result<()> {
-        self.program.eval(points, t, out);
+        self.program.eval(points, t, None, out);
+        self.check_all(points, t, out)
+    }
+
+    fn check_all(&self, points: &[[f64; 2]], t: f64, out: &[f64]) -> Result<()> {
         let m = self.exprs.len();
         if let Some(i) = out.iter().position(|v| !v.is_finite()) {
             check(&self.exprs[i % m], out[i], points[i / m], t)?;
         }
         Ok(())
+    }
+
+    /// The set bound to fixed points: what depends on x, y only is evaluated now, once.
+    pub fn bind(self, points: Vec<[f64; 2]>) -> BoundSet {
+        let cache = self.program.fill_cache(&points);
+        BoundSet { set: self, points, cache }
+    }
+}
+
+/// An [`ExprSet`] at fixed points (quadrature points), evaluated at many times: the subexpressions that
+/// depend on x, y but not t are computed once, when bound, and read at every time. Same values as
+/// [`ExprSet::eval`] at those points (the same operations, done earlier).
+#[derive(Clone, Debug)]
+pub struct BoundSet {
+    set: ExprSet,
+    points: Vec<[f64; 2]>,
+    cache: Vec<f64>,
+}
+
+impl BoundSet {
+    /// The points.
+    pub fn points(&self) -> &[[f64; 2]] {
+        &self.points
+    }
+
+    /// As [`ExprSet::eval`] at the bound points.
+    pub fn eval(&self, t: f64, out: &mut Vec<f64>) -> Result<()> {
+        self.set.program.eval(&self.points, t, Some(&self.cache), out);
+        self.set.check_all(&self.points, t, out)
     }
 }
 
@@ -275,12 +308,16 @@ mod tests {
     #[test]
     fn compiled_matches_point_and_interpreted_evaluation() {
         // integer powers (positive, negative, zero), shared subterms, t-only parts, constant outputs
-        let texts = ["x^3*y^-2 + (x^3)*t", "(1-y)^2*max(t-1/3, 0) + cos(x)*(1-y)^2", "t^2 + 1", "x", "2.5"];
+        let texts = ["x^3*y^-2 + (x^3)*t", "(1-y)^2*max(t-1/3, 0) + cos(x)*(1-y)^2", "t^2 + 1", "x", "2.5", "sin(x*y)"];
         let exprs: Vec<Expr> = texts.iter().map(|s| Expr::parse("k", s).unwrap()).collect();
         let set = ExprSet::new(&exprs.iter().collect::<Vec<_>>());
         let pts: Vec<[f64; 2]> = (0..100).map(|i| [0.1 + i as f64 * 0.37, 0.5 + (i % 7) as f64]).collect();
         let mut out = Vec::new();
         set.eval(&pts, 0.75, &mut out).unwrap();
+        // bound to the points (spatial parts cached): the same bits
+        let mut bound_out = Vec::new();
+        set.clone().bind(pts.clone()).eval(0.75, &mut bound_out).unwrap();
+        assert!(out.iter().zip(&bound_out).all(|(a, b)| a.to_bits() == b.to_bits()) && out.len() == bound_out.len());
         for (i, p) in pts.iter().enumerate() {
             for (k, e) in exprs.iter().enumerate() {
                 let v = out[i * exprs.len() + k];

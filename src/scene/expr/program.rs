@@ -8,7 +8,10 @@
 //!   instead of `powf`; within a few ulps of `powf` (each product rounds once);
 //! * operations on constants are computed at compile time (exmex's own folding already did most);
 //! * nodes that depend on neither x nor y ("uniform": constants, t and what is computed from them) are
-//!   evaluated once per call, as scalars, and broadcast.
+//!   evaluated once per call, as scalars, and broadcast;
+//! * nodes that depend on x, y but not t ("spatial") can be evaluated once for a fixed set of points
+//!   ([`Program::fill_cache`]); the evaluations at each time then read the spatial values that the rest
+//!   of the program uses from that cache and run only the instructions that involve both.
 //!
 //! The remaining instructions run over batches of [`LANES`] points: each instruction is one simple loop
 //! over the lanes (vectorised by the compiler for + − × ÷, min, max, abs). Values are register slots of
@@ -20,6 +23,8 @@ use std::collections::HashMap;
 
 /// Points per batch.
 pub const LANES: usize = 32;
+/// Points per chunk of parallel work (a whole number of batches).
+const CHUNK: usize = 16 * LANES;
 /// Largest |n| of an integer power a^n compiled into products (beyond, `powf`).
 pub const MAX_INT_POWER: f64 = 64.0;
 
@@ -55,8 +60,10 @@ pub struct Program {
     nodes: Vec<Op>,
     /// Per node: depends on x or y.
     varying: Vec<bool>,
-    /// The varying instructions in order.
-    instrs: Vec<Instr>,
+    /// The varying instructions in order, each with whether it is spatial (no t).
+    instrs: Vec<(Instr, bool)>,
+    /// Slots of the cached spatial nodes (read by a node that depends on t, or outputs), each its own.
+    cached: Vec<u32>,
     /// (slot, node) of every uniform node a varying instruction reads.
     broadcast: Vec<(u32, u32)>,
     n_slots: usize,
@@ -174,6 +181,35 @@ impl Program {
             }
             v
         };
+        let timed: Vec<bool> = {
+            let mut v = vec![false; nodes.len()];
+            for (i, op) in nodes.iter().enumerate() {
+                v[i] = match *op {
+                    Op::T => true,
+                    Op::Const(_) | Op::X | Op::Y => false,
+                    Op::Un(_, a) => v[a as usize],
+                    Op::Bin(_, a, c) => v[a as usize] || v[c as usize],
+                };
+            }
+            v
+        };
+        // spatial nodes (not x, y themselves) read by a node that also depends on t, or outputs: cached
+        let mut cache_it = vec![false; nodes.len()];
+        for (i, op) in nodes.iter().enumerate() {
+            if varying[i] && timed[i] {
+                let reads: &[u32] = match op {
+                    Op::Un(_, a) => &[*a][..],
+                    Op::Bin(_, a, c) => &[*a, *c][..],
+                    _ => &[],
+                };
+                reads.iter().for_each(|&r| cache_it[r as usize] = varying[r as usize] && !timed[r as usize]);
+            }
+        }
+        for &o in &out_nodes {
+            cache_it[o as usize] = varying[o as usize] && !timed[o as usize];
+        }
+        cache_it[0] = false;
+        cache_it[1] = false;
         // last varying reader of each node (outputs are read at the end)
         let mut last = vec![0usize; nodes.len()];
         for (i, op) in nodes.iter().enumerate() {
@@ -218,24 +254,30 @@ impl Program {
             }
         }
         let mut instrs = Vec::new();
+        let mut cached = Vec::new();
         for (i, op) in nodes.iter().enumerate() {
             if !varying[i] || matches!(op, Op::X | Op::Y) {
                 continue;
             }
-            let dst = take(&mut free);
+            // a cached node keeps a slot of its own: the cache is loaded before any instruction runs
+            let dst = if cache_it[i] { take(&mut Vec::new()) } else { take(&mut free) };
+            if cache_it[i] {
+                cached.push(dst);
+            }
             slot[i] = dst;
+            let spatial = !timed[i];
             let release = |r: u32, free: &mut Vec<u32>| {
-                if varying[r as usize] && last[r as usize] == i && r > 1 {
+                if varying[r as usize] && !cache_it[r as usize] && last[r as usize] == i && r > 1 {
                     free.push(slot[r as usize]);
                 }
             };
             match *op {
                 Op::Un(f, a) => {
-                    instrs.push(Instr::Un(f, dst, slot[a as usize]));
+                    instrs.push((Instr::Un(f, dst, slot[a as usize]), spatial));
                     release(a, &mut free);
                 }
                 Op::Bin(f, a, c) => {
-                    instrs.push(Instr::Bin(f, dst, slot[a as usize], slot[c as usize]));
+                    instrs.push((Instr::Bin(f, dst, slot[a as usize], slot[c as usize]), spatial));
                     release(a, &mut free);
                     if c != a {
                         release(c, &mut free);
@@ -245,7 +287,7 @@ impl Program {
             }
         }
         let outputs = out_nodes.iter().map(|&o| (o, Some(slot[o as usize]).filter(|_| varying[o as usize]))).collect();
-        Program { nodes, varying, instrs, broadcast, n_slots, outputs }
+        Program { nodes, varying, instrs, cached, broadcast, n_slots, outputs }
     }
 
     /// Number of outputs.
@@ -295,8 +337,10 @@ impl Program {
     }
 
     /// All outputs at every point at time t, point-major: `out[i * n_outputs + k]`. Points are split
-    /// into chunks evaluated in parallel (pointwise, so the values do not depend on the split).
-    pub fn eval(&self, points: &[[f64; 2]], t: f64, out: &mut Vec<f64>) {
+    /// into chunks evaluated in parallel (pointwise, so the values do not depend on the split). With
+    /// `cache` (from [`Program::fill_cache`] on the same points) the spatial part is read, not computed:
+    /// the same operations were done there, so the values are the same.
+    pub fn eval(&self, points: &[[f64; 2]], t: f64, cache: Option<&[f64]>, out: &mut Vec<f64>) {
         let m = self.outputs.len();
         out.clear();
         out.resize(points.len() * m, 0.0);
@@ -304,15 +348,44 @@ impl Program {
             return;
         }
         let uniform = self.uniform(t);
-        const CHUNK: usize = 16 * LANES;
+        let per_chunk = CHUNK / LANES * self.cached.len() * LANES;
         crate::parallel::for_chunks(out, CHUNK * m, |c, chunk| {
             let pts = &points[c * CHUNK..(c * CHUNK + chunk.len() / m)];
-            self.eval_chunk(pts, &uniform, chunk);
+            let cache = cache.map(|cc| &cc[c * per_chunk..(c * per_chunk + per_chunk).min(cc.len())]);
+            self.eval_chunk(pts, &uniform, Some(chunk), cache, None);
         });
     }
 
-    fn eval_chunk(&self, points: &[[f64; 2]], uniform: &[f64], out: &mut [f64]) {
+    /// The cached spatial values at `points` (batch by batch, slot by slot), for [`Program::eval`].
+    pub fn fill_cache(&self, points: &[[f64; 2]]) -> Vec<f64> {
+        let n_batches = points.len().div_ceil(LANES);
+        let mut cache = vec![0.0; n_batches * self.cached.len() * LANES];
+        if self.cached.is_empty() {
+            return cache;
+        }
+        // spatial nodes do not depend on t: any t gives their values
+        let uniform = self.uniform(0.0);
+        let per_chunk = CHUNK / LANES * self.cached.len() * LANES;
+        crate::parallel::for_chunks(&mut cache, per_chunk, |c, chunk| {
+            let pts = &points[c * CHUNK..(c * CHUNK + CHUNK).min(points.len())];
+            self.eval_chunk(pts, &uniform, None, None, Some(chunk));
+        });
+        cache
+    }
+
+    /// Evaluate batches of points: everything into `out` (no cache), the time-dependent part into `out`
+    /// from `cache`, or only the spatial part into `fill`.
+    fn eval_chunk(
+        &self,
+        points: &[[f64; 2]],
+        uniform: &[f64],
+        out: Option<&mut [f64]>,
+        cache: Option<&[f64]>,
+        mut fill: Option<&mut [f64]>,
+    ) {
         let m = self.outputs.len();
+        let nc = self.cached.len();
+        let mut out = out;
         let mut regs = vec![[0.0f64; LANES]; self.n_slots];
         for &(s, n) in &self.broadcast {
             regs[s as usize] = [uniform[n as usize]; LANES];
@@ -324,8 +397,18 @@ impl Program {
                 regs[SLOT_X as usize][l] = p[0];
                 regs[SLOT_Y as usize][l] = p[1];
             }
+            if let Some(cache) = cache {
+                for (k, &s) in self.cached.iter().enumerate() {
+                    let at = (b * nc + k) * LANES;
+                    regs[s as usize].copy_from_slice(&cache[at..at + LANES]);
+                }
+            }
             let r = regs.as_mut_ptr();
-            for ins in &self.instrs {
+            for &(ref ins, spatial) in &self.instrs {
+                // with a cache the spatial instructions were done when it was filled; filling, the others wait
+                if (cache.is_some() && spatial) || (fill.is_some() && !spatial) {
+                    continue;
+                }
                 // SAFETY: every slot index is < n_slots = regs.len() (assigned in `Program::new`), and an
                 // instruction's destination slot is taken while its operands still hold theirs, so it
                 // differs from both: the mutable and the shared references never overlap.
@@ -338,6 +421,14 @@ impl Program {
                     }
                 }
             }
+            if let Some(fill) = fill.as_deref_mut() {
+                for (k, &s) in self.cached.iter().enumerate() {
+                    let at = (b * nc + k) * LANES;
+                    fill[at..at + LANES].copy_from_slice(&regs[s as usize]);
+                }
+                continue;
+            }
+            let Some(out) = out.as_deref_mut() else { continue };
             let base = b * LANES * m;
             for (k, &(node, s)) in self.outputs.iter().enumerate() {
                 for l in 0..pts.len() {
