@@ -215,7 +215,7 @@ def classify(dso, sym):
         return "expression evaluation: compiled program"
     if "libc" in dso or "libm" in dso:
         return "libc (memcpy, memset, malloc)"
-    for key, name in [("apply_friction", "Z·μ recovery of u (contact::apply_friction)"),
+    for key, name in [("subtract_friction", "K⁻¹Eμ recovery of u (free::subtract_friction)"),
                       ("LoadBasis::build", "load superposition set-up (superpose::LoadBasis::build)"),
                       ("LoadBasis::response", "u_f = Σ c_j w_j (superpose::response)"),
                       ("from_triplets", "sparse matrix from triplets (assembly)"), ("scatter", "assembly"),
@@ -269,7 +269,8 @@ def main(argv=None):
            "(set-up + steps + writing, without process start/exit); per step = (CLI wall − set-up)/N "
            "(includes forming u and, when written, the writing of every step)",
            "* set-up = mesh+space / assembly (K and the load operator) / factorisation (AMD + Cholesky, faer, "
-           "sequential) / condensation (C = EᵀK⁻¹E, Z = K⁻¹E, and the load superposition basis)", ""]
+           "sequential, contact unknowns ordered last) / condensation (C = (L_cc L_ccᵀ)⁻¹ from the factor's trailing block, and "
+           "the load superposition basis)", ""]
 
     if args.mms_only:
         tg = mms_section(args, R, tmp, md, csvrows)
@@ -400,8 +401,9 @@ def main(argv=None):
                             wall=rs.wall, per_step=rs.per_step, setup_fact=rs.setup[2], load=rs.load))
         print(md[-1], flush=True)
     md += ["", "Example 5.1's loads are proportional (g = t·g₁), so its steps do not solve with the factor at all: "
-           "u_f = Σ c_j K⁻¹b_j (superposition) and u = u_f − Zμ with Z = K⁻¹E kept dense (n × n_c); a step is "
-           "O(n·(rank + n_c)) dense work plus the O(n_c²)-per-iteration friction QP.", ""]
+           "u_f = Σ c_j K⁻¹b_j (superposition) and u = u_f − K⁻¹Eμ with K⁻¹Eμ = P L⁻ᵀ[0; L_cc⁻¹μ], one backward "
+           "half-solve, reused while μ repeats; a step is O(n·rank) dense work, that half-solve when μ changes, and "
+           "the O(n_c²)-per-iteration friction QP.", ""]
 
     # ---------------------------------------------------------------- 4. growth
     print("== 4. growth with DOF", flush=True)
