@@ -150,8 +150,9 @@ impl FreeResponse {
         }
     }
 
-    /// u ← u_f − K⁻¹Eμ with K⁻¹Eμ = P L⁻ᵀ[0; Wμ] (one backward half).
-    fn subtract_friction(&self, u: &mut [f64], mu: &[f64]) -> Result<()> {
+    /// u ← u_f − K⁻¹Eμ with K⁻¹Eμ = P L⁻ᵀ[0; Wμ] (one backward half), for a formed u_f (superposed
+    /// loads, or given by the caller).
+    pub fn subtract_friction(&self, u: &mut [f64], mu: &[f64]) -> Result<()> {
         let n = u.len();
         let mut cache = self.friction_cache.borrow_mut();
         let (last_mu, zmu) = &mut *cache;
