@@ -1,6 +1,7 @@
 //! The free response u_f = K⁻¹lⁿ and its contact trace s_f = Eᵀu_f (`solve::free`) by each of its
-//! routes — superposed load patterns, the Z = K⁻¹E shortcut, a full solve — against a direct solve of
-//! the assembled load with a fresh factor of K.
+//! routes — superposed load patterns, or the forward half-solve with the contact unknowns ordered last
+//! (s_f = Wᵀy_c) followed by one backward half — against a direct solve of the assembled load with a
+//! fresh factor of K.
 
 mod common;
 use common::*;
@@ -22,10 +23,13 @@ fn check(p: &Problem, label: &str) {
         p.free.loads().assemble(t, &mut direct).unwrap();
         factor.solve_in_place(&mut direct);
         let trace: Vec<f64> = dofs.iter().map(|&k| direct[k]).collect();
-        let Free { u, trace: t_full } = p.free.at(n, t, true, &mut load).unwrap();
+        // u_f = uⁿ for μ = 0
+        let free = p.free.at(n, t, true, &mut load).unwrap();
+        let t_full = free.trace.clone();
+        let u = p.free.with_friction(free, &vec![0.0; dofs.len()]).unwrap();
         assert!(rel_diff(&u, &direct) <= TOL, "{label} step {n}: u_f {:e}", rel_diff(&u, &direct));
         assert!(rel_diff(&t_full, &trace) <= TOL, "{label} step {n}: trace with u");
-        let Free { u, trace: t_only } = p.free.at(n, t, false, &mut load).unwrap();
+        let Free { u, trace: t_only, .. } = p.free.at(n, t, false, &mut load).unwrap();
         assert!(u.is_empty() || dofs.is_empty(), "{label}: u formed although not wanted");
         assert!(rel_diff(&t_only, &trace) <= TOL, "{label} step {n}: trace alone {:e}", rel_diff(&t_only, &trace));
     }
@@ -49,8 +53,8 @@ fn free_response_matches_a_direct_solve_on_every_route() {
     // friction correction
     let mu: Vec<f64> = (0..q.space.contact.len()).map(|e| 1e-3 * (e as f64 + 1.0).sin()).collect();
     let mut load = Vec::new();
-    let Free { mut u, .. } = q.free.at(3, q.scene.times[3], true, &mut load).unwrap();
-    q.free.subtract_friction(&mut u, &mu);
+    let free = q.free.at(3, q.scene.times[3], true, &mut load).unwrap();
+    let u = q.free.with_friction(free, &mu).unwrap();
     for (c, m) in q.space.contact.iter().zip(&mu) {
         load[c.dof] -= m;
     }
