@@ -19,6 +19,7 @@ pub(super) struct RawScene {
     pub(super) solver: Option<RawSolver>,
     pub(super) exact: Option<RawExact>,
     pub(super) output: Option<RawOutput>,
+    pub(super) outputs: Option<super::Outputs>,
 }
 
 #[derive(Deserialize)]
