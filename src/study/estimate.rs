@@ -99,3 +99,36 @@ pub fn estimate(r: &[LevelResult]) -> Estimates {
         errs.iter().zip(verdicts).map(|(e, v)| LevelEstimate { error: *e, gci: FS_THREE * e[0], verdict: v }).collect();
     Estimates { size, model: Some(model), levels, refused: None }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Levels whose errors have orthogonal increments (|e_l| = 0.3 h_l, nested Galerkin) and jump energy
+    /// J_l = (0.1 h_l)²: the estimate √(G² + J) equals the true √(|e_l|² + J_l) at every level, β = 1.
+    #[test]
+    fn estimate_recovers_errors_with_orthogonal_increments() {
+        let h = [0.4, 0.2, 0.1, 0.05];
+        let e = |x: f64| 0.3 * x;
+        let inc = |i: usize| vec![(e(h[i - 1]).powi(2) - e(h[i]).powi(2)).sqrt()];
+        let skip = |i: usize| vec![(e(h[i - 2]).powi(2) - e(h[i]).powi(2)).sqrt()];
+        let r: Vec<LevelResult> = (0..4)
+            .map(|i| LevelResult {
+                refine: i as u32,
+                h: h[i],
+                k: 0.1,
+                increment: (i >= 1).then(|| inc(i)),
+                skip: (i >= 2).then(|| skip(i)),
+                jumps: vec![(0.1 * h[i]).powi(2)],
+                ..LevelResult::default()
+            })
+            .collect();
+        let est = estimate(&r);
+        let m = est.model.unwrap();
+        assert!((m.p - 1.0).abs() < 1e-8 && (m.beta - 1.0).abs() < 1e-6, "{m:?}");
+        for (i, l) in est.levels.iter().enumerate() {
+            let truth = (e(h[i]).powi(2) + (0.1 * h[i]).powi(2)).sqrt();
+            assert!((l.error[0] / truth - 1.0).abs() < 1e-8 && l.verdict == Verdict::InRange, "{i}: {l:?}");
+        }
+    }
+}

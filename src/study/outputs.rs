@@ -130,3 +130,29 @@ pub fn estimate(names: &[String], x: &[f64], q: &[Vec<f64>]) -> Vec<OutputEstima
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Q = 0.05 − 0.02 h (order 1, the theoretical one) on four levels is extrapolated to 0.05 and in range;
+    /// the energy column with Q = 1 + h^2.5 (above its theoretical order 2 + 0.15) is refused; an
+    /// oscillating column is refused with that reason.
+    #[test]
+    fn outputs_extrapolate_and_refuse() {
+        let x: [f64; 4] = [0.4, 0.2, 0.1, 0.05];
+        let names: Vec<String> = ["max_slip", "energy", "stick_length"].map(String::from).to_vec();
+        let q: Vec<Vec<f64>> = x
+            .iter()
+            .enumerate()
+            .map(|(i, h)| vec![0.05 - 0.02 * h, 1.0 + h.powf(2.5), 0.5 + 0.1 * (-1f64).powi(i as i32) * h])
+            .collect();
+        let e = estimate(&names, &x, &q);
+        let m = e[0].model.unwrap();
+        assert!((m.limit - 0.05).abs() < 1e-12 && (m.p - 1.0).abs() < 1e-9);
+        assert!(e[0].levels.iter().all(|l| l.2 == Verdict::InRange && (l.0 - 0.0).abs() < 0.0081));
+        assert!((e[0].levels[3].0 - 0.001).abs() < 1e-12 && (e[0].levels[3].1 - 0.00125).abs() < 1e-12);
+        assert!(e[1].levels.iter().all(|l| l.2.text().contains("outside")));
+        assert!(e[2].model.is_none() && e[2].levels[0].2.text().contains("oscillate"));
+    }
+}
