@@ -86,13 +86,14 @@ fn print_estimates(s: &Study) {
             "steps",
             "est(max)",
             "GCI",
-            if true_col { "true(max)" } else { "" },
+            if true_col { "true/ref" } else { "" },
             if true_col { "eff" } else { "" }
         );
         for (r, l) in s.levels.iter().zip(&e.levels) {
-            // the truth the estimate is compared with: the exact error on different meshes, the
-            // reference run on one mesh (the sequence's limit is the semi-discrete solution)
-            let truth = if e.size == "k" { r.reference.map(|v| v[0]) } else { r.common_err.map(|v| v.energy) };
+            // the truth the estimate is compared with: the exact error on different meshes (else the
+            // reference run), the reference run on one mesh (the sequence's limit is the semi-discrete solution)
+            let reference = r.reference.map(|v| v[0]);
+            let truth = if e.size == "k" { reference } else { r.common_err.map(|v| v.energy).or(reference) };
             let (t, eff) = truth
                 .map_or((String::new(), String::new()), |t| (format!("{t:.4e}"), format!("{:.3}", l.error[0] / t)));
             println!(
