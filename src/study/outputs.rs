@@ -114,10 +114,11 @@ pub fn estimate(names: &[String], x: &[f64], q: &[Vec<f64>]) -> Vec<OutputEstima
             }
             let (xs, qs) = ([x[n - 3], x[n - 2], x[n - 1]], [v[n - 3], v[n - 2], v[n - 1]]);
             let Some(m) = ScalarModel::fit(xs, qs) else {
-                let why = if (qs[2] - qs[1]) * (qs[1] - qs[0]) < 0.0 {
+                let scale = qs.iter().fold(0.0f64, |m, q| m.max(q.abs()));
+                let why = if (qs[2] - qs[1]).abs() <= 1e-12 * scale {
+                    "the two finest values agree to rounding"
+                } else if (qs[2] - qs[1]) * (qs[1] - qs[0]) < 0.0 {
                     "the three finest values oscillate"
-                } else if qs[2] == qs[1] {
-                    "the two finest values are equal"
                 } else {
                     "no order in (0, 8] fits the three finest values"
                 };
