@@ -100,7 +100,7 @@ def report(results, require, write):
               "elementwise mean of ∇u to leading order), β = 0 parallel errors (the k sequence: backward Euler's error "
               "θkW has one shape). Both are measured from three distances, never fitted to a true error.", "",
               "## Scalar outputs at T (finest level)", "",
-              "Extrapolated with Celik's three-level order; theoretical order 2 for the energy, 1 otherwise. "
+              "Extrapolated with Celik's three-level order; theoretical order 2 for the energy in h (1 in k), 1 otherwise. "
               "No exact values are required here; for `mms_front` the exact maximum slip at T is 1/20 (s = S(·)/20, S ≤ 1).", "",
               "| sequence | output | finest value | extrapolated | p | estimate | GCI | verdict |", "|---|---|---|---|---|---|---|---|"]
     for name, *_ in CASES:

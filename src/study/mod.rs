@@ -204,11 +204,11 @@ pub fn run_study(
         prev = Some(kept);
     }
     let names = outputs::names(&outputs::selected(scene));
-    let (_, x) = estimate::sizes(&results);
+    let (size, x) = estimate::sizes(&results);
     let q: Vec<Vec<f64>> = results.iter().map(|r| r.outputs.clone()).collect();
     Ok(Study {
         estimates: estimate::estimate(&results),
-        outputs: outputs::estimate(&names, &x, &q),
+        outputs: outputs::estimate(&names, size, &x, &q),
         output_names: names,
         levels: results,
         difference_files,
