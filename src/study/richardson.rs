@@ -32,8 +32,9 @@ use super::orders::{observed_order, order_three};
 pub const FS_THREE: f64 = 1.25;
 /// Roache's safety factor with two levels (the order assumed, not observed).
 pub const FS_TWO: f64 = 3.0;
-/// |GCI_{l−1}/(rᵖ GCI_l) − 1| allowed: a mismatch δ in the ratio is an order error δ/ln r, which moves an
-/// estimate by about rᵖ/(rᵖ−1)·δ ≤ 2δ (p ≥ 1/2... r = 2, p = 1): 0.1 keeps that within the ±20 % band.
+/// |GCI_{l−1}/(rᵖ GCI_l) − 1| allowed: a mismatch δ in the ratio is an order error δ/ln r, which moves the
+/// classical (β = 0) estimate d/(rᵖ − 1) by rᵖ/(rᵖ − 1)·δ — 2δ for r = 2, p = 1 (less for β = 1): 0.1
+/// keeps that within the ±20 % band the estimates are held to.
 pub const RATIO_TOL: f64 = 0.1;
 /// p may exceed the theoretical order by this much (the same order error budget as [`RATIO_TOL`] for r = 2:
 /// ln(1.1)/ln 2 ≈ 0.14, rounded to 0.15) before the sequence is called pre-asymptotic.
