@@ -67,6 +67,9 @@ enum Cmd {
         /// Write the table as CSV.
         #[arg(long)]
         csv: Option<PathBuf>,
+        /// Write per level the elementwise energy density of u_l − P u_{l−1} (XDMF, ParaView) into DIR.
+        #[arg(long, value_name = "DIR")]
+        differences: Option<PathBuf>,
     },
 }
 
@@ -113,19 +116,20 @@ fn load(path: &PathBuf, refine: Option<u32>, steps: Option<usize>) -> Result<Sce
 
 fn main() {
     let cli = Cli::parse();
-    let result = match cli.cmd {
-        Cmd::Check { scene, refine, steps } => load(&scene, refine, steps).and_then(cli::check::check),
-        Cmd::Run { scene, refine, steps, solver, tol, out, verbose, quiet } => {
-            load(&scene, refine, steps).and_then(|mut s| {
-                solver_overrides(&mut s, solver, tol)?;
-                cli::run::run(s, out, verbose, quiet)
-            })
-        }
-        Cmd::Study { scene, levels, reference, solver, tol, csv } => load(&scene, None, None).and_then(|mut s| {
-            solver_overrides(&mut s, solver, tol)?;
-            cli::study::study(s, &levels, reference, csv)
-        }),
-    };
+    let result =
+        match cli.cmd {
+            Cmd::Check { scene, refine, steps } => load(&scene, refine, steps).and_then(cli::check::check),
+            Cmd::Run { scene, refine, steps, solver, tol, out, verbose, quiet } => load(&scene, refine, steps)
+                .and_then(|mut s| {
+                    solver_overrides(&mut s, solver, tol)?;
+                    cli::run::run(s, out, verbose, quiet)
+                }),
+            Cmd::Study { scene, levels, reference, solver, tol, csv, differences } => load(&scene, None, None)
+                .and_then(|mut s| {
+                    solver_overrides(&mut s, solver, tol)?;
+                    cli::study::study(s, &levels, reference, csv, differences)
+                }),
+        };
     if let Err(e) = result {
         eprintln!("error: {e:#}");
         std::process::exit(1);

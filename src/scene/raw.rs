@@ -23,6 +23,7 @@ pub(super) struct RawScene {
     /// scene text stored in the results file).
     #[allow(dead_code)]
     pub(super) units: Option<RawUnits>,
+    pub(super) outputs: Option<super::Outputs>,
 }
 
 #[derive(Deserialize)]
