@@ -66,7 +66,7 @@ import dolfinx.fem.petsc  # noqa: E402
 import ufl  # noqa: E402
 from dolfinx import fem  # noqa: E402
 from dolfinx import mesh as dmesh  # noqa: E402
-from dolfinx_solve import sympy_to_ufl, vec_to_ufl  # noqa: E402  (the sympy -> UFL translation)
+from dolfinx_solve import dunavant_dx, load_form, sympy_to_ufl, vec_to_ufl  # noqa: E402  (sympy -> UFL, loads)
 
 SIDES = ("bottom", "right", "top", "left")
 
@@ -418,18 +418,8 @@ class Problem:
 
         # loads
         self.t = fem.Constant(msh, 0.0)
-        X = ufl.SpatialCoordinate(msh)
-        dx4 = ufl.Measure("dx", domain=msh, metadata={
-            "quadrature_rule": "custom", "quadrature_points": ts.DUNAVANT_REF_X.T.copy(),
-            "quadrature_weights": ts.DUNAVANT_REF_W.copy()})
-        L = None
-        if not scene.f.is_zero:
-            L = ufl.inner(vec_to_ufl(scene.f, X, self.t), v) * dx4
-        for i, bb in enumerate(scene.boundaries):
-            if bb.kind == "neumann" and not bb.traction.is_zero:
-                term = ufl.inner(vec_to_ufl(bb.traction, X, self.t), v) * ds(i + 1, metadata={"quadrature_degree": 5})
-                L = term if L is None else L + term
-        self.L = None if L is None else fem.form(L)
+        self.L = load_form(scene, msh, v, ds, self.t)
+        X, dx4 = ufl.SpatialCoordinate(msh), dunavant_dx(msh)
         self.lvec = dolfinx.fem.petsc.create_vector(V)     # ghosted, layout of V
 
         # true errors

@@ -94,6 +94,28 @@ def vec_to_ufl(vexpr, x, t):
     return ufl.as_vector([sympy_to_ufl(c.sym, x, t, c.key) for c in vexpr.comps])
 
 
+def dunavant_dx(msh):
+    """The cell measure with the 6-point Dunavant rule (degree 4) of the Rust solver and scikit-fem."""
+    return ufl.Measure("dx", domain=msh, metadata={
+        "quadrature_rule": "custom", "quadrature_points": ts.DUNAVANT_REF_X.T.copy(),
+        "quadrature_weights": ts.DUNAVANT_REF_W.copy()})
+
+
+def load_form(scene, msh, v, ds, t):
+    """The load functional (l(t), v) as a compiled form (None without loads): the body force by the
+    6-point Dunavant rule, tractions on Neumann part i (measure ds(i + 1)) by 3-point Gauss (degree 5)."""
+    X = ufl.SpatialCoordinate(msh)
+    dx4 = dunavant_dx(msh)
+    L = None
+    if not scene.f.is_zero:
+        L = ufl.inner(vec_to_ufl(scene.f, X, t), v) * dx4
+    for i, b in enumerate(scene.boundaries):
+        if b.kind == "neumann" and not b.traction.is_zero:
+            term = ufl.inner(vec_to_ufl(b.traction, X, t), v) * ds(i + 1, metadata={"quadrature_degree": 5})
+            L = term if L is None else L + term
+    return None if L is None else fem.form(L)
+
+
 class DolfinxProblem:
     """Distributed assembly of a_h, its jump part, loads and true errors (canonical ordering on rank 0)."""
 
@@ -153,18 +175,8 @@ class DolfinxProblem:
 
         # loads: UFL expressions in x and the time constant t
         self.t = fem.Constant(msh, 0.0)
-        X = ufl.SpatialCoordinate(msh)
-        dx4 = ufl.Measure("dx", domain=msh, metadata={
-            "quadrature_rule": "custom", "quadrature_points": ts.DUNAVANT_REF_X.T.copy(),
-            "quadrature_weights": ts.DUNAVANT_REF_W.copy()})
-        L = None
-        if not scene.f.is_zero:
-            L = ufl.inner(vec_to_ufl(scene.f, X, self.t), v) * dx4
-        for i, b in enumerate(scene.boundaries):
-            if b.kind == "neumann" and not b.traction.is_zero:
-                term = ufl.inner(vec_to_ufl(b.traction, X, self.t), v) * ds(i + 1, metadata={"quadrature_degree": 5})
-                L = term if L is None else L + term
-        self.L = None if L is None else fem.form(L)
+        self.L = load_form(scene, msh, v, ds, self.t)
+        X, dx4 = ufl.SpatialCoordinate(msh), dunavant_dx(msh)
 
         # true errors
         self.err_forms = None
