@@ -8,7 +8,9 @@
   (the CR field evaluated at triangle vertices: U(v_j) = sum_{i != j} U_{e_i} - U_{e_j}).
 * meshio's XDMF ``TimeSeriesReader`` (the sidecar; it reads the last temporal collection, the body): same
   numbers and values; VTK's ``vtkXdmfReader``: both blocks, contact fields at the first and last frame.
-* h5py (the ``tresca`` group): shapes of the README table, ``completed`` attribute, finiteness.
+* h5py (the ``tresca`` group): shapes of the README table, ``completed`` attribute, finiteness, and the
+  per-step checksums ``tresca/steps/checksum`` (XXH64 of each step's rows, recomputed here with numpy; the
+  first step that does not match is named: storage corruption after the file was written).
 
 Also for the file of a killed run (status ``running``): its series have room for every step of the run
 and only the first ``completed`` rows are data; every reader must still open it and see exactly the
@@ -40,6 +42,71 @@ def close(a, b, what, rtol=2e-6):
     scale = max(float(np.max(np.abs(b))) if b.size else 0.0, 1e-300)
     err = float(np.max(np.abs(a - b))) if a.size else 0.0
     check(err <= rtol * scale, f"{what}: max difference {err:.3e} (scale {scale:.3e})")
+
+
+# XXH64 (seed 0), vectorised over the rows of a (steps, bytes) uint8 array: the checksum of tresca/steps/checksum
+_P = [np.uint64(v) for v in (0x9E3779B185EBCA87, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9, 0x85EBCA77C2B2AE63,
+                             0x27D4EB2F165667C5)]
+
+
+def _rotl(x, r):
+    return (x << np.uint64(r)) | (x >> np.uint64(64 - r))
+
+
+def _round(acc, lane):
+    return _rotl(acc + lane * _P[1], 31) * _P[0]
+
+
+def xxh64_rows(rows):
+    rows = np.ascontiguousarray(rows, dtype=np.uint8)
+    S, L = rows.shape
+    with np.errstate(over="ignore"):
+        words = rows[:, : L // 8 * 8].copy().view("<u8")
+        i = 0
+        if L >= 32:
+            v = [np.full(S, x, dtype=np.uint64) for x in (_P[0] + _P[1], _P[1], np.uint64(0), np.uint64(0) - _P[0])]
+            for s in range(L // 32):
+                for j in range(4):
+                    v[j] = _round(v[j], words[:, 4 * s + j])
+            h = _rotl(v[0], 1) + _rotl(v[1], 7) + _rotl(v[2], 12) + _rotl(v[3], 18)
+            for j in range(4):
+                h = (h ^ _round(np.zeros(S, np.uint64), v[j])) * _P[0] + _P[3]
+            i = L // 32 * 32
+        else:
+            h = np.full(S, _P[4], dtype=np.uint64)
+        h = h + np.uint64(L)
+        while i + 8 <= L:
+            h = _rotl(h ^ _round(np.zeros(S, np.uint64), words[:, i // 8]), 27) * _P[0] + _P[3]
+            i += 8
+        if i + 4 <= L:
+            h = _rotl(h ^ (rows[:, i:i + 4].copy().view("<u4")[:, 0].astype(np.uint64) * _P[0]), 23) * _P[1] + _P[2]
+            i += 4
+        while i < L:
+            h = _rotl(h ^ (rows[:, i].astype(np.uint64) * _P[4]), 11) * _P[0]
+            i += 1
+        h = (h ^ (h >> np.uint64(33))) * _P[1]
+        h = (h ^ (h >> np.uint64(29))) * _P[2]
+        return h ^ (h >> np.uint64(32))
+
+
+CHECKSUMMED = ["times", "u", "energy", "steps/iterations", "steps/residual", "steps/n_stick", "steps/n_slip",
+               "steps/wall_time", "contact/slip", "contact/sigma_t", "contact/state", "contact/mu", "contact/dof",
+               "errors/energy", "errors/h1", "errors/l2"]
+
+
+def first_bad_step(g, S):
+    """The first of the S committed steps whose rows do not match tresca/steps/checksum (None: all match)."""
+    names = [k for k in CHECKSUMMED if k in g]
+    per_step = sum(g[k].dtype.itemsize * int(np.prod(g[k].shape[1:])) for k in names)
+    block = max(1, (64 << 20) // max(per_step, 1))  # steps per read: about 64 MB
+    stored = g["steps/checksum"][:S]
+    for a in range(0, S, block):
+        b = min(S, a + block)
+        parts = [np.ascontiguousarray(g[k][a:b]).reshape(b - a, -1).view(np.uint8) for k in names]
+        bad = np.nonzero(xxh64_rows(np.concatenate(parts, axis=1)) != stored[a:b])[0]
+        if len(bad):
+            return a + int(bad[0])
+    return None
 
 
 def reference(g, S):
@@ -126,6 +193,12 @@ def main(argv=None):
         close(g["contact/sigma_t"][:S], -g["contact/mu"][:S] /
               np.linalg.norm(np.diff(g["mesh/points"][()][g["mesh/edges"][()][g["contact/edges"][()]]], axis=1)[:, 0], axis=1),
               "sigma_t = -mu/|e|", 1e-14)
+    if "steps/checksum" in g:
+        bad = first_bad_step(g, S)
+        check(bad is None, f"step {bad} does not match its checksum (tresca/steps/checksum): the file was damaged "
+                           f"after it was written; steps before it are intact")
+    else:
+        print(f"{args.h5}: no tresca/steps/checksum (written before checksums were added): not verified")
     for name in ("u", "energy", "times"):
         check(np.all(np.isfinite(g[name][:S])), f"tresca/{name} has non-finite values")
     every = int(g.attrs["frame_every"])

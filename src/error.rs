@@ -31,6 +31,33 @@ pub enum Error {
     /// Reading or writing a file failed.
     #[error("{path}: {msg}")]
     Io { path: PathBuf, msg: String },
+
+    /// Another run owns the results file (see `output::lock`).
+    #[error(
+        "{path}: {holder} is already writing this results file (lock {path}.lock); wait for it to end or choose \
+         another output path"
+    )]
+    Busy { path: PathBuf, holder: String },
+
+    /// The run would need more memory or disk than there is (or than the limit given).
+    #[error(
+        "the run needs about {} of {what} but {} {limit}; {hint}",
+        human(*need),
+        human(*have)
+    )]
+    TooLarge { what: &'static str, need: u64, have: u64, limit: &'static str, hint: String },
+}
+
+/// Bytes in a readable unit (decimal: kB, MB, GB, TB).
+pub fn human(bytes: u64) -> String {
+    let b = bytes as f64;
+    match b {
+        _ if b >= 1e12 => format!("{:.1} TB", b / 1e12),
+        _ if b >= 1e9 => format!("{:.1} GB", b / 1e9),
+        _ if b >= 1e6 => format!("{:.1} MB", b / 1e6),
+        _ if b >= 1e3 => format!("{:.1} kB", b / 1e3),
+        _ => format!("{bytes} B"),
+    }
 }
 
 /// Result alias used throughout the crate.

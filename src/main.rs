@@ -4,8 +4,10 @@ mod cli;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
+use cli::out::note;
 use cli::run::OutputArgs;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use tresca_cr::scene::budget::{parse_size, Estimate};
 use tresca_cr::Scene;
 
 #[derive(Parser)]
@@ -17,13 +19,15 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
-    /// Validate a scene and print what it will model.
+    /// Validate a scene and print what it will model, with the memory and disk a run will need.
     Check {
         scene: PathBuf,
         #[arg(long)]
         refine: Option<u32>,
         #[arg(long)]
         steps: Option<usize>,
+        #[command(flatten)]
+        limits: Limits,
     },
     /// Run a scene.
     Run {
@@ -48,6 +52,8 @@ enum Cmd {
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
+        #[command(flatten)]
+        limits: Limits,
     },
     /// Convergence study: run the scene at several levels and print/write errors and observed orders.
     Study {
@@ -73,6 +79,17 @@ enum Cmd {
     },
 }
 
+/// Limits on what a run may use (default: what the machine has).
+#[derive(clap::Args, Clone, Copy)]
+struct Limits {
+    /// Refuse a run whose estimated peak memory exceeds this (e.g. 800M, 16G; default: available memory).
+    #[arg(long, value_parser = parse_size)]
+    max_memory: Option<u64>,
+    /// Refuse a run whose estimated results file exceeds this (e.g. 2G; default: free disk space).
+    #[arg(long, value_parser = parse_size)]
+    max_disk: Option<u64>,
+}
+
 /// Apply the --solver and --tol overrides.
 fn solver_overrides(s: &mut Scene, solver: Option<String>, tol: Option<f64>) -> Result<()> {
     if let Some(m) = solver {
@@ -94,13 +111,21 @@ fn method(name: &str) -> Result<tresca_cr::scene::Method> {
     })
 }
 
-fn load(path: &PathBuf, refine: Option<u32>, steps: Option<usize>) -> Result<Scene> {
+/// Read the scene, estimate what the run needs (refused when it does not fit: before anything large is
+/// allocated), then apply --refine and --steps. `output`: the results file, if one is written.
+fn load(
+    path: &Path,
+    refine: Option<u32>,
+    steps: Option<usize>,
+    limits: Limits,
+    output: Option<&Path>,
+) -> Result<(Scene, Estimate)> {
     let mut scene = Scene::from_file(path)?;
     if scene.rho < 1.0 {
         // a_h is coercive only through the jump term (plain CR fails Korn's inequality): the discrete
         // Korn constant, and with it the error, degrades like 1/ρ (reference/stability.md: ρ = 1e-4 gives
         // L² errors 2000 times those of ρ = 10 on mms_elastic)
-        eprintln!(
+        note!(
             "warning: {}: rho = {} < 1 weakens the jump stabilisation that makes Crouzeix-Raviart elasticity stable; expect large errors",
             scene.file, scene.rho
         );
@@ -108,30 +133,46 @@ fn load(path: &PathBuf, refine: Option<u32>, steps: Option<usize>) -> Result<Sce
     if let Some(k) = refine {
         scene.set_refine(k)?;
     }
+    if steps.is_some() && !scene.uniform_time {
+        scene.set_steps(1)?; // refused with the reason
+    }
+    let n = steps.unwrap_or(scene.times.len() - 1);
+    let dir = output.map(|p| p.parent().unwrap_or(Path::new(".")).to_path_buf());
+    let estimate = Estimate::of(&scene, n, output.is_some())?;
+    estimate.check(limits.max_memory, limits.max_disk, dir.as_deref())?;
     if let Some(n) = steps {
         scene.set_steps(n)?;
     }
-    Ok(scene)
+    Ok((scene, estimate))
 }
 
 fn main() {
     let cli = Cli::parse();
-    let result =
-        match cli.cmd {
-            Cmd::Check { scene, refine, steps } => load(&scene, refine, steps).and_then(cli::check::check),
-            Cmd::Run { scene, refine, steps, solver, tol, out, verbose, quiet } => load(&scene, refine, steps)
-                .and_then(|mut s| {
-                    solver_overrides(&mut s, solver, tol)?;
-                    cli::run::run(s, out, verbose, quiet)
-                }),
-            Cmd::Study { scene, levels, reference, solver, tol, csv, differences } => load(&scene, None, None)
-                .and_then(|mut s| {
-                    solver_overrides(&mut s, solver, tol)?;
-                    cli::study::study(s, &levels, reference, csv, differences)
-                }),
-        };
+    let result = match cli.cmd {
+        Cmd::Check { scene, refine, steps, limits } => {
+            // the estimate of the results file is for the scene's [output] path, else the current directory
+            let out = Scene::from_file(&scene).ok().and_then(|s| s.output).unwrap_or_else(|| PathBuf::from("run.h5"));
+            load(&scene, refine, steps, limits, Some(&out)).and_then(|(s, e)| cli::check::check(s, e))
+        }
+        Cmd::Run { scene, refine, steps, solver, tol, out, verbose, quiet, limits } => {
+            let target = out.output.clone().or_else(|| Scene::from_file(&scene).ok().and_then(|s| s.output));
+            // a resumed run's file already holds its disk space: only memory is checked then
+            let new_file = target.as_deref().filter(|_| !out.resume);
+            load(&scene, refine, steps, limits, new_file).and_then(|(mut s, _)| {
+                solver_overrides(&mut s, solver, tol)?;
+                cli::run::run(s, out, verbose, quiet)
+            })
+        }
+        Cmd::Study { scene, levels, reference, solver, tol, csv, differences } => {
+            let no_limits = Limits { max_memory: None, max_disk: None };
+            load(&scene, None, None, no_limits, None).and_then(|(mut s, _)| {
+                solver_overrides(&mut s, solver, tol)?;
+                cli::study::study(s, &levels, reference, csv, differences)
+            })
+        }
+    };
     if let Err(e) = result {
-        eprintln!("error: {e:#}");
+        note!("error: {e:#}");
         std::process::exit(1);
     }
 }

@@ -90,6 +90,36 @@ impl StepResult {
     }
 }
 
+/// The likeliest reason for an ill-conditioned K, for its message: a piece of the body held by no
+/// Dirichlet edge, slivers, a weak jump term, near-incompressibility.
+fn ill_conditioning_cause(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> String {
+    use crate::scene::PartKind;
+    let dirichlet = |e: usize| space.edge_part[e].is_some_and(|p| matches!(scene.parts[p].kind, PartKind::Dirichlet));
+    if let Some(p) = mesh.floating_piece(dirichlet) {
+        return format!(
+            "a piece of the mesh (through ({:e}, {:e})) shares no edge with the rest and has no Dirichlet edge: it \
+             floats; connect it or clamp part of it",
+            p[0], p[1]
+        );
+    }
+    let (aspect, at) = mesh.worst_aspect();
+    if aspect > 1e3 {
+        return format!(
+            "triangles of aspect ratio up to {aspect:.1e} (near ({:e}, {:e})); use better-shaped triangles",
+            at[0], at[1]
+        );
+    }
+    if scene.rho < 1.0 {
+        return "rho < 1: use rho of order 1 or more (without the jump term CR fails Korn's inequality)".into();
+    }
+    if scene.material.nu > 0.49 {
+        return "nu close to 1/2 (near-incompressible): lambda/mu is huge".into();
+    }
+    "none of a floating piece, slivers (aspect ratio > 1e3), rho < 1 or nu near 1/2: check the scale of E and \
+     of the coordinates"
+        .into()
+}
+
 impl Problem {
     /// Mesh, space, assembly, factorisation and condensation: all the work done once per run.
     pub fn new(scene: Scene) -> Result<Problem> {
@@ -115,9 +145,11 @@ impl Problem {
         if !(kappa < MAX_CONDITION) {
             return Err(Error::Linear(format!(
                 "the stiffness matrix is too ill-conditioned (condition number ≳ {kappa:.1e} > {MAX_CONDITION:.0e}; \
-                 rho = {}, E = {}, nu = {}): results would keep fewer than 4 correct digits. \
-                 Use rho of order 1 or more (without the jump term CR fails Korn's inequality)",
-                scene.rho, scene.material.e, scene.material.nu
+                 rho = {}, E = {}, nu = {}): results would keep fewer than 4 correct digits. Likely cause: {}",
+                scene.rho,
+                scene.material.e,
+                scene.material.nu,
+                ill_conditioning_cause(&scene, &mesh, &space)
             )));
         }
         let t3 = Instant::now();
@@ -180,6 +212,14 @@ impl Problem {
         if r.u.iter().any(|v| !v.is_finite()) {
             return Err(Error::Linear(format!(
                 "step {}: the solution is not finite (singular or ill-conditioned system)",
+                r.n
+            )));
+        }
+        if !r.u.is_empty() && !r.energy.is_finite() {
+            let umax = r.u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            return Err(Error::Linear(format!(
+                "step {}: the energy a_h(u, u) overflows f64 (max |u| = {umax:.3e}): the loads are too large for \
+                 the answer to be representable; u is linear in the loads, u₀ and g_a together, so scale them down",
                 r.n
             )));
         }

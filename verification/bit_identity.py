@@ -14,7 +14,8 @@ if any value differs. With ``--rel TOL`` floating-point values may differ by TOL
 magnitude of their dataset (max |a - b| <= TOL max |a|, for changes that move results by rounding only;
 float32 visualisation copies within max(TOL, 1e-6), the solvers' residuals within 1e-12 absolute);
 everything else (integers, flags, strings, shapes) must still be equal; the largest relative differences
-of every file are printed. ``scene_path`` (where the scene file was) is not compared.
+of every file are printed. ``scene_path`` (where the scene file was) is not compared; a dataset added by a
+later version (``tresca/steps/checksum``) is compared only when both files hold it.
 """
 import argparse
 import glob
@@ -28,6 +29,8 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # not numbers of the method: they change from run to run or build to build
 VOLATILE = {"steps/wall_time", "setup_times", "version", "git_commit", "scene_path"}
+# added by a later version (issue 18: per-step checksums): compared when both files have it, else skipped
+ADDED = {"tresca/steps/checksum"}
 
 
 def runs():
@@ -125,6 +128,7 @@ def cmd_compare(args):
             ia, ib = items(fa), items(fb)
         keys = sorted(k for k in set(ia) | set(ib)
                       if k.split("@")[-1] not in VOLATILE and k.split("@")[0].removeprefix("tresca/") not in VOLATILE)
+        keys = [k for k in keys if not (k in ADDED and (k in ia) != (k in ib))]
         diff = [k for k in keys if k not in ia or k not in ib or not same(ia[k], ib[k], args.rel, k)]
         worst = ""
         if args.rel is not None:

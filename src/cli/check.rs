@@ -1,6 +1,8 @@
 //! `tresca-cr check`: validate a scene, set it up, and print what it will model.
 
+use super::out::say;
 use anyhow::Result;
+use tresca_cr::scene::budget::Estimate;
 use tresca_cr::scene::PartKind;
 use tresca_cr::{Problem, Scene};
 
@@ -13,20 +15,25 @@ fn short(text: &str) -> String {
     }
 }
 
-pub fn check(scene: Scene) -> Result<()> {
+pub fn check(scene: Scene, estimate: Estimate) -> Result<()> {
     let problem = Problem::new(scene)?;
+    // what `run` evaluates before its first step: u⁰ = I_CR u₀ and, with [exact], the errors at t₀
+    problem.initial()?;
     let (s, m, sp) = (&problem.scene, &problem.mesh, &problem.space);
-    println!("scene      {} ({})", s.file, if s.title.is_empty() { "untitled" } else { &s.title });
-    println!(
+    say!("scene      {} ({})", s.file, if s.title.is_empty() { "untitled" } else { &s.title });
+    say!(
         "mesh       {} vertices, {} triangles, {} edges, h = {:.4e}",
         m.points.len(),
         m.tris.len(),
         m.edges.len(),
         m.h_max()
     );
-    println!(
+    say!(
         "material   E = {}, nu = {} (plane strain: lambda = {:.6e}, mu = {:.6e})",
-        s.material.e, s.material.nu, problem.law.lam, problem.law.mu
+        s.material.e,
+        s.material.nu,
+        problem.law.lam,
+        problem.law.mu
     );
     for (p, part) in s.parts.iter().enumerate() {
         let n = sp.edge_part.iter().filter(|&&q| q == Some(p)).count();
@@ -38,9 +45,9 @@ pub fn check(scene: Scene) -> Result<()> {
             }
             PartKind::Contact(g) => format!("contact u.n = 0, Tresca g_a = {}", short(g.text())),
         };
-        println!("part       {:<10} {:>6} edges  {}", part.name, n, what);
+        say!("part       {:<10} {:>6} edges  {}", part.name, n, what);
     }
-    println!(
+    say!(
         "unknowns   {} (paper's count 2(edges - Dirichlet edges) = {}), {} contact unknowns",
         sp.n_dofs,
         sp.paper_dofs(),
@@ -59,15 +66,19 @@ pub fn check(scene: Scene) -> Result<()> {
     } else {
         terms.push("no contact: plain elasticity");
     }
-    println!("assembled  {}", terms.join(", "));
-    println!(
+    say!("assembled  {}", terms.join(", "));
+    say!(
         "time       {} steps on [{}, {}]{}",
         problem.n_steps(),
         s.times[0],
         s.times.last().unwrap_or(&0.0),
         if s.uniform_time { " (uniform)" } else { "" }
     );
-    println!("solver     {} (tol {:.1e}, max_iter {})", s.solver.method.name(), s.solver.tol, s.solver.max_iter());
-    println!("exact      {}", if s.exact.is_some() { "given: true errors computed" } else { "none" });
-    Ok(())
+    say!("solver     {} (tol {:.1e}, max_iter {})", s.solver.method.name(), s.solver.tol, s.solver.max_iter());
+    say!("exact      {}", if s.exact.is_some() { "given: true errors computed" } else { "none" });
+    say!("estimate   {}", estimate.describe());
+    match super::out::stdout_error() {
+        Some(e) => anyhow::bail!("cannot write to standard output: {e}"),
+        None => Ok(()),
+    }
 }

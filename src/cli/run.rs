@@ -1,8 +1,32 @@
 //! `tresca-cr run`: solve a scene, writing every step to the results file as it completes.
 
+use super::out::{note, say};
 use anyhow::{Context, Result};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use tresca_cr::{Problem, Scene};
+
+/// Refuse an output path that is (or whose sidecar is) the scene or its mesh: `--force` would overwrite the
+/// run's own input.
+fn not_an_input(path: &Path, scene: &Scene) -> Result<()> {
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    let mut inputs = vec![PathBuf::from(&scene.file)];
+    if let tresca_cr::scene::MeshSpec::Gmsh { path, .. } = &scene.mesh {
+        inputs.push(path.clone());
+    }
+    for out in [path.to_path_buf(), tresca_cr::output::sidecar(path)] {
+        if let Some(i) = inputs.iter().find(|i| same(&out, i)) {
+            anyhow::bail!(
+                "{}: the output would overwrite the run's input {}; choose another -o",
+                path.display(),
+                i.display()
+            );
+        }
+    }
+    Ok(())
+}
 
 /// Where and how results are written.
 #[derive(clap::Args)]
@@ -34,23 +58,32 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
         out.commit_interval.is_finite() && out.commit_interval >= 0.0,
         "--commit-interval must be a non-negative number of seconds"
     );
+    match &path {
+        Some(p) => not_an_input(p, &scene)?,
+        None => note!("note: no results file (give -o FILE or an [output] path): the steps are solved and only this summary is kept"),
+    }
+    // the run owns its output path from here on (refused at once if another run has it)
+    let lock = path.as_deref().map(tresca_cr::output::OutputLock::acquire).transpose()?;
     let problem = Problem::new(scene)?;
     let info = Run::of(&problem);
-    let (mut writer, first) = match &path {
-        Some(p) if out.resume => {
-            let (mut w, last) = Writer::resume(p, &info)?;
+    let (mut writer, first) = match (&path, lock) {
+        (Some(p), Some(lock)) if out.resume => {
+            let (mut w, last) = Writer::resume_locked(lock, &info)?;
             w.set_commit_interval(out.commit_interval);
+            if let Some(k) = out.frame_every {
+                note!("note: --frame-every {k} is ignored on --resume: the frames follow the file's own frame_every");
+            }
             match &last {
-                Some(l) => eprintln!("resuming {} after step {} of {}", p.display(), l.n, problem.n_steps()),
-                None => eprintln!("{}: no step was committed before; running from step 0", p.display()),
+                Some(l) => note!("resuming {} after step {} of {}", p.display(), l.n, problem.n_steps()),
+                None => note!("{}: no step was committed before; running from step 0", p.display()),
             }
             (Some(w), last)
         }
-        Some(p) => {
+        (Some(_), Some(lock)) => {
             let opts = Options { force: out.force, frame_every: out.frame_every, commit_interval: out.commit_interval };
-            (Some(Writer::create_with(p, &info, &opts)?), None)
+            (Some(Writer::create_locked(lock, &info, &opts)?), None)
         }
-        None => (None, None),
+        _ => (None, None),
     };
     let n = problem.n_steps();
     let all = writer.is_some() || problem.scene.exact.is_some() || verbose;
@@ -73,7 +106,7 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
         max_res = max_res.max(r.residual);
         if verbose {
             let err = r.errors.map(|e| format!("  |||e||| {:.4e}  L2 {:.4e}", e.energy, e.l2)).unwrap_or_default();
-            println!(
+            say!(
                 "step {:>5} t = {:<10.6} it {:>5} res {:.2e} stick {:>4} slip {:>4}{}",
                 r.n,
                 r.t,
@@ -99,27 +132,36 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
             problem.run_selected(f, want, on_step)
         }),
     };
+    if let Some(z) = problem.friction.as_ref().map(|f| f.zeroed_steps()).filter(|&z| z > 0) {
+        note!(
+            "note: at {z} steps the friction bound g_a was below the rounding of the load (its effect on the slip \
+             under 1e-17 of the free slip) and was treated as zero: those steps are frictionless"
+        );
+    }
     let status = result.as_ref().map_or_else(|e| format!("stopped: {e}"), |()| "completed".to_string());
     let committed = writer.map(|w| w.finish(&status)).transpose()?;
     if let (Err(_), Some(p)) = (&result, &path) {
         let p = p.display();
         match committed {
             Some(0) => {
-                eprintln!("no step was committed, so no results file was written (an existing {p} is left as it was)")
+                note!("no step was committed, so no results file was written (an existing {p} is left as it was)")
             }
-            _ => eprintln!("every completed step is in {p}; its `tresca` group records why the run stopped"),
+            _ => note!("every completed step is in {p}; its `tresca` group records why the run stopped"),
         }
     }
     result.with_context(|| "run stopped")?;
     bar.finish_and_clear();
     let sp = &problem.space;
-    println!("unknowns {} (paper DOF {}), contact edges {}, steps {}", sp.n_dofs, sp.paper_dofs(), sp.contact.len(), n);
+    say!("unknowns {} (paper DOF {}), contact edges {}, steps {}", sp.n_dofs, sp.paper_dofs(), sp.contact.len(), n);
     let st = problem.setup;
-    println!(
+    say!(
         "set-up: mesh {:.3}s, assembly {:.3}s, factorisation {:.3}s, condensation {:.3}s",
-        st.space, st.assembly, st.factorisation, st.condensation
+        st.space,
+        st.assembly,
+        st.factorisation,
+        st.condensation
     );
-    println!(
+    say!(
         "solver {}: {} iterations in all, max residual {:.2e}; wall time {:.3}s",
         problem.scene.solver.method.name(),
         iters,
@@ -128,14 +170,22 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     );
     if let Some(r) = last {
         if !r.state.is_empty() {
-            println!("final step: {} stick, {} slip contact edges", r.n_stick(), r.n_slip());
+            say!("final step: {} stick, {} slip contact edges", r.n_stick(), r.n_slip());
         }
     }
     if problem.scene.exact.is_some() {
-        println!(
+        say!(
             "max over time nodes: energy error {:.6e}, H1 error {:.6e}, L2 error {:.6e}",
-            max_err.energy, max_err.h1, max_err.l2
+            max_err.energy,
+            max_err.h1,
+            max_err.l2
         );
+    }
+    if let Some(e) = super::out::stdout_error() {
+        // the run's result is its file: a closed or full standard output does not fail it
+        let kept =
+            path.map_or("no results file was asked for".to_string(), |p| format!("its results are in {}", p.display()));
+        note!("warning: standard output could not be written ({e}); the run went on to its end and {kept}");
     }
     Ok(())
 }

@@ -29,6 +29,8 @@ pub struct Friction {
     /// ḡ_e, the mean of g_a over edge e (Uzawa's c_τ).
     g_mean: Vec<f64>,
     settings: SolverSettings,
+    /// Steps at which the bound was treated as zero (below the rounding of the load).
+    zeroed: std::sync::atomic::AtomicUsize,
 }
 
 /// What a step's friction solve produced.
@@ -65,20 +67,29 @@ impl Friction {
     pub fn new(space: &CrSpace, c: DMatrix<f64>, settings: SolverSettings) -> Friction {
         let w = space.contact.iter().map(|e| e.length * e.g_mean).collect();
         let g_mean = space.contact.iter().map(|e| e.g_mean).collect();
-        Friction { c, w, g_mean, settings }
+        Friction { c, w, g_mean, settings, zeroed: Default::default() }
     }
 
     /// Solve step n (time t) with d = s_f − s_old from the warm start μ₀ with the scene's method, to
     /// natural residual ≤ tol.
     pub fn solve(&self, d: &[f64], mu0: &[f64], n: usize, t: f64) -> Result<FrictionSolution> {
-        let qp = Qp { c: &self.c, d, w: &self.w };
+        let (k, zeroed, w, d, mu0) = scaled(&self.c, &self.w, d, mu0);
+        if zeroed {
+            self.zeroed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        }
+        let g_mean: Vec<f64> = if k != 0 || zeroed {
+            self.g_mean.iter().zip(&w).map(|(g, w)| if *w == 0.0 { 0.0 } else { pow2_scale(*g, -k) }).collect()
+        } else {
+            self.g_mean.clone()
+        };
+        let qp = Qp { c: &self.c, d: &d, w: &w };
         let s = &self.settings;
         let sol = match s.method {
-            Method::Ssn => ssn::solve(&qp, mu0, s.tol, s.max_iter()),
-            Method::Pdas => pdas::solve(&qp, mu0, s.tol, s.max_iter()),
+            Method::Ssn => ssn::solve(&qp, &mu0, s.tol, s.max_iter()),
+            Method::Pdas => pdas::solve(&qp, &mu0, s.tol, s.max_iter()),
             Method::Uzawa => {
-                let rho = if s.uzawa_step > 0.0 { s.uzawa_step } else { uzawa::auto_step(&qp, &self.g_mean) };
-                uzawa::solve(&qp, &self.g_mean, mu0, rho, s.tol, s.max_iter())
+                let rho = if s.uzawa_step > 0.0 { s.uzawa_step } else { uzawa::auto_step(&qp, &g_mean) };
+                uzawa::solve(&qp, &g_mean, &mu0, rho, s.tol, s.max_iter())
             }
         };
         let (mu, iterations, residual) = sol.map_err(|e| Error::NotConverged {
@@ -91,8 +102,50 @@ impl Friction {
         })?;
         let slip_increment = qp.slip_increment(&mu);
         let state = classify(&qp, &mu, &slip_increment);
-        Ok(FrictionSolution { mu, slip_increment, state, iterations, residual })
+        let back = |v: Vec<f64>| if k == 0 { v } else { v.into_iter().map(|x| pow2_scale(x, k)).collect() };
+        Ok(FrictionSolution { mu: back(mu), slip_increment: back(slip_increment), state, iterations, residual })
     }
+
+    /// Number of steps whose friction bound was below the rounding of the load and treated as zero.
+    pub fn zeroed_steps(&self) -> usize {
+        self.zeroed.load(std::sync::atomic::Ordering::Relaxed)
+    }
+}
+
+/// Largest and smallest force scale (2^±450, about 1e±135) solved as given: q(μ) = ½μᵀCμ − dᵀμ and the
+/// solvers' products stay far from overflow and underflow. Beyond, the step is solved for 2^-k (d, μ₀, w)
+/// and the result scaled back, exactly (powers of two; the problem is positively homogeneous).
+const SAFE_EXP: i32 = 450;
+
+/// A friction bound whose effect on the slip, C_ee·w_e, is below this fraction of the free slip |d_e|
+/// is below the rounding of the load: it is treated as zero for the step (frictionless).
+const NEGLIGIBLE: f64 = 1e-17;
+
+fn pow2(k: i32) -> f64 {
+    f64::from_bits(((k + 1023) as u64) << 52)
+}
+
+/// v · 2^k (two factors, so |k| may reach 2046).
+fn pow2_scale(v: f64, k: i32) -> f64 {
+    let h = k / 2;
+    v * pow2(h) * pow2(k - h)
+}
+
+/// (k, zeroed, w, d, μ₀) of the step to solve: scaled by 2^-k where the forces are beyond 2^±SAFE_EXP,
+/// and w = 0 where the friction is below the rounding of the load (see [`NEGLIGIBLE`]).
+fn scaled(c: &DMatrix<f64>, w: &[f64], d: &[f64], mu0: &[f64]) -> (i32, bool, Vec<f64>, Vec<f64>, Vec<f64>) {
+    let stick = (0..d.len()).map(|e| d[e].abs() / c[(e, e)]).fold(0.0f64, f64::max);
+    let w_max = w.iter().fold(0.0f64, |a, v| a.max(*v));
+    let zeroed = w_max > 0.0 && w_max < NEGLIGIBLE * stick;
+    let w: Vec<f64> = if zeroed { vec![0.0; w.len()] } else { w.to_vec() };
+    let mu0: Vec<f64> = if zeroed { vec![0.0; mu0.len()] } else { mu0.to_vec() };
+    let m = mu0.iter().fold(stick.max(w_max), |a, v| a.max(v.abs()));
+    if m == 0.0 || !m.is_finite() || (m >= pow2(-SAFE_EXP) && m <= pow2(SAFE_EXP)) {
+        return (0, zeroed, w, d.to_vec(), mu0);
+    }
+    let k = m.log2().floor() as i32;
+    let s = |v: &[f64]| v.iter().map(|x| pow2_scale(*x, -k)).collect::<Vec<f64>>();
+    (k, zeroed, s(&w), s(d), s(&mu0))
 }
 
 /// A solver's result: (μ, iterations, residual).

@@ -7,6 +7,7 @@
 //! that every boundary edge belongs to exactly one declared part.
 
 mod gmsh;
+mod quality;
 mod refine;
 mod structured;
 
@@ -107,6 +108,16 @@ impl Mesh {
             let a2 = area2(a, b, c);
             let scale =
                 [(a, b), (b, c), (c, a)].iter().map(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1])).fold(0.0, f64::max);
+            if scale > 0.0 && scale * scale < 1e4 * f64::MIN_POSITIVE {
+                return Err(Error::mesh(
+                    src,
+                    format!(
+                        "triangle {k} at ({:e}, {:e}) has edges of {scale:.1e}: its area is beyond the normal range of f64; \
+                         give the mesh in larger units (the answer scales with them)",
+                        a[0], a[1]
+                    ),
+                ));
+            }
             if !(a2.abs() > 1e-12 * scale * scale) {
                 return Err(Error::mesh(
                     src,
@@ -157,7 +168,8 @@ impl Mesh {
                 };
                 let s1 = area2(a, b, raw.points[opp(t1)]);
                 let s2 = area2(a, b, raw.points[opp(t2)]);
-                if s1 * s2 >= 0.0 {
+                // signs, not the product s1·s2, which underflows to 0 on a mesh of size ~1e-150
+                if s1 == 0.0 || s2 == 0.0 || (s1 > 0.0) == (s2 > 0.0) {
                     return Err(Error::mesh(
                         src,
                         format!(
@@ -288,7 +300,6 @@ impl Mesh {
         let [a, b, c] = self.tris[t].map(|v| self.points[v]);
         0.5 * area2(a, b, c)
     }
-
     /// Largest edge length (the mesh size h).
     pub fn h_max(&self) -> f64 {
         (0..self.edges.len()).map(|e| self.edge_length(e)).fold(0.0, f64::max)

@@ -226,6 +226,7 @@ impl Series {
             D::Float(FloatSize::U8) => self.rewrite::<f64>(raw, steps, kept),
             D::Float(FloatSize::U4) => self.rewrite::<f32>(raw, steps, kept),
             D::Integer(IntSize::U8) => self.rewrite::<i64>(raw, steps, kept),
+            D::Unsigned(IntSize::U8) => self.rewrite::<u64>(raw, steps, kept),
             D::Unsigned(IntSize::U1) => self.rewrite::<u8>(raw, steps, kept),
             other => Err(hdf5::Error::from(format!("{}: unexpected series type {other:?}", self.ds.name()))),
         }
@@ -246,6 +247,33 @@ impl Series {
         let ds = create_contiguous::<T>(&file, &path, &shape)?;
         *self = Series::wrap(ds, self.block)?;
         self.write_steps(raw, 0, keep, &data)
+    }
+
+    /// Steps first..first+count.
+    pub fn read_steps<T: H5Type>(&self, first: usize, count: usize) -> hdf5::Result<Vec<T>> {
+        let sel = rows(first * self.block, (first + count) * self.block, &self.rest);
+        Ok(self.ds.read_slice::<T, _, IxDyn>(sel)?.into_raw_vec_and_offset().0)
+    }
+
+    /// Bytes of one step (all its rows).
+    pub fn step_bytes(&self) -> usize {
+        self.block * self.rest.iter().product::<usize>() * self.dtype.size()
+    }
+
+    /// Steps first..first+count as the little-endian bytes of the stored type.
+    pub fn read_bytes(&self, first: usize, count: usize) -> hdf5::Result<Vec<u8>> {
+        use hdf5::types::{FloatSize, IntSize, TypeDescriptor as D};
+        fn b<T: H5Type + bytemuck::Pod>(s: &Series, first: usize, count: usize) -> hdf5::Result<Vec<u8>> {
+            Ok(bytemuck::cast_slice(&s.read_steps::<T>(first, count)?).to_vec())
+        }
+        match self.dtype {
+            D::Float(FloatSize::U8) => b::<f64>(self, first, count),
+            D::Float(FloatSize::U4) => b::<f32>(self, first, count),
+            D::Integer(IntSize::U8) => b::<i64>(self, first, count),
+            D::Unsigned(IntSize::U8) => b::<u64>(self, first, count),
+            D::Unsigned(IntSize::U1) => b::<u8>(self, first, count),
+            ref other => Err(hdf5::Error::from(format!("{}: unexpected series type {other:?}", self.ds.name()))),
+        }
     }
 
     /// Read step n.

@@ -10,11 +10,18 @@ impl Writer {
     /// and return the last complete step, from which `Problem::run_from` continues; `None` when the
     /// run starts afresh from step 0 in a new file.
     pub fn resume(path: &Path, run: &Run) -> Result<(Writer, Option<StepResult>)> {
-        let afresh = || Ok((Writer::create_with(path, run, &Options { force: true, ..Options::default() })?, None));
+        Writer::resume_locked(OutputLock::acquire(path)?, run)
+    }
+
+    /// [`Writer::resume`] on the path of a lock already taken.
+    pub fn resume_locked(lock: OutputLock, run: &Run) -> Result<(Writer, Option<StepResult>)> {
+        let path = lock.target().to_path_buf();
+        let path = path.as_path();
         if !path.exists() {
             if partial_path(path).exists() {
                 // killed before step 0 was committed (only `.partial` exists): start the same run afresh
-                return afresh();
+                let opts = Options { force: true, ..Options::default() };
+                return Ok((Writer::create_locked(lock, run, &opts)?, None));
             }
             return Err(Error::Io { path: path.to_path_buf(), msg: "no results file to --resume".into() });
         }
@@ -42,7 +49,25 @@ impl Writer {
         }
         let solver = h5::read_str(g, "solver").unwrap_or_default();
         if solver != run.scene.solver.method.name() {
-            return Err(mismatch(&format!("solver ({solver})")));
+            return Err(mismatch(&format!("solver ({solver}, not {}: --solver)", run.scene.solver.method.name())));
+        }
+        // every setting that changes the answer must be the file's (the scene text covers the rest)
+        let float = |k: &str| g.attr(k).and_then(|a| a.read_scalar::<f64>()).ok();
+        let s = &run.scene.solver;
+        for (key, stored, asked, option) in [
+            ("tol", float("tol"), s.tol, "--tol / solver.tol"),
+            ("uzawa_step", float("uzawa_step"), s.uzawa_step, "solver.uzawa_step"),
+            ("rho", float("rho"), run.scene.rho, "discretisation.rho"),
+        ] {
+            if stored.map(f64::to_bits) != Some(asked.to_bits()) {
+                let was = stored.map_or("none".to_string(), |v| format!("{v:e}"));
+                return Err(mismatch(&format!(
+                    "{key} ({option}: the file's steps were solved with {was}, this run asks {asked:e})"
+                )));
+            }
+        }
+        if int("max_iter") != s.max_iter() as i64 {
+            return Err(mismatch(&format!("max_iter ({} in the file, {} asked)", int("max_iter"), s.max_iter())));
         }
         let pts =
             tresca.group.dataset("mesh/points").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "mesh/points"))?;
@@ -65,6 +90,20 @@ impl Writer {
             return Err(mismatch("time grid"));
         }
         let every = int("frame_every").max(1) as usize;
+        // storage corruption since the steps were written: refuse, naming the first bad step
+        match tresca.first_corrupt_step(completed).map_err(io(path, "--resume: verifying the step checksums"))? {
+            Some(n) => {
+                return Err(Error::Io {
+                    path: path.to_path_buf(),
+                    msg: format!(
+                        "--resume: step {n} does not match its checksum (tresca/steps/checksum): the file was \
+                         damaged after it was written. Steps 0..{} are intact; rerun with --force",
+                        n as i64 - 1
+                    ),
+                })
+            }
+            None => {}
+        }
         let frames = Frames { every, last: run.n_steps() };
         let frames_done = frames.before(completed);
         let frame_list: Vec<(usize, f64)> =
@@ -86,6 +125,8 @@ impl Writer {
         let fields = Fields::new(run);
         let prev_slip = Some(last.slip.clone());
         let opened = Opened { file, raw, tresca, vtk, xdmf, frames };
-        Ok((Writer::from_opened(path, run, fields, opened, completed, prev_slip), Some(last)))
+        let mut w = Writer::from_opened(path, run, fields, opened, completed, prev_slip);
+        w.lock = Some(lock);
+        Ok((w, Some(last)))
     }
 }

@@ -8,7 +8,11 @@
 //! `times`, `u` (·, E, 2), `energy`, `steps/{iterations, residual, n_stick, n_slip, wall_time}`,
 //! `contact/{slip, sigma_t, state, mu, dof}` (·, C) when Γ_C exists, `errors/{energy, h1, l2}` when `[exact]`.
 //! `tresca/steps` carries the attribute `completed` (number of complete steps), written after every
-//! other dataset of a step. The unknown vector of the last step is rebuilt exactly from `u` (free
+//! other dataset of a step. `tresca/steps/checksum` (u64) holds per step the XXH64 (seed 0) of the step's
+//! rows of every series above, in the order `times, u, energy, steps/{iterations, residual, n_stick, n_slip,
+//! wall_time}, contact/{slip, sigma_t, state, mu, dof}, errors/{energy, h1, l2}` (those present), as
+//! little-endian bytes; it is written with the rows, before `completed`, and checked by `--resume` and by
+//! `scripts/check_results.py` ([`step_checksums`]). The unknown vector of the last step is rebuilt exactly from `u` (free
 //! edges hold the two unknowns verbatim) and `contact/dof` (the one unknown of a contact edge).
 
 use super::h5::{attr, attr_str, attr_vec, put, Raw, Series};
@@ -84,6 +88,23 @@ pub struct Tresca {
     contact: Option<[Series; 5]>,
     /// energy, h1, l2.
     errors: Option<[Series; 3]>,
+    /// XXH64 of each step's rows (`None` in files of versions before it).
+    checksum: Option<Series>,
+}
+
+/// The XXH64 of each of `k` steps whose rows are the k equal consecutive parts of every slice of
+/// `series` (the bytes of consecutive steps of each series, in the order of the module doc).
+pub fn step_checksums(series: &[&[u8]], k: usize) -> Vec<u64> {
+    (0..k)
+        .map(|i| {
+            let mut h = xxhash_rust::xxh64::Xxh64::new(0);
+            for s in series {
+                let row = s.len() / k;
+                h.update(&s[i * row..(i + 1) * row]);
+            }
+            h.digest()
+        })
+        .collect()
 }
 
 const SCALARS: [&str; 6] = ["times", "energy", "steps/iterations", "steps/residual", "steps/n_stick", "steps/n_slip"];
@@ -157,6 +178,7 @@ impl Tresca {
         attr_str(loc, "status", "running")?;
         attr(&sg, "completed", 0i64)?;
         Ok(Tresca {
+            checksum: Some(Series::create::<u64>(&sg, "checksum", 1, &[], sc)?),
             times: Series::create::<f64>(&g, "times", 1, &[], sc)?,
             u: Series::create::<f64>(&g, "u", 1, &[ne, 2], sc)?,
             energy: Series::create::<f64>(&g, "energy", 1, &[], sc)?,
@@ -191,6 +213,7 @@ impl Tresca {
             Err(_) => None,
         };
         Ok(Tresca {
+            checksum: Series::open(&sg, "checksum", 1).ok(),
             times: Series::open(&g, SCALARS[0], 1)?,
             u: Series::open(&g, "u", 1)?,
             energy: Series::open(&g, SCALARS[1], 1)?,
@@ -222,6 +245,51 @@ impl Tresca {
         v
     }
 
+    /// The checksums of the buffered rows `b`, in step order.
+    fn checksums_of(&self, b: &Rows) -> Vec<u64> {
+        use bytemuck::cast_slice as c;
+        let mut v: Vec<&[u8]> = vec![
+            c(&b.times),
+            c(&b.u),
+            c(&b.energy),
+            c(&b.iterations),
+            c(&b.residual),
+            c(&b.n_stick),
+            c(&b.n_slip),
+            c(&b.wall),
+        ];
+        if self.contact.is_some() {
+            v.extend([c(&b.slip), c(&b.sigma_t), &b.state[..], c(&b.mu), c(&b.dof)]);
+        }
+        if self.errors.is_some() {
+            v.extend(b.errors.iter().map(|e| c(e)));
+        }
+        step_checksums(&v, b.count)
+    }
+
+    /// The first of the `completed` stored steps whose rows do not match their checksum, if any; an
+    /// error if the file has no checksums.
+    pub fn first_corrupt_step(&mut self, completed: usize) -> hdf5::Result<Option<usize>> {
+        let stored: Vec<u64> = match &self.checksum {
+            Some(c) => c.read_steps::<u64>(0, completed)?,
+            None => return Err(hdf5::Error::from("the file has no step checksums (written before they were added)")),
+        };
+        // blocks of steps of about 64 MB, so that a file larger than memory is verified too
+        let series = self.all();
+        let per_step = series.iter().map(|s| s.step_bytes()).sum::<usize>().max(1);
+        let block = ((64 << 20) / per_step).max(1);
+        for first in (0..completed).step_by(block) {
+            let count = block.min(completed - first);
+            let bytes = series.iter().map(|s| s.read_bytes(first, count)).collect::<hdf5::Result<Vec<_>>>()?;
+            let views: Vec<&[u8]> = bytes.iter().map(|b| &b[..]).collect();
+            let sums = step_checksums(&views, count);
+            if let Some(k) = sums.iter().zip(&stored[first..]).position(|(a, b)| a != b) {
+                return Ok(Some(first + k));
+            }
+        }
+        Ok(None)
+    }
+
     /// The `completed` attribute.
     pub fn completed(&self) -> hdf5::Result<usize> {
         Ok(self.steps_group.attr("completed")?.read_scalar::<i64>()?.max(0) as usize)
@@ -230,6 +298,9 @@ impl Tresca {
     /// Append buffered rows (all series; `completed` is not changed).
     pub fn write_rows(&self, raw: &Raw, b: &Rows) -> hdf5::Result<()> {
         let (n, k) = (b.first, b.count);
+        if let Some(c) = &self.checksum {
+            c.write_steps(raw, n, k, &self.checksums_of(b))?;
+        }
         self.times.write_steps(raw, n, k, &b.times)?;
         self.u.write_steps(raw, n, k, &b.u)?;
         self.energy.write_steps(raw, n, k, &b.energy)?;
@@ -261,6 +332,9 @@ impl Tresca {
     /// Give every series room for exactly `steps` steps, keeping the first `kept` (see
     /// [`Series::set_steps`]).
     pub fn set_steps(&mut self, raw: &Raw, steps: usize, kept: usize) -> hdf5::Result<()> {
+        if let Some(c) = &mut self.checksum {
+            c.set_steps(raw, steps, kept)?;
+        }
         self.all().into_iter().try_for_each(|s| s.set_steps(raw, steps, kept))
     }
 

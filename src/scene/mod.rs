@@ -7,8 +7,12 @@
 
 use crate::error::{Error, Result};
 use expr::{Expr, Vec2Expr};
+pub mod budget;
 pub mod expr;
 mod raw;
+mod values;
+pub use values::MAX_EXPR_CHARS;
+use values::{line_of, positive_finite, sized, uniform_times};
 
 use raw::*;
 use serde::Deserialize;
@@ -174,14 +178,6 @@ pub struct Scene {
     pub outputs: Option<Outputs>,
 }
 
-fn positive_finite(file: &str, key: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(Error::scene(file, key, format!("must be a positive finite number, got {v}")))
-    }
-}
-
 fn nonzero(v: Option<Vec2Expr>) -> Option<Vec2Expr> {
     v.filter(|e| !e.is_zero())
 }
@@ -261,12 +257,13 @@ impl Scene {
             let kind = match b.kind {
                 RawKind::Dirichlet => PartKind::Dirichlet,
                 RawKind::Neumann => PartKind::Neumann(match &b.traction {
-                    Some(g) => nonzero(Some(Vec2Expr::parse(&key("traction"), g)?)),
+                    Some(g) => nonzero(Some(Vec2Expr::parse(&key("traction"), sized(file, &key("traction"), g)?)?)),
                     None => None,
                 }),
                 RawKind::Contact => {
                     let text =
                         b.g_a.as_deref().ok_or_else(|| Error::scene(file, key("g_a"), "contact part needs g_a"))?;
+                    sized(file, &key("g_a"), &[text.to_string()])?;
                     PartKind::Contact(FrictionBound::parse(file, &key("g_a"), text)?)
                 }
             };
@@ -280,12 +277,12 @@ impl Scene {
             ));
         }
         let f = match raw.loads.and_then(|l| l.f) {
-            Some(f) => nonzero(Some(Vec2Expr::parse("loads.f", &f)?)),
+            Some(f) => nonzero(Some(Vec2Expr::parse("loads.f", sized(file, "loads.f", &f)?)?)),
             None => None,
         };
         let u0 = match raw.initial.and_then(|l| l.u0) {
             Some(u) => {
-                let u = Vec2Expr::parse("initial.u0", &u)?;
+                let u = Vec2Expr::parse("initial.u0", sized(file, "initial.u0", &u)?)?;
                 if u.depends_on_t() {
                     return Err(Error::scene(file, "initial.u0", "must not depend on t"));
                 }
@@ -344,6 +341,10 @@ impl Scene {
         };
         let exact = match raw.exact {
             Some(x) => {
+                sized(file, "exact.u", &x.u)?;
+                for row in &x.grad {
+                    sized(file, "exact.grad", row)?;
+                }
                 let g = |i: usize, j: usize| Expr::parse(&format!("exact.grad[{i}][{j}]"), &x.grad[i][j]);
                 Some(Exact { u: Vec2Expr::parse("exact.u", &x.u)?, grad: [[g(0, 0)?, g(0, 1)?], [g(1, 0)?, g(1, 1)?]] })
             }
@@ -405,15 +406,4 @@ impl Scene {
     pub fn has_contact(&self) -> bool {
         self.parts.iter().any(|p| matches!(p.kind, PartKind::Contact(_)))
     }
-}
-
-fn uniform_times(file: &str, t: f64, n: usize) -> Result<Vec<f64>> {
-    if n == 0 {
-        return Err(Error::scene(file, "time.steps", "must be at least 1"));
-    }
-    Ok((0..=n).map(|k| t * k as f64 / n as f64).collect())
-}
-
-fn line_of(text: &str, byte: usize) -> usize {
-    text[..byte.min(text.len())].matches('\n').count() + 1
 }

@@ -10,14 +10,41 @@
 //! force), so its cost is O(N · support) rather than O(N · unknowns).
 
 use super::factor::Factor;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::fem::loads::Loads;
 use crate::sparse::dot;
+use std::borrow::Cow;
 
 /// Largest number of load patterns handled by superposition.
 pub const MAX_RANK: usize = 4;
 /// Relative residual below which a load counts as in the span (a few hundred ulps of the load).
 pub const SPAN_TOL: f64 = 1e-13;
+
+/// ‖l‖² stays in the normal range of f64, so the unscaled computation is exact to rounding, when the
+/// largest entry of l is in [2^-450, 2^450] (about 1e±135) — every load of a physical scene in any units.
+const SAFE_EXP: i32 = 450;
+
+/// (k, l̂) with l = 2^k l̂: k = 0 and l̂ = l (borrowed, bit-identical arithmetic) when the largest entry is
+/// within 2^±SAFE_EXP or zero, else the power of two that brings it to [1, 2).
+fn unit_scale(l: &[f64]) -> (i32, Cow<'_, [f64]>) {
+    let m = l.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    if m == 0.0 || !m.is_finite() || (m >= pow2(-SAFE_EXP) && m <= pow2(SAFE_EXP)) {
+        return (0, Cow::Borrowed(l));
+    }
+    let k = m.log2().floor() as i32;
+    (k, Cow::Owned(l.iter().map(|v| pow2_scale(*v, -k)).collect()))
+}
+
+/// 2^k for |k| ≤ 1023.
+fn pow2(k: i32) -> f64 {
+    f64::from_bits(((k + 1023) as u64) << 52)
+}
+
+/// v · 2^k, exact unless the result leaves the normal range (two steps, so |k| may reach 2100).
+fn pow2_scale(v: f64, k: i32) -> f64 {
+    let h = k / 2;
+    v * pow2(h) * pow2(k - h)
+}
 
 /// Orthonormal load patterns, their responses and the coefficients of every time node.
 pub struct LoadBasis {
@@ -37,8 +64,11 @@ impl LoadBasis {
         let mut l = Vec::new();
         for &t in times {
             loads.assemble_on_support(t, &mut l)?;
-            let norm = dot(&l, &l).sqrt();
-            let mut r = l.clone();
+            // l = 2^k l̂ with l̂ of order 1 where ‖l‖² would overflow or underflow (loads beyond ~1e±150):
+            // Gram–Schmidt runs on l̂ and the coefficients are scaled back, exactly (powers of two).
+            let (k, scaled) = unit_scale(&l);
+            let norm = dot(&scaled, &scaled).sqrt();
+            let mut r = scaled.into_owned();
             let mut c = vec![0.0; b.len()];
             for _ in 0..2 {
                 for (j, bj) in b.iter().enumerate() {
@@ -55,6 +85,14 @@ impl LoadBasis {
                 r.iter_mut().for_each(|v| *v /= rn);
                 b.push(r);
                 c.push(rn);
+            }
+            if k != 0 {
+                c.iter_mut().for_each(|v| *v = pow2_scale(*v, k));
+                if let Some(bad) = c.iter().find(|v| !v.is_finite()) {
+                    return Err(Error::Linear(format!(
+                        "t = {t}: the load's coefficient {bad} is beyond the range of f64: the loads are too large"
+                    )));
+                }
             }
             coef.push(c);
         }

@@ -107,3 +107,25 @@ pub fn same_results(a: &std::path::Path, b: &std::path::Path) {
             .replace(&*b.file_name().unwrap().to_string_lossy(), "X")
     );
 }
+
+/// The release binary (for tests through the command line).
+pub fn bin() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_tresca-cr"))
+}
+
+/// `name` in a temporary directory of this test process, `prefix-<pid>`.
+pub fn tmp_in(prefix: &str, name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("{prefix}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+/// A path of the repository as a string.
+pub fn root(p: &str) -> String {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(p).display().to_string()
+}
+
+/// Standard error of a finished command.
+pub fn stderr(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}

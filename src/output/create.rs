@@ -1,0 +1,118 @@
+//! A new results file: built under `run.h5.partial` and moved into place at its first commit (see the
+//! module doc of [`super`]), on a path this run owns ([`OutputLock`]).
+
+use super::*;
+
+impl Writer {
+    /// Create `path` (and `run.xdmf` next to it) with mesh, static data and attributes. An existing file
+    /// is refused unless `force`.
+    pub fn create(path: &Path, run: &Run, force: bool) -> Result<Writer> {
+        Writer::create_with(path, run, &Options { force, ..Options::default() })
+    }
+
+    /// [`Writer::create`] with all options.
+    pub fn create_with(path: &Path, run: &Run, opts: &Options) -> Result<Writer> {
+        Writer::create_locked(OutputLock::acquire(path)?, run, opts)
+    }
+
+    /// [`Writer::create_with`] on the path of a lock already taken.
+    pub fn create_locked(lock: OutputLock, run: &Run, opts: &Options) -> Result<Writer> {
+        let path = lock.target().to_path_buf();
+        let path = path.as_path();
+        if path.is_dir() {
+            return Err(Error::Io { path: path.to_path_buf(), msg: "is a directory, not a results file".into() });
+        }
+        if path.exists() && !opts.force {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg:
+                    "results file already exists; pass --force to overwrite it or --resume to continue the run it holds"
+                        .into(),
+            });
+        }
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(ioerr(path, "cannot create the directory"))?;
+        }
+        // Build the file under a temporary name, renamed at its first commit (`publish`): a kill before
+        // that leaves no half-made file under `path` and an old file as it was (the handles follow the rename).
+        let partial = partial_path(path);
+        let file = hdf5::File::with_options()
+            .with_fapl(h5::file_access)
+            .create(&partial)
+            .map_err(io(path, "cannot create HDF5 file"))?;
+        let fields = Fields::new(run);
+        let contact = !run.space.contact.is_empty();
+        let n = run.n_steps();
+        let every = opts.frame_every.unwrap_or(n.div_ceil(AUTO_FRAMES - 1)).max(1);
+        let frames = Frames { every, last: n };
+        let tresca = Tresca::create(&file, run).map_err(io(path, "writing the tresca group"))?;
+        h5::attr(&tresca.group, "frame_every", every as i64).map_err(io(path, "attribute frame_every"))?;
+        let vtk =
+            VtkHdf::create(&file, &fields, frames.total(), contact).map_err(io(path, "writing the VTKHDF group"))?;
+        let xdmf = Xdmf::create(&file, path, &fields, contact, frames.total())
+            .map_err(ioerr(path, "writing the XDMF sidecar"))?;
+        file.flush().map_err(io(path, "flush"))?;
+        let raw = Raw::open(&partial).map_err(ioerr(path, "cannot open the new file for writing"))?;
+        let pending = Some(Pending { old: std::fs::File::open(path).ok(), partial });
+        let mut w = Writer::from_opened(path, run, fields, Opened { file, raw, tresca, vtk, xdmf, frames }, 0, None);
+        w.interval = opts.commit_interval;
+        w.pending = pending;
+        w.lock = Some(lock);
+        Ok(w)
+    }
+
+    /// The writer of an open file whose first `completed` steps are committed (the last one's slip
+    /// `prev_slip`), committing every step until told otherwise.
+    pub(super) fn from_opened(
+        path: &Path,
+        run: &Run,
+        fields: Fields,
+        o: Opened,
+        completed: usize,
+        prev_slip: Option<Vec<f64>>,
+    ) -> Writer {
+        let frames_done = o.frames.before(completed);
+        let mut rows = Rows::default();
+        rows.reset(completed);
+        let mut frame_rows = FrameRows::default();
+        frame_rows.reset(frames_done);
+        Writer {
+            path: path.to_path_buf(),
+            file: o.file,
+            raw: o.raw,
+            space: run.space.clone(),
+            fields,
+            tresca: o.tresca,
+            vtk: o.vtk,
+            xdmf: o.xdmf,
+            frames: o.frames,
+            interval: Options::default().commit_interval,
+            buf: StepFields::default(),
+            rows,
+            frame_rows,
+            frame_steps: Vec::new(),
+            prev_slip,
+            completed,
+            frames_done,
+            last_commit: Instant::now(),
+            finished: false,
+            pending: None,
+            seconds: [0.0; 2],
+            lock: None,
+        }
+    }
+
+    /// Move a new file and its sidecar into place (`rename`, atomic for each; the old file's blocks
+    /// are freed by a background thread). Done at the first commit, so a run killed or failing before
+    /// its step 0 is on disk leaves an old pair as it was and no file without a step.
+    pub(super) fn publish(&mut self) -> Result<()> {
+        if let Some(Pending { partial, old }) = self.pending.take() {
+            std::fs::rename(&partial, &self.path).map_err(ioerr(&self.path, "cannot move the new file into place"))?;
+            if let Some(old) = old {
+                std::thread::spawn(move || drop(old));
+            }
+            self.xdmf.publish().map_err(ioerr(&self.path, "cannot move the XDMF sidecar into place"))?;
+        }
+        Ok(())
+    }
+}
