@@ -17,7 +17,11 @@ fn main() {
         for line in text.lines().filter(|l| !l.trim_start().starts_with('#')) {
             for (i, s) in line.split('"').enumerate() {
                 if i % 2 == 1 && s.len() > longest.2.len() && Expr::parse("k", s).is_ok() {
-                    longest = (f.file_name().unwrap().to_string_lossy().into(), line.split('=').next().unwrap().trim().into(), s.into());
+                    longest = (
+                        f.file_name().unwrap().to_string_lossy().into(),
+                        line.split('=').next().unwrap().trim().into(),
+                        s.into(),
+                    );
                 }
             }
         }

@@ -74,7 +74,7 @@ fn solvers_reach_the_kkt_solution() {
     for method in [Method::Ssn, Method::Pdas, Method::Uzawa] {
         for (name, c, d, w) in cases() {
             let want = oracle(&c, &d, &w);
-            let fr = Friction { c: c.clone(), w: w.clone(), g_mean: w.clone(), settings: settings(method) };
+            let fr = Friction::from_parts(c.clone(), w.clone(), w.clone(), settings(method));
             let mu0 = if name == "pdas cycles" { CYCLE_START.to_vec() } else { vec![0.0; d.len()] };
             let got = fr.solve(&d, &mu0, 7, 0.5);
             if method == Method::Pdas && name == "pdas cycles" {
@@ -101,7 +101,7 @@ fn non_convergence_names_step_and_time() {
     let (_, c, d, w) = cases().pop().expect("cases");
     let mut s = settings(Method::Uzawa);
     s.max_iter_given = Some(2);
-    let fr = Friction { c, w: w.clone(), g_mean: w, settings: s };
+    let fr = Friction::from_parts(c, w.clone(), w, s);
     let e = fr.solve(&d, &[0.0; 3], 12, 0.375).expect_err("2 Uzawa iterations cannot reach 1e-12");
     match e {
         Error::NotConverged { step, time, solver, iterations, .. } => {

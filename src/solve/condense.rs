@@ -44,7 +44,12 @@ mod tests {
         for i in 0..m {
             for j in 0..m {
                 let a = node(i, j);
-                t.extend([(2 * a, 2 * a, 4.5), (2 * a + 1, 2 * a + 1, 4.5), (2 * a, 2 * a + 1, 0.25), (2 * a + 1, 2 * a, 0.25)]);
+                t.extend([
+                    (2 * a, 2 * a, 4.5),
+                    (2 * a + 1, 2 * a + 1, 4.5),
+                    (2 * a, 2 * a + 1, 0.25),
+                    (2 * a + 1, 2 * a, 0.25),
+                ]);
                 for (di, dj) in [(0, 1), (1, 0)] {
                     if i + di < m && j + dj < m {
                         let b = node(i + di, j + dj);

@@ -140,4 +140,3 @@ pub(super) fn lint(text: &str) -> std::result::Result<String, String> {
     }
     Ok(out)
 }
-

@@ -60,7 +60,15 @@ impl Expr {
             _ => None,
         };
         let program = Arc::new(Program::new(&[&tree]));
-        Ok(Expr { key: key.to_string(), text: text.to_string(), normalised, tree: Arc::new(tree), program, uses, constant })
+        Ok(Expr {
+            key: key.to_string(),
+            text: text.to_string(),
+            normalised,
+            tree: Arc::new(tree),
+            program,
+            uses,
+            constant,
+        })
     }
 
     /// The constant value if the expression has no variables.
