@@ -66,7 +66,7 @@ import dolfinx.fem.petsc  # noqa: E402
 import ufl  # noqa: E402
 from dolfinx import fem  # noqa: E402
 from dolfinx import mesh as dmesh  # noqa: E402
-from dolfinx_solve import dunavant_dx, load_form, sympy_to_ufl, vec_to_ufl  # noqa: E402  (sympy -> UFL, loads)
+from dolfinx_solve import error_forms, load_form  # noqa: E402  (sympy -> UFL, loads)
 
 SIDES = ("bottom", "right", "top", "left")
 
@@ -419,23 +419,13 @@ class Problem:
         # loads
         self.t = fem.Constant(msh, 0.0)
         self.L = load_form(scene, msh, v, ds, self.t)
-        X, dx4 = ufl.SpatialCoordinate(msh), dunavant_dx(msh)
         self.lvec = dolfinx.fem.petsc.create_vector(V)     # ghosted, layout of V
 
         # true errors
         self.uh = fem.Function(V)
         self.err_forms = None
         if scene.exact_u is not None:
-            ue = vec_to_ufl(scene.exact_u, X, self.t)
-            G = ufl.as_matrix([[sympy_to_ufl(scene.exact_grad[i][j].sym, X, self.t) for j in range(2)]
-                               for i in range(2)]) - ufl.grad(self.uh)
-            Es = ufl.sym(G)
-            el = (lam * ufl.tr(Es) ** 2 + 2 * mu * ufl.inner(Es, Es)) * dx4
-            el = el + 2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(self.uh), ufl.jump(self.uh)) * dS2
-            if ids["dirichlet"]:
-                el = el + pen * ufl.inner(self.uh, self.uh) * ds(ids["dirichlet"], metadata={"quadrature_degree": 3})
-            self.err_forms = [fem.form(el), fem.form(ufl.inner(G, G) * dx4),
-                              fem.form(ufl.inner(ue - self.uh, ue - self.uh) * dx4)]
+            self.err_forms = error_forms(scene, self.uh, self.t, (lam, mu, rho, pen), h, dS2, ds, ids["dirichlet"])
         self.times_setup["assembly"] = time.perf_counter() - tic
         memlog(comm, "loads and error forms compiled")
         self.mem_setup["assembly"] = peak_mb()
