@@ -26,7 +26,8 @@ import sys
 import h5py
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import ROOT  # noqa: E402
 # not numbers of the method: they change from run to run or build to build
 VOLATILE = {"steps/wall_time", "setup_times", "version", "git_commit", "scene_path"}
 # added by a later version (issue 18: per-step checksums): compared when both files have it, else skipped

@@ -27,10 +27,8 @@ import estimates  # verification/estimates.py: Richardson/GCI estimates proved o
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIN = os.path.join(ROOT, "target", "release", "tresca-cr")
-REF = os.path.join(ROOT, "reference")
-PY = sys.executable
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import BIN, PY, REF, ROOT, orders  # noqa: E402
 RESULTS = []  # (requirement id, statement, passed, measured, command, reference file)
 
 
@@ -73,15 +71,6 @@ def study(scene, levels, name, reference=None, solver=None, extra=()):
         for k, v in r.items():
             r[k] = value(v)
     return rows, " ".join(os.path.relpath(c, ROOT) if c.startswith(ROOT) else c for c in cmd)
-
-
-def orders(x, e):
-    """Successive orders and least-squares slope of log e against log x."""
-    succ = [math.log(e[i - 1] / e[i]) / math.log(x[i - 1] / x[i]) for i in range(1, len(e))]
-    lx, le = [math.log(v) for v in x], [math.log(v) for v in e]
-    mx, me = sum(lx) / len(lx), sum(le) / len(le)
-    fit = sum((a - mx) * (b - me) for a, b in zip(lx, le)) / sum((a - mx) ** 2 for a in lx)
-    return succ, fit
 
 
 def rate_ok(x, e, p, tol):
