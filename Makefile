@@ -10,7 +10,7 @@ BIN   := target/release/tresca-cr
 PY312 := $(shell for p in $$(pyenv root 2>/dev/null)/versions/3.12*/bin/python3.12 /usr/local/bin/python3.12 /usr/bin/python3.12; do \
            [ -x "$$p" ] && "$$p" -c 'import sys' 2>/dev/null && echo "$$p" && break; done)
 
-.PHONY: all deps build venv test verify bench clean-out
+.PHONY: all deps paraview build venv test verify bench clean-out
 
 all: build
 
@@ -20,6 +20,14 @@ deps:
 	  echo "installing libhdf5-dev pkg-config"; \
 	  (apt-get update -qq && apt-get install -y -qq libhdf5-dev pkg-config) >/dev/null || \
 	  (sudo apt-get update -qq && sudo apt-get install -y -qq libhdf5-dev pkg-config) >/dev/null; \
+	fi
+
+# Debian's ParaView 5.11 (pvpython) and a virtual X server, for verification/paraview_check.py (make verify).
+paraview:
+	@if ! command -v pvpython >/dev/null 2>&1 || ! command -v xvfb-run >/dev/null 2>&1; then \
+	  echo "installing paraview python3-paraview xvfb xauth"; \
+	  (apt-get update -qq && apt-get install -y -qq --no-install-recommends paraview python3-paraview xvfb xauth) >/dev/null || \
+	  (sudo apt-get update -qq && sudo apt-get install -y -qq --no-install-recommends paraview python3-paraview xvfb xauth) >/dev/null; \
 	fi
 
 build: deps
@@ -38,7 +46,7 @@ test: build venv
 	cargo test --release --locked
 	$(PY) verification/python_tests.py
 
-verify: build venv
+verify: build venv paraview
 	$(PY) verification/run_all.py
 
 bench: build venv

@@ -3,10 +3,11 @@
 
     .venv/bin/python scripts/check_results.py run.h5 [--xdmf run.xdmf]
 
-* VTK's ``vtkHDFReader`` (the VTKHDF view): numbers of points, cells and frames, array names, and every
-  frame's displacement / von Mises / contact arrays against values recomputed here from ``tresca/u``
+* VTK's ``vtkHDFReader`` (the VTKHDF view, a collection of the blocks ``body`` and ``contact``): numbers of
+  points, cells and frames, each block's array names, and every frame's displacement / von Mises / contact arrays against values recomputed here from ``tresca/u``
   (the CR field evaluated at triangle vertices: U(v_j) = sum_{i != j} U_{e_i} - U_{e_j}).
-* meshio's XDMF ``TimeSeriesReader`` (the sidecar): same numbers and values.
+* meshio's XDMF ``TimeSeriesReader`` (the sidecar; it reads the last temporal collection, the body): same
+  numbers and values; VTK's ``vtkXdmfReader``: both blocks, contact fields at the first and last frame.
 * h5py (the ``tresca`` group): shapes of the README table, ``completed`` attribute, finiteness, and the
   per-step checksums ``tresca/steps/checksum`` (XXH64 of each step's rows, recomputed here with numpy; the
   first step that does not match is named: storage corruption after the file was written).
@@ -137,6 +138,32 @@ def reference(g, S):
     return disp.reshape(len(u), 3 * len(tri), 2), vm, sxx
 
 
+BODY_CELLS = ["strain", "stress", "von_mises"]
+CONTACT_CELLS = ["sigma_t", "slip", "slip_increment", "stick_slip"]
+
+
+def array_names(data):
+    return sorted(data.GetArrayName(i) for i in range(data.GetNumberOfArrays()))
+
+
+def contact_points(g):
+    """Broken-mesh point (3t + j) of each of the 2C contact line points: the ends of Γ_C edge k as
+    vertices of its one triangle, in the order (j+1, j+2) after the local vertex j opposite the edge."""
+    tri, edges = g["mesh/triangles"][()], g["mesh/edges"][()]
+    out = []
+    for e in g["contact/edges"][()]:
+        a, b = sorted(edges[e])
+        for t, tv in enumerate(tri):
+            for i in range(3):
+                if sorted((tv[(i + 1) % 3], tv[(i + 2) % 3])) == [a, b]:
+                    out += [3 * t + (i + 1) % 3, 3 * t + (i + 2) % 3]
+                    break
+            else:
+                continue
+            break
+    return np.array(out)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     ap.add_argument("h5")
@@ -179,61 +206,97 @@ def main(argv=None):
     frames = [n for n in steps if n % every == 0 or n == int(g.attrs["steps"])]
     times = g["times"][:S]
     disp_ref, vm_ref, sxx_ref = reference(g, S)
-    P, NC = 3 * T, T + C
+    P = 3 * T
+    contact_pts = contact_points(g) if C else None
     print(f"{args.h5}: {S} steps, {len(frames)} frames (every {every}), {T} triangles, {E} edges, {C} contact edges, "
           f"status {g.attrs['status']!r}")
 
-    # --- VTK vtkHDFReader
+    # --- VTK vtkHDFReader: a PartitionedDataSetCollection of `body` and `contact`
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy as v2n
     r = vtk.vtkHDFReader()
     r.SetFileName(args.h5)
     r.UpdateInformation()
     check(r.GetNumberOfSteps() == len(frames), f"VTKHDF: {r.GetNumberOfSteps()} steps, expected {len(frames)} frames")
-    want_cells = ["cell_kind", "strain", "stress", "von_mises"] + (["sigma_t", "slip", "slip_increment", "stick_slip"] if C else [])
+    want_blocks = {"body": (P, T, ["displacement"], BODY_CELLS)}
+    if C:
+        want_blocks["contact"] = (2 * C, C, ["displacement"], CONTACT_CELLS)
     for k, n in enumerate(frames[: r.GetNumberOfSteps()]):
         r.SetStep(k)
         r.Update()
-        o = r.GetOutput()
-        check(o.GetNumberOfPoints() == P and o.GetNumberOfCells() == NC,
-              f"VTKHDF frame {k}: {o.GetNumberOfPoints()} points, {o.GetNumberOfCells()} cells; expected {P}, {NC}")
-        names = sorted(o.GetCellData().GetArrayName(i) for i in range(o.GetCellData().GetNumberOfArrays()))
-        check(names == sorted(want_cells), f"VTKHDF cell arrays {names}")
-        d = v2n(o.GetPointData().GetArray("displacement"))
-        close(d[:, :2], disp_ref[n], f"VTKHDF displacement frame {k} (step {n})")
-        check(np.all(d[:, 2] == 0), "VTKHDF displacement z != 0")
-        close(v2n(o.GetCellData().GetArray("von_mises"))[:T], vm_ref[n], f"VTKHDF von_mises frame {k}", 2e-5)
-        close(v2n(o.GetCellData().GetArray("stress"))[:T, 0], sxx_ref[n], f"VTKHDF stress xx frame {k}", 2e-5)
-        if C:
-            close(v2n(o.GetCellData().GetArray("sigma_t"))[T:], g["contact/sigma_t"][n], f"VTKHDF sigma_t frame {k}")
-            check(np.array_equal(v2n(o.GetCellData().GetArray("stick_slip"))[T:], g["contact/state"][n]),
+        o = r.GetOutputDataObject(0)
+        if not check(o.IsA("vtkPartitionedDataSetCollection"), f"VTKHDF: {o.GetClassName()}, not a collection"):
+            break
+        blocks = {o.GetMetaData(i).Get(vtk.vtkCompositeDataSet.NAME()): o.GetPartition(i, 0)
+                  for i in range(o.GetNumberOfPartitionedDataSets())}
+        check(sorted(blocks) == sorted(want_blocks), f"VTKHDF blocks {sorted(blocks)}")
+        for name, (npt, ncl, pnames, cnames) in want_blocks.items():
+            b = blocks.get(name)
+            if not check(b is not None, f"VTKHDF block {name} missing"):
+                continue
+            check(b.GetNumberOfPoints() == npt and b.GetNumberOfCells() == ncl,
+                  f"VTKHDF {name} frame {k}: {b.GetNumberOfPoints()} points, {b.GetNumberOfCells()} cells; expected {npt}, {ncl}")
+            check(array_names(b.GetCellData()) == sorted(cnames), f"VTKHDF {name} cell arrays {array_names(b.GetCellData())}")
+            check(array_names(b.GetPointData()) == pnames, f"VTKHDF {name} point arrays {array_names(b.GetPointData())}")
+        body, cont = blocks.get("body"), blocks.get("contact")
+        if body is not None:
+            d = v2n(body.GetPointData().GetArray("displacement"))
+            close(d[:, :2], disp_ref[n], f"VTKHDF displacement frame {k} (step {n})")
+            check(np.all(d[:, 2] == 0), "VTKHDF displacement z != 0")
+            close(v2n(body.GetCellData().GetArray("von_mises")), vm_ref[n], f"VTKHDF von_mises frame {k}", 2e-5)
+            close(v2n(body.GetCellData().GetArray("stress"))[:, 0], sxx_ref[n], f"VTKHDF stress xx frame {k}", 2e-5)
+        if C and cont is not None:
+            close(v2n(cont.GetCellData().GetArray("sigma_t")), g["contact/sigma_t"][n], f"VTKHDF sigma_t frame {k}")
+            close(v2n(cont.GetCellData().GetArray("slip")), g["contact/slip"][n], f"VTKHDF slip frame {k}")
+            check(np.array_equal(v2n(cont.GetCellData().GetArray("stick_slip")), g["contact/state"][n]),
                   f"VTKHDF stick_slip frame {k}")
+            close(v2n(cont.GetPointData().GetArray("displacement"))[:, :2], disp_ref[n][contact_pts],
+                  f"VTKHDF contact displacement frame {k}")
         tval = r.GetOutputInformation(0).Get(vtk.vtkStreamingDemandDrivenPipeline.TIME_STEPS())
         if k == 0 and tval is not None:
             close(np.array(tval), times[frames], "VTKHDF time values", 1e-15)
 
-    # --- meshio XDMF time series
+    # --- meshio XDMF time series: reads the last temporal collection, the body
     import meshio
     with meshio.xdmf.TimeSeriesReader(xdmf) as rd:
         points, cells = rd.read_points_cells()
         check(len(points) == P, f"XDMF: {len(points)} points, expected {P}")
-        ncell = sum(len(c.data) for c in cells)
-        check(ncell == NC, f"XDMF: {ncell} cells, expected {NC}")
+        check([c.type for c in cells] == ["triangle"] and len(cells[0].data) == T, f"XDMF (meshio): cells {cells}")
         check(rd.num_steps == len(frames), f"XDMF: {rd.num_steps} steps, expected {len(frames)}")
         for k in range(rd.num_steps):
             t, pd, cd = rd.read_data(k)
             n = frames[k]
             check(abs(t - times[n]) <= 1e-12 * max(1.0, abs(times[n])), f"XDMF time {t} != {times[n]}")
             close(pd["displacement"][:, :2], disp_ref[n], f"XDMF displacement frame {k}")
-            vm = np.concatenate(cd["von_mises"])
-            close(vm[:T], vm_ref[n], f"XDMF von_mises frame {k}", 2e-5)
-            check(sorted(cd) == sorted(want_cells), f"XDMF cell arrays {sorted(cd)}")
+            close(np.concatenate(cd["von_mises"]), vm_ref[n], f"XDMF von_mises frame {k}", 2e-5)
+            check(sorted(cd) == sorted(BODY_CELLS), f"XDMF (meshio) cell arrays {sorted(cd)}")
+
+    # --- VTK's XDMF reader: both blocks, the contact fields at the first and the last frame
+    x = vtk.vtkXdmfReader()
+    x.SetFileName(xdmf)
+    x.UpdateInformation()
+    tsteps = x.GetOutputInformation(0).Get(vtk.vtkStreamingDemandDrivenPipeline.TIME_STEPS()) or []
+    check(len(tsteps) == len(frames), f"XDMF (vtkXdmfReader): {len(tsteps)} time steps, expected {len(frames)}")
+    for k in sorted({0, len(tsteps) - 1}) if len(tsteps) else []:
+        x.UpdateTimeStep(tsteps[k])
+        o = x.GetOutputDataObject(0)
+        blocks = {o.GetMetaData(i).Get(vtk.vtkCompositeDataSet.NAME()): o.GetBlock(i) for i in range(o.GetNumberOfBlocks())}
+        check(sorted(blocks) == sorted(want_blocks), f"XDMF (vtkXdmfReader) blocks {sorted(blocks)}")
+        n = frames[k]
+        if "body" in blocks:
+            close(v2n(blocks["body"].GetCellData().GetArray("von_mises")), vm_ref[n], f"XDMF (VTK) von_mises frame {k}", 2e-5)
+            check(array_names(blocks["body"].GetCellData()) == sorted(BODY_CELLS), "XDMF (VTK) body cell arrays")
+        if C and "contact" in blocks:
+            cd = blocks["contact"].GetCellData()
+            check(array_names(cd) == sorted(CONTACT_CELLS), f"XDMF (VTK) contact cell arrays {array_names(cd)}")
+            close(v2n(cd.GetArray("slip")), g["contact/slip"][n], f"XDMF (VTK) slip frame {k}")
+            check(np.array_equal(v2n(cd.GetArray("stick_slip")), g["contact/state"][n]), f"XDMF (VTK) stick_slip frame {k}")
     if FAIL:
         print(f"FAILED ({len(FAIL)}):")
         for m in FAIL[:50]:
             print("  " + m)
         return 1
-    print("OK: VTKHDF (vtkHDFReader), XDMF (meshio) and the tresca group agree")
+    print("OK: VTKHDF (vtkHDFReader), XDMF (meshio, vtkXdmfReader) and the tresca group agree")
     return 0
 
 

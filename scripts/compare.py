@@ -66,7 +66,8 @@ def match(ref, other, what):
     return idx
 
 
-def rel(a, b):
+def rel_l2(a, b):
+    """‖a − b‖₂ / ‖a‖₂ (‖a − b‖₂ when a vanishes)."""
     na = np.linalg.norm(a)
     return np.linalg.norm(a - b) / na if na > 0 else np.linalg.norm(a - b)
 
@@ -99,7 +100,7 @@ def compare_files(path_a, path_b, err_floor=1e-12):
     nflags = 0
     rows = []
     for n in range(N1):
-        du = rel(A["u"][n].ravel(), uB[n].ravel())
+        du = rel_l2(A["u"][n].ravel(), uB[n].ravel())
         dE = (abs(A["energy"][n] - B["energy"][n]) / abs(A["energy"][n]) if abs(A["energy"][n]) > 0
               else abs(B["energy"][n])) if "energy" in A and "energy" in B else 0.0
         dsig = float(np.max(np.abs(A["sigma_t"][n] - sB[n]))) / gscale if has_c else 0.0

@@ -94,6 +94,47 @@ def vec_to_ufl(vexpr, x, t):
     return ufl.as_vector([sympy_to_ufl(c.sym, x, t, c.key) for c in vexpr.comps])
 
 
+def dunavant_dx(msh):
+    """The cell measure with the 6-point Dunavant rule (degree 4) of the Rust solver and scikit-fem."""
+    return ufl.Measure("dx", domain=msh, metadata={
+        "quadrature_rule": "custom", "quadrature_points": ts.DUNAVANT_REF_X.T.copy(),
+        "quadrature_weights": ts.DUNAVANT_REF_W.copy()})
+
+
+def error_forms(scene, uh, t, params, h, dS2, ds, dirichlet):
+    """Compiled forms of the squared true errors of uh against the scene's exact solution: energy (with
+    the jump terms on interior edges and on the Dirichlet part `dirichlet`, 2-point Gauss), H1 seminorm
+    and L2, by the Dunavant rule. params = (lambda, mu, rho, 2 rho mu / h penalty on Gamma_D)."""
+    lam, mu, rho, pen = params
+    msh = uh.function_space.mesh
+    X, dx4 = ufl.SpatialCoordinate(msh), dunavant_dx(msh)
+    ue = vec_to_ufl(scene.exact_u, X, t)
+    G = ufl.as_matrix([[sympy_to_ufl(scene.exact_grad[i][j].sym, X, t) for j in range(2)]
+                       for i in range(2)]) - ufl.grad(uh)
+    Es = ufl.sym(G)
+    el = (lam * ufl.tr(Es) ** 2 + 2 * mu * ufl.inner(Es, Es)) * dx4
+    # jump part of the energy error as an integral of squares (no cancellation)
+    el = el + 2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(uh), ufl.jump(uh)) * dS2
+    if dirichlet:
+        el = el + pen * ufl.inner(uh, uh) * ds(dirichlet, metadata={"quadrature_degree": 3})
+    return [fem.form(el), fem.form(ufl.inner(G, G) * dx4), fem.form(ufl.inner(ue - uh, ue - uh) * dx4)]
+
+
+def load_form(scene, msh, v, ds, t):
+    """The load functional (l(t), v) as a compiled form (None without loads): the body force by the
+    6-point Dunavant rule, tractions on Neumann part i (measure ds(i + 1)) by 3-point Gauss (degree 5)."""
+    X = ufl.SpatialCoordinate(msh)
+    dx4 = dunavant_dx(msh)
+    L = None
+    if not scene.f.is_zero:
+        L = ufl.inner(vec_to_ufl(scene.f, X, t), v) * dx4
+    for i, b in enumerate(scene.boundaries):
+        if b.kind == "neumann" and not b.traction.is_zero:
+            term = ufl.inner(vec_to_ufl(b.traction, X, t), v) * ds(i + 1, metadata={"quadrature_degree": 5})
+            L = term if L is None else L + term
+    return None if L is None else fem.form(L)
+
+
 class DolfinxProblem:
     """Distributed assembly of a_h, its jump part, loads and true errors (canonical ordering on rank 0)."""
 
@@ -153,34 +194,13 @@ class DolfinxProblem:
 
         # loads: UFL expressions in x and the time constant t
         self.t = fem.Constant(msh, 0.0)
-        X = ufl.SpatialCoordinate(msh)
-        dx4 = ufl.Measure("dx", domain=msh, metadata={
-            "quadrature_rule": "custom", "quadrature_points": ts.DUNAVANT_REF_X.T.copy(),
-            "quadrature_weights": ts.DUNAVANT_REF_W.copy()})
-        L = None
-        if not scene.f.is_zero:
-            L = ufl.inner(vec_to_ufl(scene.f, X, self.t), v) * dx4
-        for i, b in enumerate(scene.boundaries):
-            if b.kind == "neumann" and not b.traction.is_zero:
-                term = ufl.inner(vec_to_ufl(b.traction, X, self.t), v) * ds(i + 1, metadata={"quadrature_degree": 5})
-                L = term if L is None else L + term
-        self.L = None if L is None else fem.form(L)
+        self.L = load_form(scene, msh, v, ds, self.t)
 
         # true errors
         self.err_forms = None
         if scene.exact_u is not None:
             self.uh = fem.Function(V)
-            ue = vec_to_ufl(scene.exact_u, X, self.t)
-            G = ufl.as_matrix([[sympy_to_ufl(scene.exact_grad[i][j].sym, X, self.t) for j in range(2)]
-                               for i in range(2)]) - ufl.grad(self.uh)
-            Es = ufl.sym(G)
-            el = (lam * ufl.tr(Es) ** 2 + 2 * mu * ufl.inner(Es, Es)) * dx4
-            # jump part of the energy error as an integral of squares (no cancellation)
-            el = el + 2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(self.uh), ufl.jump(self.uh)) * dS2
-            if ids["dirichlet"]:
-                el = el + pen * ufl.inner(self.uh, self.uh) * ds(ids["dirichlet"], metadata={"quadrature_degree": 3})
-            self.err_forms = [fem.form(el), fem.form(ufl.inner(G, G) * dx4),
-                              fem.form(ufl.inner(ue - self.uh, ue - self.uh) * dx4)]
+            self.err_forms = error_forms(scene, self.uh, self.t, (lam, mu, rho, pen), h, dS2, ds, ids["dirichlet"])
 
     def _gather_matrix(self, form):
         A = fem.assemble_matrix(form)             # not finalised: ghost rows hold partial sums

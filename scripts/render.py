@@ -9,11 +9,17 @@ For each chosen time (nearest stored step; default: quarter, half and final time
   stress or |u|, with Γ_C drawn in black;
 * ``DIR/contact_<n>.png`` (when Γ_C exists): σ_τ/ḡ along Γ_C and the slip velocity Δs/Δt, with slip
   edges shaded.
-Units are the scene's (the README's Example 5.1: mm, daN/mm², s).
+Only committed steps are drawn (``tresca/steps`` attribute ``completed``): the file of a killed run (status
+"running") has room for every step but data in its first ``completed`` rows only; a killed or stopped run
+is said so on stdout and in every title. Axis and colour-bar units come from the scene's optional
+``[units]`` table (``length``, ``force``, ``time``; stress is force/length²), read from the scene text
+stored in the file; without it the labels say "length", "force/length²", "time".
 """
 import argparse
 import os
 import sys
+import textwrap
+import tomllib
 
 import h5py
 import numpy as np
@@ -25,16 +31,45 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 
 
+def units(scene_text):
+    """Unit labels from the scene's optional [units] table."""
+    try:
+        u = tomllib.loads(scene_text).get("units", {})
+    except (tomllib.TOMLDecodeError, TypeError):
+        u = {}
+    L, F, T = u.get("length", "length"), u.get("force", "force"), u.get("time", "time")
+    return {"L": L, "S": f"{F}/{L}²", "T": f" {u['time']}" if "time" in u else "", "V": f"{L}/{T}"}
+
+
 def load(path):
+    """The committed steps of a results file and a note saying whether the run was killed or stopped."""
     f = h5py.File(path, "r")
     g = f["tresca"]
-    d = {k: g[k][()] for k in ("mesh/points", "mesh/triangles", "mesh/edges", "times", "u")}
+    S = int(g["steps"].attrs["completed"])
+    N = int(g.attrs["steps"])
+    status = str(g.attrs.get("status", ""))
+    d = {k: g[k][()] for k in ("mesh/points", "mesh/triangles", "mesh/edges")}
+    d["times"], d["u"] = g["times"][:S], g["u"][:S]
     d["E"], d["nu"] = float(g.attrs["E"]), float(g.attrs["nu"])
     d["title"] = str(g.attrs.get("title", "")) or os.path.basename(path)
+    d["units"] = units(str(g.attrs.get("scene", "")))
+    d["note"] = ""
+    if status.startswith("running"):
+        d["note"] = f"killed run: {S} of {N + 1} steps committed"
+    elif status.startswith("stopped"):
+        d["note"] = f"stopped run: {S} of {N + 1} steps"
     if "contact" in g:
-        for k in ("edges", "tangent", "g", "slip", "sigma_t", "state"):
+        for k in ("edges", "tangent", "g"):
             d["c_" + k] = g["contact/" + k][()]
+        for k in ("slip", "sigma_t", "state"):
+            d["c_" + k] = g["contact/" + k][:S]
     return d
+
+
+def title(d, text):
+    """Figure title: the run, what is shown, and the kill/stop note; wrapped, never clipped (bbox tight)."""
+    head = d["title"] + (f"  [{d['note']}]" if d["note"] else "")
+    return "\n".join(textwrap.wrap(head, 80) + textwrap.wrap(text, 80))
 
 
 def tri_edges(tri, edges):
@@ -68,11 +103,12 @@ def deformed(d, n, te, field, scale, out):
     umax = float(np.abs(d["u"]).max()) or 1.0
     s = scale if scale else 0.1 * size / umax
     y = x + s * disp
+    u_ = d["units"]
     if field == "vm":
-        val, label = vm, "von Mises stress (plane strain) [force/length²]"
+        val, label = vm, f"von Mises stress (plane strain) [{u_['S']}]"
     else:
-        val, label = np.linalg.norm(disp, axis=2).mean(axis=1), "|u| (triangle mean) [length]"
-    fig, ax = plt.subplots(figsize=(6.4, 5.6))
+        val, label = np.linalg.norm(disp, axis=2).mean(axis=1), f"|u| (triangle mean) [{u_['L']}]"
+    fig, ax = plt.subplots(figsize=(7.0, 6.0))
     ax.add_collection(PolyCollection(x, facecolors="none", edgecolors="0.8", linewidths=0.4))
     pc = PolyCollection(y, array=val, cmap="viridis", edgecolors="face", linewidths=0.2)
     ax.add_collection(pc)
@@ -89,14 +125,15 @@ def deformed(d, n, te, field, scale, out):
             segs.append([y[t, ja], y[t, jb]])
         ax.add_collection(LineCollection(segs, colors="k", linewidths=2.0, label="Γ_C (deformed)"))
         ax.add_collection(LineCollection(pts[e2], colors="r", linewidths=1.0, linestyles=":", label="Γ_C (reference)"))
-        ax.legend(loc="upper right", fontsize=8)
+        # below the axes, never over the body
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8, frameon=False)
     ax.autoscale()
     ax.set_aspect("equal")
-    ax.set_xlabel("x [length]")
-    ax.set_ylabel("y [length]")
-    ax.set_title(f"{d['title']}\nt = {d['times'][n]:.4g}, step {n}: deformed ×{s:.3g} (grey: reference)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
+    ax.set_xlabel(f"x [{u_['L']}]")
+    ax.set_ylabel(f"y [{u_['L']}]")
+    ax.set_title(title(d, f"t = {d['times'][n]:.4g}{u_['T']}, step {n}: deformed ×{s:.3g} (grey: reference). "
+                    "Gaps between triangles: the CR field is continuous only at edge midpoints"), fontsize=9)
+    fig.savefig(out, dpi=120, bbox_inches="tight")
     plt.close(fig)
 
 
@@ -124,17 +161,17 @@ def contact(d, n, out):
     a1.plot(s[order], sig[order], ".", color="tab:blue")
     a1.axhline(1, color="k", lw=0.8, ls="--")
     a1.axhline(-1, color="k", lw=0.8, ls="--")
+    u_ = d["units"]
     a1.set_ylabel("σ_τ / ḡ  [–]")
     a1.set_ylim(-1.15, 1.15)
     a2.step(s[order], vel[order], where="mid", color="tab:red")
     a2.plot(s[order], vel[order], ".", color="tab:red")
-    a2.set_ylabel("slip velocity Δs/Δt [length/time]")
-    a2.set_xlabel("position along Γ_C, x·τ [length]")
+    a2.set_ylabel(f"slip velocity Δs/Δt [{u_['V']}]")
+    a2.set_xlabel(f"position along Γ_C, x·τ [{u_['L']}]")
     nslip = int(state.sum())
-    a1.set_title(f"{d['title']}: Γ_C at t = {times[n]:.4g} (step {n}); shaded: slip ({nslip} of {len(state)} edges)",
-                 fontsize=10)
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
+    a1.set_title(title(d, f"Γ_C at t = {times[n]:.4g}{u_['T']} (step {n}); shaded: slip ({nslip} of {len(state)} edges)"),
+                 fontsize=9)
+    fig.savefig(out, dpi=120, bbox_inches="tight")
     plt.close(fig)
 
 
@@ -150,6 +187,8 @@ def main(argv=None):
     t = d["times"]
     if len(t) == 0:
         sys.exit(f"error: {args.h5} holds no complete step")
+    if d["note"]:
+        print(f"note: {args.h5}: {d['note']}; drawing committed steps only (t ≤ {t[-1]:.4g})")
     want = args.times if args.times else [t[0] + q * (t[-1] - t[0]) for q in (0.25, 0.5, 1.0)]
     os.makedirs(args.out, exist_ok=True)
     te = tri_edges(d["mesh/triangles"], d["mesh/edges"])

@@ -22,7 +22,6 @@ The scenes of 4 and 8 are generated here with sympy (f = -div sigma(u), g = sigm
 """
 import argparse
 import os
-import subprocess
 import sys
 import tempfile
 import time
@@ -31,10 +30,11 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(os.path.dirname(HERE), "verification"))
 import tresca_scene as ts  # noqa: E402
+from common import CASES, MPIRUN, PY  # noqa: E402
+from common import run as run_cmd  # noqa: E402
 
-PY = sys.executable
-MPIRUN = os.path.join(os.path.dirname(PY), "mpirun")
 RESULTS = []
 
 
@@ -45,19 +45,13 @@ def check(name, ok, detail=""):
 
 
 def run(cmd, expect_ok=True):
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    if expect_ok and p.returncode != 0:
-        print(p.stdout[-2000:], p.stderr[-4000:], file=sys.stderr)
-        raise RuntimeError(f"command failed: {' '.join(cmd)}")
-    return p
+    return run_cmd(cmd, check=expect_ok)[0]
 
 
 def solve(solver, scene, out, extra=(), mpi=0):
     script = os.path.join(HERE, f"{solver}_solve.py")
     cmd = ([MPIRUN, "-n", str(mpi)] if mpi else []) + [PY, script, scene, "-o", out, "-q", *extra]
-    t0 = time.perf_counter()
-    run(cmd)
-    return time.perf_counter() - t0
+    return run_cmd(cmd)[1]
 
 
 def compare(a, b, tol=1e-8):
@@ -201,7 +195,7 @@ def check_meshes():
     ok &= {1, 5} <= set(m2.triangles[0]) and {1, 5} <= set(m2.triangles[1])
     ok &= np.allclose(m.points[m.boundary_segments["right"][:, 0], 0], 2.0)
     check("mesh: structured counts, orientation, diagonals, side names", ok)
-    sc = ts.load_scene(os.path.join(HERE, "scenes", "trapezoid.toml"))
+    sc = ts.load_scene(os.path.join(CASES, "trapezoid.toml"))
     sc.mesh["refine"] = 0
     g0 = ts.build_mesh(sc)
     sc.mesh["refine"] = 2
@@ -302,8 +296,15 @@ def main():
             os.makedirs(args.write_scenes, exist_ok=True)
             with open(os.path.join(args.write_scenes, f"{name}.toml"), "w") as fh:
                 fh.write(text)
-    for name in ("example51", "cyclic", "trapezoid"):
-        paths[name] = os.path.join(HERE, "scenes", f"{name}.toml")
+    for name in ("cyclic", "trapezoid"):
+        paths[name] = os.path.join(CASES, f"{name}.toml")
+    # Example 5.1 on the paper's n = 8 mesh (refine 2 of its 2 x 2 cells), as a scene of its own
+    with open(os.path.join(CASES, "paper_example_5_1.toml")) as fh:
+        ex51 = fh.read().replace("cells = [2, 2]", "cells = [8, 8]")
+    assert "cells = [8, 8]" in ex51, "paper_example_5_1.toml changed: update this generator"
+    paths["example51"] = os.path.join(tmp, "example51.toml")
+    with open(paths["example51"], "w") as fh:
+        fh.write(ex51)
 
     import h5py
     # patch tests and cross-checks

@@ -195,6 +195,7 @@ _SCHEMA = {
     "solver": {"method", "tol", "max_iter", "uzawa_step"},
     "exact": {"u", "grad"},
     "output": {"path"},
+    "units": {"length", "force", "time"},  # labels for pictures only (scripts/render.py)
 }
 
 

@@ -13,7 +13,7 @@
 //! | linear solves | [`solve`] | K factored once, condensation C = EᵀK⁻¹E, free response u_f = K⁻¹lⁿ |
 //! | friction | [`friction`] | the per-step box QP on Γ_C by SSN, Uzawa or PDAS |
 //! | time stepping | [`stepping`] | set-up once, then backward Euler steps |
-//! | studies | [`study`] | convergence studies and observed orders |
+//! | studies | [`study`] | convergence studies, observed orders, error estimates without an exact solution (Richardson, GCI) |
 //! | output | [`output`] | HDF5 results (`/tresca`, VTKHDF, XDMF), resume |
 //!
 //! Each backward-Euler step solves

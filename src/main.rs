@@ -73,6 +73,9 @@ enum Cmd {
         /// Write the table as CSV.
         #[arg(long)]
         csv: Option<PathBuf>,
+        /// Write per level the elementwise energy density of u_l − P u_{l−1} (XDMF, ParaView) into DIR.
+        #[arg(long, value_name = "DIR")]
+        differences: Option<PathBuf>,
     },
 }
 
@@ -160,11 +163,11 @@ fn main() {
                 cli::run::run(s, out, verbose, quiet)
             })
         }
-        Cmd::Study { scene, levels, reference, solver, tol, csv } => {
+        Cmd::Study { scene, levels, reference, solver, tol, csv, differences } => {
             let no_limits = Limits { max_memory: None, max_disk: None };
             load(&scene, None, None, no_limits, None).and_then(|(mut s, _)| {
                 solver_overrides(&mut s, solver, tol)?;
-                cli::study::study(s, &levels, reference, csv)
+                cli::study::study(s, &levels, reference, csv, differences)
             })
         }
     };

@@ -1,6 +1,7 @@
-//! Order-preserving parallel map for the expensive, independent work of a step: evaluating expression
-//! strings at quadrature points. Results come back in input order and every reduction stays sequential
-//! in the caller, so a run is bit-identical whatever the number of threads. Short inputs stay sequential.
+//! Order-preserving parallel work for the expensive, independent parts of a step: evaluating
+//! expressions at quadrature points. Results come back in input order (or in place) and every reduction
+//! stays sequential in the caller, so a run is bit-identical whatever the number of threads. Short
+//! inputs stay sequential.
 
 use rayon::prelude::*;
 
@@ -13,5 +14,16 @@ pub fn map<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync + Send) -> 
         items.iter().map(f).collect()
     } else {
         items.par_iter().with_min_len(256).map(f).collect()
+    }
+}
+
+/// `f(i, chunk_i)` for the consecutive chunks of `chunk` entries of `out` (the last may be shorter), in
+/// parallel when there are several chunks and `out` is long. Each chunk is written by one call only.
+pub fn for_chunks<R: Send>(out: &mut [R], chunk: usize, f: impl Fn(usize, &mut [R]) + Sync + Send) {
+    let chunk = chunk.max(1);
+    if out.len() <= chunk || out.len() < MIN_PARALLEL {
+        out.chunks_mut(chunk).enumerate().for_each(|(i, c)| f(i, c));
+    } else {
+        out.par_chunks_mut(chunk).enumerate().for_each(|(i, c)| f(i, c));
     }
 }

@@ -16,7 +16,7 @@ use crate::friction::{EdgeState, Friction};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::solve::factor::Factor;
-use crate::solve::free::{Free, FreeResponse};
+use crate::solve::free::FreeResponse;
 use crate::sparse::{dot, energy};
 use faer::sparse::SparseColMat;
 use std::time::Instant;
@@ -136,7 +136,9 @@ impl Problem {
         let stiffness = stiffness(&mesh, &space, &law, scene.rho);
         let loads = Loads::new(&scene, &mesh, &space);
         let t2 = Instant::now();
-        let factor = Factor::new(&stiffness)?;
+        // contact unknowns last: the condensation then comes from the factor (solve::condense)
+        let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
+        let factor = Factor::with_last(&stiffness, &contact)?;
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
         // ranges) factorises without complaint but returns meaningless displacements: refuse it.
         let kappa = factor.condition_estimate(&stiffness, 12);
@@ -154,7 +156,7 @@ impl Problem {
         let (free, c) = FreeResponse::new(factor, loads, &space, &scene.times)?;
         let friction = c.map(|c| Friction::new(&space, c, scene.solver));
         let t4 = Instant::now();
-        let errors = scene.exact.as_ref().map(|_| ErrorEvaluator::new(&mesh, &space, &law, scene.rho));
+        let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(x));
         let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
         Ok(Problem {
             setup: SetupTimes {
@@ -235,9 +237,10 @@ impl Problem {
     pub fn step(&self, n: usize, prev: &StepResult, load: &mut Vec<f64>, want_u: bool) -> Result<StepResult> {
         let start = Instant::now();
         let t = self.scene.times[n];
-        let Free { mut u, trace } = self.free.at(n, t, want_u, load)?;
+        let free = self.free.at(n, t, want_u, load)?;
         let Some(friction) = &self.friction else {
             // a_h(u, u) = (l, u)
+            let u = free.u;
             let energy = dot(load, &u);
             let r = StepResult {
                 n,
@@ -254,13 +257,13 @@ impl Problem {
             };
             return self.finish(r);
         };
-        let d: Vec<f64> = trace.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
+        let d: Vec<f64> = free.trace.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
         let sol = friction.solve(&d, &prev.mu, n, t)?;
         // s = s_f − Cμ
         let slip: Vec<f64> = prev.slip.iter().zip(&sol.slip_increment).map(|(a, b)| a + b).collect();
-        let mut energy = f64::NAN;
+        let (mut u, mut energy) = (Vec::new(), f64::NAN);
         if want_u {
-            self.free.subtract_friction(&mut u, &sol.mu);
+            u = self.free.with_friction(free, &sol.mu)?;
             // a_h(u, u) = (l, u) − Σ_e μ_e s_e, since K u = l − Eμ
             energy = dot(load, &u) - dot(&sol.mu, &slip);
         }

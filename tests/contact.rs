@@ -12,7 +12,7 @@ use tresca_cr::{Problem, Scene};
 fn contact_scenes() -> Vec<(String, Scene)> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut out = Vec::new();
-    for dir in ["verification/cases", "scripts/scenes", "tests/scenes"] {
+    for dir in ["verification/cases"] {
         let Ok(entries) = std::fs::read_dir(root.join(dir)) else { continue };
         let mut paths: Vec<_> = entries.filter_map(|e| e.ok()).map(|e| e.path()).collect();
         paths.sort();

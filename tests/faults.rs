@@ -17,11 +17,25 @@ fn run(args: &[&str]) -> Output {
     spawn(bin().args(args)).wait_with_output().unwrap()
 }
 
-const BASE: &str = "scripts/scenes/example51.toml";
+/// Example 5.1 on the paper's n = 8 mesh (its 2 × 2 cells refined twice) as a scene file of its own,
+/// written once per test process.
+fn base() -> String {
+    static BASE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    BASE.get_or_init(|| {
+        let text = std::fs::read_to_string(root("verification/cases/paper_example_5_1.toml")).unwrap();
+        assert!(text.contains("cells = [2, 2]"), "paper_example_5_1.toml changed: update base()");
+        let p = tmp("base.toml");
+        // u0 given explicitly (zero), so that tests can replace it
+        let text = text.replace("cells = [2, 2]", "cells = [8, 8]") + "\n[initial]\nu0 = [\"0\", \"0\"]\n";
+        std::fs::write(&p, text).unwrap();
+        p.display().to_string()
+    })
+    .clone()
+}
 
 /// Example 5.1 with `from` replaced by `to`, written to `name`.
 fn scene_with(name: &str, from: &str, to: &str) -> String {
-    let text = std::fs::read_to_string(root(BASE)).unwrap();
+    let text = std::fs::read_to_string(base()).unwrap();
     assert!(text.contains(from), "{from}");
     let p = tmp(name);
     std::fs::write(&p, text.replace(from, to)).unwrap();
@@ -112,7 +126,7 @@ fn resume_during_a_run_is_refused() {
 #[test]
 fn closed_or_full_stdout_is_reported_not_a_panic() {
     let out = tmp("pipe.h5");
-    let mut child = spawn(bin().args(["run", &root(BASE), "-v", "-o", out.to_str().unwrap(), "--steps", "400"]));
+    let mut child = spawn(bin().args(["run", &base(), "-v", "-o", out.to_str().unwrap(), "--steps", "400"]));
     drop(child.stdout.take()); // the reader went away
     let o = child.wait_with_output().unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
@@ -122,7 +136,7 @@ fn closed_or_full_stdout_is_reported_not_a_panic() {
         let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
         let o = {
             let _g = fork_guard();
-            bin().args(["check", &root(BASE)]).stdout(full).output().unwrap()
+            bin().args(["check", &base()]).stdout(full).output().unwrap()
         };
         assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
         assert!(stderr(&o).contains("cannot write to standard output"), "{}", stderr(&o));
@@ -134,22 +148,22 @@ fn closed_or_full_stdout_is_reported_not_a_panic() {
 #[test]
 fn runs_that_cannot_fit_are_refused_with_the_estimate() {
     for cmd in ["check", "run"] {
-        let o = run(&[cmd, &root(BASE), "--steps", "10000000000"]);
+        let o = run(&[cmd, &base(), "--steps", "10000000000"]);
         assert_eq!(o.status.code(), Some(1), "{cmd}: {}", stderr(&o));
         assert!(stderr(&o).contains("of memory"), "{cmd}: {}", stderr(&o));
     }
-    let huge = scene_with("huge.toml", "cells    = [8, 8]", "cells    = [10000, 10000]");
+    let huge = scene_with("huge.toml", "cells = [8, 8]", "cells = [10000, 10000]");
     for cmd in ["check", "run"] {
         let o = run(&[cmd, &huge, "--max-memory", "16G"]);
         assert_eq!(o.status.code(), Some(1), "{cmd}: {}", stderr(&o));
         assert!(stderr(&o).contains("B of memory") && stderr(&o).contains("--max-memory"), "{}", stderr(&o));
     }
     let out = tmp("big.h5");
-    let o = run(&["run", &root(BASE), "--steps", "100000000", "-o", out.to_str().unwrap(), "--max-disk", "1G"]);
+    let o = run(&["run", &base(), "--steps", "100000000", "-o", out.to_str().unwrap(), "--max-disk", "1G"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("of disk for the results file"), "{}", stderr(&o));
     assert!(!out.exists());
-    let o = run(&["check", &root(BASE)]);
+    let o = run(&["check", &base()]);
     assert!(o.status.success());
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("estimate   memory ~") && text.contains("results file ~"), "{text}");
@@ -160,13 +174,13 @@ fn runs_that_cannot_fit_are_refused_with_the_estimate() {
 #[test]
 fn resume_checks_settings_and_checksums() {
     let out = tmp("res.h5");
-    let o = run(&["run", &root(BASE), "-q", "-o", out.to_str().unwrap(), "--steps", "80"]);
+    let o = run(&["run", &base(), "-q", "-o", out.to_str().unwrap(), "--steps", "80"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let p = out.to_str().unwrap();
-    let o = run(&["run", &root(BASE), "-q", "-o", p, "--steps", "80", "--resume", "--tol", "1e-3"]);
+    let o = run(&["run", &base(), "-q", "-o", p, "--steps", "80", "--resume", "--tol", "1e-3"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("tol (--tol"), "{}", stderr(&o));
-    let o = run(&["run", &root(BASE), "-q", "-o", p, "--steps", "80", "--resume", "--frame-every", "3"]);
+    let o = run(&["run", &base(), "-q", "-o", p, "--steps", "80", "--resume", "--frame-every", "3"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("--frame-every 3 is ignored on --resume"), "{}", stderr(&o));
     assert_complete(&out, 80);
@@ -182,7 +196,7 @@ fn resume_checks_settings_and_checksums() {
     let f = std::fs::OpenOptions::new().write(true).open(&out).unwrap();
     std::os::unix::fs::FileExt::write_all_at(&f, &noise, offset).unwrap();
     drop(f);
-    let o = run(&["run", &root(BASE), "-q", "-o", p, "--steps", "80", "--resume"]);
+    let o = run(&["run", &base(), "-q", "-o", p, "--steps", "80", "--resume"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("step 50 does not match its checksum"), "{}", stderr(&o));
     let py = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
@@ -199,11 +213,11 @@ fn resume_checks_settings_and_checksums() {
 /// the energy a_h(u, u) ~ load² is representable; beyond it the run is refused with a message.
 #[test]
 fn loads_scale_over_the_f64_range() {
-    let text = std::fs::read_to_string(root(BASE)).unwrap();
+    let text = std::fs::read_to_string(base()).unwrap();
     let scaled = |f: f64| {
         let t = text
             .replace(r#"["0.02*(5-y)*t", "-0.01*t"]"#, &format!(r#"["{f:e}*0.02*(5-y)*t", "-{f:e}*0.01*t"]"#))
-            .replace(r#"g_a  = "0.0012""#, &format!(r#"g_a = "{f:e}*0.0012""#));
+            .replace(r#"g_a = "0.0012""#, &format!(r#"g_a = "{f:e}*0.0012""#));
         let p = tresca_cr::Problem::new(tresca_cr::Scene::from_str(&t, "scaled.toml").unwrap()).unwrap();
         let mut us = Vec::new();
         let r = p.run(|r| {
@@ -240,7 +254,7 @@ fn misleading_messages_are_fixed() {
     // an output path that is a directory is refused before any step
     let dir = tmp("isdir.h5");
     std::fs::create_dir_all(&dir).unwrap();
-    let o = run(&["run", &root(BASE), "-q", "-o", dir.to_str().unwrap()]);
+    let o = run(&["run", &base(), "-q", "-o", dir.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("is a directory") && !stderr(&o).contains("every completed step"), "{}", stderr(&o));
     // the run's own input is never an output
@@ -257,7 +271,7 @@ fn misleading_messages_are_fixed() {
     let u0 = scene_with("u0.toml", r#"u0 = ["0", "0"]"#, r#"u0 = ["1/(x-2)", "0"]"#);
     let exact = format!(
         "{}\n[exact]\nu = [\"sqrt(x-1)\", \"0\"]\ngrad = [[\"0\", \"0\"], [\"0\", \"0\"]]\n",
-        std::fs::read_to_string(root(BASE)).unwrap()
+        std::fs::read_to_string(base()).unwrap()
     );
     let exact_path = tmp("exact.toml");
     std::fs::write(&exact_path, exact).unwrap();
@@ -266,13 +280,13 @@ fn misleading_messages_are_fixed() {
         assert_eq!((c.status.code(), r.status.code()), (Some(1), Some(1)), "{s}: {}", stderr(&c));
     }
     // a tiny friction bound against a unit load: frictionless, said so (it used to fail the line search)
-    let tiny = scene_with("tiny.toml", r#"g_a  = "0.0012""#, r#"g_a = "1e-25""#);
+    let tiny = scene_with("tiny.toml", r#"g_a = "0.0012""#, r#"g_a = "1e-25""#);
     let o = run(&["run", &tiny, "-q"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("treated as zero"), "{}", stderr(&o));
     // a huge expression is refused at once
     let long = format!("{}x", "x+".repeat(100_000));
-    let big = scene_with("bigexpr.toml", r#"g_a  = "0.0012""#, &format!(r#"g_a = "{long}""#));
+    let big = scene_with("bigexpr.toml", r#"g_a = "0.0012""#, &format!(r#"g_a = "{long}""#));
     let start = std::time::Instant::now();
     let o = run(&["check", &big]);
     assert_eq!(o.status.code(), Some(1));
@@ -285,7 +299,7 @@ fn misleading_messages_are_fixed() {
 /// saying so, and a piece of the mesh without a Dirichlet edge is found.
 #[test]
 fn mesh_messages_name_the_cause() {
-    let corners = "corners  = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]";
+    let corners = "corners = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]";
     let thin = scene_with("thin.toml", corners, "corners = [[0.0, 0.0], [4e6, 0.0], [4e6, 4.0], [0.0, 4.0]]");
     let o = run(&["check", &thin]);
     assert_eq!(o.status.code(), Some(1));
@@ -332,7 +346,7 @@ fn a_stale_lock_is_taken_over() {
     let out = tmp("stale.h5");
     let lock = tresca_cr::output::lock_path(&out);
     std::fs::write(&lock, "4194303 (a run that was killed)").unwrap();
-    let o = run(&["run", &root(BASE), "-q", "-o", out.to_str().unwrap(), "--steps", "8"]);
+    let o = run(&["run", &base(), "-q", "-o", out.to_str().unwrap(), "--steps", "8"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_complete(&out, 8);
     assert!(!lock.exists());

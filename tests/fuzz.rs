@@ -15,7 +15,7 @@ fn cases() -> u32 {
 }
 
 const BASE: &str = include_str!("../verification/cases/paper_example_5_1.toml");
-const MSH: &str = include_str!("scenes/lshape.msh");
+const MSH: &str = include_str!("../verification/cases/lshape.msh");
 
 /// Apply byte-level edits (replace, delete, insert) at positions given as fractions of the length.
 fn mutate(base: &str, edits: &[(f64, u8, u8)]) -> String {

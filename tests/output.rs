@@ -78,7 +78,10 @@ fn check_file(p: &Problem, rs: &[StepResult], path: &Path) {
     let (nt, ne, nc) = (mesh.tris.len(), mesh.edges.len(), sp.contact.len());
     let n1 = rs.len();
     assert_eq!(attr_i64(&f, "tresca/steps", "completed"), n1 as i64);
-    assert_eq!(attr_i64(&f, "VTKHDF/Steps", "NSteps"), n1 as i64);
+    assert_eq!(attr_i64(&f, "VTKHDF/body/Steps", "NSteps"), n1 as i64);
+    if nc > 0 {
+        assert_eq!(attr_i64(&f, "VTKHDF/contact/Steps", "NSteps"), n1 as i64);
+    }
     assert_eq!(attr_str(&f, "tresca", "scene"), p.scene.text);
     assert_eq!(attr_str(&f, "tresca", "status"), "completed");
     assert_eq!(attr_str(&f, "tresca", "version"), env!("CARGO_PKG_VERSION"));
@@ -90,7 +93,7 @@ fn check_file(p: &Problem, rs: &[StepResult], path: &Path) {
     assert_eq!(shape(&f, "tresca/u"), [n1, ne, 2]);
     let times: Vec<f64> = rs.iter().map(|r| r.t).collect();
     assert_eq!(f64s(&f, "tresca/times"), times);
-    assert_eq!(f64s(&f, "VTKHDF/Steps/Values"), times);
+    assert_eq!(f64s(&f, "VTKHDF/body/Steps/Values"), times);
     let u = f64s(&f, "tresca/u");
     let energy = f64s(&f, "tresca/energy");
     let iters: Vec<i64> = f.dataset("tresca/steps/iterations").unwrap().read_raw().unwrap();
@@ -128,16 +131,17 @@ fn check_file(p: &Problem, rs: &[StepResult], path: &Path) {
             assert_eq!(l2[n], r.errors.unwrap().l2);
         }
     }
-    // VTKHDF
+    // VTKHDF: a collection of the body (triangles) and the contact line (Γ_C edges), each with its own fields
     let np = 3 * nt;
-    let ncell = nt + nc;
-    assert_eq!(shape(&f, "VTKHDF/Points"), [np, 3]);
-    assert_eq!(shape(&f, "VTKHDF/Types"), [ncell]);
-    assert_eq!(shape(&f, "VTKHDF/PointData/displacement"), [n1 * np, 3]);
-    assert_eq!(shape(&f, "VTKHDF/CellData/stress"), [n1 * ncell, 6]);
-    let disp = f32s(&f, "VTKHDF/PointData/displacement");
-    let vm = f32s(&f, "VTKHDF/CellData/von_mises");
-    let stress = f32s(&f, "VTKHDF/CellData/stress");
+    let ncell = nt;
+    assert_eq!(shape(&f, "VTKHDF/body/Points"), [np, 3]);
+    assert_eq!(shape(&f, "VTKHDF/body/Types"), [nt]);
+    assert_eq!(shape(&f, "VTKHDF/body/PointData/displacement"), [n1 * np, 3]);
+    assert_eq!(shape(&f, "VTKHDF/body/CellData/stress"), [n1 * nt, 6]);
+    assert!(f.dataset("VTKHDF/body/CellData/slip").is_err(), "the body carries no contact field");
+    let disp = f32s(&f, "VTKHDF/body/PointData/displacement");
+    let vm = f32s(&f, "VTKHDF/body/CellData/von_mises");
+    let stress = f32s(&f, "VTKHDF/body/CellData/stress");
     let (lam, mu) = (p.law.lam, p.law.mu);
     for (n, r) in rs.iter().enumerate() {
         let mid = sp.midpoint_values(&r.u);
@@ -181,23 +185,38 @@ fn check_file(p: &Problem, rs: &[StepResult], path: &Path) {
         close32(&sxx, &want_sxx, &format!("stress xx step {n}"));
     }
     if nc > 0 {
-        let st = f32s(&f, "VTKHDF/CellData/sigma_t");
-        let inc = f32s(&f, "VTKHDF/CellData/slip_increment");
+        assert_eq!(shape(&f, "VTKHDF/contact/Points"), [2 * nc, 3]);
+        assert_eq!(shape(&f, "VTKHDF/contact/Types"), [nc]);
+        assert!(f.dataset("VTKHDF/contact/CellData/von_mises").is_err(), "the contact line carries no body field");
+        assert_eq!(f64s(&f, "VTKHDF/contact/Steps/Values"), times);
+        let st = f32s(&f, "VTKHDF/contact/CellData/sigma_t");
+        let inc = f32s(&f, "VTKHDF/contact/CellData/slip_increment");
         let n = n1 - 1;
         let want: Vec<f64> = (0..nc).map(|k| -rs[n].mu[k] / sp.contact[k].length).collect();
-        close32(&st[n * ncell + nt..(n + 1) * ncell], &want, "sigma_t");
+        close32(&st[n * nc..(n + 1) * nc], &want, "sigma_t");
         let want: Vec<f64> = (0..nc).map(|k| rs[n].slip[k] - rs[n - 1].slip[k]).collect();
-        close32(&inc[n * ncell + nt..(n + 1) * ncell], &want, "slip_increment");
+        close32(&inc[n * nc..(n + 1) * nc], &want, "slip_increment");
+        // the contact line's points move with the body: its displacement is the body's at the same points
+        let (cp, cd) = (f64s(&f, "VTKHDF/contact/Points"), f32s(&f, "VTKHDF/contact/PointData/displacement"));
+        let bp = f64s(&f, "VTKHDF/body/Points");
+        for q in 0..2 * nc {
+            let b = (0..np).find(|&b| bp[3 * b..3 * b + 3] == cp[3 * q..3 * q + 3]).expect("contact point on the body");
+            let on_body = (0..np).filter(|&b| bp[3 * b..3 * b + 3] == cp[3 * q..3 * q + 3]).any(|b| {
+                disp[n * 3 * np + 3 * b..n * 3 * np + 3 * b + 3] == cd[n * 6 * nc + 3 * q..n * 6 * nc + 3 * q + 3]
+            });
+            assert!(on_body, "contact point {q} (body point {b}): displacement is none of the body's there");
+        }
     }
     // XDMF virtual datasets resolve to the same rows
     for k in 0..n1 {
-        let v = f32s(&f, &format!("xdmf/displacement/{k:06}"));
+        let v = f32s(&f, &format!("xdmf/body/displacement/{k:06}"));
         assert_eq!(v, &disp[k * 3 * np..(k + 1) * 3 * np]);
-        let v = f32s(&f, &format!("xdmf/stress/{k:06}"));
+        let v = f32s(&f, &format!("xdmf/body/stress/{k:06}"));
         assert_eq!(v, &stress[k * 6 * ncell..(k + 1) * 6 * ncell]);
     }
     let x = std::fs::read_to_string(sidecar(path)).unwrap();
-    assert_eq!(x.matches("<Grid Name=\"step_").count(), n1);
+    let collections = if nc > 0 { 2 } else { 1 };
+    assert_eq!(x.matches("<Grid Name=\"step_").count(), collections * n1);
     assert!(x.trim_end().ends_with("</Xdmf>"));
 }
 
@@ -381,7 +400,7 @@ fn sigkill_at_random_moments_leaves_complete_steps_and_resume_is_bit_identical()
         let every = attr_i64(&f, "tresca", "frame_every") as usize;
         let last = p.n_steps();
         let frames = done.div_ceil(every) + usize::from(done > last && last % every != 0);
-        assert_eq!(attr_i64(&f, "VTKHDF/Steps", "NSteps") as usize, frames);
+        assert_eq!(attr_i64(&f, "VTKHDF/body/Steps", "NSteps") as usize, frames);
         assert!(shape(&f, "tresca/u")[0] >= done);
         // every completed step equals the uninterrupted run
         let g = hdf5::File::open(&full).unwrap();

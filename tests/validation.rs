@@ -132,7 +132,7 @@ fn mesh_geometry() {
 fn gmsh_files() {
     let dir = std::env::temp_dir().join(format!("tresca-validation-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let good = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/scenes/lshape.msh")).unwrap();
+    let good = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/verification/cases/lshape.msh")).unwrap();
     let scene = |msh: &str, name: &str| {
         let p = dir.join(name);
         std::fs::write(&p, msh).unwrap();

@@ -22,9 +22,18 @@ Sections:
     refine 2..7 -> 25k..1.57M unknowns), one step (no output) and five steps (written, per-step wall times
     read back from tresca/steps/wall_time), time and peak RSS (/usr/bin/time -f %M).
  5. perf profile of the Example 5.1 finest run (solve-only and written).
+ 6. Manufactured-solution runs (issue 13): mms_stop refine 5 (64 steps), verification/bench/bench_mms_poly.toml
+    (196,608 unknowns, 80 steps), mms_front refine 2 (256 steps), Example 5.1 n = 64 (refine 5, 1280 steps),
+    all with true errors at every node where the scene has [exact]; process wall and CPU time (user + sys of
+    the child), the set-up split; the expression throughput of the longest expression of verification/cases/
+    (examples/expr_throughput.rs, one thread: exmex's interpreter against the compiled program); mms_stop
+    refine 4 side by side with scripts/skfem_solve.py and scripts/dolfinx_solve.py; a perf profile of
+    mms_stop refine 5.
 """
 import argparse
 import csv
+import json
+import resource
 import os
 import re
 import shutil
@@ -37,10 +46,8 @@ import time
 import h5py
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIN = os.path.join(ROOT, "target", "release", "tresca-cr")
-PY = sys.executable
-REF = os.path.join(ROOT, "reference")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import BIN, PY, REF, ROOT  # noqa: E402
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 ELASTIC = os.path.join(ROOT, "verification", "bench", "bench_elastic.toml")
 TIME = "/usr/bin/time"
@@ -57,13 +64,24 @@ def cpu_model():
     return "unknown"
 
 
+LAST_CPU = [0.0]
+
+
+def child_cpu():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def timed(cmd, env=None, mem=False):
-    """Run cmd; return (wall seconds, stdout, peak RSS in KB or None)."""
+    """Run cmd; return (wall seconds, stdout, peak RSS in KB or None). Its CPU time (user + sys) is left
+    in LAST_CPU[0]."""
     if mem:
         cmd = [TIME, "-f", "MAXRSS %M"] + cmd
+    c0 = child_cpu()
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
     wall = time.perf_counter() - t0
+    LAST_CPU[0] = child_cpu() - c0
     if p.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stdout}\n{p.stderr}")
     rss = None
@@ -94,6 +112,7 @@ class Rec:
     def __init__(self, cmd, repeats, env=None, mem=False, h5=None):
         self.cmd = cmd
         self.walls, self.cli, self.setups, self.loads, self.rss, self.step_walls = [], [], [], [], [], []
+        self.cpus = []
         self.info = None
         for _ in range(repeats):
             la = load1()
@@ -101,6 +120,7 @@ class Rec:
             r = parse_rust(out)
             self.info = r
             self.walls.append(w)
+            self.cpus.append(LAST_CPU[0])
             self.cli.append(r["cli_wall"])
             self.setups.append(r["setup"])
             self.loads.append(la)
@@ -115,6 +135,10 @@ class Rec:
     @property
     def wall(self):
         return med(self.walls)
+
+    @property
+    def cpu(self):
+        return med(self.cpus)
 
     @property
     def setup(self):
@@ -154,9 +178,9 @@ def floor_scene(tmp):
     return path
 
 
-def perf_profile(cmd, tmp, label):
+def perf_profile(cmd, tmp, label, freq=20000):
     data = os.path.join(tmp, f"perf_{label}.data")
-    p = subprocess.run(["perf", "record", "-F", "20000", "-g", "-o", data, "--"] + cmd,
+    p = subprocess.run(["perf", "record", "-F", str(freq), "-g", "-o", data, "--"] + cmd,
                        capture_output=True, text=True, cwd=ROOT)
     if p.returncode != 0:
         return None, p.stderr[-500:]
@@ -183,9 +207,13 @@ def classify(dso, sym):
         return "HDF5 library"
     if dso.startswith("ld-") or sym.startswith("_dl_") or sym in ("do_lookup_x", "check_match", "strcmp"):
         return "dynamic loader (process start: relocations, symbol lookup)"
+    if re.match(r"^(__)?(sin|cos|tan|exp|pow|log|atan)", sym):
+        return "expression evaluation: libm (sin, cos, exp, pow)"
+    if "expr::" in sym:
+        return "expression evaluation: compiled program"
     if "libc" in dso or "libm" in dso:
         return "libc (memcpy, memset, malloc)"
-    for key, name in [("apply_friction", "Z·μ recovery of u (contact::apply_friction)"),
+    for key, name in [("subtract_friction", "K⁻¹Eμ recovery of u (free::subtract_friction)"),
                       ("LoadBasis::build", "load superposition set-up (superpose::LoadBasis::build)"),
                       ("LoadBasis::response", "u_f = Σ c_j w_j (superpose::response)"),
                       ("from_triplets", "sparse matrix from triplets (assembly)"), ("scatter", "assembly"),
@@ -196,7 +224,10 @@ def classify(dso, sym):
                       ("pulp::", "faer SIMD kernels (pulp: factorisation updates, triangular solves)"),
                       ("matvec", "sparse K·v (condition estimate, energies)"),
                       ("llt", "Cholesky (symbolic+numeric+solves)"), ("gemm", "dense kernels (gemm, condensation)"),
-                      ("exmex", "expression evaluation"), ("output", "results writer (Rust side)"),
+                      ("exmex", "expression evaluation: exmex interpreter"),
+                      ("forward_solve", "Cholesky (symbolic+numeric+solves)"),
+                      ("backward_solve", "Cholesky (symbolic+numeric+solves)"),
+                      ("loads::", "load assembly (scatter of the values)"), ("norms::", "error norms (sums)"), ("output", "results writer (Rust side)"),
                       ("hdf5", "HDF5 library"), ("ssn", "friction QP (ssn/uzawa)"), ("uzawa", "friction QP (ssn/uzawa)"),
                       ("contact", "friction QP (ssn/uzawa)"), ("finish", "finiteness check + errors (finish)"),
                       ("Condensed::new", "condensation")]:
@@ -212,6 +243,7 @@ def main(argv=None):
     ap.add_argument("--max-refine-growth", type=int, default=7)
     ap.add_argument("--no-python", action="store_true")
     ap.add_argument("--no-perf", action="store_true")
+    ap.add_argument("--mms-only", action="store_true", help="only section 6 (issue 13), into reference/performance_mms.md")
     args = ap.parse_args(argv)
     R = 3 if args.quick else args.repeats
     levels = range(3) if args.quick else range(5)
@@ -235,7 +267,18 @@ def main(argv=None):
            "(set-up + steps + writing, without process start/exit); per step = (CLI wall − set-up)/N "
            "(includes forming u and, when written, the writing of every step)",
            "* set-up = mesh+space / assembly (K and the load operator) / factorisation (AMD + Cholesky, faer, "
-           "sequential) / condensation (C = EᵀK⁻¹E, Z = K⁻¹E, and the load superposition basis)", ""]
+           "sequential, contact unknowns ordered last) / condensation (C = (L_cc L_ccᵀ)⁻¹ from the factor's trailing block, and "
+           "the load superposition basis)", ""]
+
+    if args.mms_only:
+        tg = mms_section(args, R, tmp, md, csvrows)
+        for t, m, ok in tg:
+            md.append(f"| {t} | {m} | {'PASS' if ok else 'FAIL'} |")
+        with open(os.path.join(REF, "performance_mms.md"), "w") as f:
+            f.write("\n".join(md) + "\n")
+        for t, m, ok in tg:
+            print(f"[{'PASS' if ok else 'FAIL'}] {t}: {m}")
+        return
 
     # ---------------------------------------------------------------- 1. Example 5.1
     print("== 1. Example 5.1 at the levels of Table 5.1", flush=True)
@@ -356,8 +399,9 @@ def main(argv=None):
                             wall=rs.wall, per_step=rs.per_step, setup_fact=rs.setup[2], load=rs.load))
         print(md[-1], flush=True)
     md += ["", "Example 5.1's loads are proportional (g = t·g₁), so its steps do not solve with the factor at all: "
-           "u_f = Σ c_j K⁻¹b_j (superposition) and u = u_f − Zμ with Z = K⁻¹E kept dense (n × n_c); a step is "
-           "O(n·(rank + n_c)) dense work plus the O(n_c²)-per-iteration friction QP.", ""]
+           "u_f = Σ c_j K⁻¹b_j (superposition) and u = u_f − K⁻¹Eμ with K⁻¹Eμ = P L⁻ᵀ[0; L_cc⁻¹μ], one backward "
+           "half-solve, reused while μ repeats; a step is O(n·rank) dense work, that half-solve when μ changes, and "
+           "the O(n_c²)-per-iteration friction QP.", ""]
 
     # ---------------------------------------------------------------- 4. growth
     print("== 4. growth with DOF", flush=True)
@@ -417,8 +461,10 @@ def main(argv=None):
                     md.append(f"| {p:.1f} % | {g} |")
             md += ["", "Top symbols (self):", "", "```"] + lines[:25] + ["```", ""]
 
+    tg13 = mms_section(args, R, tmp, md, csvrows)
+
     # ---------------------------------------------------------------- targets
-    md += ["## Targets (issue 7)", "", "| target | measured | result |", "|---|---|---|"]
+    md += ["## Targets (issues 7 and 13)", "", "| target | measured | result |", "|---|---|---|"]
     tg = []
     if kf == 4:
         tg.append(("Example 5.1 finest (6,208 DOF, 640 steps) solved < 0.1 s",
@@ -438,6 +484,12 @@ def main(argv=None):
                    f"step after set-up {fmt_t(step)}; a whole 1-step run {fmt_t(w1)} (factorisation {fmt_t(st[2])}, "
                    f"assembly {fmt_t(st[1])}), peak {rss / 1024 ** 2:.2f} GB", step < 2.0))
         tg.append((f"(stricter reading) a whole 1-step run at {n} unknowns < 2 s", fmt_t(w1), w1 < 2.0))
+    if kf == 4:
+        tg.append(("(issue 13) Example 5.1 finest solved < 25 ms (process)", f"{fmt_t(fin_s.wall)} (CPU {fmt_t(fin_s.cpu)})",
+                   fin_s.wall < 0.025))
+        tg.append(("(issue 13) Example 5.1 finest written in full, per-step commits < 80 ms (process)",
+                   f"{fmt_t(fin_w.wall)} (CPU {fmt_t(fin_w.cpu)})", fin_w.wall < 0.08))
+    tg += tg13
     for t, m, ok in tg:
         md.append(f"| {t} | {m} | {'PASS' if ok else 'FAIL'} |")
     md += ["", f"Load average at the end: {' '.join(open('/proc/loadavg').read().split()[:3])}.", ""]
@@ -454,6 +506,107 @@ def main(argv=None):
     print("wrote reference/performance.md, reference/performance.csv")
     for t, m, ok in tg:
         print(f"[{'PASS' if ok else 'FAIL'}] {t}: {m}")
+
+
+MMS_RUNS = [
+    # (label, scene, extra arguments, wall target in s or None)
+    ("mms_stop, refine 5, 64 steps", os.path.join("verification", "cases", "mms_stop.toml"), ["--refine", "5", "--steps", "64"], 5.0),
+    ("bench_mms_poly (256×128, 80 steps)", os.path.join("verification", "bench", "bench_mms_poly.toml"), [], 5.0),
+    ("mms_front, refine 2, 256 steps", os.path.join("verification", "cases", "mms_front.toml"), ["--refine", "2", "--steps", "256"], 0.5),
+    ("Example 5.1 n = 64 (refine 5, 1280 steps)", os.path.join("verification", "cases", "paper_example_5_1.toml"),
+     ["--refine", "5", "--steps", "1280"], 0.12),
+]
+
+
+def mms_section(args, R, tmp, md, csvrows):
+    """Section 6 (issue 13); returns its target rows."""
+    print("== 6. manufactured-solution runs", flush=True)
+    tg = []
+    md += ["## 6. Manufactured-solution runs and the condensation (issue 13)", "",
+           "`tresca-cr run SCENE ARGS -q` (solve-only, true errors at every time node when the scene has `[exact]`). "
+           "CPU = user + sys time of the process (both cores count), next to the wall time: on this shared "
+           "machine the wall time also contains waiting for a core. Set-up split from the CLI (ms resolution). "
+           "Before issue 13 (2-core machine, from the issue): mms_stop r5 87 s (condensation 21 s), the "
+           "196,608-unknown polynomial case 54 s (condensation 12.6 s), mms_front r2 7–16 s, Example 5.1 n = 64 0.36 s.", "",
+           "| run | unknowns | contact edges | process wall (median) | CPU | set-up mesh / asm / fact / cond | per step | target | load |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    rec = {}
+    for label, scene, extra, target in MMS_RUNS:
+        r = Rec([BIN, "run", os.path.join(ROOT, scene)] + extra + ["-q"], R)
+        rec[label] = r
+        i = r.info
+        st = " / ".join(f"{v * 1e3:.0f}" for v in r.setup) + " ms"
+        md.append(f"| `{scene} {' '.join(extra)}` | {i['unknowns']} | {i['contact']} | {fmt_t(r.wall)} | {fmt_t(r.cpu)} | "
+                  f"{st} | {fmt_t(r.per_step)} | < {fmt_t(target)} | {r.load} |")
+        csvrows.append(dict(section="mms", mode=label, dofs=i["unknowns"], steps=i["steps"], wall=r.wall, cli_wall=med(r.cli),
+                            per_step=r.per_step, setup_mesh=r.setup[0], setup_asm=r.setup[1], setup_fact=r.setup[2],
+                            setup_cond=r.setup[3], load=r.load))
+        print(md[-1], flush=True)
+        tg.append((f"(issue 13) {label} < {fmt_t(target)}", f"{fmt_t(r.wall)} wall, CPU {fmt_t(r.cpu)}", r.wall < target))
+    conds = [(lab, r.setup[3], r.info["contact"], r.info["unknowns"]) for lab, r in rec.items() if r.info["unknowns"] >= 1e5 or r.info["contact"] >= 128]
+    for lab, c, nc, n in conds:
+        tg.append((f"(issue 13) condensation, {nc} contact unknowns on {n} unknowns < 0.3 s", fmt_t(c), c < 0.3))
+    md.append("")
+
+    # expression throughput
+    p = subprocess.run(["cargo", "run", "--release", "--quiet", "--example", "expr_throughput"], capture_output=True,
+                       text=True, cwd=ROOT, env=dict(os.environ, RAYON_NUM_THREADS="1"))
+    if p.returncode == 0:
+        e = json.loads(p.stdout.strip().splitlines()[-1])
+        md += ["### Expression throughput (one core)", "",
+               f"The longest expression of `verification/cases/` (`{e['file']}`, `{e['key']}`, {e['chars']} characters; "
+               f"{e['instructions']} instructions per point once compiled): exmex's interpreter "
+               f"{e['interpreted_points_per_s']:.3g} points/s, the compiled program {e['compiled_points_per_s']:.3g} "
+               f"points/s ({e['speedup']:.0f}×; median of 5, `RAYON_NUM_THREADS=1 cargo run --release --example expr_throughput`).", ""]
+    else:
+        md += [f"expr_throughput failed: {p.stderr[-300:]}", ""]
+
+    # side by side with the Python solvers on mms_stop refine 4
+    if not args.no_python:
+        scene = os.path.join(ROOT, "verification", "cases", "mms_stop.toml")
+        steps = "16"
+        rust_h5 = os.path.join(tmp, "mms_stop_r4.h5")
+        rr = Rec([BIN, "run", scene, "--refine", "4", "--steps", steps, "-q", "-o", rust_h5, "--force"], R, h5=rust_h5)
+        md += ["### mms_stop refine 4 (16 steps) against the Python solvers", "",
+               f"Rust written in full: {fmt_t(rr.wall)} (CPU {fmt_t(rr.cpu)}). Same command shape as section 2.", "",
+               "| solver | process (median) | CPU | ratio process/Rust | ratio CPU/Rust | max du vs Rust | load |", "|---|---|---|---|---|---|---|"]
+        for name in ["skfem", "dolfinx"]:
+            out = os.path.join(tmp, f"{name}_mms_stop_r4.h5")
+            cmd = [PY, os.path.join(ROOT, "scripts", f"{name}_solve.py"), scene, "-o", out, "--refine", "4", "--steps", steps, "-q"]
+            walls, cpus, loads = [], [], []
+            for _ in range(R):
+                loads.append(load1())
+                w, _, _ = timed(cmd)
+                walls.append(w)
+                cpus.append(LAST_CPU[0])
+            cmp = subprocess.run([PY, os.path.join(ROOT, "scripts", "compare.py"), rust_h5, out, "--quiet"],
+                                 capture_output=True, text=True)
+            m = re.search(r"max du = (\S+),", cmp.stdout)
+            du = float(m.group(1)) if m else float("nan")
+            w, c = med(walls), med(cpus)
+            md.append(f"| {name} | {fmt_t(w)} | {fmt_t(c)} | {w / rr.wall:.1f}× | {c / rr.cpu:.1f}× | {du:.1e} | "
+                      f"{min(loads):.2f}-{max(loads):.2f} |")
+            print(md[-1], flush=True)
+            tg.append((f"(issue 13) ≥ 20× faster than {name} on mms_stop refine 4 at equal answers",
+                       f"{w / rr.wall:.1f}× (process), {c / rr.cpu:.1f}× (CPU); max du {du:.1e}", w / rr.wall >= 20 and du < 1e-8))
+        md.append("")
+
+    # profile of mms_stop refine 5
+    if not args.no_perf and shutil.which("perf"):
+        label, scene, extra, _ = MMS_RUNS[0]
+        lines, groups = perf_profile([BIN, "run", os.path.join(ROOT, scene)] + extra + ["-q"], tmp, "mms_stop", freq=2000)
+        if lines is not None:
+            md += [f"### Profile: {label}", "", "Grouped self time (`perf record -F 2000 -g`; all threads):", "",
+                   "| share | where |", "|---|---|"]
+            for g, pc in sorted(groups.items(), key=lambda kv: -kv[1]):
+                if pc >= 0.5:
+                    md.append(f"| {pc:.1f} % | {g} |")
+            expr = sum(pc for g, pc in groups.items() if g.startswith("expression evaluation"))
+            md += ["", f"Expression evaluation in all: {expr:.1f} % of the samples.", "",
+                   "Top symbols (self):", "", "```"] + lines[:20] + ["```", ""]
+            tg.append(("(issue 13) expression evaluation < 25 % of an MMS run (mms_stop r5, perf samples)",
+                       f"{expr:.1f} %", expr < 25))
+    return tg
 
 
 if __name__ == "__main__":

@@ -25,7 +25,6 @@ import importlib.metadata
 import json
 import os
 import platform
-import shlex
 import subprocess
 import sys
 import time
@@ -33,14 +32,15 @@ import time
 import h5py
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import BIN, MPIRUN, PY, ROOT, SCRIPTS  # noqa: E402
+from common import CASES as CASES_DIR  # noqa: E402
+from common import cmdline  # noqa: E402
+from common import short_path as rel  # noqa: E402
+
+sys.path.insert(0, SCRIPTS)
 import compare  # noqa: E402
 
-BIN = os.path.join(ROOT, "target", "release", "tresca-cr")
-PY = sys.executable
-MPIRUN = os.path.join(os.path.dirname(PY), "mpirun")
-CASES_DIR = os.path.join(ROOT, "verification", "cases")
 TOL = 1e-8
 
 # case -> (levels, steps override or None) ; quick: one level each
@@ -152,14 +152,6 @@ def generated_scenes(workdir):
     with open(out["expr_functions"], "w") as fh:
         fh.write(text)
     return out
-
-
-def rel(p):
-    return os.path.relpath(p, ROOT) if os.path.isabs(p) and p.startswith(ROOT) else p
-
-
-def cmdline(cmd):
-    return " ".join(shlex.quote(rel(c)) for c in cmd)
 
 
 def run_code(code, scene, out, refine, steps, mpi=0):

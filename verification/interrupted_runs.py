@@ -24,10 +24,10 @@ import time
 
 import h5py
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIN = os.path.join(ROOT, "target", "release", "tresca-cr")
-PY = sys.executable
-EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import BIN, PY, ROOT, case  # noqa: E402
+
+EX51 = case("paper_example_5_1")
 FAILED = []
 
 

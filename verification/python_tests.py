@@ -8,6 +8,8 @@
 2. results file read by real clients: VTK's vtkHDFReader, meshio (XDMF) and h5py, values checked against
    the solver's (scripts/check_results.py on a fresh Example 5.1 run);
    and verification/interrupted_runs.py: the same for the files of a killed, a stopped and a resumed run;
+   and verification/paraview_check.py --skip-missing: ParaView's three XDMF readers (pvpython) on a finished,
+   a killed and a resumed run, and a rendered picture (skipped with a message where pvpython is absent);
 3. verification/cross_check.py --quick: Rust == scikit-fem == dolfinx (1e-8, identical stick/slip sets) on
    every scene of verification/cases at one mesh level, plus one mpirun -n 2 case
    (report out/cross_check_quick.md, requirements out/cross_check_quick.json).
@@ -20,8 +22,8 @@ import subprocess
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-PY = sys.executable
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import PY, ROOT  # noqa: E402
 BUDGET = 240.0
 
 
@@ -40,6 +42,7 @@ def main():
                                                "-q", "-o", h5, "--force"]),
         ("VTK / meshio / h5py read the results file", [PY, "scripts/check_results.py", h5]),
         ("files of killed, stopped and resumed runs", [PY, "verification/interrupted_runs.py"]),
+        ("ParaView opens finished, killed and resumed runs", [PY, "verification/paraview_check.py", "--skip-missing"]),
         ("Python solver checks", [PY, "scripts/test_python_solvers.py", "--quick", "--no-cases"] + mpi),
         ("cross-check Rust / scikit-fem / dolfinx", [PY, "verification/cross_check.py", "--quick",
                                                       "--json", "out/cross_check_quick.json"] + mpi),

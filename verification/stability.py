@@ -19,9 +19,9 @@ import tempfile
 import h5py
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIN = os.path.join(ROOT, "target", "release", "tresca-cr")
-REF = os.path.join(ROOT, "reference")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import BIN, REF, ROOT  # noqa: E402
+from common import rel_to as rel  # noqa: E402
 NEAR = os.path.join(ROOT, "verification", "cases", "near_incompressible.toml")
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 MMS_EL = os.path.join(ROOT, "verification", "cases", "mms_elastic.toml")
@@ -127,10 +127,6 @@ def run(scene, *extra, out=None):
 def h5(path, name):
     with h5py.File(path, "r") as f:
         return f[name][()]
-
-
-def rel(a, b):
-    return float(np.max(np.abs(a - b)) / max(np.max(np.abs(b)), 1e-300))
 
 
 # ----------------------------------------------------------------------------- P1 conforming (scikit-fem)

@@ -1,19 +1,26 @@
-//! `tresca-cr study`: a convergence study printed as a table (and written as CSV).
+//! `tresca-cr study`: a convergence study printed as a table (and written as CSV), then the error
+//! estimates without an exact solution (Richardson, GCI, asymptotic-range verdict per level).
 
 use anyhow::{Context, Result};
 use std::path::PathBuf;
-use tresca_cr::study::{Level, LevelResult};
+use tresca_cr::study::{Level, LevelResult, Study};
 use tresca_cr::Scene;
 
-pub fn study(scene: Scene, levels: &[Level], reference: Option<Level>, csv: Option<PathBuf>) -> Result<()> {
+pub fn study(
+    scene: Scene,
+    levels: &[Level],
+    reference: Option<Level>,
+    csv: Option<PathBuf>,
+    differences: Option<PathBuf>,
+) -> Result<()> {
     use tresca_cr::study::orders::observed_order;
-    use tresca_cr::study::{csv_row, run_study, CSV_HEADER};
+    use tresca_cr::study::run_study;
     println!(
         "{:>3} {:>6} {:>9} {:>9} {:>8} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>8}",
         "ref", "steps", "h", "k", "DOF", "energy", "ord", "L2", "ord", "consec(T)", "ord", "vs ref(T)", "ord", "wall s"
     );
     let mut prev: Option<LevelResult> = None;
-    let results = run_study(&scene, levels, reference, |r| {
+    let study = run_study(&scene, levels, reference, differences.as_deref(), |r| {
         let o = |f: &dyn Fn(&LevelResult) -> Option<f64>| match (&prev, f(r)) {
             // orders against h, or against k when only the time step changes
             (Some(p), Some(b)) => {
@@ -46,14 +53,77 @@ pub fn study(scene: Scene, levels: &[Level], reference: Option<Level>, csv: Opti
         );
         prev = Some(r.clone());
     })?;
+    println!("(energy, L2: true errors, max over each level's own time nodes)");
+    print_estimates(&study);
+    for f in &study.difference_files {
+        println!("wrote {}", f.display());
+    }
     if let Some(path) = csv {
-        let mut text = String::from(CSV_HEADER);
-        text.push('\n');
-        for r in &results {
-            text += &csv_row(r);
-            text.push('\n');
-        }
-        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+        std::fs::write(&path, tresca_cr::study::csv::text(&study))
+            .with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(())
+}
+
+/// The estimates: energy norm per level, then every scalar output.
+fn print_estimates(s: &Study) {
+    let e = &s.estimates;
+    println!();
+    match (&e.model, &e.refused) {
+        (Some(m), _) => println!(
+            "Error estimate without an exact solution (energy norm, order in {}): p = {:.3}, β = {:.3} from the three finest levels",
+            e.size, m.p, m.beta
+        ),
+        (None, why) => {
+            println!("No error estimate (energy norm): not yet: refine further ({})", why.clone().unwrap_or_default());
+        }
+    }
+    if e.model.is_some() {
+        let true_col = s.levels.iter().any(|r| r.common_err.is_some() || r.reference.is_some());
+        println!(
+            "{:>3} {:>6} {:>11} {:>11} {:>11} {:>7}  verdict",
+            "ref",
+            "steps",
+            "est(max)",
+            "GCI",
+            if true_col { "true/ref" } else { "" },
+            if true_col { "eff" } else { "" }
+        );
+        for (r, l) in s.levels.iter().zip(&e.levels) {
+            // the truth the estimate is compared with: the exact error on different meshes (else the
+            // reference run), the reference run on one mesh (the sequence's limit is the semi-discrete solution)
+            let reference = r.reference.map(|v| v[0]);
+            let truth = if e.size == "k" { reference } else { r.common_err.map(|v| v.energy).or(reference) };
+            let (t, eff) = truth
+                .map_or((String::new(), String::new()), |t| (format!("{t:.4e}"), format!("{:.3}", l.error[0] / t)));
+            println!(
+                "{:>3} {:>6} {:>11.4e} {:>11.4e} {:>11} {:>7}  {}",
+                r.refine,
+                r.steps,
+                l.error[0],
+                l.gci,
+                t,
+                eff,
+                l.verdict.text()
+            );
+        }
+    }
+    for o in &s.outputs {
+        match o.model {
+            Some(m) => println!("\nOutput {} at T: extrapolated {:.6e}, p = {:.3}", o.name, m.limit, m.p),
+            None => println!("\nOutput {} at T: no extrapolation", o.name),
+        }
+        for (r, (l, q)) in s.levels.iter().zip(o.levels.iter().zip(s.levels.iter().map(|r| r.outputs.clone()))) {
+            let idx = s.outputs.iter().position(|x| x.name == o.name).unwrap_or(0);
+            println!(
+                "{:>3} {:>6} value {:>12.5e}  est {:>10.3e}  GCI {:>10.3e}  {}",
+                r.refine,
+                r.steps,
+                q.get(idx).copied().unwrap_or(f64::NAN),
+                l.0,
+                l.1,
+                l.2.text()
+            );
+        }
+    }
 }

@@ -1,12 +1,13 @@
 //! The load functional t ↦ lⁿ on the unknowns of V_h:
 //!   (lⁿ, v) = ∫_Ω f(tₙ)·v (Dunavant degree 4) + Σ_{Neumann e} ∫_e g(tₙ)·v (3-point Gauss).
-//! Quadrature points and basis values are stored once, so each step only evaluates the expressions.
+//! Quadrature points and the weights w·φ feeding each unknown are stored once, so each step evaluates the
+//! (compiled) load expressions at all points of a term in one batch, then scatters sequentially.
 
 use super::quadrature::{edge_point, tri_point, GAUSS3, TRI4};
-use super::space::{CrSpace, EdgeDof, Element};
+use super::space::{CrSpace, Element};
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::scene::expr::Vec2Expr;
+use crate::scene::expr::{BoundSet, ExprSet, Vec2Expr};
 use crate::scene::{PartKind, Scene};
 
 /// A quadrature point of a load term: position, and the (edge, weight · φ) pairs it feeds.
@@ -16,30 +17,38 @@ struct LoadPoint {
     edges: [(usize, f64); 3],
 }
 
+/// One contribution of a point's value v: `out[slot] += w · (c·v)`.
+#[derive(Clone, Copy, Debug)]
+struct Scatter {
+    slot: usize,
+    w: f64,
+    c: [f64; 2],
+}
+
 /// Precomputed quadrature for one vector load (body force or one Neumann part).
 #[derive(Clone, Debug)]
 struct LoadTerm {
-    expr: Vec2Expr,
-    points: Vec<LoadPoint>,
+    /// Both components, compiled together and bound to the quadrature points.
+    expr: BoundSet,
+    /// The contributions of point i: `scatter[first[i]..first[i + 1]]`.
+    first: Vec<usize>,
+    scatter: Vec<Scatter>,
 }
 
 /// The load functional t ↦ l(t) on the unknowns.
 #[derive(Clone, Debug)]
 pub struct Loads {
     terms: Vec<LoadTerm>,
-    /// The unknowns of each edge's midpoint value (the space's numbering).
-    edge_dof: Vec<EdgeDof>,
     n_dofs: usize,
     /// The unknowns any load can touch, increasing (all of them with a body force, only boundary ones
-    /// with tractions alone); `slot[k]` is the position of unknown k in it.
+    /// with tractions alone).
     support: Vec<usize>,
-    slot: Vec<usize>,
 }
 
 impl Loads {
     /// Quadrature points of the body force (if any) and of every Neumann part with a traction.
     pub fn new(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Loads {
-        let mut terms = Vec::new();
+        let mut raw: Vec<(&Vec2Expr, Vec<LoadPoint>)> = Vec::new();
         if let Some(f) = &scene.f {
             let mut points = Vec::with_capacity(6 * mesh.tris.len());
             for t in 0..mesh.tris.len() {
@@ -51,7 +60,7 @@ impl Loads {
                     points.push(LoadPoint { x: tri_point(el.pts, l), edges });
                 }
             }
-            terms.push(LoadTerm { expr: f.clone(), points });
+            raw.push((f, points));
         }
         for (p, part) in scene.parts.iter().enumerate() {
             let PartKind::Neumann(Some(g)) = &part.kind else {
@@ -73,10 +82,10 @@ impl Loads {
                     points.push(LoadPoint { x, edges });
                 }
             }
-            terms.push(LoadTerm { expr: g.clone(), points });
+            raw.push((g, points));
         }
         let mut touched = vec![false; space.n_dofs];
-        for p in terms.iter().flat_map(|t| &t.points) {
+        for p in raw.iter().flat_map(|t| &t.1) {
             for &(e, _) in &p.edges {
                 for (k, _) in space.edge_dof[e].terms() {
                     touched[k] = true;
@@ -88,7 +97,22 @@ impl Loads {
         for (i, &k) in support.iter().enumerate() {
             slot[k] = i;
         }
-        Loads { terms, edge_dof: space.edge_dof.clone(), n_dofs: space.n_dofs, support, slot }
+        let terms = raw
+            .into_iter()
+            .map(|(e, pts)| {
+                let mut first = vec![0];
+                let mut scatter = Vec::new();
+                for p in &pts {
+                    for &(e, w) in &p.edges {
+                        scatter.extend(space.edge_dof[e].terms().map(|(k, c)| Scatter { slot: slot[k], w, c }));
+                    }
+                    first.push(scatter.len());
+                }
+                let points = pts.iter().map(|p| p.x).collect();
+                LoadTerm { expr: ExprSet::new(&[&e.0[0], &e.0[1]]).bind(points), first, scatter }
+            })
+            .collect();
+        Loads { terms, n_dofs: space.n_dofs, support }
     }
 
     /// The unknowns a load can be nonzero on (increasing).
@@ -100,15 +124,13 @@ impl Loads {
     pub fn assemble_on_support(&self, t: f64, out: &mut Vec<f64>) -> Result<()> {
         out.clear();
         out.resize(self.support.len(), 0.0);
+        let mut values = Vec::new();
         for term in &self.terms {
-            // the expression values in parallel (order kept), the sums sequentially: bit-identical results
-            let values = crate::parallel::map(&term.points, |p| term.expr.eval(p.x[0], p.x[1], t));
-            for (p, v) in term.points.iter().zip(values) {
-                let v = v?;
-                for &(e, wphi) in &p.edges {
-                    for (k, c) in self.edge_dof[e].terms() {
-                        out[self.slot[k]] += wphi * (c[0] * v[0] + c[1] * v[1]);
-                    }
+            // the expression values in parallel batches, the sums sequentially: bit-identical results
+            term.expr.eval(t, &mut values)?;
+            for (i, v) in values.chunks_exact(2).enumerate() {
+                for s in &term.scatter[term.first[i]..term.first[i + 1]] {
+                    out[s.slot] += s.w * (s.c[0] * v[0] + s.c[1] * v[1]);
                 }
             }
         }

@@ -67,6 +67,11 @@ impl Friction {
     pub fn new(space: &CrSpace, c: DMatrix<f64>, settings: SolverSettings) -> Friction {
         let w = space.contact.iter().map(|e| e.length * e.g_mean).collect();
         let g_mean = space.contact.iter().map(|e| e.g_mean).collect();
+        Friction::from_parts(c, w, g_mean, settings)
+    }
+
+    /// The problem of operator C, weights w and mean bounds ḡ (Uzawa's c_τ).
+    pub(crate) fn from_parts(c: DMatrix<f64>, w: Vec<f64>, g_mean: Vec<f64>, settings: SolverSettings) -> Friction {
         Friction { c, w, g_mean, settings, zeroed: Default::default() }
     }
 
@@ -222,3 +227,6 @@ pub fn classify(qp: &Qp, mu: &[f64], ds: &[f64]) -> Vec<EdgeState> {
 pub fn stalled(solver: &'static str, iterations: usize, residual: f64) -> Stalled {
     Stalled { solver, iterations, residual }
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,4 +1,4 @@
-//! Semismooth Newton for the condensed friction QP (see `contact`): Bertsekas' projected Newton method.
+//! Semismooth Newton for the condensed friction QP (see `friction`): Bertsekas' projected Newton method.
 //!
 //! Each iteration splits the edges into an ε-active set A (at a bound, with the gradient g = Cμ − d pushing
 //! outward) and a free set F, takes the Newton step p_F = −C_FF⁻¹ g_F on F and a scaled gradient step

@@ -1,18 +1,21 @@
-//! Visualisation fields of one step on the broken mesh.
+//! Visualisation fields of one step, for two datasets: the **body** (the T triangles on the broken mesh)
+//! and the **contact line** Γ_C (its C edges as line cells). Each carries only the fields that exist on it.
 //!
 //! The broken mesh has 3 points per triangle (point 3t + j is local vertex j of triangle t), so the CR
 //! field is written exactly as a discontinuous P1 field: on T, u_h|_T = Σ_i φ_i U_{e_i} with
 //! φ_i = 1 − 2λ_i, hence at local vertex j (λ_j = 1): u_h|_T(v_j) = Σ_{i≠j} U_{e_i} − U_{e_j}.
-//! Cells are the T triangles followed by the C Γ_C edges as line cells; a line cell uses the two broken
-//! points of its one triangle, so it moves with the body.
+//! Warped by this field, neighbouring triangles separate: the CR field is continuous only at edge
+//! midpoints, so the gaps are the method's nonconformity, not an error of the picture.
+//! Contact edge k has its own two points 2k, 2k + 1: the broken points of its one triangle, with that
+//! triangle's displacement there, so the line moves with the body.
 //!
-//! Per cell (constant on a triangle; a Γ_C line cell repeats its triangle's values):
+//! Body cell arrays (constant on a triangle):
 //! * `strain`: symmetric tensor in VTK's 6-component order (xx, yy, zz, xy, yz, xz); ε_zz = ε_yz = ε_xz = 0,
 //!   ε_xy is the tensor (not engineering) shear strain;
 //! * `stress`: same order, plane strain: σ = λ tr ε I + 2μ ε, σ_zz = λ tr ε;
 //! * `von_mises`: √(½[(σxx−σyy)² + (σyy−σzz)² + (σzz−σxx)²] + 3σxy²).
 //!
-//! Contact cell arrays (zero on triangles): `sigma_t` = σ_τ·τ_e = −μ_e/|e|, `slip` = u_τ(m_e),
+//! Contact cell arrays: `sigma_t` = σ_τ·τ_e = −μ_e/|e|, `slip` = u_τ(m_e),
 //! `slip_increment` = sⁿ − sⁿ⁻¹ (0 at step 0), `stick_slip` = 0 stick, 1 slip.
 
 use super::Run;
@@ -23,36 +26,30 @@ use crate::stepping::StepResult;
 /// Components of the strain and stress arrays.
 pub const TENSOR: usize = 6;
 
-/// Static broken-mesh geometry and what a step needs to evaluate fields fast.
+/// Static geometry of both datasets and what a step needs to evaluate fields fast.
 pub struct Fields {
-    /// Broken points (3T, 3), z = 0.
+    /// Broken body points (3T, 3), z = 0.
     pub points: Vec<[f64; 3]>,
-    /// Connectivity of the T triangles then the C line cells.
-    pub connectivity: Vec<i64>,
-    /// VTK cell types: 5 triangle, 3 line.
-    pub types: Vec<u8>,
-    /// Offsets into connectivity (T + C + 1).
-    pub offsets: Vec<i64>,
-    /// 0 triangle, 1 Γ_C edge.
-    pub cell_kind: Vec<u8>,
+    /// Contact line points (2C, 3): point 2k + i is broken point `contact_points_of[2k + i]` of the body.
+    pub contact_points: Vec<[f64; 3]>,
+    contact_points_of: Vec<usize>,
     /// tri_edges of every triangle.
     tri_edges: Vec<[usize; 3]>,
     /// Element geometry of every triangle.
     elements: Vec<Element>,
-    /// Triangle of each contact edge.
-    contact_tri: Vec<usize>,
     /// |e| of each contact edge.
     contact_len: Vec<f64>,
     law: Elasticity,
 }
 
-/// One step's cell and point arrays (f32, as written).
+/// One step's arrays (f32, as written): body point and cell arrays, then contact point and cell arrays.
 #[derive(Default)]
 pub struct StepFields {
     pub displacement: Vec<f32>,
     pub strain: Vec<f32>,
     pub stress: Vec<f32>,
     pub von_mises: Vec<f32>,
+    pub contact_displacement: Vec<f32>,
     pub sigma_t: Vec<f32>,
     pub slip: Vec<f32>,
     pub slip_increment: Vec<f32>,
@@ -73,62 +70,52 @@ impl Fields {
             }
             elements.push(Element::new(mesh, t));
         }
-        let mut connectivity: Vec<i64> = (0..3 * nt as i64).collect();
-        let mut types = vec![5u8; nt];
-        let mut offsets: Vec<i64> = (0..=nt as i64).map(|k| 3 * k).collect();
-        let mut cell_kind = vec![0u8; nt];
-        let mut contact_tri = Vec::with_capacity(nc);
+        let mut contact_points_of = Vec::with_capacity(2 * nc);
         let mut contact_len = Vec::with_capacity(nc);
         for c in &space.contact {
             let t = mesh.edge_tris[c.edge].0;
             let i =
                 mesh.tri_edges[t].iter().position(|&e| e == c.edge).expect("contact edge is an edge of its triangle");
-            connectivity.push((3 * t + (i + 1) % 3) as i64);
-            connectivity.push((3 * t + (i + 2) % 3) as i64);
-            offsets.push(connectivity.len() as i64);
-            types.push(3);
-            cell_kind.push(1);
-            contact_tri.push(t);
+            contact_points_of.extend([3 * t + (i + 1) % 3, 3 * t + (i + 2) % 3]);
             contact_len.push(c.length);
         }
         Fields {
+            contact_points: contact_points_of.iter().map(|&q| points[q]).collect(),
             points,
-            connectivity,
-            types,
-            offsets,
-            cell_kind,
+            contact_points_of,
             tri_edges: mesh.tri_edges.clone(),
             elements,
-            contact_tri,
             contact_len,
             law: p.law,
         }
     }
 
+    /// Body points (3T).
     pub fn n_points(&self) -> usize {
         self.points.len()
     }
-    pub fn n_cells(&self) -> usize {
-        self.types.len()
-    }
+    /// Triangles T.
     pub fn n_tris(&self) -> usize {
         self.tri_edges.len()
+    }
+    /// Contact edges C.
+    pub fn n_contact(&self) -> usize {
+        self.contact_len.len()
     }
 
     /// Evaluate every array of a step into `out` (buffers are reused). `mid` are the midpoint values,
     /// `prev_slip` the previous step's slip (None at step 0).
     pub fn eval(&self, mid: &[[f64; 2]], r: &StepResult, prev_slip: Option<&[f64]>, out: &mut StepFields) {
         let nt = self.n_tris();
-        let nc = self.contact_tri.len();
-        let ncell = nt + nc;
+        let nc = self.n_contact();
         out.displacement.clear();
         out.strain.clear();
         out.stress.clear();
         out.von_mises.clear();
         out.displacement.reserve(9 * nt);
-        out.strain.reserve(TENSOR * ncell);
-        out.stress.reserve(TENSOR * ncell);
-        out.von_mises.reserve(ncell);
+        out.strain.reserve(TENSOR * nt);
+        out.stress.reserve(TENSOR * nt);
+        out.von_mises.reserve(nt);
         for (te, el) in self.tri_edges.iter().zip(&self.elements) {
             let u = te.map(|e| mid[e]);
             let s = [u[0][0] + u[1][0] + u[2][0], u[0][1] + u[1][1] + u[2][1]];
@@ -141,20 +128,14 @@ impl Fields {
             out.stress.extend_from_slice(&[sxx as f32, syy as f32, szz as f32, sxy as f32, 0.0, 0.0]);
             out.von_mises.push(von_mises(ss.stress) as f32);
         }
-        for &t in &self.contact_tri {
-            out.strain.extend_from_within(TENSOR * t..TENSOR * (t + 1));
-            out.stress.extend_from_within(TENSOR * t..TENSOR * (t + 1));
-            out.von_mises.push(out.von_mises[t]);
-        }
-        if nc == 0 {
-            return;
+        out.contact_displacement.clear();
+        for &q in &self.contact_points_of {
+            out.contact_displacement.extend_from_slice(&out.displacement[3 * q..3 * q + 3]);
         }
         for v in [&mut out.sigma_t, &mut out.slip, &mut out.slip_increment] {
             v.clear();
-            v.resize(nt, 0.0);
         }
         out.stick_slip.clear();
-        out.stick_slip.resize(nt, 0);
         for k in 0..nc {
             out.sigma_t.push((-r.mu[k] / self.contact_len[k]) as f32);
             out.slip.push(r.slip[k] as f32);

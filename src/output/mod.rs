@@ -3,8 +3,8 @@
 //! | group | for | content |
 //! |---|---|---|
 //! | `/tresca` | the project's tools (`scripts/`) | the README table, f64, one row per completed step ([`tresca`]) |
-//! | `/VTKHDF` | ParaView ≥ 5.13, VTK ≥ 9.3 `vtkHDFReader` | temporal UnstructuredGrid: broken mesh (3 points per triangle) + Γ_C line cells, f32 fields ([`vtkhdf`], [`fields`]) |
-//! | `/xdmf` | `run.xdmf` (meshio, ParaView's XDMF readers) | static mixed topology and per-step virtual datasets onto `/VTKHDF` arrays ([`xdmf`]) |
+//! | `/VTKHDF` | ParaView ≥ 5.13, VTK ≥ 9.4 `vtkHDFReader` | temporal PartitionedDataSetCollection: block `body` (broken mesh, 3 points per triangle) and block `contact` (Γ_C line cells), each with only its own f32 fields ([`vtkhdf`], [`fields`]) |
+//! | `/xdmf` | `run.xdmf` (ParaView 5.11's XDMF readers, meshio's `TimeSeriesReader`) | static topologies and per-frame virtual datasets onto `/VTKHDF` arrays, one temporal collection per block ([`xdmf`]) |
 //!
 //! **What is written when.** Every step goes to `/tresca`; the VTKHDF/XDMF views get *frames*: the
 //! steps n with n % `frame_every` == 0 and the last step ([`Options::frame_every`]; by default at most
@@ -15,7 +15,7 @@
 //! 0: every step), at the last step, and by [`Writer::finish`] / drop. A commit appends the
 //! batch to every time-dependent dataset (allocated for the whole run at creation, contiguous, written
 //! straight to the kernel: [`h5::Series`]), then sets `tresca/steps` attribute `completed` and
-//! `VTKHDF/Steps` attribute `NSteps`, flushes the file (H5Fflush: only these counters are dirty
+//! `NSteps` of each `VTKHDF/<block>/Steps`, flushes the file (H5Fflush: only these counters are dirty
 //! metadata), and only then appends the frames to `run.xdmf`. A new file is built as `run.h5.partial`
 //! and `run.xdmf.partial`, both renamed into place at the first commit (a run that commits
 //! nothing removes them), so a file under its name always holds at least step 0, and a run killed
@@ -309,7 +309,7 @@ impl Writer {
         };
         write().map_err(io(&path, &format!("writing steps {}..{}", self.completed, steps - 1)))?;
         // The series data is in the kernel now (direct writes, see `h5::Series`), so the counters that
-        // declare it complete may follow in one flush. `VTKHDF/Steps/Values` grows in that same flush: it
+        // declare it complete may follow in one flush. Each block's `Steps/Values` grows in that same flush: it
         // must never be longer than `NSteps` (see `vtkhdf::VtkHdf`).
         let f0 = Instant::now();
         let mark = || -> hdf5::Result<()> {

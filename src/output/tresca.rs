@@ -3,7 +3,8 @@
 //! a resumed run is bit-identical; σ_τ = −μ/|e| alone would round) and `tresca/contact/dof` (the contact
 //! unknown of uⁿ, equal to `slip` up to rounding).
 //!
-//! Time series (first axis = completed steps, grown one row per step):
+//! Time series (first axis = time node, allocated for all N + 1 steps at creation and filled as steps
+//! are committed; rows beyond `completed` hold no data, and a stopped run is cut to its steps):
 //! `times`, `u` (·, E, 2), `energy`, `steps/{iterations, residual, n_stick, n_slip, wall_time}`,
 //! `contact/{slip, sigma_t, state, mu, dof}` (·, C) when Γ_C exists, `errors/{energy, h1, l2}` when `[exact]`.
 //! `tresca/steps` carries the attribute `completed` (number of complete steps), written after every

@@ -1,31 +1,32 @@
-//! The `/VTKHDF` group: a temporal VTKHDF 2.x `UnstructuredGrid` (read by VTK ≥ 9.3's `vtkHDFReader`
-//! and ParaView ≥ 5.13) with a static mesh written once.
+//! The `/VTKHDF` group: a temporal VTKHDF 2.x `PartitionedDataSetCollection` of two `UnstructuredGrid`
+//! blocks (read by VTK ≥ 9.4's `vtkHDFReader`, whose temporal composite support this needs, and ParaView
+//! ≥ 5.13), so the body and the contact line Γ_C are separate datasets, each with only its own fields.
 //!
-//! * Attributes `Version` = [2, 2], `Type` = "UnstructuredGrid" (fixed-length ASCII).
-//! * Static: `NumberOfPoints` [3T], `NumberOfCells` [T + C], `NumberOfConnectivityIds`, `Points` (3T, 3),
-//!   `Connectivity`, `Offsets`, `Types` (5 triangle, 3 line); the broken mesh of [`super::fields`].
-//!   `CellData/cell_kind` (0 triangle, 1 Γ_C edge) is static too (its offsets are all 0).
-//! * Per frame f (rows f·P … (f+1)·P−1 of a flattened time-space array, f32; frames are the steps
-//!   n with n % frame_every == 0 and the last step, see [`Frames`]): `PointData/displacement`
-//!   (P, 3); `CellData/{strain, stress}` (T + C, 6), `CellData/von_mises`, and with Γ_C
-//!   `CellData/{sigma_t, slip, slip_increment}` (f32) and `CellData/stick_slip` (u8).
-//! * `Steps`: attribute `NSteps` (complete frames; updated after the data), `Values` (frame times, grown
-//!   per frame). `PartOffsets`, `NumberOfParts` (1), `PointOffsets`, `CellOffsets`, `ConnectivityIdOffsets` (0: the
-//!   geometry is shared by every frame), `PointDataOffsets/*` and `CellDataOffsets/*` (f·P, f·(T+C)) are
-//!   written for all frames at creation; readers only use the first `NSteps` entries.
+//! * `/VTKHDF`: attributes `Version` = [2, 2], `Type` = "PartitionedDataSetCollection" (fixed-length ASCII);
+//!   `Assembly/{body, contact}` are soft links to the blocks (groups track creation order, as the spec asks).
+//! * `/VTKHDF/body` (`Index` 0): T triangles on the broken mesh of [`super::fields`] (3T points); point data
+//!   `displacement` (3T, 3); cell data `strain`, `stress` (T, 6) and `von_mises` (T).
+//! * `/VTKHDF/contact` (`Index` 1, only when Γ_C exists): C line cells on 2C points; point data
+//!   `displacement` (2C, 3, the body's at the same points); cell data `sigma_t`, `slip`, `slip_increment`
+//!   (f32) and `stick_slip` (u8).
+//! * Per block, static `NumberOfPoints`, `NumberOfCells`, `NumberOfConnectivityIds`, `Points`,
+//!   `Connectivity`, `Offsets`, `Types`; per frame f (rows f·B … (f+1)·B−1 of flattened time-space arrays,
+//!   f32; frames are the steps n with n % frame_every == 0 and the last step, see [`Frames`]) the arrays above.
+//! * Per block `Steps` (the spec has no top-level `Steps` for composites; both blocks hold the same
+//!   frames): attribute `NSteps` (complete frames; updated after the data, in the same flush for both
+//!   blocks), `Values` (frame times, grown per frame). `PartOffsets`, `NumberOfParts` (1), `PointOffsets`,
+//!   `CellOffsets`, `ConnectivityIdOffsets` (0: static geometry), `PointDataOffsets/*` and
+//!   `CellDataOffsets/*` (f·B) are written for all frames at creation; readers only use the first `NSteps`.
 
 use super::fields::{Fields, StepFields, TENSOR};
 use super::h5::{attr, attr_fixed_ascii, attr_vec, put, Raw, Series};
+use hdf5::plist::group_create::LinkCreationOrder;
 use hdf5::{Dataset, Extent, Extents, File, Group};
 
-/// Names of the per-step cell arrays with their components (all f32 but `stick_slip`).
-pub fn cell_arrays(contact: bool) -> Vec<(&'static str, usize)> {
-    let mut v = vec![("strain", TENSOR), ("stress", TENSOR), ("von_mises", 1)];
-    if contact {
-        v.extend([("sigma_t", 1), ("slip", 1), ("slip_increment", 1), ("stick_slip", 1)]);
-    }
-    v
-}
+/// Cell arrays of the body block with their components (f32).
+pub const BODY_CELLS: [(&str, usize); 3] = [("strain", TENSOR), ("stress", TENSOR), ("von_mises", 1)];
+/// Cell arrays of the contact block (f32 but `stick_slip`, u8).
+pub const CONTACT_CELLS: [(&str, usize); 4] = [("sigma_t", 1), ("slip", 1), ("slip_increment", 1), ("stick_slip", 1)];
 
 /// Which steps are visualisation frames: n % every == 0, and the last step N.
 #[derive(Clone, Copy, Debug)]
@@ -53,8 +54,11 @@ pub struct FrameRows {
     pub first: usize,
     pub times: Vec<f64>,
     displacement: Vec<f32>,
-    /// f32 cell arrays in the order of [`cell_arrays`] (without `stick_slip`).
-    cells: [Vec<f32>; 6],
+    /// Body cell arrays in the order of [`BODY_CELLS`].
+    cells: [Vec<f32>; 3],
+    contact_displacement: Vec<f32>,
+    /// Contact f32 cell arrays in the order of [`CONTACT_CELLS`] (without `stick_slip`).
+    contact_cells: [Vec<f32>; 3],
     stick_slip: Vec<u8>,
 }
 
@@ -62,8 +66,11 @@ impl FrameRows {
     pub fn push(&mut self, t: f64, s: &StepFields) {
         self.times.push(t);
         self.displacement.extend_from_slice(&s.displacement);
-        let src = [&s.strain, &s.stress, &s.von_mises, &s.sigma_t, &s.slip, &s.slip_increment];
-        for (d, v) in self.cells.iter_mut().zip(src) {
+        for (d, v) in self.cells.iter_mut().zip([&s.strain, &s.stress, &s.von_mises]) {
+            d.extend_from_slice(v);
+        }
+        self.contact_displacement.extend_from_slice(&s.contact_displacement);
+        for (d, v) in self.contact_cells.iter_mut().zip([&s.sigma_t, &s.slip, &s.slip_increment]) {
             d.extend_from_slice(v);
         }
         self.stick_slip.extend_from_slice(&s.stick_slip);
@@ -76,48 +83,62 @@ impl FrameRows {
     }
 }
 
-pub struct VtkHdf {
+/// One `UnstructuredGrid` block: its `Steps` group and its time series.
+struct Block {
     steps: Group,
     /// `Steps/Values`, the one per-frame array whose length must equal `NSteps` at every commit: VTK
     /// 9.7's reader corrupts its heap on a longer one (measured; a killed run's file crashed it). It is
     /// chunked and grown frame by frame, in the same flush as `NSteps`.
     values: Dataset,
     displacement: Series,
-    /// In the order of [`cell_arrays`].
+    /// In the order of the block's cell array list.
     cells: Vec<Series>,
 }
 
-impl VtkHdf {
-    pub fn create(file: &File, f: &Fields, n_frames: usize, contact: bool) -> hdf5::Result<VtkHdf> {
-        let root = file.create_group("VTKHDF")?;
-        attr_vec(&root, "Version", &[2i64, 2])?;
-        attr_fixed_ascii::<16>(&root, "Type", "UnstructuredGrid")?;
-        let (np, ncell) = (f.n_points(), f.n_cells());
-        put(&root, "NumberOfPoints", &[1], &[np as i64])?;
-        put(&root, "NumberOfCells", &[1], &[ncell as i64])?;
-        put(&root, "NumberOfConnectivityIds", &[1], &[f.connectivity.len() as i64])?;
-        put(&root, "Points", &[np, 3], f.points.as_flattened())?;
-        put(&root, "Connectivity", &[f.connectivity.len()], &f.connectivity)?;
-        put(&root, "Offsets", &[f.offsets.len()], &f.offsets)?;
-        put(&root, "Types", &[ncell], &f.types)?;
-        let pd = root.create_group("PointData")?;
-        let cd = root.create_group("CellData")?;
-        put(&cd, "cell_kind", &[ncell], &f.cell_kind)?;
-        let steps = root.create_group("Steps")?;
+/// A group whose links keep their creation order (the VTKHDF spec asks this of composite groups).
+fn ordered_group(parent: &Group, name: &str) -> hdf5::Result<Group> {
+    parent.create_group_builder().with_gcpl(|p| p.link_creation_order(LinkCreationOrder::Indexed)).create(name)
+}
+
+impl Block {
+    /// Create block `name` of `points` with cells of `per_cell` points each (VTK type `vtk_type`).
+    #[allow(clippy::too_many_arguments)]
+    fn create(
+        root: &Group,
+        name: &str,
+        index: i64,
+        points: &[[f64; 3]],
+        per_cell: usize,
+        vtk_type: u8,
+        arrays: &[(&str, usize)],
+        m: usize,
+    ) -> hdf5::Result<Block> {
+        let g = root.create_group(name)?;
+        attr(&g, "Index", index)?;
+        attr_vec(&g, "Version", &[2i64, 2])?;
+        attr_fixed_ascii::<16>(&g, "Type", "UnstructuredGrid")?;
+        let (np, ncell) = (points.len(), points.len() / per_cell);
+        put(&g, "NumberOfPoints", &[1], &[np as i64])?;
+        put(&g, "NumberOfCells", &[1], &[ncell as i64])?;
+        put(&g, "NumberOfConnectivityIds", &[1], &[np as i64])?;
+        put(&g, "Points", &[np, 3], points.as_flattened())?;
+        put(&g, "Connectivity", &[np], &(0..np as i64).collect::<Vec<_>>())?;
+        put(&g, "Offsets", &[ncell + 1], &(0..=ncell).map(|k| (per_cell * k) as i64).collect::<Vec<_>>())?;
+        put(&g, "Types", &[ncell], &vec![vtk_type; ncell])?;
+        let pd = g.create_group("PointData")?;
+        let cd = g.create_group("CellData")?;
+        let steps = g.create_group("Steps")?;
         attr(&steps, "NSteps", 0i64)?;
-        let m = n_frames;
         let zeros = vec![0i64; m];
         for name in ["PartOffsets", "PointOffsets", "CellOffsets", "ConnectivityIdOffsets"] {
             put(&steps, name, &[m], &zeros)?;
         }
         put(&steps, "NumberOfParts", &[m], &vec![1i64; m])?;
-        let pdo = steps.create_group("PointDataOffsets")?;
         let off = |b: usize| (0..m).map(|n| (n * b) as i64).collect::<Vec<_>>();
-        put(&pdo, "displacement", &[m], &off(np))?;
+        put(&steps.create_group("PointDataOffsets")?, "displacement", &[m], &off(np))?;
         let cdo = steps.create_group("CellDataOffsets")?;
-        put(&cdo, "cell_kind", &[m], &zeros)?;
         let mut cells = Vec::new();
-        for (name, nc) in cell_arrays(contact) {
+        for &(name, nc) in arrays {
             put(&cdo, name, &[m], &off(ncell))?;
             let rest: &[usize] = if nc == 1 { &[] } else { &[nc] };
             cells.push(if name == "stick_slip" {
@@ -126,7 +147,7 @@ impl VtkHdf {
                 Series::create::<f32>(&cd, name, ncell, rest, m)?
             });
         }
-        Ok(VtkHdf {
+        Ok(Block {
             values: steps
                 .new_dataset::<f64>()
                 .chunk(1024)
@@ -138,49 +159,92 @@ impl VtkHdf {
         })
     }
 
-    pub fn open(file: &File, contact: bool) -> hdf5::Result<VtkHdf> {
-        let root = file.group("VTKHDF")?;
-        let np = root.dataset("Points")?.shape()[0];
-        let ncell = root.dataset("Types")?.shape()[0];
-        let cd = root.group("CellData")?;
-        let cells = cell_arrays(contact)
-            .into_iter()
-            .map(|(name, _)| Series::open(&cd, name, ncell))
-            .collect::<hdf5::Result<Vec<_>>>()?;
-        let steps = root.group("Steps")?;
-        Ok(VtkHdf {
+    fn open(g: &Group, arrays: &[(&str, usize)]) -> hdf5::Result<Block> {
+        let np = g.dataset("Points")?.shape()[0];
+        let ncell = g.dataset("Types")?.shape()[0];
+        let cd = g.group("CellData")?;
+        let cells = arrays.iter().map(|(name, _)| Series::open(&cd, name, ncell)).collect::<hdf5::Result<Vec<_>>>()?;
+        let steps = g.group("Steps")?;
+        Ok(Block {
             values: steps.dataset("Values")?,
-            displacement: Series::open(&root.group("PointData")?, "displacement", np)?,
+            displacement: Series::open(&g.group("PointData")?, "displacement", np)?,
             cells,
             steps,
         })
     }
 
-    /// Append buffered frames (NSteps is not changed).
-    pub fn write_frames(&self, raw: &Raw, b: &FrameRows) -> hdf5::Result<()> {
+    fn write_times(&self, b: &FrameRows) -> hdf5::Result<()> {
         let (f, k) = (b.first, b.count());
         if k > 0 {
             self.values.resize(f + k)?;
             self.values.write_slice(&b.times, f..f + k)?;
         }
-        self.displacement.write_steps(raw, f, k, &b.displacement)?;
-        for (series, data) in self.cells.iter().zip(&b.cells) {
+        Ok(())
+    }
+
+    fn set_frames(&mut self, raw: &Raw, frames: usize, kept: usize) -> hdf5::Result<()> {
+        self.values.resize(kept.min(frames))?;
+        std::iter::once(&mut self.displacement).chain(&mut self.cells).try_for_each(|s| s.set_steps(raw, frames, kept))
+    }
+}
+
+pub struct VtkHdf {
+    body: Block,
+    contact: Option<Block>,
+}
+
+impl VtkHdf {
+    pub fn create(file: &File, f: &Fields, n_frames: usize, contact: bool) -> hdf5::Result<VtkHdf> {
+        let root = ordered_group(file, "VTKHDF")?;
+        attr_vec(&root, "Version", &[2i64, 2])?;
+        attr_fixed_ascii::<28>(&root, "Type", "PartitionedDataSetCollection")?;
+        let assembly = ordered_group(&root, "Assembly")?;
+        let body = Block::create(&root, "body", 0, &f.points, 3, 5, &BODY_CELLS, n_frames)?;
+        assembly.link_soft("/VTKHDF/body", "body")?;
+        let contact = if contact {
+            let b = Block::create(&root, "contact", 1, &f.contact_points, 2, 3, &CONTACT_CELLS, n_frames)?;
+            assembly.link_soft("/VTKHDF/contact", "contact")?;
+            Some(b)
+        } else {
+            None
+        };
+        Ok(VtkHdf { body, contact })
+    }
+
+    pub fn open(file: &File, contact: bool) -> hdf5::Result<VtkHdf> {
+        let root = file.group("VTKHDF")?;
+        let body = Block::open(&root.group("body")?, &BODY_CELLS)?;
+        let contact = if contact { Some(Block::open(&root.group("contact")?, &CONTACT_CELLS)?) } else { None };
+        Ok(VtkHdf { body, contact })
+    }
+
+    /// Append buffered frames (NSteps is not changed).
+    pub fn write_frames(&self, raw: &Raw, b: &FrameRows) -> hdf5::Result<()> {
+        let (f, k) = (b.first, b.count());
+        self.body.write_times(b)?;
+        self.body.displacement.write_steps(raw, f, k, &b.displacement)?;
+        for (series, data) in self.body.cells.iter().zip(&b.cells) {
             series.write_steps(raw, f, k, data)?;
         }
-        if let Some(series) = self.cells.get(6) {
-            series.write_steps(raw, f, k, &b.stick_slip)?;
+        if let Some(c) = &self.contact {
+            c.write_times(b)?;
+            c.displacement.write_steps(raw, f, k, &b.contact_displacement)?;
+            for (series, data) in c.cells.iter().zip(&b.contact_cells) {
+                series.write_steps(raw, f, k, data)?;
+            }
+            c.cells[3].write_steps(raw, f, k, &b.stick_slip)?;
         }
         Ok(())
     }
 
+    /// Set `NSteps` of every block (they always hold the same frames).
     pub fn set_nsteps(&self, n: usize) -> hdf5::Result<()> {
-        attr(&self.steps, "NSteps", n as i64)
+        std::iter::once(&self.body).chain(&self.contact).try_for_each(|b| attr(&b.steps, "NSteps", n as i64))
     }
 
     /// Give every frame series room for exactly `frames` frames, keeping the first `kept`; `Values`
     /// holds exactly the kept frames.
     pub fn set_frames(&mut self, raw: &Raw, frames: usize, kept: usize) -> hdf5::Result<()> {
-        self.values.resize(kept.min(frames))?;
-        std::iter::once(&mut self.displacement).chain(&mut self.cells).try_for_each(|s| s.set_steps(raw, frames, kept))
+        std::iter::once(&mut self.body).chain(&mut self.contact).try_for_each(|b| b.set_frames(raw, frames, kept))
     }
 }

@@ -1,33 +1,88 @@
-//! The XDMF3 sidecar `run.xdmf` next to `run.h5`: a Temporal collection of Uniform grids whose HDF
-//! DataItems reference datasets of `run.h5`, so no array is stored twice.
+//! The XDMF3 sidecar `run.xdmf` next to `run.h5`: two Temporal collections, `contact` (the Γ_C line
+//! cells, when Γ_C exists) and `body` (the triangles), of Uniform grids whose HDF DataItems reference
+//! datasets of `run.h5`, so no array is stored twice. ParaView's three XDMF readers (`XDMFReader`,
+//! `Xdmf3ReaderS`, `Xdmf3ReaderT`, 5.11) show the pair as a two-block dataset with one time axis, each
+//! block with only its own fields; meshio's `xdmf.TimeSeriesReader` reads the *last* temporal collection
+//! of a domain, hence `body` comes last.
 //!
-//! Readers such as meshio read a DataItem as a whole dataset (no hyperslabs), so each step's arrays are
-//! exposed as HDF5 *virtual datasets* `/xdmf/<array>/<f>` mapping rows f·B … (f+1)·B−1 (frame f) of the flattened
-//! VTKHDF arrays (B = points or cells). Static: `/xdmf/topology` (XDMF Mixed: `4 a b c` per triangle,
-//! `2 2 a b` per Γ_C line cell), geometry `/VTKHDF/Points`, `cell_kind` `/VTKHDF/CellData/cell_kind`.
-//! Every grid repeats Topology and Geometry (same datasets). Strain and stress are 6-component
-//! (xx, yy, zz, xy, yz, xz) and declared `Matrix` so no reader reorders them as XDMF `Tensor6`.
+//! Readers such as meshio read a DataItem as a whole dataset (no hyperslabs), so each frame's arrays are
+//! exposed as HDF5 *virtual datasets* `/xdmf/<block>/<array>/<f>` mapping rows f·B … (f+1)·B−1 (frame f) of
+//! the flattened VTKHDF arrays of the block (B = its points or cells). Static: `/xdmf/body/topology`
+//! (T, 3), `/xdmf/contact/topology` (C, 2), geometry `/VTKHDF/<block>/Points`. Every grid repeats
+//! Topology and Geometry (same datasets). Strain and stress are 6-component (xx, yy, zz, xy, yz, xz) and
+//! declared `Matrix` so no reader reorders them as XDMF `Tensor6`.
 //!
 //! The virtual datasets of every frame of the run are created with the file, so committing a frame
 //! changes no HDF5 metadata (see `super::h5::Series`); those of frames not yet written map rows that hold
-//! no data yet, and a stopped run drops them ([`Xdmf::drop_frames_from`]). The text is appended per
-//! frame after the HDF5 step is flushed (seeking back over the closing tags), and rewritten whole on
-//! resume, so it never names data the file does not hold.
+//! no data yet, and a stopped run drops them ([`Xdmf::drop_frames_from`]). The text holds, in each
+//! collection, one fixed-size *slot* per frame of the run, blank (whitespace, which XML ignores) until the
+//! frame's grid is written into it in place after the HDF5 step is flushed ([`Xdmf::append_text`]); the
+//! text is rewritten whole on resume, so it never names data the file does not hold.
 //!
 //! The text is started under `run.xdmf.partial` and moved into place by [`Xdmf::publish`] only once
 //! `run.h5` is in place (after its own rename on create, after the flush on resume): a run killed while
 //! it builds a new file therefore leaves the old pair `run.h5` + `run.xdmf` as they were. (Found by
 //! `verification/interrupted_runs.py` on CI: truncating `run.xdmf` at creation, before the HDF5 rename,
 //! left a complete old `run.h5` beside an empty collection that meshio refuses.)
+//!
+//! The HDF5 file is referenced by its bare name, relative to the XDMF file. ParaView 5.11's Xdmf3
+//! readers resolve it wrongly when the XDMF file itself is opened by a bare relative name (`run.xdmf`
+//! becomes a search for `run.xdmfrun.h5` and pvpython aborts); `./run.h5` fails the same way and an
+//! absolute name would break moved files, so `scripts/paraview_view.py` opens files by absolute path.
 
 use super::fields::Fields;
 use super::h5::{put, rows};
-use super::vtkhdf::cell_arrays;
+use super::vtkhdf::{BODY_CELLS, CONTACT_CELLS};
 use hdf5::{File, Group};
-use std::io::{Seek, SeekFrom, Write};
+use std::io::Write;
+use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
-const TAIL: &str = "    </Grid>\n  </Domain>\n</Xdmf>\n";
+const HEAD: &str = "<?xml version=\"1.0\"?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n";
+const TAIL: &str = "  </Domain>\n</Xdmf>\n";
+
+/// Sizes of the two blocks: body points (3T) and triangles, contact points (2C) and edges.
+#[derive(Clone, Copy)]
+struct Sizes {
+    np: usize,
+    nt: usize,
+    cp: usize,
+    nc: usize,
+}
+
+/// One array exposed per frame.
+struct Array {
+    block: &'static str,
+    name: &'static str,
+    /// Rows per frame and components.
+    rows: usize,
+    comps: usize,
+    /// u8 (`stick_slip`) or f32.
+    byte: bool,
+    node: bool,
+}
+
+/// Arrays exposed per frame, body first.
+fn arrays(z: Sizes, contact: bool) -> Vec<Array> {
+    let mut v = vec![Array { block: "body", name: "displacement", rows: z.np, comps: 3, byte: false, node: true }];
+    for (name, comps) in BODY_CELLS {
+        v.push(Array { block: "body", name, rows: z.nt, comps, byte: false, node: false });
+    }
+    if contact {
+        v.push(Array { block: "contact", name: "displacement", rows: z.cp, comps: 3, byte: false, node: true });
+        for (name, comps) in CONTACT_CELLS {
+            v.push(Array { block: "contact", name, rows: z.nc, comps, byte: name == "stick_slip", node: false });
+        }
+    }
+    v
+}
+
+/// A temporal collection of the text: where its slots start and how long each is.
+struct Section {
+    block: &'static str,
+    offset: u64,
+    slot: usize,
+}
 
 pub struct Xdmf {
     pub path: PathBuf,
@@ -37,14 +92,11 @@ pub struct Xdmf {
     /// One group per array of [`arrays`].
     groups: Vec<Group>,
     file: std::fs::File,
-    /// Length of the text without TAIL.
-    len: u64,
-    np: usize,
-    ncell: usize,
-    topo_len: usize,
+    sizes: Sizes,
     contact: bool,
     /// Frames of the whole run.
     total_frames: usize,
+    sections: Vec<Section>,
 }
 
 /// The XDMF path of a results file: same stem, extension `xdmf`.
@@ -52,40 +104,26 @@ pub fn sidecar(h5: &Path) -> PathBuf {
     h5.with_extension("xdmf")
 }
 
-/// Arrays exposed per step: (name, VTKHDF source, rows per step, components, XDMF number type, precision).
-fn arrays(np: usize, ncell: usize, contact: bool) -> Vec<(String, String, usize, usize, &'static str, u8)> {
-    let mut v = vec![("displacement".to_string(), "/VTKHDF/PointData/displacement".to_string(), np, 3, "Float", 4)];
-    for (name, nc) in cell_arrays(contact) {
-        let (ty, prec) = if name == "stick_slip" { ("UChar", 1) } else { ("Float", 4) };
-        v.push((name.to_string(), format!("/VTKHDF/CellData/{name}"), ncell, nc, ty, prec));
-    }
-    v
-}
-
 impl Xdmf {
-    /// Create `/xdmf` (topology, per-array groups, the virtual datasets of all `total_frames` frames) in
+    /// Create `/xdmf` (topologies, per-array groups, the virtual datasets of all `total_frames` frames) in
     /// the HDF5 file and start the text.
     pub fn create(h5: &File, h5_path: &Path, f: &Fields, contact: bool, total_frames: usize) -> std::io::Result<Xdmf> {
-        let mk = || -> hdf5::Result<(Group, usize)> {
+        let z = Sizes { np: f.n_points(), nt: f.n_tris(), cp: f.contact_points.len(), nc: f.n_contact() };
+        let mk = || -> hdf5::Result<Group> {
             let g = h5.create_group("xdmf")?;
-            let mut topo = Vec::with_capacity(4 * f.n_cells());
-            for c in 0..f.n_cells() {
-                let (a, b) = (f.offsets[c] as usize, f.offsets[c + 1] as usize);
-                if f.types[c] == 5 {
-                    topo.push(4);
-                } else {
-                    topo.extend([2, 2]);
-                }
-                topo.extend_from_slice(&f.connectivity[a..b]);
+            let body = g.create_group("body")?;
+            put(&body, "topology", &[z.nt, 3], &(0..z.np as i64).collect::<Vec<_>>())?;
+            if contact {
+                let c = g.create_group("contact")?;
+                put(&c, "topology", &[z.nc, 2], &(0..z.cp as i64).collect::<Vec<_>>())?;
             }
-            put(&g, "topology", &[topo.len()], &topo)?;
-            for (name, ..) in arrays(0, 0, contact) {
-                g.create_group(&name)?;
+            for a in arrays(z, contact) {
+                g.create_group(&format!("{}/{}", a.block, a.name))?;
             }
-            Ok((g, topo.len()))
+            Ok(g)
         };
-        let (group, topo_len) = mk().map_err(std::io::Error::other)?;
-        let x = Xdmf::start(h5_path, group, f.n_points(), f.n_cells(), topo_len, contact, total_frames)?;
+        let group = mk().map_err(std::io::Error::other)?;
+        let x = Xdmf::start(h5_path, group, z, contact, total_frames)?;
         (0..total_frames).try_for_each(|k| x.add_frame_datasets(k)).map_err(std::io::Error::other)?;
         Ok(x)
     }
@@ -99,15 +137,14 @@ impl Xdmf {
         contact: bool,
         total_frames: usize,
     ) -> std::io::Result<Xdmf> {
-        let get = || -> hdf5::Result<(Group, usize, usize, usize)> {
-            let g = h5.group("xdmf")?;
-            let np = h5.dataset("VTKHDF/Points")?.shape()[0];
-            let ncell = h5.dataset("VTKHDF/Types")?.shape()[0];
-            let topo_len = g.dataset("topology")?.shape()[0];
-            Ok((g, np, ncell, topo_len))
+        let get = || -> hdf5::Result<(Group, Sizes)> {
+            let n = |p: &str| h5.dataset(p).map(|d| d.shape()[0]);
+            let (np, nt) = (n("VTKHDF/body/Points")?, n("VTKHDF/body/Types")?);
+            let (cp, nc) = if contact { (n("VTKHDF/contact/Points")?, n("VTKHDF/contact/Types")?) } else { (0, 0) };
+            Ok((h5.group("xdmf")?, Sizes { np, nt, cp, nc }))
         };
-        let (group, np, ncell, topo_len) = get().map_err(std::io::Error::other)?;
-        let mut x = Xdmf::start(h5_path, group, np, ncell, topo_len, contact, total_frames)?;
+        let (group, z) = get().map_err(std::io::Error::other)?;
+        let mut x = Xdmf::start(h5_path, group, z, contact, total_frames)?;
         let counts = x.groups.iter().map(|g| g.member_names().map(|m| m.len())).collect::<hdf5::Result<Vec<_>>>();
         let present = counts.map_err(std::io::Error::other)?.into_iter().min().unwrap_or(0);
         x.drop_frames_from(present).map_err(std::io::Error::other)?;
@@ -130,45 +167,37 @@ impl Xdmf {
         Ok(())
     }
 
-    fn start(
-        h5_path: &Path,
-        group: Group,
-        np: usize,
-        ncell: usize,
-        topo_len: usize,
-        contact: bool,
-        total_frames: usize,
-    ) -> std::io::Result<Xdmf> {
+    fn start(h5_path: &Path, group: Group, sizes: Sizes, contact: bool, total_frames: usize) -> std::io::Result<Xdmf> {
         let path = sidecar(h5_path);
         let partial = super::partial_path(&path);
-        let mut file = std::fs::File::create(&partial)?;
-        let head = "<?xml version=\"1.0\"?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n    \
-                    <Grid Name=\"tresca\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-        file.write_all(head.as_bytes())?;
-        file.write_all(TAIL.as_bytes())?;
-        let groups = arrays(0, 0, contact)
+        let groups = arrays(sizes, contact)
             .iter()
-            .map(|a| group.group(&a.0))
+            .map(|a| group.group(&format!("{}/{}", a.block, a.name)))
             .collect::<hdf5::Result<Vec<_>>>()
             .map_err(std::io::Error::other)?;
         let h5_name = h5_path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        Ok(Xdmf {
-            path,
-            partial,
-            h5_name,
-            groups,
-            file,
-            len: head.len() as u64,
-            np,
-            ncell,
-            topo_len,
-            contact,
-            total_frames,
-        })
+        let file = std::fs::File::create(&partial)?;
+        let mut x = Xdmf { path, partial, h5_name, groups, file, sizes, contact, total_frames, sections: Vec::new() };
+        // contact first: meshio reads the last collection, which should be the body
+        let blocks: &[&'static str] = if contact { &["contact", "body"] } else { &["body"] };
+        let mut text = String::from(HEAD);
+        for &block in blocks {
+            // the longest grid text of this run (widest time, frame and step numbers) plus slack
+            let slot = x.grid(block, total_frames.saturating_sub(1), usize::MAX, -1.2345678901234567e-300).len() + 2;
+            text += &format!("    <Grid Name=\"{block}\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
+            x.sections.push(Section { block, offset: text.len() as u64, slot });
+            let mut blank = " ".repeat(slot - 1);
+            blank.push('\n');
+            text += &blank.repeat(total_frames);
+            text += "    </Grid>\n";
+        }
+        text += TAIL;
+        x.file.write_all(text.as_bytes())?;
+        Ok(x)
     }
 
     /// Move the text from `run.xdmf.partial` to `run.xdmf` (atomically replacing an old sidecar); the
-    /// open handle follows the rename, so later frames are appended to the published file.
+    /// open handle follows the rename, so later frames are written into the published file.
     pub fn publish(&self) -> std::io::Result<()> {
         std::fs::rename(&self.partial, &self.path)
     }
@@ -180,18 +209,18 @@ impl Xdmf {
 
     /// Create the virtual datasets of frame n.
     fn add_frame_datasets(&self, n: usize) -> hdf5::Result<()> {
-        for (i, (_, src, block, nc, ty, _)) in arrays(self.np, self.ncell, self.contact).into_iter().enumerate() {
-            let rest: Vec<usize> = if nc == 1 { vec![] } else { vec![nc] };
+        for (a, g) in arrays(self.sizes, self.contact).iter().zip(&self.groups) {
+            let src = format!("/VTKHDF/{}/{}/{}", a.block, if a.node { "PointData" } else { "CellData" }, a.name);
+            let rest: Vec<usize> = if a.comps == 1 { vec![] } else { vec![a.comps] };
             // the source's extent at its largest: a selection of all of a smaller extent would become "all"
-            let mut src_ext = vec![self.total_frames * block];
+            let mut src_ext = vec![self.total_frames * a.rows];
             src_ext.extend(&rest);
-            let mut shape = vec![block];
+            let mut shape = vec![a.rows];
             shape.extend(&rest);
-            let g = &self.groups[i];
             let key = format!("{n:06}");
-            let sel = rows(n * block, (n + 1) * block, &rest);
-            let all = rows(0, block, &rest);
-            if ty == "UChar" {
+            let sel = rows(n * a.rows, (n + 1) * a.rows, &rest);
+            let all = rows(0, a.rows, &rest);
+            if a.byte {
                 g.new_dataset::<u8>()
                     .shape(shape.clone())
                     .virtual_map(".", &src, src_ext, sel, shape, all)
@@ -206,41 +235,58 @@ impl Xdmf {
         Ok(())
     }
 
-    /// Append the grid of frame f (step n) to the text (after the HDF5 file holds it).
-    pub fn append_text(&mut self, f: usize, n: usize, t: f64) -> std::io::Result<()> {
-        let h = &self.h5_name;
+    /// The grid of frame f (step n, time t) of `block`.
+    fn grid(&self, block: &str, f: usize, n: usize, t: f64) -> String {
+        let (h, z) = (&self.h5_name, self.sizes);
         let item = |dims: String, ty: &str, prec: u8, path: &str| {
             format!("<DataItem Dimensions=\"{dims}\" NumberType=\"{ty}\" Precision=\"{prec}\" Format=\"HDF\">{h}:{path}</DataItem>")
         };
+        let (np, topo) = if block == "body" {
+            (
+                z.np,
+                format!(
+                    "Type=\"Triangle\" NumberOfElements=\"{}\">{}",
+                    z.nt,
+                    item(format!("{} 3", z.nt), "Int", 8, "/xdmf/body/topology")
+                ),
+            )
+        } else {
+            let it = item(format!("{} 2", z.nc), "Int", 8, "/xdmf/contact/topology");
+            (z.cp, format!("Type=\"Polyline\" NodesPerElement=\"2\" NumberOfElements=\"{}\">{it}", z.nc))
+        };
         let mut s = format!(
             "      <Grid Name=\"step_{n:06}\" GridType=\"Uniform\">\n        <Time Value=\"{t:e}\"/>\n        \
-             <Topology Type=\"Mixed\" NumberOfElements=\"{}\">{}</Topology>\n        \
-             <Geometry GeometryType=\"XYZ\">{}</Geometry>\n",
-            self.ncell,
-            item(self.topo_len.to_string(), "Int", 8, "/xdmf/topology"),
-            item(format!("{} 3", self.np), "Float", 8, "/VTKHDF/Points"),
+             <Topology {topo}</Topology>\n        <Geometry GeometryType=\"XYZ\">{}</Geometry>\n",
+            item(format!("{np} 3"), "Float", 8, &format!("/VTKHDF/{block}/Points")),
         );
-        s += &format!(
-            "        <Attribute Name=\"cell_kind\" AttributeType=\"Scalar\" Center=\"Cell\">{}</Attribute>\n",
-            item(self.ncell.to_string(), "UChar", 1, "/VTKHDF/CellData/cell_kind")
-        );
-        for (name, _, block, nc, ty, prec) in arrays(self.np, self.ncell, self.contact) {
-            let (kind, center) = match (name.as_str(), nc) {
-                ("displacement", _) => ("Vector", "Node"),
+        for a in arrays(z, self.contact).iter().filter(|a| a.block == block) {
+            let (kind, center) = match (a.node, a.comps) {
+                (true, _) => ("Vector", "Node"),
                 (_, 1) => ("Scalar", "Cell"),
                 _ => ("Matrix", "Cell"),
             };
-            let dims = if nc == 1 { block.to_string() } else { format!("{block} {nc}") };
+            let dims = if a.comps == 1 { a.rows.to_string() } else { format!("{} {}", a.rows, a.comps) };
+            let (ty, prec) = if a.byte { ("UChar", 1) } else { ("Float", 4) };
             s += &format!(
-                "        <Attribute Name=\"{name}\" AttributeType=\"{kind}\" Center=\"{center}\">{}</Attribute>\n",
-                item(dims, ty, prec, &format!("/xdmf/{name}/{f:06}"))
+                "        <Attribute Name=\"{}\" AttributeType=\"{kind}\" Center=\"{center}\">{}</Attribute>\n",
+                a.name,
+                item(dims, ty, prec, &format!("/xdmf/{block}/{}/{f:06}", a.name))
             );
         }
-        s += "      </Grid>\n";
-        self.file.seek(SeekFrom::Start(self.len))?;
-        self.file.write_all(s.as_bytes())?;
-        self.file.write_all(TAIL.as_bytes())?;
-        self.len += s.len() as u64;
+        s + "      </Grid>"
+    }
+
+    /// Write the grids of frame f (step n) into their slots (after the HDF5 file holds the frame).
+    pub fn append_text(&mut self, f: usize, n: usize, t: f64) -> std::io::Result<()> {
+        for sec in &self.sections {
+            let mut s = self.grid(sec.block, f, n, t);
+            if s.len() >= sec.slot || f >= self.total_frames {
+                return Err(std::io::Error::other(format!("frame {f} does not fit the XDMF text")));
+            }
+            s += &" ".repeat(sec.slot - 1 - s.len());
+            s.push('\n');
+            self.file.write_all_at(s.as_bytes(), sec.offset + (f * sec.slot) as u64)?;
+        }
         Ok(())
     }
 }

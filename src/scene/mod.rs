@@ -132,6 +132,25 @@ pub struct Exact {
     pub grad: [[Expr; 2]; 2],
 }
 
+/// Scalar outputs a study estimates (`[outputs]`), all at the final time T. Without the table a study
+/// reports `max_slip`, `stick_length` (scenes with contact) and `energy`.
+#[derive(Clone, Debug, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Outputs {
+    /// max over Γ_C edges of |u_τ(m_e)|.
+    #[serde(default)]
+    pub max_slip: bool,
+    /// Total length of the Γ_C edges that stick in the last step.
+    #[serde(default)]
+    pub stick_length: bool,
+    /// Elastic energy ½ a_h(u, u).
+    #[serde(default)]
+    pub energy: bool,
+    /// σ_τ·τ on the Γ_C edge nearest to each point.
+    #[serde(default)]
+    pub traction_at: Vec<[f64; 2]>,
+}
+
 /// A validated scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -155,6 +174,8 @@ pub struct Scene {
     pub solver: SolverSettings,
     pub exact: Option<Exact>,
     pub output: Option<PathBuf>,
+    /// `[outputs]`: the scalar outputs a study estimates.
+    pub outputs: Option<Outputs>,
 }
 
 fn nonzero(v: Option<Vec2Expr>) -> Option<Vec2Expr> {
@@ -344,6 +365,7 @@ impl Scene {
             solver,
             exact,
             output: raw.output.and_then(|o| o.path),
+            outputs: raw.outputs,
         })
     }
 

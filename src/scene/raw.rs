@@ -19,6 +19,20 @@ pub(super) struct RawScene {
     pub(super) solver: Option<RawSolver>,
     pub(super) exact: Option<RawExact>,
     pub(super) output: Option<RawOutput>,
+    /// Optional `[units]` (labels only: the solver is unit-free; `scripts/render.py` reads them from the
+    /// scene text stored in the results file).
+    #[allow(dead_code)]
+    pub(super) units: Option<RawUnits>,
+    pub(super) outputs: Option<super::Outputs>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)]
+pub(super) struct RawUnits {
+    pub(super) length: Option<String>,
+    pub(super) force: Option<String>,
+    pub(super) time: Option<String>,
 }
 
 #[derive(Deserialize)]

@@ -17,15 +17,29 @@
 //! draws from the C library's global `rand`), so the same K always gets the same ordering, hence
 //! bit-identical results. If METIS cannot be used (tiny or edgeless graphs, indices beyond i32, an
 //! error) the ordering falls back to AMD: the ordering only affects speed.
+//!
+//! Unknowns ordered last ([`Factor::with_last`], the contact unknowns): with K's permuted form
+//! [K_oo K_ol; K_lo K_ll] = L Lᵀ, the trailing block of L satisfies L_ll L_llᵀ = K_ll − K_lo K_oo⁻¹ K_ol,
+//! the Schur complement, whose inverse is the block (K⁻¹)_ll. So the condensed operator comes from the
+//! factor without any solve ([`Factor::last_block`]), and since L⁻¹E = [0; L_ll⁻¹] (L lower
+//! triangular) a step can split its solve into the halves [`Factor::forward_solve`] and
+//! [`Factor::backward_solve`] and add the friction force in between (`solve::free`). Moving a few
+//! boundary unknowns to the end of a fill-reducing ordering changes the fill little (they act as one
+//! more separator). The supernodal kernel is always used: it exposes the triangular halves and the
+//! trailing block.
 
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering,
 };
+use faer::sparse::linalg::{amd, SupernodalThreshold};
 use faer::sparse::SparseColMat;
 use faer::{Conj, MatMut, Par, Side};
+use nalgebra::DMatrix;
 use std::cell::RefCell;
 use std::sync::Mutex;
 
@@ -35,27 +49,49 @@ pub struct Factor {
     values: Vec<f64>,
     scratch: RefCell<MemBuffer>,
     n: usize,
+    /// The unknowns ordered last, in this order (see [`Factor::with_last`]).
+    last: Vec<usize>,
+    /// The fill-reducing permutation: position → unknown.
+    fwd: Vec<usize>,
 }
 
 impl Factor {
     /// Factorise the SPD matrix `k` (lower triangle read); faer chooses the simplicial or supernodal
     /// kernel (supernodal for larger fill).
     pub fn new(k: &SparseColMat<usize, f64>) -> Result<Factor> {
-        Factor::with_ordering(k, k.nrows() >= ND_MIN_SIZE)
+        Factor::with_last(k, &[])
     }
 
-    /// As [`Factor::new`], with nested dissection tried (`nested`) or AMD.
-    fn with_ordering(k: &SparseColMat<usize, f64>, nested: bool) -> Result<Factor> {
+    /// As [`Factor::new`], with the distinct unknowns `last` ordered last, in the given order.
+    pub fn with_last(k: &SparseColMat<usize, f64>, last: &[usize]) -> Result<Factor> {
+        Factor::with_ordering(k, k.nrows() >= ND_MIN_SIZE, last)
+    }
+
+    /// As [`Factor::with_last`], with nested dissection tried (`nested`) or AMD.
+    fn with_ordering(k: &SparseColMat<usize, f64>, nested: bool, last: &[usize]) -> Result<Factor> {
         let n = k.nrows();
-        let params = CholeskySymbolicParams::default();
-        let nd = if nested { nested_dissection(k) } else { None };
-        let ordering = match &nd {
-            Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, n)),
-            None => SymmetricOrdering::Amd,
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
         };
+        let base = match if nested { nested_dissection(k) } else { None } {
+            Some((fwd, _)) => fwd,
+            None => amd_order(k, params.amd_params)?,
+        };
+        let mut is_last = vec![false; n];
+        for &i in last {
+            if i >= n || std::mem::replace(&mut is_last[i], true) {
+                return Err(Error::Linear(format!("unknown {i} cannot be ordered last (out of range or repeated)")));
+            }
+        }
+        let fwd: Vec<usize> = base.into_iter().filter(|&i| !is_last[i]).chain(last.iter().copied()).collect();
+        let mut inv = vec![0usize; n];
+        for (new, &old) in fwd.iter().enumerate() {
+            inv[old] = new;
+        }
+        let ordering = SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n));
         let symbolic = factorize_symbolic_cholesky(k.symbolic(), Side::Lower, ordering, params)
             .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))?;
-        drop(nd);
         let mut values = vec![0.0; symbolic.len_val()];
         let mut buf = MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
             .map_err(|_| Error::Linear("out of memory for the Cholesky factorisation".into()))?;
@@ -68,7 +104,85 @@ impl Factor {
             })?;
         let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
             .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
-        Ok(Factor { symbolic, values, scratch: RefCell::new(scratch), n })
+        Ok(Factor { symbolic, values, scratch: RefCell::new(scratch), n, last: last.to_vec(), fwd })
+    }
+
+    /// The unknowns ordered last (see [`Factor::with_last`]).
+    pub fn last(&self) -> &[usize] {
+        &self.last
+    }
+
+    fn supernodal(&self) -> Option<SupernodalLltRef<'_, usize, f64>> {
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => Some(SupernodalLltRef::new(s, &self.values)),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        }
+    }
+
+    /// L_ll, the trailing m × m block of L for the m unknowns ordered last (rows and columns in the
+    /// order of [`Factor::last`]), lower triangular: L_ll L_llᵀ = ((K⁻¹)_ll)⁻¹.
+    pub fn last_block(&self) -> Result<DMatrix<f64>> {
+        let m = self.last.len();
+        let n0 = self.n - m;
+        let llt = self.supernodal().ok_or_else(|| Error::Linear("the factor is not supernodal".into()))?;
+        let mut l = DMatrix::zeros(m, m);
+        for s in (0..llt.symbolic().n_supernodes()).rev() {
+            let sn = llt.supernode(s);
+            let (start, val, pattern) = (sn.start(), sn.val(), sn.pattern());
+            let size = val.ncols();
+            if start + size <= n0 {
+                break;
+            }
+            for jj in 0..size {
+                let g = start + jj;
+                if g < n0 {
+                    continue;
+                }
+                for ii in jj..size {
+                    l[(start + ii - n0, g - n0)] = val[(ii, jj)];
+                }
+                for (p, &r) in pattern.iter().enumerate() {
+                    l[(r - n0, g - n0)] = val[(size + p, jj)];
+                }
+            }
+        }
+        Ok(l)
+    }
+
+    /// x ← L⁻¹ Pᵀx: the forward half of a solve, the result in the factor's (permuted) order, where
+    /// the unknowns ordered last occupy the last positions.
+    pub fn forward_solve(&self, x: &mut [f64]) -> Result<()> {
+        let llt = self.supernodal().ok_or_else(|| Error::Linear("the factor is not supernodal".into()))?;
+        let mut y: Vec<f64> = self.fwd.iter().map(|&old| x[old]).collect();
+        let mut buf = self.scratch.borrow_mut();
+        llt.l_solve_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut y, self.n, 1),
+            Par::Seq,
+            MemStack::new(&mut buf),
+        );
+        x.copy_from_slice(&y);
+        Ok(())
+    }
+
+    /// y ← P L⁻ᵀ y: the backward half of a solve, from the factor's order to the unknowns' order.
+    pub fn backward_solve(&self, y: &mut [f64]) -> Result<()> {
+        let llt = self.supernodal().ok_or_else(|| Error::Linear("the factor is not supernodal".into()))?;
+        {
+            let mut buf = self.scratch.borrow_mut();
+            llt.l_transpose_solve_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(y, self.n, 1),
+                Par::Seq,
+                MemStack::new(&mut buf),
+            );
+        }
+        let mut x = vec![0.0; self.n];
+        for (new, &old) in self.fwd.iter().enumerate() {
+            x[old] = y[new];
+        }
+        y.copy_from_slice(&x);
+        Ok(())
     }
 
     /// Estimate of the 2-norm condition number λ_max/λ_min of K from the Rayleigh quotients vᵀKv of
@@ -135,6 +249,18 @@ impl Factor {
         let mut buf = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(x.ncols(), Par::Seq));
         llt.solve_in_place_with_conj(Conj::No, x, Par::Seq, MemStack::new(&mut buf));
     }
+}
+
+/// faer's approximate minimum degree ordering of K (position → unknown).
+fn amd_order(k: &SparseColMat<usize, f64>, control: amd::Control) -> Result<Vec<usize>> {
+    let n = k.nrows();
+    let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
+    let nnz = k.symbolic().compute_nnz();
+    let mut buf = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<usize>(n, nnz))
+        .map_err(|_| Error::Linear("out of memory for the AMD ordering".into()))?;
+    amd::order_maybe_unsorted(&mut fwd, &mut inv, k.symbolic(), control, MemStack::new(&mut buf))
+        .map_err(|e| Error::Linear(format!("AMD ordering failed: {e:?}")))?;
+    Ok(fwd)
 }
 
 /// Below this many unknowns K is ordered by AMD: METIS's own cost would exceed what its better ordering
@@ -312,8 +438,8 @@ mod tests {
         let k = grid(40);
         let (fwd, inv) = nested_dissection(&k).expect("METIS ordering");
         assert!(fwd.iter().enumerate().all(|(new, &old)| inv[old] == new));
-        let nd = Factor::with_ordering(&k, true).unwrap();
-        let amd = Factor::with_ordering(&k, false).unwrap();
+        let nd = Factor::with_ordering(&k, true, &[]).unwrap();
+        let amd = Factor::with_ordering(&k, false, &[]).unwrap();
         assert!(residual(&k, &nd) < 1e-12 && residual(&k, &amd) < 1e-12);
     }
 
@@ -333,18 +459,18 @@ mod tests {
         let diag = |n: usize| csc_from_triplets(n, &(0..n).map(|i| (i, i, 2.0)).collect::<Vec<_>>());
         for n in [0, 1, 2, 5] {
             assert!(nested_dissection(&diag(n)).is_none());
-            let f = Factor::with_ordering(&diag(n), true).unwrap();
+            let f = Factor::with_ordering(&diag(n), true, &[]).unwrap();
             assert!(residual(&diag(n), &f) < 1e-15);
         }
         // One coupled pair: a single METIS vertex, no edges.
         let pair = csc_from_triplets(2, &[(0, 0, 2.0), (1, 1, 2.0), (0, 1, 1.0), (1, 0, 1.0)]);
         assert!(nested_dissection(&pair).is_none());
-        assert!(residual(&pair, &Factor::with_ordering(&pair, true).unwrap()) < 1e-15);
+        assert!(residual(&pair, &Factor::with_ordering(&pair, true, &[]).unwrap()) < 1e-15);
         // Three unknowns: METIS on a 2-vertex graph.
         let three = csc_from_triplets(
             3,
             &[(0, 0, 4.0), (1, 1, 4.0), (2, 2, 4.0), (1, 2, 1.0), (2, 1, 1.0), (0, 2, 1.0), (2, 0, 1.0)],
         );
-        assert!(residual(&three, &Factor::with_ordering(&three, true).unwrap()) < 1e-14);
+        assert!(residual(&three, &Factor::with_ordering(&three, true, &[]).unwrap()) < 1e-14);
     }
 }

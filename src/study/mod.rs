@@ -1,26 +1,29 @@
 //! Convergence studies: one scene run at a list of levels (refinement, number of steps), with
 //!
-//! * true errors when the scene has an exact solution (max over time nodes and at the final time),
-//! * the paper's consecutive-level error |||u_l − P u_{l−1}||| on level l (P: `prolong`),
-//! * the error against a finer reference run u_ref, the true error with u replaced by u_ref:
-//!   |||u_ref − u_l|||² = Σ_{T ∈ reference mesh} ∫_T σ(u_ref − u_l):ε(u_ref − u_l) + Σ_{e ∈ E_l⁰} (2ρμ/h_e) ∫_e |[u_l]|²
-//!   (u_l is linear on each reference triangle of nested meshes; the exact u has no jumps),
+//! * true errors when the scene has an exact solution: the max over each level's own time nodes ("max
+//!   over n", the paper's ℓ∞(0,T) norm), the max over the nodes common to all levels, and at T,
+//! * the distances between levels ([`measure`]): the paper's consecutive-level error, the error against
+//!   a finer reference run, and the distances of the Richardson model,
+//! * error estimates without an exact solution ([`estimate`] for the energy norm, [`outputs`] for
+//!   scalar outputs, both on [`richardson`]) with GCIs and an asymptotic-range verdict per level,
 //!
-//! all of them at the time nodes common to all levels — the nodes of the coarsest time grid — as the max
-//! over these nodes and the value at the final time. Only there is u formed, so long runs stay cheap.
-//! When the reference has the same mesh as a level (a time study against a semi-discrete reference), the
-//! difference is measured in that mesh's discrete energy norm a_h(u_ref − u_l, u_ref − u_l)^{1/2}.
-//! For the consecutive error |||·||| is the discrete energy norm a_h(·,·)^{1/2} of the finer level.
+//! distances at the common time nodes — the nodes of the coarsest time grid — where alone u is kept, so
+//! long runs stay cheap (with an exact solution u is formed at every node for the true errors).
 
+pub mod csv;
+pub mod differences;
+pub mod estimate;
+pub mod measure;
 pub mod orders;
+pub mod outputs;
+pub mod richardson;
 
 use crate::error::{Error, Result};
-use crate::fem::norms::{ErrorEvaluator, ErrorNorms};
-use crate::fem::prolong::{parent_triangles, prolong_with};
-use crate::fem::space::Element;
+use crate::fem::norms::ErrorNorms;
 use crate::scene::Scene;
-use crate::sparse::energy;
 use crate::stepping::{Problem, StepResult};
+use measure::{max_last, Kept};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// A level: uniform refinements and number of uniform time steps.
@@ -55,8 +58,10 @@ pub struct LevelResult {
     pub paper_dofs: usize,
     pub wall: f64,
     pub iterations: usize,
-    /// True errors, max over time nodes.
+    /// True errors, max over the level's own time nodes ("max over n").
     pub max_err: Option<ErrorNorms>,
+    /// True errors, max over the time nodes common to all levels.
+    pub common_err: Option<ErrorNorms>,
     /// True errors at the final time.
     pub final_err: Option<ErrorNorms>,
     /// max over the common nodes of the solution's discrete energy norm a_h(u, u)^{1/2}.
@@ -65,95 +70,68 @@ pub struct LevelResult {
     pub consecutive: Option<[f64; 2]>,
     /// Error against the reference run: max over common nodes, and at the final time.
     pub reference: Option<[f64; 2]>,
+    /// Model distance to the previous level, per common node ([`measure::distance`]).
+    pub increment: Option<Vec<f64>>,
+    /// Model distance to the level two back, per common node.
+    pub skip: Option<Vec<f64>>,
+    /// Own jump energy per common node ([`measure::jumps`]).
+    pub jumps: Vec<f64>,
+    /// Scalar outputs at T ([`outputs`]).
+    pub outputs: Vec<f64>,
 }
 
-/// A finished run kept for comparisons: problem and unknowns at the common time nodes.
-struct Kept {
-    problem: Problem,
-    u: Vec<Vec<f64>>,
+/// A finished study: the levels, the energy-norm estimates and the output estimates.
+#[derive(Clone, Debug)]
+pub struct Study {
+    pub levels: Vec<LevelResult>,
+    pub estimates: estimate::Estimates,
+    pub output_names: Vec<String>,
+    pub outputs: Vec<outputs::OutputEstimate>,
+    /// Files written by `--differences`.
+    pub difference_files: Vec<PathBuf>,
 }
 
-/// a_h(e, e)^{1/2} on the unknowns of `p`.
-fn energy_norm(p: &Problem, e: &[f64]) -> f64 {
-    energy(&p.stiffness, e).max(0.0).sqrt()
-}
-
-/// ‖u_fine − P u_coarse‖ at every common node: (max, final).
-fn difference(fine: &Kept, coarse: &Kept) -> Result<[f64; 2]> {
-    let mut worst: f64 = 0.0;
-    let mut last = 0.0;
-    let (c, f) = (&coarse.problem, &fine.problem);
-    let parent = parent_triangles(&c.mesh, &f.mesh)?;
-    for (uf, uc) in fine.u.iter().zip(&coarse.u) {
-        let pu = prolong_with(&parent, (&c.mesh, &c.space), uc, (&f.mesh, &f.space));
-        let d: Vec<f64> = uf.iter().zip(&pu).map(|(a, b)| a - b).collect();
-        last = energy_norm(&fine.problem, &d);
-        worst = worst.max(last);
-    }
-    Ok([worst, last])
-}
-
-/// |||u_ref − u_l||| at every common node (see module doc): (max, final).
-fn reference_error(rf: &Kept, lv: &Kept) -> Result<[f64; 2]> {
-    let (rp, lp) = (&rf.problem, &lv.problem);
-    if rp.scene.mesh_level() == lp.scene.mesh_level() {
-        let (mut worst, mut last): (f64, f64) = (0.0, 0.0);
-        for (ur, ul) in rf.u.iter().zip(&lv.u) {
-            let diff: Vec<f64> = ur.iter().zip(ul).map(|(a, b)| a - b).collect();
-            last = energy_norm(lp, &diff);
-            worst = worst.max(last);
-        }
-        return Ok([worst, last]);
-    }
-    let parent = parent_triangles(&lp.mesh, &rp.mesh)?;
-    let jumps = ErrorEvaluator::new(&lp.mesh, &lp.space, &lp.law, lp.scene.rho);
-    let (rel, lel): (Vec<Element>, Vec<Element>) = (
-        (0..rp.mesh.tris.len()).map(|t| Element::new(&rp.mesh, t)).collect(),
-        (0..lp.mesh.tris.len()).map(|t| Element::new(&lp.mesh, t)).collect(),
-    );
-    let (mut worst, mut last): (f64, f64) = (0.0, 0.0);
-    for (ur, ul) in rf.u.iter().zip(&lv.u) {
-        let (mr, ml) = (rp.space.midpoint_values(ur), lp.space.midpoint_values(ul));
-        let mut en = jumps.jump_energy(&ml);
-        for (t, el) in rel.iter().enumerate() {
-            let gr = el.gradient(rp.mesh.tri_edges[t].map(|e| mr[e]));
-            let pt = parent[t];
-            let gl = lel[pt].gradient(lp.mesh.tri_edges[pt].map(|e| ml[e]));
-            let d = [[gr[0][0] - gl[0][0], gr[0][1] - gl[0][1]], [gr[1][0] - gl[1][0], gr[1][1] - gl[1][1]]];
-            en += el.area * lp.law.energy_density(d);
-        }
-        last = en.max(0.0).sqrt();
-        worst = worst.max(last);
-    }
-    Ok([worst, last])
-}
-
-fn run_level(scene: &Scene, level: Level, common: &[f64], out: &mut LevelResult) -> Result<Kept> {
+/// Run one level; `own_nodes`: form u at every node for the true errors' max over the level's own nodes
+/// (else only at the common nodes, as for a reference run).
+fn run_level(scene: &Scene, level: Level, common: &[f64], own_nodes: bool, out: &mut LevelResult) -> Result<Kept> {
     let mut s = scene.clone();
     s.set_refine(level.refine)?;
     s.set_steps(level.steps)?;
     let start = Instant::now();
     let problem = Problem::new(s)?;
     let mut u = Vec::new();
-    let (mut max_err, mut final_err, mut iterations, mut norm_max) = (None::<ErrorNorms>, None, 0, 0.0f64);
-    let nodes: Vec<usize> = (0..problem.scene.times.len())
-        .filter(|&n| common.iter().any(|&t| (t - problem.scene.times[n]).abs() <= 1e-12 * t.abs().max(1.0)))
-        .collect();
+    let (mut max_err, mut common_err, mut final_err) = (None::<ErrorNorms>, None::<ErrorNorms>, None);
+    let (mut iterations, mut norm_max) = (0, 0.0f64);
+    let times = &problem.scene.times;
+    let is_common: Vec<bool> =
+        times.iter().map(|&s| common.iter().any(|&t| (t - s).abs() <= 1e-12 * t.abs().max(1.0))).collect();
+    // with an exact solution u is formed at every node, for the max over the level's own nodes
+    let all = own_nodes && problem.scene.exact.is_some();
+    let names = outputs::selected(scene);
+    let mut values = Vec::new();
     let first = problem.initial()?;
+    let last_n = times.len() - 1;
     let mut on_step = |r: &StepResult| -> Result<()> {
         iterations += r.iterations;
         if let Some(e) = r.errors {
-            max_err = Some(max_err.map_or(e, |m: ErrorNorms| m.max(e)));
+            let mx = |m: Option<ErrorNorms>| Some(m.map_or(e, |m| m.max(e)));
+            max_err = mx(max_err);
+            if is_common[r.n] {
+                common_err = mx(common_err);
+            }
             final_err = Some(e);
         }
-        if nodes.contains(&r.n) {
+        if is_common[r.n] {
             norm_max = norm_max.max(r.energy.max(0.0).sqrt());
             u.push(r.u.clone());
+        }
+        if r.n == last_n {
+            values = outputs::values(&names, &problem, r);
         }
         Ok(())
     };
     on_step(&first)?;
-    problem.run_selected(first, |n| nodes.contains(&n), on_step)?;
+    problem.run_selected(first, |n| all || is_common[n], &mut on_step)?;
     if u.len() != common.len() {
         return Err(Error::scene(
             &scene.file,
@@ -165,27 +143,31 @@ fn run_level(scene: &Scene, level: Level, common: &[f64], out: &mut LevelResult)
         refine: level.refine,
         steps: level.steps,
         h: problem.mesh.h_max(),
-        k: problem.scene.times.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max),
+        k: times.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max),
         dofs: problem.space.n_dofs,
         paper_dofs: problem.space.paper_dofs(),
         wall: start.elapsed().as_secs_f64(),
         iterations,
         max_err,
+        common_err,
         final_err,
         norm_max,
-        consecutive: None,
-        reference: None,
+        outputs: values,
+        ..LevelResult::default()
     };
     Ok(Kept { problem, u })
 }
 
-/// Run the study. Levels must share the time nodes of the coarsest grid (e.g. steps doubling).
+/// Run the study. Levels must share the time nodes of the coarsest grid (e.g. steps doubling). With
+/// `differences`, the elementwise energy density of u_l − P u_{l−1} of every level l ≥ 2 is written there
+/// ([`differences`]).
 pub fn run_study(
     scene: &Scene,
     levels: &[Level],
     reference: Option<Level>,
+    differences: Option<&Path>,
     mut report: impl FnMut(&LevelResult),
-) -> Result<Vec<LevelResult>> {
+) -> Result<Study> {
     if !scene.uniform_time {
         return Err(Error::scene(&scene.file, "time", "a study needs `T` and `steps` (uniform grids), not `times`"));
     }
@@ -193,55 +175,42 @@ pub fn run_study(
     let (t0, t1) = (scene.times[0], *scene.times.last().expect("nodes"));
     let common: Vec<f64> = (0..=n0).map(|i| t0 + (t1 - t0) * i as f64 / n0 as f64).collect();
     let reference = match reference {
-        Some(l) => Some(run_level(scene, l, &common, &mut LevelResult::default())?),
+        Some(l) => Some(run_level(scene, l, &common, false, &mut LevelResult::default())?),
         None => None,
     };
     let mut results = Vec::new();
-    let mut prev: Option<Kept> = None;
+    let mut difference_files = Vec::new();
+    let (mut prev, mut prev2): (Option<Kept>, Option<Kept>) = (None, None);
     for &level in levels {
         let mut r = LevelResult::default();
-        let kept = run_level(scene, level, &common, &mut r)?;
+        let kept = run_level(scene, level, &common, true, &mut r)?;
+        r.jumps = measure::jumps(&kept);
         if let Some(p) = &prev {
-            r.consecutive = Some(difference(&kept, p)?);
+            r.consecutive = Some(max_last(&measure::consecutive(&kept, p)?));
+            r.increment = Some(measure::distance(&kept, p)?);
+            if let Some(dir) = differences {
+                difference_files.push(differences::write(dir, &kept, p)?);
+            }
+        }
+        if let Some(p2) = &prev2 {
+            r.skip = Some(measure::distance(&kept, p2)?);
         }
         if let Some(rf) = &reference {
-            r.reference = Some(reference_error(rf, &kept)?);
+            r.reference = Some(max_last(&measure::reference_error(rf, &kept)?));
         }
         report(&r);
         results.push(r);
+        prev2 = prev.take();
         prev = Some(kept);
     }
-    Ok(results)
-}
-
-/// CSV header matching [`csv_row`].
-pub const CSV_HEADER: &str = "refine,steps,h,k,dofs,paper_dofs,wall_s,iterations,energy_max,h1_max,l2_max,energy_T,h1_T,l2_T,consecutive_max,consecutive_T,reference_max,reference_T,norm_max";
-
-/// One CSV row (empty fields for quantities not computed).
-pub fn csv_row(r: &LevelResult) -> String {
-    let f = |v: Option<f64>| v.map(|x| format!("{x:.10e}")).unwrap_or_default();
-    let m = |a: Option<ErrorNorms>, i: usize| f(a.map(|v| [v.energy, v.h1, v.l2][i]));
-    let c = |a: Option<[f64; 2]>, i: usize| f(a.map(|v| v[i]));
-    format!(
-        "{},{},{:.10e},{:.10e},{},{},{:.6},{},{},{},{},{},{},{},{},{},{},{},{:.10e}",
-        r.refine,
-        r.steps,
-        r.h,
-        r.k,
-        r.dofs,
-        r.paper_dofs,
-        r.wall,
-        r.iterations,
-        m(r.max_err, 0),
-        m(r.max_err, 1),
-        m(r.max_err, 2),
-        m(r.final_err, 0),
-        m(r.final_err, 1),
-        m(r.final_err, 2),
-        c(r.consecutive, 0),
-        c(r.consecutive, 1),
-        c(r.reference, 0),
-        c(r.reference, 1),
-        r.norm_max
-    )
+    let names = outputs::names(&outputs::selected(scene));
+    let (size, x) = estimate::sizes(&results);
+    let q: Vec<Vec<f64>> = results.iter().map(|r| r.outputs.clone()).collect();
+    Ok(Study {
+        estimates: estimate::estimate(&results),
+        outputs: outputs::estimate(&names, size, &x, &q),
+        output_names: names,
+        levels: results,
+        difference_files,
+    })
 }

@@ -29,21 +29,8 @@ pub fn max_errors(steps: &[StepResult]) -> (f64, f64) {
     })
 }
 
-/// Observed orders between successive levels: log(e_i/e_{i+1}) / log(h_i/h_{i+1}).
-pub fn successive_rates(h: &[f64], e: &[f64]) -> Vec<f64> {
-    (1..h.len()).map(|i| (e[i - 1] / e[i]).ln() / (h[i - 1] / h[i]).ln()).collect()
-}
-
-/// Least-squares slope of log e against log h.
-pub fn fitted_rate(h: &[f64], e: &[f64]) -> f64 {
-    let x: Vec<f64> = h.iter().map(|v| v.ln()).collect();
-    let y: Vec<f64> = e.iter().map(|v| v.ln()).collect();
-    let n = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
-    sxy / sxx
-}
+#[allow(unused_imports)]
+pub use tresca_cr::study::orders::{fitted_order as fitted_rate, successive_orders as successive_rates};
 
 /// Print a convergence table.
 pub fn print_table(title: &str, h: &[f64], cols: &[(&str, &[f64])]) {
@@ -59,7 +46,7 @@ pub fn print_table(title: &str, h: &[f64], cols: &[(&str, &[f64])]) {
             let r = if i == 0 {
                 "-".to_string()
             } else {
-                format!("{:.3}", (e[i - 1] / e[i]).ln() / (h[i - 1] / h[i]).ln())
+                format!("{:.3}", tresca_cr::study::orders::observed_order(e[i - 1], e[i], h[i - 1], h[i]))
             };
             print!(" {:>12.4e} {:>6}", e[i], r);
         }

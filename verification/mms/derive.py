@@ -394,9 +394,7 @@ on the unit square, clamped at x = 0 (left), tractions g = sigma(u) n on bottom/
 body force f = -div sigma(u). E = 100, nu = 0.3, rho = 10.
 Each time step is an independent elastic solve (no history), so there is no time error.
 Expected: energy / H1 error O(h), L2 error O(h^2) under refinement (refine = 0, 1, 2, ...).
-Measured with scripts/skfem_solve.py, refine 0..4: max_n energy error 2.85e-1, 1.51e-1, 7.69e-2,
-3.88e-2, 1.94e-2 (rates 0.92 0.97 0.99 1.00); L2 5.54e-3, 1.61e-3, 4.24e-4, 1.08e-4, 2.73e-5 (1.78 1.92
-1.97 1.99).""",
+Measured errors and rates: reference/cross_check.md and `tresca-cr study` on this scene.""",
         E=E, nu=nu, corners=UNIT_SQUARE, cells=[4, 4], diagonal="first",
         kinds={"bottom": "neumann", "right": "neumann", "top": "neumann", "left": "dirichlet"},
         u=u, g_a=None, T=1, steps=2, expect={})
@@ -436,9 +434,7 @@ Time: s' is continuous and vanishes at both fronts; the exact solution satisfies
 inclusion at the nodes except on the O(k) strip the trailing front crosses in a step, where the
 traction defect is O(k^3): the energy error does not depend on N. The L2 error does a little at
 coarse N (time/space cancellation) and settles for N >= 64, hence steps = 64 for the h study.
-Measured with scripts/skfem_solve.py, N = 64, refine 0..4: max_n energy error 1.40e-1, 8.05e-2,
-3.97e-2, 2.02e-2, 1.02e-2 (rates 0.80 1.02 0.97 0.99); max_n L2 error 1.07e-2, 2.29e-3, 6.55e-4,
-1.61e-4, 3.79e-5 (rates 2.23 1.81 2.02 2.09).""",
+Measured errors and rates: reference/h_mms_front.md (make verify regenerates it).""",
         E=E, nu=nu, corners=UNIT_SQUARE, cells=[4, 4], diagonal="first",
         kinds={"bottom": "contact", "right": "neumann", "top": "dirichlet", "left": "neumann"},
         u=u, g_a=ga.subs(Xs, x), T=1, steps=64,
@@ -472,9 +468,7 @@ FINDING to show: the exact u satisfies the backward-Euler step EXACTLY at every 
 slip increment over (t_{n-1}, t_n] is non-zero is slipping at t_n, so sigma_t(t_n) = -g_a there), so
 the semi-discretisation in time has zero error: the error is independent of N (only the spatial O(h)
 energy / O(h^2) L2 error remains, up to the O(h)-wide discrete front).
-Measured with scripts/skfem_solve.py, N = 8, refine 0..4: max_n energy error 8.47e-2, 4.30e-2, 2.16e-2,
-1.08e-2, 5.43e-3 (rates 0.98 0.99 1.00 1.00); L2 1.46e-3, 3.85e-4, 1.06e-4, 2.63e-5, 6.74e-6 (1.92 1.86
-2.02 1.97). At refine 3 the errors for N = 2, 4, 8, 32 agree to 5 digits (1.0845e-2, 2.6311e-5).""",
+Measured errors, independent of N: reference/be_exact_stick_to_slip.md (make verify regenerates it).""",
         E=E, nu=nu, corners=UNIT_SQUARE, cells=[4, 4], diagonal="first",
         kinds={"bottom": "contact", "right": "neumann", "top": "dirichlet", "left": "neumann"},
         u=u, g_a=ga.subs(Xs, x), T=1, steps=8,
@@ -511,9 +505,7 @@ moves towards c0 and points only pass from stick to slip. Slip is in the -tau di
 E = 10, nu = 0.3. Expected: energy/H1 O(h), L2 O(h^2); as in mms_stick_to_slip backward Euler is
 exact at the nodes (no time error). Exercises the normal/tangent handling on a slanted edge and the
 negative slip sign.
-Measured with scripts/skfem_solve.py, N = 8, refine 0..4: max_n energy error 9.22e-2, 4.71e-2, 2.37e-2,
-1.19e-2, 5.95e-3 (rates 0.97 0.99 1.00 1.00); L2 2.03e-3, 5.36e-4, 1.36e-4, 3.46e-5, 8.61e-6 (1.92 1.98
-1.98 2.01).""",
+Measured errors and rates: reference/h_mms_rotated.md (make verify regenerates it).""",
         E=E, nu=nu, corners=corners, cells=[4, 4], diagonal="second",
         kinds={"bottom": "contact", "right": "neumann", "top": "dirichlet", "left": "neumann"},
         u=u, g_a=ga.subs(Xs, X_of), T=1, steps=8,
@@ -553,10 +545,9 @@ slip a(x)(t* - t_{n-1}) = a(x) theta k, theta = frac(N t*/T), and keeps that err
 times: e(t_n) = theta k ||W|| for t_n > t*, W the elastic field of a unit-rate slip a(x) with zero
 loads. Hence O(k), but theta = frac(N/3) alternates 1/3, 2/3 for N = 2^j, so observed rates alternate
 ~0 and ~2. Use N = 4^j (4, 16, 64, 256: theta = 1/3 always) or N = 2*4^j (theta = 2/3) and compute the
-order with log ratio / log 4. Measured (scripts/skfem_solve.py): E(T) is identical for N = 4 and 8,
-for 16 and 32, for 64 and 128 (theta k = 1/12, 1/48, 1/192). The time error dominates at refine 4 for
-N <= 16 (energy 5.31e-2, 1.42e-2) and at refine 5 for N <= 64 (energy 5.28e-2, 1.35e-2, 4.42e-3:
-rates 0.99, 0.80 per factor 4 as the space error appears; L2 1.85e-2, 4.62e-3, 1.16e-3: rates 1.00).""",
+order with log ratio / log 4: E(T) is then the same for N = 4 and 8, 16 and 32, 64 and 128
+(theta k = 1/12, 1/48, 1/192). Measured errors and rates: reference/k_study_mms_stop.md and
+reference/joint_mms_stop.md (make verify regenerates them).""",
         E=E, nu=nu, corners=UNIT_SQUARE, cells=[4, 4], diagonal="first",
         kinds={"bottom": "contact", "right": "neumann", "top": "dirichlet", "left": "neumann"},
         u=u, g_a=ga.subs(Xs, x), T=1, steps=4, t_special=[ts],

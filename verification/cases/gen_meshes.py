@@ -1,6 +1,6 @@
 """Generate the unstructured Gmsh 4.1 meshes used by the tests (committed; rerun only to change them).
 
-    .venv/bin/python tests/scenes/gen_meshes.py      (needs `pip install gmsh==4.15.2`)
+    .venv/bin/python verification/cases/gen_meshes.py      (needs `pip install gmsh==4.15.2`)
 
 lshape.msh: the L-shaped polygon (0,2)^2 minus [1,2]x[1,2], h ~ 0.35, physical curves
 "clamp" (x = 0), "loaded" (the other sides except y = 0) and "floor" (y = 0).
@@ -23,6 +23,6 @@ gmsh.model.addPhysicalGroup(2, [surf], name="body")
 gmsh.model.mesh.generate(2)
 gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
 gmsh.option.setNumber("Mesh.Binary", 0)
-gmsh.write("tests/scenes/lshape.msh")
+gmsh.write("verification/cases/lshape.msh")
 gmsh.finalize()
-print("wrote tests/scenes/lshape.msh")
+print("wrote verification/cases/lshape.msh")

@@ -1,0 +1,142 @@
+//! Reading conventions of exmex that differ from mathematics, rejected before parsing, and the
+//! rewriting of what exmex cannot read (scientific notation, `pi`).
+
+/// Reject the two constructs whose exmex reading differs from the usual mathematical one:
+/// a unary minus in front of a power (exmex reads `-x^2` as `(-x)^2`) and chained powers
+/// (exmex reads `2^x^2` as `(2^x)^2`). Both must be parenthesised explicitly.
+/// Returns the text with scientific-notation literals (`1.2e-3`, which exmex cannot read) written out.
+pub(super) fn lint(text: &str) -> std::result::Result<String, String> {
+    let mut out = String::with_capacity(text.len());
+    #[derive(Clone, Copy, PartialEq)]
+    enum Tok {
+        Atom,
+        Ident,
+        /// min, max, atan2: exmex's two-argument functions, which it cannot nest
+        Binary,
+        Open,
+        Close,
+        Comma,
+        Op(char),
+    }
+    let mut toks = Vec::new();
+    let mut chars = text.chars().peekable();
+    while let Some(&c) = chars.peek() {
+        if c.is_whitespace() {
+            out.push(c);
+            chars.next();
+        } else if c.is_ascii_digit() || c == '.' {
+            let mut lit = String::new();
+            while let Some(d) = chars.next_if(|d| d.is_ascii_digit() || *d == '.') {
+                lit.push(d);
+            }
+            // exponent notation such as 1e-3
+            if chars.peek().is_some_and(|d| *d == 'e' || *d == 'E') {
+                let mut look = chars.clone();
+                look.next();
+                let sign = look.next_if(|d| *d == '-' || *d == '+');
+                if look.peek().is_some_and(|d| d.is_ascii_digit()) {
+                    chars.next();
+                    lit.push('e');
+                    if let Some(sg) = sign {
+                        chars.next();
+                        lit.push(sg);
+                    }
+                    while let Some(d) = chars.next_if(|d| d.is_ascii_digit()) {
+                        lit.push(d);
+                    }
+                }
+            }
+            let v: f64 = lit.parse().map_err(|_| format!("malformed number `{lit}`"))?;
+            if lit.contains('e') {
+                // Rust's Display never uses exponent notation and round-trips exactly
+                out.push_str(&format!("{v}"));
+            } else {
+                out.push_str(&lit);
+            }
+            toks.push(Tok::Atom);
+        } else if c.is_alphanumeric() || c == '_' {
+            let mut name = String::new();
+            while let Some(d) = chars.next_if(|d| d.is_alphanumeric() || *d == '_') {
+                name.push(d);
+            }
+            // `pi` is accepted for exmex's `PI`
+            out.push_str(if name == "pi" { "PI" } else { &name });
+            toks.push(if matches!(name.as_str(), "min" | "max" | "atan2") { Tok::Binary } else { Tok::Ident });
+        } else {
+            out.push(c);
+            chars.next();
+            toks.push(match c {
+                '(' => Tok::Open,
+                ')' => Tok::Close,
+                ',' => Tok::Comma,
+                other => Tok::Op(other),
+            });
+        }
+    }
+    // index just past the operand starting at i (atom, identifier, call or parenthesised group)
+    let skip_operand = |i: usize| -> usize {
+        let mut j = i;
+        if matches!(toks.get(j), Some(Tok::Ident | Tok::Binary)) && toks.get(j + 1) == Some(&Tok::Open) {
+            j += 1;
+        }
+        if toks.get(j) == Some(&Tok::Open) {
+            let mut depth = 0;
+            while j < toks.len() {
+                match toks[j] {
+                    Tok::Open => depth += 1,
+                    Tok::Close => {
+                        depth -= 1;
+                        if depth == 0 {
+                            return j + 1;
+                        }
+                    }
+                    _ => {}
+                }
+                j += 1;
+            }
+            return j;
+        }
+        j + 1
+    };
+    // depth of parentheses at which each open two-argument call started
+    let mut calls: Vec<usize> = Vec::new();
+    let mut depth = 0usize;
+    for t in &toks {
+        match t {
+            Tok::Open => depth += 1,
+            Tok::Close => {
+                depth = depth.saturating_sub(1);
+                if calls.last() == Some(&depth) {
+                    calls.pop();
+                }
+            }
+            Tok::Binary => {
+                if !calls.is_empty() {
+                    return Err("exmex cannot nest min/max/atan2 inside another min/max/atan2; \
+                                write max(a, b) as (a + b + abs(a - b))/2"
+                        .into());
+                }
+                calls.push(depth);
+            }
+            _ => {}
+        }
+    }
+    for i in 0..toks.len() {
+        let unary = toks[i] == Tok::Op('-') && (i == 0 || matches!(toks[i - 1], Tok::Open | Tok::Comma | Tok::Op(_)));
+        if unary && toks.get(skip_operand(i + 1)) == Some(&Tok::Op('^')) {
+            return Err(
+                "ambiguous unary minus before a power: exmex reads -a^b as (-a)^b; write -(a^b) or (-a)^b".into()
+            );
+        }
+        if toks[i] == Tok::Op('^') {
+            let mut j = i + 1;
+            while toks.get(j).is_some_and(|t| matches!(t, Tok::Op('-') | Tok::Op('+'))) {
+                j += 1;
+            }
+            if toks.get(skip_operand(j)) == Some(&Tok::Op('^')) {
+                return Err("chained powers: exmex reads a^b^c as (a^b)^c; parenthesise, e.g. a^(b^c)".into());
+            }
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,76 @@
+//! The compiled expressions against exmex's interpreter (what runs evaluated before compilation), on
+//! every expression of `verification/cases/` at the quadrature points where runs evaluate them: the
+//! degree-4 triangle rule on every element and the 2- and 3-point Gauss rules on every edge of the mesh
+//! at refinement 2, at every time node of the scene.
+
+use std::path::Path;
+use tresca_cr::fem::quadrature::{edge_point, tri_point, GAUSS2, GAUSS3, TRI4};
+use tresca_cr::mesh::Mesh;
+use tresca_cr::scene::expr::{Expr, ExprSet};
+use tresca_cr::Scene;
+
+/// Every expression string of a scene file (the keys that hold expressions).
+fn expressions(v: &toml::Value, key: &str, out: &mut Vec<(String, String)>) {
+    match v {
+        toml::Value::String(s) if matches!(key, "g_a" | "traction" | "f" | "u0" | "u" | "grad") => {
+            out.push((key.to_string(), s.clone()))
+        }
+        toml::Value::Array(a) => a.iter().for_each(|x| expressions(x, key, out)),
+        toml::Value::Table(t) => t.iter().for_each(|(k, x)| expressions(x, k, out)),
+        _ => {}
+    }
+}
+
+#[test]
+fn compiled_agrees_with_interpreter_on_all_cases() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/cases");
+    let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    files.sort();
+    let (mut worst, mut worst_at) = (0.0f64, String::new());
+    let mut n_values = 0usize;
+    for file in files.iter().filter(|p| p.extension().is_some_and(|e| e == "toml")) {
+        let mut scene = Scene::from_file(file).unwrap();
+        scene.set_refine(2).unwrap();
+        let mesh = Mesh::from_spec(&scene.mesh).unwrap();
+        let mut pts: Vec<[f64; 2]> = Vec::new();
+        for t in &mesh.tris {
+            let p = t.map(|v| mesh.points[v]);
+            pts.extend(TRI4.iter().map(|(l, _)| tri_point(p, *l)));
+        }
+        for e in &mesh.edges {
+            let [a, b] = e.map(|v| mesh.points[v]);
+            pts.extend(GAUSS2.iter().chain(&GAUSS3).map(|(s, _)| edge_point(a, b, *s)));
+        }
+        let mut found = Vec::new();
+        expressions(&toml::from_str::<toml::Value>(&scene.text).unwrap(), "", &mut found);
+        assert!(!found.is_empty());
+        for (key, text) in found {
+            let e = Expr::parse(&key, &text).unwrap();
+            let set = ExprSet::new(&[&e]);
+            let bound = set.clone().bind(pts.clone());
+            let reference = e.interpreted().unwrap();
+            let (mut compiled, mut from_bound) = (Vec::new(), Vec::new());
+            for &t in &scene.times {
+                set.eval(&pts, t, &mut compiled).unwrap();
+                // the spatial parts cached at binding: the same operations, so the same bits
+                bound.eval(t, &mut from_bound).unwrap();
+                assert!(compiled.iter().zip(&from_bound).all(|(a, b)| a.to_bits() == b.to_bits()), "{key} `{text}`");
+                let exact: Vec<f64> = pts.iter().map(|p| reference.eval(p[0], p[1], t)).collect();
+                // relative to the expression's size over the mesh at this time: these expressions are
+                // sums of terms of that size, so a change of a few ulps in one term (integer powers as
+                // products, shared subterms) shows as ~1e-16 of it, also where the sum cancels to ~0
+                let scale = exact.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for (i, (c, r)) in compiled.iter().zip(&exact).enumerate() {
+                    let d = (c - r).abs() / scale.max(f64::MIN_POSITIVE);
+                    n_values += 1;
+                    if d > worst {
+                        worst = d;
+                        worst_at = format!("{} {key} `{text}` at {:?}, t={t}: {c} vs {r}", file.display(), pts[i]);
+                    }
+                }
+            }
+        }
+    }
+    println!("max relative difference compiled vs interpreted over {n_values} values: {worst:.3e} ({worst_at})");
+    assert!(worst <= 1e-13, "max relative difference {worst:e}: {worst_at}");
+}
