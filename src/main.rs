@@ -118,9 +118,12 @@ fn load(
     refine: Option<u32>,
     steps: Option<usize>,
     limits: Limits,
-    output: Option<&Path>,
+    output: impl FnOnce(&Scene) -> Option<PathBuf>,
 ) -> Result<(Scene, Estimate)> {
     let mut scene = Scene::from_file(path)?;
+    // the results file whose disk the estimate is for, chosen from the scene just read (parsed once)
+    let output = output(&scene);
+    let output = output.as_deref();
     if scene.rho < 1.0 {
         // a_h is coercive only through the jump term (plain CR fails Korn's inequality): the discrete
         // Korn constant, and with it the error, degrades like 1/ρ (reference/stability.md: ρ = 1e-4 gives
@@ -151,13 +154,13 @@ fn main() {
     let result = match cli.cmd {
         Cmd::Check { scene, refine, steps, limits } => {
             // the estimate of the results file is for the scene's [output] path, else the current directory
-            let out = Scene::from_file(&scene).ok().and_then(|s| s.output).unwrap_or_else(|| PathBuf::from("run.h5"));
-            load(&scene, refine, steps, limits, Some(&out)).and_then(|(s, e)| cli::check::check(s, e))
+            let out = |s: &Scene| Some(s.output.clone().unwrap_or_else(|| PathBuf::from("run.h5")));
+            load(&scene, refine, steps, limits, out).and_then(|(s, e)| cli::check::check(s, e))
         }
         Cmd::Run { scene, refine, steps, solver, tol, out, verbose, quiet, limits } => {
-            let target = out.output.clone().or_else(|| Scene::from_file(&scene).ok().and_then(|s| s.output));
             // a resumed run's file already holds its disk space: only memory is checked then
-            let new_file = target.as_deref().filter(|_| !out.resume);
+            let (given, resume) = (out.output.clone(), out.resume);
+            let new_file = move |s: &Scene| given.or_else(|| s.output.clone()).filter(|_| !resume);
             load(&scene, refine, steps, limits, new_file).and_then(|(mut s, _)| {
                 solver_overrides(&mut s, solver, tol)?;
                 cli::run::run(s, out, verbose, quiet)
@@ -165,7 +168,7 @@ fn main() {
         }
         Cmd::Study { scene, levels, reference, solver, tol, csv, differences } => {
             let no_limits = Limits { max_memory: None, max_disk: None };
-            load(&scene, None, None, no_limits, None).and_then(|(mut s, _)| {
+            load(&scene, None, None, no_limits, |_| None).and_then(|(mut s, _)| {
                 solver_overrides(&mut s, solver, tol)?;
                 cli::study::study(s, &levels, reference, csv, differences)
             })
