@@ -27,6 +27,19 @@ from paraview.simple import (AnnotateTimeFilter, ColorBy, ExtractBlock, GetActiv
                              WarpByVector, XDMFReader)
 
 
+def scalar_bar(lut, view, title, orientation, position, length):
+    """A black-on-white colour legend of `lut` at a fixed place of the view (off the body)."""
+    bar = GetScalarBar(lut, view)
+    bar.Title = title
+    bar.ComponentTitle = ""
+    bar.TitleColor = bar.LabelColor = [0, 0, 0]
+    bar.WindowLocation = "Any Location"
+    bar.Orientation = orientation
+    bar.Position = position
+    bar.ScalarBarLength = length
+    return bar
+
+
 def version():
     from paraview.simple import GetParaViewVersion
     v = GetParaViewVersion()
@@ -118,14 +131,7 @@ def main(argv=None):
     lut.ApplyPreset("Viridis (matplotlib)", True)
     lut.RescaleTransferFunction(max(vm_lo, 0.0), vm_hi if vm_hi > vm_lo else vm_lo + 1.0)
     lut.AutomaticRescaleRangeMode = "Never"
-    bar = GetScalarBar(lut, view)
-    bar.Title = "von Mises stress (plane strain)"
-    bar.ComponentTitle = ""
-    bar.TitleColor = bar.LabelColor = [0, 0, 0]
-    bar.WindowLocation = "Any Location"
-    bar.Orientation = "Vertical"
-    bar.Position = [0.89, 0.12]
-    bar.ScalarBarLength = 0.7
+    scalar_bar(lut, view, "von Mises stress (plane strain)", "Vertical", [0.89, 0.12], 0.7)
     db.SetScalarBarVisibility(view, True)
     dc = Show(warp_c, view)
     ColorBy(dc, ("CELLS", "stick_slip"))
@@ -135,14 +141,7 @@ def main(argv=None):
     ss.InterpretValuesAsCategories = 1
     ss.Annotations = ["0", "stick", "1", "slip"]
     ss.IndexedColors = [0.12, 0.35, 0.95, 0.9, 0.1, 0.1]
-    sbar = GetScalarBar(ss, view)
-    sbar.Title = "contact line"
-    sbar.ComponentTitle = ""
-    sbar.TitleColor = sbar.LabelColor = [0, 0, 0]
-    sbar.WindowLocation = "Any Location"
-    sbar.Orientation = "Horizontal"
-    sbar.Position = [0.35, 0.03]
-    sbar.ScalarBarLength = 0.3
+    scalar_bar(ss, view, "contact line", "Horizontal", [0.35, 0.03], 0.3)
     dc.SetScalarBarVisibility(view, True)
     label = Text()
     lt = Show(label, view)
