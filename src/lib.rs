@@ -14,6 +14,7 @@
 //! | friction | [`friction`] | the per-step box QP on Γ_C by SSN, Uzawa or PDAS |
 //! | time stepping | [`stepping`] | set-up once, then backward Euler steps |
 //! | studies | [`study`] | convergence studies, observed orders, error estimates without an exact solution (Richardson, GCI) |
+//! | planning | [`plan`] | target accuracy → the cheapest (refine, steps, solver, tolerance), from pilot runs |
 //! | output | [`output`] | HDF5 results (`/tresca`, VTKHDF, XDMF), resume |
 //!
 //! Each backward-Euler step solves
@@ -25,6 +26,7 @@ pub mod friction;
 pub mod mesh;
 pub mod output;
 pub mod parallel;
+pub mod plan;
 pub mod scene;
 pub mod solve;
 pub mod sparse;

@@ -1,4 +1,4 @@
-//! The `tresca-cr` command line: `check`, `run`, `study`. Library errors become messages and exit codes here.
+//! The `tresca-cr` command line: `check`, `run`, `study`, `plan`. Library errors become messages and exit codes here.
 
 mod cli;
 
@@ -76,6 +76,33 @@ enum Cmd {
         /// Write per level the elementwise energy density of u_l − P u_{l−1} (XDMF, ParaView) into DIR.
         #[arg(long, value_name = "DIR")]
         differences: Option<PathBuf>,
+    },
+    /// Plan the cheapest run that meets a target accuracy: pilot runs, error and cost models, the
+    /// cheapest (refine, steps, solver, tolerance) and two runners-up, or a refusal (exit code 2).
+    Plan {
+        scene: PathBuf,
+        /// The error to reach (absolute, in the quantity's units).
+        #[arg(long)]
+        target: f64,
+        /// energy (energy-norm error, max over the time nodes), max-slip, stick-length, elastic-energy or
+        /// a traction_x_y output of [outputs] (at T).
+        #[arg(long, default_value = "energy")]
+        quantity: String,
+        /// Wall time the planned run may take (e.g. 90s, 10m, 2h).
+        #[arg(long, default_value = "1h", value_parser = cli::plan::parse_duration)]
+        budget: f64,
+        /// Wall time the pilot runs may take (default: a tenth of the budget).
+        #[arg(long, value_parser = cli::plan::parse_duration)]
+        pilot_budget: Option<f64>,
+        /// Run the plan and report the achieved error estimate (and the true error with [exact]).
+        #[arg(long)]
+        run: bool,
+        /// Write the plan and the runners-up as CSV.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Refuse configurations whose estimated peak memory exceeds this (default: available memory).
+        #[arg(long, value_parser = parse_size)]
+        max_memory: Option<u64>,
     },
 }
 
@@ -171,6 +198,23 @@ fn main() {
             load(&scene, None, None, no_limits, |_| None).and_then(|(mut s, _)| {
                 solver_overrides(&mut s, solver, tol)?;
                 cli::study::study(s, &levels, reference, csv, differences)
+            })
+        }
+        Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory } => {
+            let no_limits = Limits { max_memory: None, max_disk: None };
+            let options = tresca_cr::plan::Options {
+                target,
+                quantity: tresca_cr::plan::pilot::Quantity::parse(&quantity),
+                budget,
+                pilot_budget: pilot_budget.unwrap_or(budget / 10.0),
+                max_memory,
+            };
+            load(&scene, None, None, no_limits, |_| None).and_then(|(s, _)| {
+                let code = cli::plan::run(s, options, csv, run)?;
+                if code != 0 {
+                    std::process::exit(code);
+                }
+                Ok(())
             })
         }
     };

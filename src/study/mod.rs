@@ -56,7 +56,10 @@ pub struct LevelResult {
     pub k: f64,
     pub dofs: usize,
     pub paper_dofs: usize,
+    /// Wall time of the level: set-up and steps (seconds).
     pub wall: f64,
+    /// The set-up part of `wall` (mesh, assembly, factorisation, condensation).
+    pub setup: f64,
     pub iterations: usize,
     /// True errors, max over the level's own time nodes ("max over n").
     pub max_err: Option<ErrorNorms>,
@@ -147,6 +150,7 @@ fn run_level(scene: &Scene, level: Level, common: &[f64], own_nodes: bool, out: 
         dofs: problem.space.n_dofs,
         paper_dofs: problem.space.paper_dofs(),
         wall: start.elapsed().as_secs_f64(),
+        setup: problem.setup.as_array().iter().sum(),
         iterations,
         max_err,
         common_err,
@@ -158,9 +162,96 @@ fn run_level(scene: &Scene, level: Level, common: &[f64], own_nodes: bool, out: 
     Ok(Kept { problem, u })
 }
 
-/// Run the study. Levels must share the time nodes of the coarsest grid (e.g. steps doubling). With
-/// `differences`, the elementwise energy density of u_l − P u_{l−1} of every level l ≥ 2 is written there
-/// ([`differences`]).
+/// A study under way: levels are added one at a time ([`Sequence::push`]), each compared with the two
+/// before it, then [`Sequence::finish`] estimates the errors. Levels must share the time nodes of the
+/// coarsest grid (`common`: e.g. steps doubling, or all levels with the same steps).
+pub struct Sequence<'a> {
+    scene: &'a Scene,
+    common: Vec<f64>,
+    reference: Option<Kept>,
+    differences: Option<&'a Path>,
+    difference_files: Vec<PathBuf>,
+    results: Vec<LevelResult>,
+    prev: Option<Kept>,
+    prev2: Option<Kept>,
+}
+
+impl<'a> Sequence<'a> {
+    /// A sequence whose common time nodes are those of `min_steps` uniform steps, with an optional
+    /// reference run and, with `differences`, the elementwise energy density of u_l − P u_{l−1} of every
+    /// level l ≥ 2 written there ([`differences`]).
+    pub fn new(
+        scene: &'a Scene,
+        min_steps: usize,
+        reference: Option<Level>,
+        differences: Option<&'a Path>,
+    ) -> Result<Sequence<'a>> {
+        if !scene.uniform_time {
+            return Err(Error::scene(&scene.file, "time", "a study needs `T` and `steps` (uniform grids), not `times`"));
+        }
+        let (t0, t1) = (scene.times[0], *scene.times.last().expect("nodes"));
+        let common: Vec<f64> = (0..=min_steps).map(|i| t0 + (t1 - t0) * i as f64 / min_steps as f64).collect();
+        let reference = match reference {
+            Some(l) => Some(run_level(scene, l, &common, false, &mut LevelResult::default())?),
+            None => None,
+        };
+        Ok(Sequence {
+            scene,
+            common,
+            reference,
+            differences,
+            difference_files: vec![],
+            results: vec![],
+            prev: None,
+            prev2: None,
+        })
+    }
+
+    /// Run one more level and compare it with the previous two (and the reference run).
+    pub fn push(&mut self, level: Level) -> Result<&LevelResult> {
+        let mut r = LevelResult::default();
+        let kept = run_level(self.scene, level, &self.common, true, &mut r)?;
+        r.jumps = measure::jumps(&kept);
+        if let Some(p) = &self.prev {
+            r.consecutive = Some(max_last(&measure::consecutive(&kept, p)?));
+            r.increment = Some(measure::distance(&kept, p)?);
+            if let Some(dir) = self.differences {
+                self.difference_files.push(differences::write(dir, &kept, p)?);
+            }
+        }
+        if let Some(p2) = &self.prev2 {
+            r.skip = Some(measure::distance(&kept, p2)?);
+        }
+        if let Some(rf) = &self.reference {
+            r.reference = Some(max_last(&measure::reference_error(rf, &kept)?));
+        }
+        self.results.push(r);
+        self.prev2 = self.prev.take();
+        self.prev = Some(kept);
+        Ok(self.results.last().expect("just pushed"))
+    }
+
+    /// The levels run so far.
+    pub fn levels(&self) -> &[LevelResult] {
+        &self.results
+    }
+
+    /// The study of the levels run so far, with its error estimates.
+    pub fn finish(&self) -> Study {
+        let names = outputs::names(&outputs::selected(self.scene));
+        let (size, x) = estimate::sizes(&self.results);
+        let q: Vec<Vec<f64>> = self.results.iter().map(|r| r.outputs.clone()).collect();
+        Study {
+            estimates: estimate::estimate(&self.results),
+            outputs: outputs::estimate(&names, size, &x, &q),
+            output_names: names,
+            levels: self.results.clone(),
+            difference_files: self.difference_files.clone(),
+        }
+    }
+}
+
+/// Run the study of `levels` ([`Sequence`]), reporting each level as it finishes.
 pub fn run_study(
     scene: &Scene,
     levels: &[Level],
@@ -168,49 +259,10 @@ pub fn run_study(
     differences: Option<&Path>,
     mut report: impl FnMut(&LevelResult),
 ) -> Result<Study> {
-    if !scene.uniform_time {
-        return Err(Error::scene(&scene.file, "time", "a study needs `T` and `steps` (uniform grids), not `times`"));
-    }
     let n0 = levels.iter().map(|l| l.steps).min().ok_or_else(|| Error::scene(&scene.file, "study", "no levels"))?;
-    let (t0, t1) = (scene.times[0], *scene.times.last().expect("nodes"));
-    let common: Vec<f64> = (0..=n0).map(|i| t0 + (t1 - t0) * i as f64 / n0 as f64).collect();
-    let reference = match reference {
-        Some(l) => Some(run_level(scene, l, &common, false, &mut LevelResult::default())?),
-        None => None,
-    };
-    let mut results = Vec::new();
-    let mut difference_files = Vec::new();
-    let (mut prev, mut prev2): (Option<Kept>, Option<Kept>) = (None, None);
+    let mut seq = Sequence::new(scene, n0, reference, differences)?;
     for &level in levels {
-        let mut r = LevelResult::default();
-        let kept = run_level(scene, level, &common, true, &mut r)?;
-        r.jumps = measure::jumps(&kept);
-        if let Some(p) = &prev {
-            r.consecutive = Some(max_last(&measure::consecutive(&kept, p)?));
-            r.increment = Some(measure::distance(&kept, p)?);
-            if let Some(dir) = differences {
-                difference_files.push(differences::write(dir, &kept, p)?);
-            }
-        }
-        if let Some(p2) = &prev2 {
-            r.skip = Some(measure::distance(&kept, p2)?);
-        }
-        if let Some(rf) = &reference {
-            r.reference = Some(max_last(&measure::reference_error(rf, &kept)?));
-        }
-        report(&r);
-        results.push(r);
-        prev2 = prev.take();
-        prev = Some(kept);
+        report(seq.push(level)?);
     }
-    let names = outputs::names(&outputs::selected(scene));
-    let (size, x) = estimate::sizes(&results);
-    let q: Vec<Vec<f64>> = results.iter().map(|r| r.outputs.clone()).collect();
-    Ok(Study {
-        estimates: estimate::estimate(&results),
-        outputs: outputs::estimate(&names, size, &x, &q),
-        output_names: names,
-        levels: results,
-        difference_files,
-    })
+    Ok(seq.finish())
 }

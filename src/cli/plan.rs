@@ -1,0 +1,211 @@
+//! `tresca-cr plan`: print the pilot's evidence, the fitted models and the cheapest configuration predicted
+//! to meet the target (or the refusal), optionally write them as CSV, and with `--run` run the plan and
+//! report the achieved error estimate (and the true error when the scene has `[exact]`).
+
+use super::out::{note, say};
+use anyhow::{Context, Result};
+use std::path::PathBuf;
+use tresca_cr::plan::model::{Combine, TimeError};
+use tresca_cr::plan::pilot::{fit, Quantity};
+use tresca_cr::plan::{plan, Candidate, Options, Plan};
+use tresca_cr::study::orders::successive_orders;
+use tresca_cr::study::{run_study, Level, Study};
+use tresca_cr::Scene;
+
+/// Exit code of a refusal (no plan; distinct from errors, which exit with 1).
+pub const REFUSED: i32 = 2;
+
+pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool) -> Result<i32> {
+    say!("Planning {} for the {} ≤ {:e}", scene.file, options.quantity.describe(), options.target);
+    let p = plan(&scene, &options)?;
+    print_evidence(&p);
+    if let Some(path) = &csv {
+        std::fs::write(path, csv_text(&p)).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    for n in &p.notes {
+        say!("note: {n}");
+    }
+    if let Some(why) = &p.refused {
+        say!("\nNo plan: {why}");
+        return Ok(REFUSED);
+    }
+    say!("\n{:>8} {:>6} {:>7} {:>10} {:>6} {:>8} {:>11} {:>11} {:>11} {:>11} {:>9}", "", "refine", "steps", "unknowns", "solver", "tol", "pred error", "space", "time", "pred wall", "memory");
+    for (i, c) in p.best.iter().enumerate() {
+        let role = if i == 0 { "plan" } else { "runner-up" };
+        say!(
+            "{role:>8} {:>6} {:>7} {:>10} {:>6} {:>8.0e} {:>11.4e} {:>11.4e} {:>11.4e} {:>10.3}s {:>8}M",
+            c.refine,
+            c.steps,
+            c.unknowns,
+            p.solver,
+            p.tol,
+            c.error,
+            c.space_error,
+            c.time_error,
+            c.wall,
+            c.memory >> 20
+        );
+    }
+    let b = &p.best[0];
+    say!(
+        "\nrun it: tresca-cr run {} --refine {} --steps {} --solver {} --tol {:e}",
+        scene.file,
+        b.refine,
+        b.steps,
+        p.solver,
+        p.tol
+    );
+    if execute {
+        execute_plan(&scene, &p, b)?;
+    }
+    Ok(0)
+}
+
+fn print_evidence(p: &Plan) {
+    say!("\nPilot runs (the scene without [exact]; wall = set-up + steps, seconds):");
+    for (name, study, fit) in [("time", &p.time, &p.time_fit), ("space", &p.space, &p.space_fit)] {
+        say!("  {name} sequence, sizes {}:", fit.size);
+        say!("  {:>6} {:>7} {:>9} {:>10} {:>9} {:>9} {:>7} {:>11}  verdict", "refine", "steps", "h", "unknowns", "set-up", "wall", "it/step", "est error");
+        for (i, r) in study.levels.iter().enumerate() {
+            let est = fit.errors.get(i).map_or("-".into(), |e| format!("{e:.4e}"));
+            let verdict = fit.verdicts.get(i).map_or(String::new(), |v| v.text());
+            say!(
+                "  {:>6} {:>7} {:>9.3e} {:>10} {:>9.4} {:>9.4} {:>7.2} {:>11}  {}",
+                r.refine,
+                r.steps,
+                r.h,
+                r.dofs,
+                r.setup,
+                r.wall,
+                r.iterations as f64 / r.steps as f64,
+                est,
+                verdict
+            );
+        }
+        if let Some(why) = &fit.refused {
+            say!("  no estimate: {why}");
+        }
+    }
+    say!("Pilot cost: {:.3} s (pilot budget {:.3} s)", p.pilot_wall, p.options.pilot_budget);
+    let orders = |f: &tresca_cr::plan::pilot::Fit| {
+        if f.errors.len() < 2 {
+            return String::new();
+        }
+        let o = successive_orders(&f.x, &f.errors);
+        format!(", successive orders {}", o.iter().map(|v| format!("{v:.3}")).collect::<Vec<_>>().join(" "))
+    };
+    if let Some(m) = &p.error {
+        let range = |x: &[f64]| format!("[{:.3e}, {:.3e}]", x.last().copied().unwrap_or(0.0), x[0]);
+        say!(
+            "\nError model: e_h = {:.4e} h^{:.3} (h in {}{}, β = {})",
+            m.space.c,
+            m.space.p,
+            range(&p.space_fit.x),
+            orders(&p.space_fit),
+            p.space_fit.beta.map_or("-".into(), |b| format!("{b:.3}"))
+        );
+        match m.time {
+            TimeError::Law(t) => say!(
+                "             e_k = {:.4e} k^{:.3} (k in {}{}, steps ×{})",
+                t.c,
+                t.p,
+                range(&p.time_fit.x),
+                orders(&p.time_fit),
+                p.time_ratio
+            ),
+            TimeError::Bound(b) => say!("             e_k ≤ {b:.3e} for every N ≥ {} (a bound from the time pilot's distances; see the note)", p.scene_steps),
+        }
+        say!(
+            "             e = {}",
+            match m.combine {
+                Combine::Quadrature => "√(e_h² + e_k²) (β ≥ 0.5: the spatial error is orthogonal to smooth fields)",
+                Combine::Sum => "e_h + e_k",
+            }
+        );
+    }
+    if let Some(c) = &p.cost {
+        say!(
+            "Cost model:  wall = {:.3e} n^{:.3} + N · {:.3e} n ln n s (n unknowns, N steps)",
+            c.setup.c,
+            c.setup.p,
+            c.step
+        );
+    }
+}
+
+fn csv_text(p: &Plan) -> String {
+    let mut s = String::from("role,refine,steps,unknowns,solver,tol,pred_error,space_error,time_error,pred_wall,memory,pilot_wall\n");
+    let mut row = |role: &str, c: &Candidate| {
+        s.push_str(&format!(
+            "{role},{},{},{},{},{:e},{:e},{:e},{:e},{:e},{},{:e}\n",
+            c.refine, c.steps, c.unknowns, p.solver, p.tol, c.error, c.space_error, c.time_error, c.wall, c.memory, p.pilot_wall
+        ));
+    };
+    for (i, c) in p.best.iter().enumerate() {
+        row(if i == 0 { "plan" } else { "runner-up" }, c);
+    }
+    if let Some(c) = &p.over_budget {
+        row("over-budget", c);
+    }
+    if p.best.is_empty() {
+        s.push_str(&format!("refused,,,,,,,,,,,{:e}\n", p.pilot_wall));
+    }
+    s
+}
+
+/// Run the plan as the finest level of a short study at its steps (refine r−3 … r, as far as the
+/// scene's mesh allows: about 1.3 times the run; four levels for the asymptotic check), whose Richardson estimate of the finest level, combined
+/// with the time model at its steps, is the achieved estimate; the true error too when the scene has one.
+fn execute_plan(scene: &Scene, p: &Plan, b: &Candidate) -> Result<()> {
+    let mut s = scene.clone();
+    s.solver.method = tresca_cr::scene::Method::Ssn;
+    s.solver.tol = p.tol;
+    let first = b.refine.saturating_sub(3).max(scene.mesh_level());
+    let levels: Vec<Level> = (first..=b.refine).map(|refine| Level { refine, steps: b.steps }).collect();
+    say!("\nRunning the plan (levels {first}..={} at {} steps, for the estimate):", b.refine, b.steps);
+    let study: Study = run_study(&s, &levels, None, None, |r| {
+        say!("  refine {} steps {}: {:.3} s", r.refine, r.steps, r.wall);
+    })?;
+    let f = fit(&study, &p.options.quantity)?;
+    let model = p.error.expect("a plan has an error model");
+    let space = match (f.errors.last(), f.not_in_range()) {
+        (Some(&e), None) => e,
+        (_, why) => {
+            note!("the run's own levels give no estimate ({}): the pilot's model is used", why.unwrap_or_default());
+            model.space_error(b.h)
+        }
+    };
+    let time = model.time_error(b.k);
+    let achieved = match model.combine {
+        Combine::Quadrature => space.hypot(time),
+        Combine::Sum => space + time,
+    };
+    let finest = study.levels.last().expect("levels");
+    say!(
+        "achieved estimate {achieved:.4e} (space {space:.4e} from the run's levels, time {time:.4e} from the model) against the target {:e}: {}",
+        p.options.target,
+        if achieved <= p.options.target { "met" } else { "NOT met" }
+    );
+    if let (Quantity::Energy, Some(e)) = (&p.options.quantity, finest.max_err) {
+        say!("true energy error (max over the time nodes) {:.4e}: {}", e.energy, if e.energy <= p.options.target { "met" } else { "NOT met" });
+    }
+    say!("wall of the planned level {:.3} s (predicted {:.3} s)", finest.wall, b.wall);
+    Ok(())
+}
+
+/// A duration such as 90, 90s, 250ms, 10m or 2h, in seconds.
+pub fn parse_duration(text: &str) -> std::result::Result<f64, String> {
+    let t = text.trim();
+    let (num, unit) = t.split_at(t.find(|c: char| c.is_ascii_alphabetic()).unwrap_or(t.len()));
+    let mult = match unit {
+        "" | "s" => 1.0,
+        "ms" => 1e-3,
+        "m" | "min" => 60.0,
+        "h" => 3600.0,
+        _ => return Err(format!("`{text}`: expected a duration such as 90s, 250ms, 10m or 2h")),
+    };
+    match num.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v * mult),
+        _ => Err(format!("`{text}`: expected a positive duration such as 90s, 250ms, 10m or 2h")),
+    }
+}

@@ -1,0 +1,406 @@
+//! `tresca-cr plan`: from a target accuracy to the cheapest (refinement, steps, solver, tolerance).
+//!
+//! 1. Pilot runs ([`pilot`]): a time sequence on a coarse mesh from N/16 of the scene's N steps
+//!    ([`time_base`]), and a space sequence r₀, r₀+1, …, their cost bounded by the pilot budget. The
+//!    scene's N is the fewest steps a plan offers: its nodes are the times the user asked for.
+//! 2. Models ([`model`]): e(h, k) = C_h hᵖ ⊕ C_k k^q from the sequences' estimates, only when their finest
+//!    levels are in the asymptotic range (else a refusal naming the reason); wall(n, N) = S(n) + N s(n)
+//!    from their wall times.
+//! 3. Search: for each refinement r ≥ r₀ with C_h h_rᵖ below the target, the fewest steps of the time
+//!    pilot's family (N₀·ratio^j, the grids on which the time model was observed) whose predicted error
+//!    meets the target; the cheapest within the budget and memory is the plan, the next two (other
+//!    refinements) the runners-up.
+//!
+//! The space pilot grows one level at a time while the plan lies more than [`MAX_EXTRAPOLATION`] levels
+//! beyond it and the next level costs at most [`EXTENSION_SHARE`] of the planned run: the fewer levels a
+//! prediction is extrapolated, the less an order error δ costs (a factor 2^{δm} after m levels).
+//!
+//! Solver: semismooth Newton (its iterations per step do not grow with refinement: 1–3 here, printed;
+//! Uzawa's grow like 1/h, `reference/work_precision.md`). Tolerance: the natural residual is relative to
+//! the force scale, so a relative error tol in μ moves u by at most about tol·‖u‖: tol = 10^⌊log₁₀(0.01
+//! target/‖u‖)⌋ keeps the solver's share of the error under 1 % of the target, within [1e-12, 1e-6] (a
+//! tighter one buys nothing, a looser one saves no Newton iteration worth having).
+
+pub mod model;
+pub mod pilot;
+
+use crate::error::{Error, Result};
+use crate::scene::budget::{available_memory, Estimate};
+use crate::scene::Scene;
+use crate::study::{Level, LevelResult, Study};
+use model::{Combine, CostModel, CostSample, ErrorModel, PowerLaw, TimeError, ORTHOGONAL_BETA};
+use pilot::{fit, pilot_scene, time_pilot, Fit, Quantity, Runner};
+
+/// Levels of the space pilot before any extension (four: the asymptotic check needs a fourth level).
+pub const SPACE_LEVELS: u32 = 4;
+/// A plan may lie this many levels beyond the space pilot's finest level without extending the pilot.
+pub const MAX_EXTRAPOLATION: u32 = 2;
+/// The pilot is extended by a level only if that level costs at most this share of the planned run.
+pub const EXTENSION_SHARE: f64 = 0.1;
+/// The time step is said not to matter when the time pilot bounds its error by this share of the target.
+pub const NEGLIGIBLE_SHARE: f64 = 0.01;
+/// A time pilot without a regular order is not retried on coarser-spaced grids (×4) when its distances
+/// already bound the time error by this share of the target: that bound then enters the prediction.
+pub const TIME_BOUND_SHARE: f64 = 0.25;
+/// The space pilot samples time on the time pilot's first grid only if the time grids move the solution
+/// by at most this share of the spatial error on the time pilot's mesh (else it runs the scene's steps).
+pub const SAMPLING_SHARE: f64 = 0.1;
+/// Deepest refinement searched (the scene's own limit).
+const MAX_REFINE: u32 = 12;
+/// Most steps searched.
+const MAX_STEPS: usize = 1 << 22;
+
+/// What the user asks for.
+#[derive(Clone, Debug)]
+pub struct Options {
+    pub target: f64,
+    pub quantity: Quantity,
+    /// Seconds the planned run may take.
+    pub budget: f64,
+    /// Seconds the pilot runs may take.
+    pub pilot_budget: f64,
+    /// Bytes the planned run may use (default: the available memory).
+    pub max_memory: Option<u64>,
+}
+
+/// One configuration and its predictions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Candidate {
+    pub refine: u32,
+    pub steps: usize,
+    pub unknowns: u64,
+    pub h: f64,
+    pub k: f64,
+    pub error: f64,
+    pub space_error: f64,
+    pub time_error: f64,
+    pub wall: f64,
+    pub memory: u64,
+}
+
+/// A plan, or a refusal with the evidence gathered so far.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    pub options: Options,
+    pub space: Study,
+    pub space_fit: Fit,
+    pub time: Study,
+    pub time_fit: Fit,
+    /// Steps grow by this factor in the time pilot and in the search.
+    pub time_ratio: usize,
+    /// The scene's steps: the fewest a plan offers.
+    pub scene_steps: usize,
+    pub error: Option<ErrorModel>,
+    pub cost: Option<CostModel>,
+    /// Seconds the pilot runs took.
+    pub pilot_wall: f64,
+    /// The plan and up to two runners-up, cheapest first (empty when refused).
+    pub best: Vec<Candidate>,
+    /// The cheapest configuration meeting the target beyond the budget, when none fits it.
+    pub over_budget: Option<Candidate>,
+    pub solver: &'static str,
+    pub tol: f64,
+    pub notes: Vec<String>,
+    pub refused: Option<String>,
+}
+
+/// Cost samples of pilot levels, with their steps.
+fn samples(levels: &[LevelResult]) -> Vec<(CostSample, usize)> {
+    levels
+        .iter()
+        .map(|r| {
+            let step = (r.wall - r.setup).max(0.0) / r.steps as f64;
+            (CostSample { n: r.dofs as f64, setup: r.setup, step }, r.steps)
+        })
+        .collect()
+}
+
+fn space_samples(levels: &[LevelResult]) -> Vec<CostSample> {
+    samples(levels).into_iter().map(|(c, _)| c).collect()
+}
+
+/// Make the plan (module doc).
+pub fn plan(scene: &Scene, options: &Options) -> Result<Plan> {
+    let target = options.target;
+    if !(target.is_finite() && target > 0.0) {
+        return Err(Error::scene(&scene.file, "--target", format!("{target}: must be a positive number")));
+    }
+    let s = pilot_scene(scene, &options.quantity)?;
+    let (r0, n0) = (s.mesh_level(), s.times.len() - 1);
+    let q = &options.quantity;
+    let nt = time_base(n0);
+    let time_pilot_run = time_pilot(&s, r0 + 2, nt, n0, q, TIME_BOUND_SHARE * target, options.pilot_budget)?;
+    let (time, _, spent) = &time_pilot_run;
+    let time_fit = fit(time, q)?;
+    if nt == n0 || time_fit.not_in_range().is_none() {
+        // a time law: the spatial error of the time-discrete problem depends on the grid (module doc)
+        return space_pilot(&s, options, &time_pilot_run, &time_fit, n0, *spent);
+    }
+    let coarse = space_pilot(&s, options, &time_pilot_run, &time_fit, nt, *spent)?;
+    // sampling time on nt steps is sound when the time grids change the solution on the time pilot's
+    // mesh by at most SAMPLING_SHARE of that mesh's spatial error
+    let moved = time_fit.distances.iter().copied().fold(0.0, f64::max);
+    let on_mesh = coarse.space.levels.iter().position(|l| l.refine == r0 + 2).and_then(|i| coarse.space_fit.errors.get(i));
+    match on_mesh {
+        Some(&e) if moved <= SAMPLING_SHARE * e => Ok(coarse),
+        _ => {
+            let mut p = space_pilot(&s, options, &time_pilot_run, &time_fit, n0, coarse.pilot_wall)?;
+            p.notes.insert(
+                0,
+                format!(
+                    "the time grids move the solution by {moved:.2e}, more than {} % of the spatial error on their mesh: the \
+                     space pilot was rerun on the scene's {n0} steps",
+                    100.0 * SAMPLING_SHARE
+                ),
+            );
+            Ok(p)
+        }
+    }
+}
+
+/// The space pilot on `nh` steps, extended level by level (module doc), and the plan it gives.
+fn space_pilot(
+    s: &Scene,
+    options: &Options,
+    (time, time_ratio, _): &(Study, usize, f64),
+    time_fit: &Fit,
+    nh: usize,
+    mut spent: f64,
+) -> Result<Plan> {
+    let r0 = s.mesh_level();
+    let mut run = Runner::new(s, nh)?;
+    let mut notes = Vec::new();
+    let mut r = r0;
+    loop {
+        let cost = CostModel::fit(&space_samples(run.levels()), &samples(&time.levels));
+        let predicted = |r: u32| cost.map_or(0.0, |c| c.predict(unknowns(s, r).unwrap_or(0) as f64, nh));
+        if run.levels().len() as u32 >= SPACE_LEVELS {
+            let draft = decide(s, options, &run.study(), time, time_fit, *time_ratio, spent + run.spent, vec![])?;
+            let extend = match draft.best.first() {
+                _ if draft.space_fit.not_in_range().is_some() => true, // not yet in the asymptotic range
+                Some(b) => b.refine > r - 1 + MAX_EXTRAPOLATION && predicted(r) <= EXTENSION_SHARE * b.wall,
+                None => false,
+            };
+            if !extend || r > r0 + MAX_REFINE {
+                let mut done = draft;
+                done.notes.splice(0..0, notes);
+                return Ok(done);
+            }
+        }
+        if !run.push(Level { refine: r, steps: nh }, predicted(r), options.pilot_budget - spent)? {
+            notes.push(format!(
+                "the pilot budget ({:.3} s) does not allow level {r} (predicted {:.3} s): raise --pilot-budget for more evidence",
+                options.pilot_budget,
+                predicted(r)
+            ));
+            spent += run.spent;
+            let mut done = decide(s, options, &run.study(), time, time_fit, *time_ratio, spent, notes)?;
+            if done.refused.is_none() && (run.levels().len() as u32) < SPACE_LEVELS {
+                done.refused = Some("fewer than four space levels: no asymptotic-range check".into());
+                done.best.clear();
+            }
+            return Ok(done);
+        }
+        r += 1;
+    }
+}
+
+/// The time pilot's first grid: N/2^j for the largest j ≤ 4 that divides N and leaves at least
+/// min(N, 4) steps. The time pilot then shows whether grids coarser than the scene's already give its
+/// answer; if so, the space pilot samples time on that grid (1/16 of the nodes at most, at least the
+/// quarter points), and its levels cost a fraction of the planned run even one or two refinements below
+/// it. If the time error follows a law instead, the space pilot runs the scene's N steps: the spatial
+/// error of the time-discrete problem then depends on the time grid (a slip that stops inside a step).
+fn time_base(n: usize) -> usize {
+    (0..=4).rev().map(|j| 1usize << j).filter(|d| n % d == 0).map(|d| n / d).find(|&m| m >= n.min(4)).unwrap_or(n)
+}
+
+/// Unknowns at refinement r (the budget's count, exact for structured meshes).
+fn unknowns(s: &Scene, r: u32) -> Result<u64> {
+    let mut t = s.clone();
+    t.set_refine(r)?;
+    Ok(Estimate::of(&t, 1, false)?.unknowns)
+}
+
+/// Fit the models to the pilots and search (module doc).
+#[allow(clippy::too_many_arguments)]
+fn decide(
+    s: &Scene,
+    options: &Options,
+    space: &Study,
+    time: &Study,
+    time_fit: &Fit,
+    time_ratio: usize,
+    pilot_wall: f64,
+    mut notes: Vec<String>,
+) -> Result<Plan> {
+    let target = options.target;
+    let space_fit = fit(space, &options.quantity)?;
+    let cost = CostModel::fit(&space_samples(&space.levels), &samples(&time.levels));
+    let mut plan = Plan {
+        options: options.clone(),
+        space: space.clone(),
+        space_fit: space_fit.clone(),
+        time: time.clone(),
+        time_fit: time_fit.clone(),
+        time_ratio,
+        scene_steps: s.times.len() - 1,
+        error: None,
+        cost,
+        pilot_wall,
+        best: vec![],
+        over_budget: None,
+        solver: "ssn",
+        tol: 1e-12,
+        notes: vec![],
+        refused: None,
+    };
+    if let Some(why) = space_fit.not_in_range() {
+        plan.refused = Some(format!("the space pilot is not in the asymptotic range: {why}"));
+        plan.notes = notes;
+        return Ok(plan);
+    }
+    let n0 = s.times.len() - 1;
+    let nt = time.levels[0].steps;
+    let t_total = s.times[n0] - s.times[0];
+    let law = match (time_fit.not_in_range(), time_fit.x.last(), time_fit.errors.last()) {
+        (None, Some(&x), Some(&e)) => Some(TimeError::Law(PowerLaw::through(x, e, time_fit.p))),
+        _ => None,
+    };
+    let time_law = match law {
+        Some(law) => {
+            if time_ratio == 4 {
+                notes.push(format!(
+                    "on time grids doubling from {nt} steps the observed orders were irregular (a slip that stops inside a \
+                     step: the error depends on where in the step it stops); on grids ×4 they are regular, so only \
+                     N = {nt}·4^j is offered"
+                ));
+            }
+            law
+        }
+        None => {
+            let steps: Vec<usize> = time.levels.iter().map(|l| l.steps).collect();
+            let bound = time_fit.time_bound(&steps, n0, time_ratio);
+            let b = bound.at(0.0);
+            if b > target {
+                plan.refused = Some(format!(
+                    "the time pilot (steps {}) is not in the asymptotic range ({}) and its distances only bound the time \
+                     error by {b:.3e}, above the target",
+                    steps_list(time),
+                    time_fit.not_in_range().unwrap_or_default()
+                ));
+                plan.notes = notes;
+                return Ok(plan);
+            }
+            notes.push(if b <= NEGLIGIBLE_SHARE * target {
+                format!(
+                    "the time step does not change the answer: the time levels {} bound the time error by {b:.2e} (≤ {} % \
+                     of the target); backward Euler is exact at the nodes for these data (a proportional load, or points \
+                     that only pass from stick to slip), so the scene's {n0} steps suffice and more steps only add output times",
+                    steps_list(time),
+                    100.0 * NEGLIGIBLE_SHARE
+                )
+            } else {
+                format!(
+                    "the time pilot (steps {}) shows no regular order ({}); its distances bound the time error by {b:.2e} \
+                     for any N ≥ {n0} (see plan::model::TimeError), which the plan uses",
+                    steps_list(time),
+                    time_fit.not_in_range().unwrap_or_default()
+                )
+            });
+            bound
+        }
+    };
+    let (hx, he) = (*space_fit.x.last().expect("levels"), *space_fit.errors.last().expect("levels"));
+    let combine = match space_fit.beta {
+        Some(b) if b >= ORTHOGONAL_BETA => Combine::Quadrature,
+        _ => Combine::Sum,
+    };
+    let error = ErrorModel { space: PowerLaw::through(hx, he, space_fit.p), time: time_law, combine };
+    plan.error = Some(error);
+    let Some(cost) = cost else {
+        plan.refused = Some("no pilot run to fit the cost model to".into());
+        return Ok(plan);
+    };
+    let finest = space.levels.last().expect("levels");
+    let memory_limit = options.max_memory.or_else(available_memory);
+    let ratio = if matches!(error.time, TimeError::Law(_)) { time_ratio } else { 1 };
+    let mut all = Vec::new();
+    for r in s.mesh_level()..=MAX_REFINE {
+        let h = finest.h * 0.5f64.powi(r as i32 - finest.refine as i32);
+        if error.space_error(h) >= target {
+            continue;
+        }
+        // the time law's grids (the pilot's first grid times ratio^j) from the scene's N on
+        let mut n = if ratio == 1 { n0 } else { time.levels[0].steps };
+        while n < n0 {
+            n *= ratio;
+        }
+        while n <= MAX_STEPS {
+            let k = t_total / n as f64;
+            let e = error.predict(h, k);
+            if e <= target {
+                let mut t = s.clone();
+                t.set_refine(r)?;
+                let est = Estimate::of(&t, n, false)?;
+                all.push(Candidate {
+                    refine: r,
+                    steps: n,
+                    unknowns: est.unknowns,
+                    h,
+                    k,
+                    error: e,
+                    space_error: error.space_error(h),
+                    time_error: error.time_error(k),
+                    wall: cost.predict(est.unknowns as f64, n),
+                    memory: est.memory,
+                });
+                break;
+            }
+            if ratio == 1 {
+                break;
+            }
+            n *= ratio;
+        }
+    }
+    let fits = |c: &Candidate| memory_limit.is_none_or(|m| c.memory <= m);
+    let mut ok: Vec<Candidate> = all.iter().filter(|c| fits(c) && c.wall <= options.budget).cloned().collect();
+    ok.sort_by(|a, b| a.wall.total_cmp(&b.wall));
+    ok.truncate(3);
+    if ok.is_empty() {
+        plan.over_budget = all.iter().filter(|c| fits(c)).min_by(|a, b| a.wall.total_cmp(&b.wall)).cloned();
+        plan.refused = Some(match &plan.over_budget {
+            Some(c) => format!(
+                "the target is out of reach within the budget of {:.3} s: the cheapest configuration predicted to meet it \
+                 (refine {}, {} steps, {} unknowns) would take {:.3e} s",
+                options.budget, c.refine, c.steps, c.unknowns, c.wall
+            ),
+            None => format!("no configuration up to refine {MAX_REFINE} and {MAX_STEPS} steps meets the target within memory"),
+        });
+    } else {
+        let b = &ok[0];
+        if b.refine > finest.refine + MAX_EXTRAPOLATION {
+            notes.push(format!(
+                "the plan is {} levels beyond the pilot's finest (refine {}): extending the pilot would cost more than {} % of the run",
+                b.refine - finest.refine,
+                finest.refine,
+                100.0 * EXTENSION_SHARE
+            ));
+        }
+        let scale = match &options.quantity {
+            Quantity::Energy => finest.norm_max,
+            Quantity::Output(name) => {
+                let i = space.output_names.iter().position(|n| n == name).unwrap_or(0);
+                finest.outputs.get(i).map_or(0.0, |v| v.abs())
+            }
+        };
+        plan.tol = if scale > 0.0 { 10f64.powf((0.01 * target / scale).log10().floor()).clamp(1e-12, 1e-6) } else { 1e-12 };
+    }
+    plan.best = ok;
+    plan.notes = notes;
+    Ok(plan)
+}
+
+fn steps_list(study: &Study) -> String {
+    study.levels.iter().map(|l| l.steps.to_string()).collect::<Vec<_>>().join(", ")
+}

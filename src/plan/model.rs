@@ -1,0 +1,223 @@
+//! The planner's two models, fitted to its pilot runs ([`super::pilot`]).
+//!
+//! **Error.** e(h, k) = e_h ⊕ e_k with e_h = C_h hᵖ (the spatial error, from a sequence of meshes at a
+//! fixed time grid) and e_k = C_k k^q (the time error, from a sequence of time grids on one mesh); p and q
+//! are the orders the sequences show ([`super::super::study::richardson`]), C_h and C_k are fixed by the
+//! estimated error of each sequence's finest level. The two parts combine as
+//!   e = √(e_h² + e_k²)   when they are orthogonal in the energy inner product, else   e = e_h + e_k.
+//! Orthogonal: the spatial error of CR is a_h-orthogonal to V_h to leading order (Galerkin orthogonality
+//! on nested meshes; the study measures it as the correlation exponent β ≈ 1), while the time error of
+//! backward Euler is a smooth field (θkW for a slip that stops inside a step) that V_h resolves; the sum
+//! is the triangle inequality, used for scalar outputs and whenever β < ½.
+//!
+//! **Cost.** wall(n, N) = S(n) + N s(n) for n unknowns and N steps, S the set-up (assembly, the one
+//! factorisation, condensation) and s the cost of a step (load, one triangular-solve pair, the friction
+//! solve). S is a power law through the space pilot's finest level, its exponent from the two finest
+//! levels clamped to what the algorithms can do: between O(n) (assembly) and O(n^1.5) (sparse Cholesky
+//! of a 2D mesh). s = c n ln n, the cost of the triangular solves with a fill-reducing factor of a 2D mesh
+//! (the friction work, O(n_c²) per iteration with n_c ∝ √n under uniform refinement, is smaller), with c
+//! from the time pilot's level with the most steps: per-step costs measured over a few steps are
+//! dominated by the first steps' extra Newton iterations and by start-up.
+
+/// y = c xᵖ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PowerLaw {
+    pub c: f64,
+    pub p: f64,
+}
+
+impl PowerLaw {
+    /// The law of exponent p through (x, y).
+    pub fn through(x: f64, y: f64, p: f64) -> PowerLaw {
+        PowerLaw { c: y / x.powf(p), p }
+    }
+
+    pub fn at(&self, x: f64) -> f64 {
+        self.c * x.powf(self.p)
+    }
+
+    /// The x at which the law reaches y (x = (y/c)^{1/p}).
+    pub fn solve(&self, y: f64) -> f64 {
+        (y / self.c).powf(1.0 / self.p)
+    }
+}
+
+/// How the spatial and the time error add up (module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Combine {
+    Quadrature,
+    Sum,
+}
+
+/// The correlation exponent from which the spatial error is taken as orthogonal to the time error.
+pub const ORTHOGONAL_BETA: f64 = 0.5;
+
+/// The time error e_k: a power law observed on the time pilot, or, when the pilot shows no regular
+/// order, a bound from its distances (for every k up to the pilot's coarsest step).
+///
+/// The bound: if e_k(N) does not grow as N grows and decreases at least like k^{1/2} (the lowest order
+/// the asymptotic check accepts), the distance between the coarsest and the finest of m + 1 levels with
+/// ratio r is at least e_k(N₀)(1 − r^{−m/2}), so e_k(N) ≤ e_k(N₀) ≤ Σⱼ dⱼ/(1 − r^{−m/2}) for N ≥ N₀
+/// (dⱼ: the distances of successive levels, whose sum bounds that of the extremes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TimeError {
+    Law(PowerLaw),
+    Bound(f64),
+}
+
+impl TimeError {
+    /// The bound of a sequence of `levels` time levels with ratio `ratio` and successive distances
+    /// summing to `sum` (the enum's doc).
+    pub fn bound(sum: f64, ratio: f64, levels: usize) -> TimeError {
+        let m = levels.saturating_sub(1) as f64;
+        TimeError::Bound(if m > 0.0 { sum / (1.0 - ratio.powf(-0.5 * m)) } else { f64::INFINITY })
+    }
+
+    pub fn at(&self, k: f64) -> f64 {
+        match self {
+            TimeError::Law(l) => l.at(k),
+            TimeError::Bound(b) => *b,
+        }
+    }
+}
+
+/// e(h, k) = e_h ⊕ e_k (module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorModel {
+    pub space: PowerLaw,
+    pub time: TimeError,
+    pub combine: Combine,
+}
+
+impl ErrorModel {
+    pub fn space_error(&self, h: f64) -> f64 {
+        self.space.at(h)
+    }
+
+    pub fn time_error(&self, k: f64) -> f64 {
+        self.time.at(k)
+    }
+
+    /// The predicted error at mesh size h and time step k.
+    pub fn predict(&self, h: f64, k: f64) -> f64 {
+        let (a, b) = (self.space_error(h), self.time_error(k));
+        match self.combine {
+            Combine::Quadrature => a.hypot(b),
+            Combine::Sum => a + b,
+        }
+    }
+}
+
+/// Exponent range of the set-up cost (module doc).
+pub const SETUP_EXPONENT: (f64, f64) = (1.0, 1.5);
+
+/// One measured run: unknowns, set-up seconds, seconds per step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CostSample {
+    pub n: f64,
+    pub setup: f64,
+    pub step: f64,
+}
+
+/// wall(n, N) = S(n) + N s(n) (module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CostModel {
+    pub setup: PowerLaw,
+    /// s(n) = c n ln n.
+    pub step: f64,
+}
+
+impl CostModel {
+    /// Fit S to the `space` samples: exponent from the two largest n, clamped to [`SETUP_EXPONENT`],
+    /// through the largest; and s(n) = c n ln n through the `time` sample with the most steps per
+    /// set-up (the most representative per-step cost: many steps of the size the plans take). None
+    /// without samples.
+    pub fn fit(space: &[CostSample], time: &[(CostSample, usize)]) -> Option<CostModel> {
+        // a phase too fast for the clock still costs something
+        fn floor(t: f64) -> f64 {
+            t.max(1e-9)
+        }
+        let mut s: Vec<CostSample> = space.iter().copied().filter(|c| c.n > 1.0).collect();
+        s.sort_by(|a, b| a.n.total_cmp(&b.n));
+        let last = *s.last()?;
+        let alpha = match s.len() {
+            1 => SETUP_EXPONENT.0,
+            m => {
+                let (a, b) = (s[m - 2], s[m - 1]);
+                let e = (floor(b.setup) / floor(a.setup)).ln() / (b.n / a.n).ln();
+                if e.is_finite() { e.clamp(SETUP_EXPONENT.0, SETUP_EXPONENT.1) } else { SETUP_EXPONENT.0 }
+            }
+        };
+        let (t, _) = time.iter().copied().filter(|(c, _)| c.n > 1.0).max_by_key(|&(_, steps)| steps)?;
+        Some(CostModel { setup: PowerLaw::through(last.n, floor(last.setup), alpha), step: floor(t.step) / (t.n * t.n.ln()) })
+    }
+
+    /// Seconds per step at n unknowns.
+    pub fn step_at(&self, n: f64) -> f64 {
+        self.step * n * n.max(2.0).ln()
+    }
+
+    /// Predicted wall time of a run with n unknowns and `steps` steps.
+    pub fn predict(&self, n: f64, steps: usize) -> f64 {
+        self.setup.at(n) + steps as f64 * self.step_at(n)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A power law through a point returns that point, and solve inverts at.
+    #[test]
+    fn power_law_round_trip() {
+        let l = PowerLaw::through(0.25, 0.03, 1.2);
+        assert!((l.at(0.25) - 0.03).abs() < 1e-15);
+        assert!((l.solve(l.at(0.07)) - 0.07).abs() < 1e-14);
+    }
+
+    /// Quadrature is the Euclidean sum, Sum the plain one; no time law means no time error.
+    #[test]
+    fn error_parts_combine() {
+        let space = PowerLaw { c: 3.0, p: 1.0 };
+        let time = TimeError::Law(PowerLaw { c: 4.0, p: 1.0 });
+        let q = ErrorModel { space, time, combine: Combine::Quadrature };
+        assert!((q.predict(1.0, 1.0) - 5.0).abs() < 1e-14);
+        let s = ErrorModel { combine: Combine::Sum, ..q };
+        assert!((s.predict(1.0, 1.0) - 7.0).abs() < 1e-14);
+        let bounded = ErrorModel { time: TimeError::Bound(0.0), ..q };
+        assert_eq!(bounded.predict(0.5, 1e9), 1.5);
+    }
+
+    /// The bound holds for errors e_k = C k^{1/2} (the slowest accepted) on levels N, 2N, 4N, 8N: the
+    /// coarsest level's error equals the bound computed from the successive distances (parallel errors,
+    /// so the distances are differences of the errors), and exceeds it for no faster order.
+    #[test]
+    fn time_bound_covers_the_slowest_order() {
+        for q in [0.5, 1.0, 2.0] {
+            let e: Vec<f64> = (0..4).map(|j| 0.3 * (0.1 / 2f64.powi(j)).powf(q)).collect();
+            let sum: f64 = e.windows(2).map(|w| w[0] - w[1]).sum();
+            let b = TimeError::bound(sum, 2.0, 4).at(0.1);
+            assert!(b >= e[0] * (1.0 - 1e-12), "q = {q}: bound {b} < error {}", e[0]);
+            if q == 0.5 {
+                assert!((b / e[0] - 1.0).abs() < 1e-12);
+            }
+        }
+    }
+
+    /// Samples of S = 1e-6 n^1.2 and s = 1e-8 n ln n give back those laws; a set-up slope outside the
+    /// allowed range is clamped (a flat, overhead-dominated set-up is taken as linear).
+    #[test]
+    fn cost_fit_recovers_and_clamps() {
+        let sample = |n: f64| CostSample { n, setup: 1e-6 * n.powf(1.2), step: 1e-8 * n * n.ln() };
+        let space: Vec<CostSample> = [1e3, 4e3, 1.6e4].iter().map(|&n| sample(n)).collect();
+        let time = [(sample(1e3), 10), (sample(2e3), 400), (CostSample { step: 1.0, ..sample(5e2) }, 40)];
+        let m = CostModel::fit(&space, &time).unwrap();
+        assert!((m.setup.p - 1.2).abs() < 1e-12);
+        let n = 1e6;
+        let want = 1e-6 * n.powf(1.2) + 10.0 * 1e-8 * n * n.ln();
+        assert!((m.predict(n, 10) / want - 1.0).abs() < 1e-12);
+        let flat = [CostSample { n: 1e3, setup: 0.01, step: 0.0 }, CostSample { n: 4e3, setup: 0.011, step: 0.0 }];
+        assert_eq!(CostModel::fit(&flat, &time).unwrap().setup.p, SETUP_EXPONENT.0);
+        assert!(CostModel::fit(&[], &time).is_none() && CostModel::fit(&space, &[]).is_none());
+    }
+}

@@ -1,0 +1,235 @@
+//! The planner's pilot runs and what their estimates say about one quantity.
+//!
+//! Two cheap sequences of the scene, both without its `[exact]` table (the planner must work without
+//! one, and the cost of a run is measured without the error evaluation):
+//! * **space**: the scene's mesh refined r₀, r₀+1, … at N/8 steps (`super::space_steps`): its estimates (Richardson
+//!   on the distances between levels, [`crate::study::estimate`]) give the spatial error C_h hᵖ of the
+//!   time-discrete problem, its wall times the cost model;
+//! * **time**: one mesh (r₀+2) at N₀, 2N₀, … up to 4N steps (N₀: `super::time_base`, N the scene's), or
+//!   N₀, 4N₀, 16N₀, 64N₀ when the doubling sequence is not in the asymptotic range (a slip that stops inside a step gives an O(k) error θk‖W‖ whose
+//!   fraction θ of the step alternates under doubling, see `verification/cases/mms_stop.toml`): the time
+//!   error C_k k^q of the space-discrete problem.
+
+use super::model::TimeError;
+use crate::error::{Error, Result};
+use crate::scene::Scene;
+use crate::study::richardson::Verdict;
+use crate::study::{estimate, Level, LevelResult, Sequence, Study};
+
+/// The error the planner is asked to bound.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// The energy-norm error, max over the time nodes.
+    Energy,
+    /// A scalar output of `[outputs]` at T, by its study name (`max_slip`, `energy`, `traction_x_y`, …).
+    Output(String),
+}
+
+impl Quantity {
+    /// `energy` (the energy-norm error), `elastic-energy` (the output ½a_h(u,u)) or an output name
+    /// (`-` and `_` alike).
+    pub fn parse(text: &str) -> Quantity {
+        match text.replace('-', "_").as_str() {
+            "energy" => Quantity::Energy,
+            "elastic_energy" => Quantity::Output("energy".into()),
+            other => Quantity::Output(other.into()),
+        }
+    }
+
+    pub fn describe(&self) -> String {
+        match self {
+            Quantity::Energy => "energy-norm error (max over the time nodes)".into(),
+            Quantity::Output(name) => format!("error of the output {name} at T"),
+        }
+    }
+}
+
+/// What a sequence says about the quantity's error.
+#[derive(Clone, Debug)]
+pub struct Fit {
+    /// "h" or "k".
+    pub size: &'static str,
+    /// Level sizes, coarse → fine.
+    pub x: Vec<f64>,
+    /// Estimated error per level (empty when refused).
+    pub errors: Vec<f64>,
+    pub verdicts: Vec<Verdict>,
+    /// Observed order of the three finest levels.
+    pub p: f64,
+    /// Correlation exponent of the errors (energy norm only).
+    pub beta: Option<f64>,
+    /// Why there is no estimate.
+    pub refused: Option<String>,
+    /// Distance of each level to the one before (max over the common nodes; |ΔQ| for an output; 0 for
+    /// the first level).
+    pub distances: Vec<f64>,
+}
+
+impl Fit {
+    /// Why the finest level cannot be trusted, if it cannot.
+    pub fn not_in_range(&self) -> Option<String> {
+        if let Some(why) = &self.refused {
+            return Some(why.clone());
+        }
+        match self.verdicts.last() {
+            Some(Verdict::InRange) => None,
+            Some(Verdict::NotYet(why)) => Some(why.clone()),
+            None => Some("no levels".into()),
+        }
+    }
+}
+
+/// The quantity's estimates in a finished study.
+pub fn fit(study: &Study, q: &Quantity) -> Result<Fit> {
+    let (size, x) = estimate::sizes(&study.levels);
+    match q {
+        Quantity::Energy => {
+            let e = &study.estimates;
+            let distances = study
+                .levels
+                .iter()
+                .map(|r| r.increment.as_ref().map_or(0.0, |v| v.iter().copied().fold(0.0, f64::max)))
+                .collect();
+            Ok(Fit {
+                size,
+                x,
+                errors: e.levels.iter().map(|l| l.error[0]).collect(),
+                verdicts: e.levels.iter().map(|l| l.verdict.clone()).collect(),
+                p: e.model.map_or(f64::NAN, |m| m.p),
+                beta: e.model.map(|m| m.beta),
+                refused: e.refused.clone(),
+                distances,
+            })
+        }
+        Quantity::Output(name) => {
+            let i = study.output_names.iter().position(|n| n == name).ok_or_else(|| {
+                Error::scene("--quantity", name, format!("no such output; the scene has {}", study.output_names.join(", ")))
+            })?;
+            let o = &study.outputs[i];
+            let values: Vec<f64> = study.levels.iter().map(|r| r.outputs[i]).collect();
+            let distances = std::iter::once(0.0).chain(values.windows(2).map(|w| (w[1] - w[0]).abs())).collect();
+            let refused = o.model.is_none().then(|| format!("{name}: no monotone convergence of the three finest levels"));
+            Ok(Fit {
+                size,
+                x,
+                errors: if refused.is_some() { vec![] } else { o.levels.iter().map(|l| l.0).collect() },
+                verdicts: o.levels.iter().map(|l| l.2.clone()).collect(),
+                p: o.model.map_or(f64::NAN, |m| m.p),
+                beta: None,
+                refused,
+                distances,
+            })
+        }
+    }
+}
+
+/// The scene the pilots run: without `[exact]`, with the quantity among its outputs.
+pub fn pilot_scene(scene: &Scene, q: &Quantity) -> Result<Scene> {
+    if !scene.uniform_time {
+        return Err(Error::scene(&scene.file, "time", "the planner needs `T` and `steps` (uniform grids), not `times`"));
+    }
+    let mut s = scene.clone();
+    s.exact = None;
+    if let Quantity::Output(name) = q {
+        let mut o = crate::study::outputs::selected(&s);
+        match name.as_str() {
+            "max_slip" => o.max_slip = true,
+            "stick_length" => o.stick_length = true,
+            "energy" => o.energy = true,
+            _ => {}
+        }
+        if !crate::study::outputs::names(&o).contains(name) {
+            return Err(Error::scene(
+                &scene.file,
+                "--quantity",
+                format!("`{name}` is not an output of this scene (energy, elastic-energy, max-slip, stick-length, or a traction_x_y of [outputs])"),
+            ));
+        }
+        s.outputs = Some(o);
+    }
+    Ok(s)
+}
+
+/// A sequence that adds levels only while their predicted cost fits what is left of the pilot budget.
+pub struct Runner<'a> {
+    seq: Sequence<'a>,
+    pub spent: f64,
+}
+
+impl<'a> Runner<'a> {
+    pub fn new(scene: &'a Scene, min_steps: usize) -> Result<Runner<'a>> {
+        Ok(Runner { seq: Sequence::new(scene, min_steps, None, None)?, spent: 0.0 })
+    }
+
+    /// Run `level`, unless `predicted` seconds would take the pilot past `budget`.
+    pub fn push(&mut self, level: Level, predicted: f64, budget: f64) -> Result<bool> {
+        if !self.seq.levels().is_empty() && self.spent + predicted > budget {
+            return Ok(false);
+        }
+        let wall = self.seq.push(level)?.wall;
+        self.spent += wall;
+        Ok(true)
+    }
+
+    pub fn levels(&self) -> &[LevelResult] {
+        self.seq.levels()
+    }
+
+    pub fn study(&self) -> Study {
+        self.seq.finish()
+    }
+}
+
+impl Fit {
+    /// The bound on the time error for every grid of at least `min_steps` steps, from the levels of a
+    /// time sequence (steps `steps`, ratio `ratio`) with at least that many ([`TimeError::bound`]).
+    pub fn time_bound(&self, steps: &[usize], min_steps: usize, ratio: usize) -> TimeError {
+        let from = steps.iter().position(|&n| n >= min_steps).unwrap_or(steps.len());
+        let sum: f64 = self.distances.iter().skip(from + 1).sum();
+        TimeError::bound(sum, ratio as f64, steps.len() - from)
+    }
+}
+
+/// The time pilot on mesh level `refine`: grids doubling from `first` steps up to 4 times the scene's
+/// `steps` (at least four), then N, 4N, 16N, 64N from `first` if the doubling sequence is not in the
+/// asymptotic range (module doc) and its distances do not already bound the time error of grids of
+/// `steps` steps or more by `enough` ([`Fit::time_bound`]). Returns the study, the ratio used and the
+/// seconds spent.
+pub fn time_pilot(
+    scene: &Scene,
+    refine: u32,
+    first: usize,
+    steps: usize,
+    q: &Quantity,
+    enough: f64,
+    budget: f64,
+) -> Result<(Study, usize, f64)> {
+    let mut spent = 0.0;
+    let mut last = None;
+    for ratio in [2usize, 4] {
+        let mut grids = vec![first];
+        while grids.len() < 4 || (ratio == 2 && *grids.last().expect("grids") < 4 * steps) {
+            let next = grids.last().expect("grids").checked_mul(ratio);
+            grids.push(next.ok_or_else(|| Error::scene(&scene.file, "steps", "too many steps"))?);
+        }
+        let mut run = Runner::new(scene, first)?;
+        for &n in &grids {
+            // a step costs about the same at every N: the next level costs ratio × the last one's steps
+            let predicted = run.levels().last().map_or(0.0, |r| (r.wall - r.setup) * ratio as f64 + r.setup);
+            if !run.push(Level { refine, steps: n }, predicted, budget - spent)? {
+                break;
+            }
+        }
+        spent += run.spent;
+        let study = run.study();
+        let f = fit(&study, q)?;
+        let run_steps: Vec<usize> = study.levels.iter().map(|l| l.steps).collect();
+        let done = f.not_in_range().is_none() || f.time_bound(&run_steps, steps, ratio).at(0.0) <= enough;
+        last = Some((study, ratio));
+        if done {
+            break;
+        }
+    }
+    let (study, ratio) = last.expect("two ratios tried");
+    Ok((study, ratio, spent))
+}
