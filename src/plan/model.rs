@@ -213,7 +213,7 @@ mod tests {
         let time = [(sample(1e3), 10), (sample(2e3), 400), (CostSample { step: 1.0, ..sample(5e2) }, 40)];
         let m = CostModel::fit(&space, &time).unwrap();
         assert!((m.setup.p - 1.2).abs() < 1e-12);
-        let n = 1e6;
+        let n: f64 = 1e6;
         let want = 1e-6 * n.powf(1.2) + 10.0 * 1e-8 * n * n.ln();
         assert!((m.predict(n, 10) / want - 1.0).abs() < 1e-12);
         let flat = [CostSample { n: 1e3, setup: 0.01, step: 0.0 }, CostSample { n: 4e3, setup: 0.011, step: 0.0 }];
