@@ -368,14 +368,21 @@ fn decide(
     ok.sort_by(|a, b| a.wall.total_cmp(&b.wall));
     ok.truncate(3);
     if ok.is_empty() {
-        plan.over_budget = all.iter().filter(|c| fits(c)).min_by(|a, b| a.wall.total_cmp(&b.wall)).cloned();
+        let cheapest = |f: &dyn Fn(&Candidate) -> bool| all.iter().filter(|c| f(c)).min_by(|a, b| a.wall.total_cmp(&b.wall)).cloned();
+        plan.over_budget = cheapest(&|c| fits(c)).or_else(|| cheapest(&|_| true));
         plan.refused = Some(match &plan.over_budget {
             Some(c) => format!(
-                "the target is out of reach within the budget of {:.3} s: the cheapest configuration predicted to meet it \
-                 (refine {}, {} steps, {} unknowns) would take {:.3e} s",
-                options.budget, c.refine, c.steps, c.unknowns, c.wall
+                "the target is out of reach within the budget of {:.0} s and {} of memory: the cheapest configuration \
+                 predicted to meet it (refine {}, {} steps, {} unknowns) would take {:.3e} s and {:.1} GB",
+                options.budget,
+                memory_limit.map_or("any amount".into(), |m| format!("{:.1} GB", m as f64 / 1e9)),
+                c.refine,
+                c.steps,
+                c.unknowns,
+                c.wall,
+                c.memory as f64 / 1e9
             ),
-            None => format!("no configuration up to refine {MAX_REFINE} and {MAX_STEPS} steps meets the target within memory"),
+            None => format!("no configuration up to refine {MAX_REFINE} and {MAX_STEPS} steps is predicted to meet the target"),
         });
     } else {
         let b = &ok[0];

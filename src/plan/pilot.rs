@@ -161,9 +161,16 @@ impl<'a> Runner<'a> {
         Ok(Runner { seq: Sequence::new(scene, min_steps, None, None)?, spent: 0.0 })
     }
 
-    /// Run `level`, unless `predicted` seconds would take the pilot past `budget`.
+    /// Run `level`, unless `predicted` seconds would take the pilot past `budget` or the level would not
+    /// fit in the available memory together with the two levels a sequence keeps.
     pub fn push(&mut self, level: Level, predicted: f64, budget: f64) -> Result<bool> {
         if !self.seq.levels().is_empty() && self.spent + predicted > budget {
+            return Ok(false);
+        }
+        let mut s = self.seq.scene().clone();
+        s.set_refine(level.refine)?;
+        let need = crate::scene::budget::Estimate::of(&s, level.steps, false)?.memory.saturating_mul(3) / 2;
+        if crate::scene::budget::available_memory().is_some_and(|m| need > m) {
             return Ok(false);
         }
         let wall = self.seq.push(level)?.wall;

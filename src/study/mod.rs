@@ -231,6 +231,11 @@ impl<'a> Sequence<'a> {
         Ok(self.results.last().expect("just pushed"))
     }
 
+    /// The scene the levels are run from.
+    pub fn scene(&self) -> &Scene {
+        self.scene
+    }
+
     /// The levels run so far.
     pub fn levels(&self) -> &[LevelResult] {
         &self.results
