@@ -78,7 +78,7 @@ enum Cmd {
         differences: Option<PathBuf>,
     },
     /// Plan the cheapest run that meets a target accuracy: pilot runs, error and cost models, the
-    /// cheapest (refine, steps, solver, tolerance) and two runners-up, or a refusal (exit code 2).
+    /// cheapest (refine, steps, solver, tolerance) and two runners-up, or a refusal (exit code 3).
     Plan {
         scene: PathBuf,
         /// The error to reach (absolute, in the quantity's units).

@@ -406,6 +406,26 @@ def distributed(quick):
         require(r["id"], r["statement"], r["passed"], r["measured"], r["command"], r.get("reference", "reference/distributed.md"))
 
 
+def planner(quick):
+    """The planner against the truth (issue 15): verification/planner.py, P1-P4 per manufactured case."""
+    out = os.path.join(ROOT, "out", "planner.json")
+    cmd = [PY, "verification/planner.py", "--json", out] + \
+        (["--quick", "--md", os.path.join(ROOT, "out", "planner_quick.md")] if quick else [])
+    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    print(p.stdout[-3000:])
+    import json
+    try:
+        reqs = json.load(open(out))
+    except Exception as e:  # noqa: BLE001
+        require("P0-planner", "the planner check shall produce its requirement list", False, f"{e}; {p.stderr[-300:]}",
+                " ".join(cmd), "-")
+        return
+    for r in reqs:
+        if quick and r["id"].startswith("P4"):
+            continue  # the planner's share is a claim about fine targets, which --quick does not reach
+        require(r["id"], r["statement"], r["passed"], r["measured"], r["command"], r["reference"])
+
+
 def stability():
     """Stability at the extremes (issue 7): verification/stability.py, one requirement per case."""
     cmd = [PY, "verification/stability.py"]
@@ -442,6 +462,7 @@ def main():
         "joint": lambda: joint_study(args.quick),
         "paper": lambda: paper_tables(args.quick),
         "estimates": lambda: estimates.run(study, require, write, args.quick),
+        "planner": lambda: planner(args.quick),
         "clients": results_clients,
         "paraview": paraview,
         "stability": stability,

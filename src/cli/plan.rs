@@ -12,8 +12,8 @@ use tresca_cr::study::orders::successive_orders;
 use tresca_cr::study::{run_study, Level, Study};
 use tresca_cr::Scene;
 
-/// Exit code of a refusal (no plan; distinct from errors, which exit with 1).
-pub const REFUSED: i32 = 2;
+/// Exit code of a refusal (no plan; errors exit with 1, command-line usage errors with 2 as clap does).
+pub const REFUSED: i32 = 3;
 
 pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool) -> Result<i32> {
     say!("Planning {} for the {} ≤ {:e}", scene.file, options.quantity.describe(), options.target);

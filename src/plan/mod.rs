@@ -382,7 +382,9 @@ fn decide(
                 c.wall,
                 c.memory as f64 / 1e9
             ),
-            None => format!("no configuration up to refine {MAX_REFINE} and {MAX_STEPS} steps is predicted to meet the target"),
+            None => format!(
+                "the target is out of reach: no configuration up to refine {MAX_REFINE} and {MAX_STEPS} steps is predicted to meet it"
+            ),
         });
     } else {
         let b = &ok[0];

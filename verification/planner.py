@@ -1,0 +1,276 @@
+"""Issue 15: `tresca-cr plan` checked against the truth -> reference/planner.md (+ reference/planner.csv).
+
+    .venv/bin/python verification/planner.py [--quick] [--json OUT] [--cases mms_front mms_stop ...]
+
+For each manufactured case (exact solution known):
+ 1. Brute-force grid, the work-precision data of this check: refine r = 0..R and steps N = N_s·2^j (N_s the
+    scene's steps: the fewest a plan offers). Every configuration is run once with the scene's [exact] for
+    its true error (the CLI's "max over time nodes: energy error") and on the scene without [exact] for its
+    cost: CPU time (user + sys) of the process, median of 3 (one run when it takes over 2 s). CPU time, not
+    wall, because the machine is shared: waiting for a core is not a cost of the method.
+ 2. Sweep: targets 10^(-1/2 - j/4), j = 0..8 (3.16e-1 .. 3.16e-3: two decades, 9 targets). For each,
+    `tresca-cr plan SCENE --target T --csv F` (its CPU time is the planner's own cost: all pilot runs);
+    the plan (refine, steps, ssn, tol) is then run like a grid point (true error with [exact], cost without).
+ 3. Requirements (per case):
+    P1  the plan meets the target in truth (true error <= target) for >= 90 % of the sweep;
+    P2  it never misses by more than 25 % (true error <= 1.25 target);
+    P3  its cost is within 2x of the cheapest grid configuration whose true error meets the target;
+    P4  the planner's own cost is below 20 % of the plan's cost for the targets whose plan lies at the two
+        finest refinements the sweep reaches.
+ 4. Example 5.1 (no exact solution): the plans for targets 1e-4 (run with --run: the achieved estimate) and
+    1e-5, against what the paper's pairing N = 20 n (n = 2^(r+1)) costs at the same mesh.
+"""
+import argparse
+import csv
+import json
+import os
+import re
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import BIN, REF, ROOT, case, cmdline  # noqa: E402
+
+# grid per case: steps N_s·2^j for j < len; refinements 0..R
+CASES = {
+    "mms_front": dict(doublings=3, R=6),
+    "mms_rotated": dict(doublings=4, R=6),
+    "mms_stop": dict(doublings=7, R=6),
+}
+TARGETS = [10 ** (-0.5 - j / 4) for j in range(9)]
+EX51 = case("paper_example_5_1")
+
+
+def load1():
+    return float(open("/proc/loadavg").read().split()[0])
+
+
+def child_cpu():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def timed(cmd):
+    """(completed process, wall seconds, CPU seconds of the child)."""
+    c0, t0 = child_cpu(), time.perf_counter()
+    p = subprocess.run([str(c) for c in cmd], cwd=ROOT, capture_output=True, text=True)
+    return p, time.perf_counter() - t0, child_cpu() - c0
+
+
+def strip_exact(text):
+    out, skip = [], False
+    for line in text.splitlines():
+        if line.startswith("["):
+            skip = line.strip() == "[exact]"
+        if not skip:
+            out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def scene_steps(path):
+    return int(re.search(r"^steps\s*=\s*(\d+)", open(path).read(), re.M).group(1))
+
+
+class Runner:
+    """Runs configurations of one case (cached): true error with [exact], cost without."""
+
+    def __init__(self, name, tmp):
+        self.full = case(name)
+        self.bare = os.path.join(tmp, f"{name}_noexact.toml")
+        open(self.bare, "w").write(strip_exact(open(self.full).read()))
+        self.cache = {}
+
+    def config(self, r, n, tol=None):
+        key = (r, n, tol)
+        if key in self.cache:
+            return self.cache[key]
+        extra = ["--solver", "ssn", "--tol", f"{tol:g}"] if tol else []
+        cmd = [BIN, "run", self.full, "--refine", r, "--steps", n, "-q"] + extra
+        p, _, _ = timed(cmd)
+        if p.returncode != 0:
+            raise RuntimeError(f"{cmdline(cmd)} failed:\n{p.stderr}")
+        err = float(re.search(r"energy error (\S+),", p.stdout).group(1))
+        cpus, walls, loads = [], [], []
+        for _ in range(3):
+            loads.append(load1())
+            q, w, c = timed([BIN, "run", self.bare, "--refine", r, "--steps", n, "-q"] + extra)
+            if q.returncode != 0:
+                raise RuntimeError(q.stderr)
+            cpus.append(c)
+            walls.append(w)
+            if w > 2.0:
+                break
+        row = dict(refine=r, steps=n, tol=tol, error=err, cpu=statistics.median(cpus), wall=statistics.median(walls),
+                   load=max(loads), cmd=cmdline(cmd))
+        self.cache[key] = row
+        return row
+
+
+def plan(scene, target, tmp, extra=()):
+    """Run `tresca-cr plan`; returns (plan row or None, planner CPU s, planner wall s, stdout, command)."""
+    out = os.path.join(tmp, "plan.csv")
+    if os.path.exists(out):
+        os.remove(out)
+    cmd = [BIN, "plan", scene, "--target", f"{target:.6g}", "--csv", out] + list(extra)
+    p, wall, cpu = timed(cmd)
+    if p.returncode not in (0, 3):
+        raise RuntimeError(f"{cmdline(cmd)} failed:\n{p.stderr}")
+    rows = list(csv.DictReader(open(out))) if os.path.exists(out) else []
+    best = next((r for r in rows if r["role"] == "plan"), None)
+    return best, cpu, wall, p.stdout, cmd
+
+
+def sweep_case(name, spec, tmp, quick):
+    run = Runner(name, tmp)
+    ns = scene_steps(run.full)
+    rmax = 4 if quick else spec["R"]
+    steps = [ns * 2 ** j for j in range(min(spec["doublings"], 3) if quick else spec["doublings"])]
+    grid = []
+    for r in range(rmax + 1):
+        for n in steps:
+            row = run.config(r, n)
+            grid.append(row)
+            print(f"  grid {name} r={r} N={n}: error {row['error']:.4e}, CPU {row['cpu']:.3f} s", flush=True)
+    targets = TARGETS[:5] if quick else TARGETS
+    sweep = []
+    for t in targets:
+        best, pcpu, pwall, _, cmd = plan(run.full, t, tmp)
+        cheapest = min((g for g in grid if g["error"] <= t), key=lambda g: g["cpu"], default=None)
+        row = dict(case=name, target=t, planner_cpu=pcpu, planner_wall=pwall, plan_cmd=cmdline(cmd),
+                   cheapest=cheapest)
+        if best is None:
+            row.update(refused=True)
+        else:
+            r, n, tol = int(best["refine"]), int(best["steps"]), float(best["tol"])
+            got = run.config(r, n, tol)
+            row.update(refused=False, refine=r, steps=n, tol=tol, pred_error=float(best["pred_error"]),
+                       pred_wall=float(best["pred_wall"]), pilot_wall=float(best["pilot_wall"]), error=got["error"],
+                       cpu=got["cpu"], wall=got["wall"], run_cmd=got["cmd"])
+        sweep.append(row)
+        print(f"  sweep {name} target {t:.3e}: " + ("refused" if row["refused"] else
+              f"r={row['refine']} N={row['steps']} tol={row['tol']:g}: true {row['error']:.4e} "
+              f"({row['error'] / t:.3f} of target), CPU {row['cpu']:.3f} s, planner {pcpu:.3f} s; cheapest "
+              + (f"r={cheapest['refine']} N={cheapest['steps']} {cheapest['cpu']:.3f} s" if cheapest else "none")), flush=True)
+    return grid, sweep, steps
+
+
+def requirements(name, sweep, grid_cmd):
+    reqs = []
+    planned = [s for s in sweep if not s["refused"]]
+    met = [s for s in planned if s["error"] <= s["target"]]
+    frac = len(met) / len(sweep)
+    worst = max((s["error"] / s["target"] for s in planned), default=float("inf"))
+    reqs.append(dict(id=f"P1-{name}", statement=f"{name}: the plan shall meet the target in truth for >= 90 % of the sweep",
+                     passed=frac >= 0.9, measured=f"{len(met)}/{len(sweep)} targets met ({100 * frac:.0f} %); "
+                     f"{len(sweep) - len(planned)} refused"))
+    reqs.append(dict(id=f"P2-{name}", statement=f"{name}: the plan shall never miss the target by more than 25 %",
+                     passed=len(planned) == len(sweep) and worst <= 1.25, measured=f"worst true/target {worst:.3f}"))
+    ratios = [s["cpu"] / s["cheapest"]["cpu"] for s in planned if s["cheapest"]]
+    reqs.append(dict(id=f"P3-{name}", statement=f"{name}: the plan's cost shall be within 2x of the cheapest grid configuration "
+                     "meeting the target in truth", passed=bool(ratios) and max(ratios) <= 2.0,
+                     measured=f"cost / cheapest: max {max(ratios, default=float('nan')):.2f}, median "
+                     f"{statistics.median(ratios) if ratios else float('nan'):.2f} over {len(ratios)} targets"))
+    levels = sorted({s["refine"] for s in planned})[-2:]
+    fine = [s for s in planned if s["refine"] in levels]
+    shares = [s["planner_cpu"] / s["cpu"] for s in fine]
+    reqs.append(dict(id=f"P4-{name}", statement=f"{name}: the planner's own runs shall cost < 20 % of the plan for targets at the "
+                     f"two finest levels of the sweep (refine {levels})", passed=bool(shares) and max(shares) < 0.2,
+                     measured=f"planner CPU / plan CPU: max {max(shares, default=float('nan')):.3f} over {len(shares)} targets"))
+    for r in reqs:
+        r.update(command=grid_cmd, reference="reference/planner.md")
+    return reqs
+
+
+def example51(tmp, quick):
+    """Plans for Example 5.1 and the paper's pairing N = 20 n at the planned mesh."""
+    lines = []
+    for t in ([1e-4] if quick else [1e-4, 1e-5]):
+        run_it = t == 1e-4 and not quick
+        best, pcpu, _, out, cmd = plan(EX51, t, tmp, ["--run"] if run_it else [])
+        lines.append(f"### target {t:g}\n\n`{cmdline(cmd)}{' --run' if run_it else ''}` (planner CPU {pcpu:.2f} s"
+                     f"{', with the run' if run_it else ''}):\n\n```\n{out.strip()}\n```\n")
+        if best is not None:
+            r, n = int(best["refine"]), int(best["steps"])
+            rows = []
+            for label, steps in [("plan", n), ("paper's pairing N = 20 n", 40 * 2 ** r)]:
+                c = [BIN, "run", EX51, "--refine", r, "--steps", steps, "-q"]
+                p, wall, cpu = timed(c)
+                rows.append(f"| {label} | {r} | {2 ** (r + 1)} | {steps} | {cpu:.2f} s | {wall:.2f} s | "
+                            f"`{cmdline(c)}` |")
+            lines.append("| run | refine | n | steps | CPU | wall | command |\n|---|---|---|---|---|---|---|\n" + "\n".join(rows) + "\n")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="refine <= 4, 5 targets, fewer steps (for make test)")
+    ap.add_argument("--json", help="write the requirement list here")
+    ap.add_argument("--md", default=os.path.join(REF, "planner.md"))
+    ap.add_argument("--cases", nargs="*", default=list(CASES))
+    args = ap.parse_args(argv)
+    tmp = tempfile.mkdtemp(prefix="tresca-plan-")
+    t0 = time.time()
+    md = ["<!-- generated by verification/planner.py -->", "# The planner against the truth (issue 15)", "",
+          f"Generated by `.venv/bin/python verification/planner.py{' --quick' if args.quick else ''}`. "
+          f"Machine: {os.uname().nodename}, {os.cpu_count()} cores (shared: costs are CPU seconds, user + sys, of the "
+          "process; wall in the CSV). Binary: " + subprocess.run([BIN, "--version"], capture_output=True, text=True).stdout.strip()
+          + ".", "",
+          "Cost of a configuration = CPU time of `tresca-cr run SCENE --refine r --steps N [--solver ssn --tol TOL] -q` on the "
+          "scene without `[exact]` (median of 3 under 2 s); true error = the same command on the scene with `[exact]` (CLI "
+          "\"max over time nodes: energy error\"). Planner cost = CPU time of `tresca-cr plan SCENE --target T` (all pilot runs). "
+          "Brute-force cheapest = the cheapest grid configuration whose true error meets the target.", ""]
+    reqs, csv_rows = [], []
+    for name in args.cases:
+        print(f"{name}:", flush=True)
+        grid, sweep, steps = sweep_case(name, CASES[name], tmp, args.quick)
+        reqs += requirements(name, sweep, f"verification/planner.py --cases {name}")
+        md += [f"## {name}", "", "| target | plan r | N | tol | predicted error | true error | true/target | plan CPU | predicted wall "
+               "| planner CPU | planner/plan | cheapest r, N | its error | its CPU | plan/cheapest |", "|" + "---|" * 15]
+        for s in sweep:
+            ch = s["cheapest"]
+            chs = (f"{ch['refine']}, {ch['steps']} | {ch['error']:.3e} | {ch['cpu']:.3f} s") if ch else "– | – | –"
+            if s["refused"]:
+                md.append(f"| {s['target']:.3e} | refused | | | | | | | | {s['planner_cpu']:.3f} s | | {chs} | |")
+                continue
+            ratio = f"{s['cpu'] / ch['cpu']:.2f}" if ch else "–"
+            md.append(f"| {s['target']:.3e} | {s['refine']} | {s['steps']} | {s['tol']:g} | {s['pred_error']:.3e} | "
+                      f"{s['error']:.3e} | {s['error'] / s['target']:.3f} | {s['cpu']:.3f} s | {s['pred_wall']:.3f} s | "
+                      f"{s['planner_cpu']:.3f} s | {s['planner_cpu'] / s['cpu']:.3f} | {chs} | {ratio} |")
+            csv_rows.append(dict(case=name, target=s["target"], refine=s["refine"], steps=s["steps"], tol=s["tol"],
+                                 pred_error=s["pred_error"], true_error=s["error"], cpu=s["cpu"], wall=s["wall"],
+                                 pred_wall=s["pred_wall"], planner_cpu=s["planner_cpu"],
+                                 cheapest_refine=ch["refine"] if ch else "", cheapest_steps=ch["steps"] if ch else "",
+                                 cheapest_cpu=ch["cpu"] if ch else ""))
+        md += ["", f"Plan command: `tresca-cr plan verification/cases/{name}.toml --target T`. Grid (true energy error / CPU "
+               "seconds; steps as columns):", "", "| r | " + " | ".join(f"N = {n}" for n in steps) + " |",
+               "|" + "---|" * (len(steps) + 1)]
+        for r in sorted({g["refine"] for g in grid}):
+            cells = [next(g for g in grid if g["refine"] == r and g["steps"] == n) for n in steps]
+            md.append(f"| {r} | " + " | ".join(f"{c['error']:.3e} / {c['cpu']:.3f}" for c in cells) + " |")
+        md.append("")
+        for r in reqs[-4:]:
+            md.append(f"* **{r['id']}** {'PASS' if r['passed'] else 'FAIL'}: {r['statement']} — {r['measured']}")
+        md.append("")
+    md += ["## Example 5.1 (the paper's scene, no exact solution)", "", example51(tmp, args.quick)]
+    md += ["", f"Total time of this check: {time.time() - t0:.0f} s."]
+    with open(args.md, "w") as f:
+        f.write("\n".join(md) + "\n")
+    if not args.quick:
+        with open(os.path.join(REF, "planner.csv"), "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(csv_rows[0]) if csv_rows else ["case"])
+            w.writeheader()
+            w.writerows(csv_rows)
+    for r in reqs:
+        print(f"[{'PASS' if r['passed'] else 'FAIL'}] {r['id']}: {r['statement']} — {r['measured']}")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(reqs, f, indent=1)
+    return 0 if all(r["passed"] for r in reqs) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
