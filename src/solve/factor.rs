@@ -34,7 +34,8 @@ use std::cell::RefCell;
 pub struct Factor {
     symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
-    scratch: RefCell<MemBuffer>,
+    /// Solve scratch, sized for this many right-hand sides.
+    scratch: RefCell<(usize, MemBuffer)>,
     n: usize,
     /// The unknowns ordered last, in this order (see [`Factor::with_last`]).
     last: Vec<usize>,
@@ -91,7 +92,7 @@ impl Factor {
             })?;
         let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
             .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
-        Ok(Factor { symbolic, values, scratch: RefCell::new(scratch), n, last: last.to_vec(), fwd })
+        Ok(Factor { symbolic, values, scratch: RefCell::new((1, scratch)), n, last: last.to_vec(), fwd })
     }
 
     /// The unknowns ordered last (see [`Factor::with_last`]).
@@ -139,36 +140,70 @@ impl Factor {
     /// x ← L⁻¹ Pᵀx: the forward half of a solve, the result in the factor's (permuted) order, where
     /// the unknowns ordered last occupy the last positions.
     pub fn forward_solve(&self, x: &mut [f64]) -> Result<()> {
-        let llt = self.supernodal().ok_or_else(|| Error::Linear("the factor is not supernodal".into()))?;
-        let mut y: Vec<f64> = self.fwd.iter().map(|&old| x[old]).collect();
-        let mut buf = self.scratch.borrow_mut();
-        llt.l_solve_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(&mut y, self.n, 1),
-            Par::Seq,
-            MemStack::new(&mut buf),
-        );
+        let mut y = vec![0.0; self.n];
+        self.permute_in(x, &mut y);
+        self.forward_block(&mut y, 1)?;
         x.copy_from_slice(&y);
         Ok(())
     }
 
     /// y ← P L⁻ᵀ y: the backward half of a solve, from the factor's order to the unknowns' order.
     pub fn backward_solve(&self, y: &mut [f64]) -> Result<()> {
-        let llt = self.supernodal().ok_or_else(|| Error::Linear("the factor is not supernodal".into()))?;
-        {
-            let mut buf = self.scratch.borrow_mut();
-            llt.l_transpose_solve_with_conj(
-                Conj::No,
-                MatMut::from_column_major_slice_mut(y, self.n, 1),
-                Par::Seq,
-                MemStack::new(&mut buf),
-            );
-        }
+        self.backward_block(y, 1)?;
         let mut x = vec![0.0; self.n];
-        for (new, &old) in self.fwd.iter().enumerate() {
-            x[old] = y[new];
-        }
+        self.permute_out(y, &mut x);
         y.copy_from_slice(&x);
+        Ok(())
+    }
+
+    /// y ← Pᵀx, column by column (both column-major with n rows): into the factor's order.
+    pub fn permute_in(&self, x: &[f64], y: &mut [f64]) {
+        if self.n == 0 {
+            return;
+        }
+        for (yc, xc) in y.chunks_exact_mut(self.n).zip(x.chunks_exact(self.n)) {
+            yc.iter_mut().zip(&self.fwd).for_each(|(yi, &old)| *yi = xc[old]);
+        }
+    }
+
+    /// x ← P y, column by column: from the factor's order back to the unknowns' order.
+    pub fn permute_out(&self, y: &[f64], x: &mut [f64]) {
+        if self.n == 0 {
+            return;
+        }
+        for (xc, yc) in x.chunks_exact_mut(self.n).zip(y.chunks_exact(self.n)) {
+            yc.iter().zip(&self.fwd).for_each(|(&yi, &old)| xc[old] = yi);
+        }
+    }
+
+    /// Y ← L⁻¹Y for the `cols` columns of Y (column-major, n rows, in the factor's order): one pass
+    /// over L for all columns, each column computed independently of the others.
+    pub fn forward_block(&self, y: &mut [f64], cols: usize) -> Result<()> {
+        self.block_half(y, cols, true)
+    }
+
+    /// Y ← L⁻ᵀY for the `cols` columns of Y (in the factor's order), as [`Factor::forward_block`].
+    pub fn backward_block(&self, y: &mut [f64], cols: usize) -> Result<()> {
+        self.block_half(y, cols, false)
+    }
+
+    fn block_half(&self, y: &mut [f64], cols: usize, forward: bool) -> Result<()> {
+        let llt = self.supernodal().ok_or_else(|| Error::Linear("the factor is not supernodal".into()))?;
+        if y.len() != self.n * cols {
+            return Err(Error::Linear(format!("internal: a block of {} values for {cols} columns", y.len())));
+        }
+        let mut scratch = self.scratch.borrow_mut();
+        if scratch.0 < cols {
+            scratch.1 = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq))
+                .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
+            scratch.0 = cols;
+        }
+        let (y, stack) = (MatMut::from_column_major_slice_mut(y, self.n, cols), MemStack::new(&mut scratch.1));
+        if forward {
+            llt.l_solve_with_conj(Conj::No, y, Par::Seq, stack);
+        } else {
+            llt.l_transpose_solve_with_conj(Conj::No, y, Par::Seq, stack);
+        }
         Ok(())
     }
 
@@ -226,7 +261,7 @@ impl Factor {
             Conj::No,
             MatMut::from_column_major_slice_mut(x, self.n, 1),
             Par::Seq,
-            MemStack::new(&mut buf),
+            MemStack::new(&mut buf.1),
         );
     }
 
