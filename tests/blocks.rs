@@ -23,18 +23,35 @@ fn rel(a: &[f64], b: &[f64]) -> f64 {
 }
 
 #[test]
-fn resumed_and_step_by_step_runs_match_the_blocked_run() {
+fn assembled_loads_resumed_and_step_by_step_match_the_blocked_run() {
     // the benchmark's loads span 5 time patterns: every step assembles and solves
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/verification/bench/bench_mms_poly.toml");
     let text = std::fs::read_to_string(path).unwrap().replace("cells    = [256, 128]", "cells    = [16, 8]");
     let mut s = Scene::from_str(&text, path).unwrap();
     s.set_steps(40).unwrap();
     let p = Problem::new(s).unwrap();
+    assert!(!p.free.superposed());
+    check(&p);
+}
+
+#[test]
+fn superposed_loads_resumed_and_step_by_step_match_the_blocked_run() {
+    // slips, then sticks from t = 1/3 on: μ repeats, then changes at every step
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/verification/cases/mms_stop.toml");
+    let mut s = Scene::from_file(std::path::Path::new(path)).unwrap();
+    s.set_refine(1).unwrap();
+    s.set_steps(40).unwrap();
+    let p = Problem::new(s).unwrap();
+    assert!(p.free.superposed());
+    check(&p);
+}
+
+fn check(p: &Problem) {
     assert!(p.free.block_size() > 1, "the scene must take the blocked path");
-    let full = collect(&p, None);
+    let full = collect(p, None);
     assert_eq!(full.len(), 41);
     for from in [1, 13, 16, 17, 39] {
-        let resumed = collect(&p, Some(full[from].clone()));
+        let resumed = collect(p, Some(full[from].clone()));
         for (a, b) in full[from + 1..].iter().zip(&resumed) {
             assert_eq!(a.n, b.n);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();

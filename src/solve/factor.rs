@@ -348,6 +348,24 @@ mod tests {
         r.iter().zip(&b).map(|(r, b)| (r - b).abs()).fold(0.0, f64::max)
     }
 
+    /// The blocked steps (`solve::free::Block`) rely on this: in a solve with B columns each column's
+    /// result depends neither on the other columns nor on its position.
+    #[test]
+    fn block_columns_are_independent_of_neighbours_and_position() {
+        let k = grid(70);
+        let n = k.nrows();
+        let f = Factor::with_last(&k, &[0, 2, 4, 6]).unwrap();
+        let b: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+        let cols = 16;
+        let mut y: Vec<f64> = (0..n * cols).map(|i| if (i / n) % 2 == 0 { b[i % n] } else { ((i * 13) % 7) as f64 }).collect();
+        f.forward_block(&mut y, cols).unwrap();
+        f.backward_block(&mut y, cols).unwrap();
+        let bits = |c: usize| y[c * n..(c + 1) * n].iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        for c in (2..cols).step_by(2) {
+            assert_eq!(bits(0), bits(c), "column {c}");
+        }
+    }
+
     #[test]
     fn nested_dissection_orders_and_solves() {
         let k = grid(40);

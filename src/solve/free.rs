@@ -49,8 +49,12 @@ pub struct Block {
     n: usize,
     /// lⁿ, column by column, in the unknowns' order.
     loads: Vec<f64>,
-    /// yⁿ = L⁻¹Pᵀlⁿ, then (after [`FreeResponse::finish_block`]) yⁿ − [0; Wμⁿ] solved backward.
+    /// yⁿ = L⁻¹Pᵀlⁿ, then (after [`FreeResponse::finish_block`]) yⁿ − [0; Wμⁿ] solved backward;
+    /// with superposed loads [0; Wμⁿ] solved backward.
     y: Vec<f64>,
+    /// Superposed loads: the last μ solved for in a block and its K⁻¹Eμ, reused while μ repeats
+    /// (bit-equal; the columns are computed independently of their position, so reuse changes no bit).
+    friction: (Vec<f64>, Vec<f64>),
 }
 
 impl Block {
@@ -142,10 +146,9 @@ impl FreeResponse {
         &self.loads
     }
 
-    /// Steps per block when every step assembles and solves with Γ_C (see [`Block`]), else 0: the
-    /// superposed and contact-free paths solve step by step.
+    /// Steps per block with Γ_C (see [`Block`]), else 0: without Γ_C steps are solved one by one.
     pub fn block_size(&self) -> usize {
-        if self.basis.is_some() || self.contact_dofs.is_empty() {
+        if self.contact_dofs.is_empty() {
             return 0;
         }
         (BLOCK_VALUES / self.n_dofs.max(1)).clamp(1, MAX_BLOCK)
@@ -154,13 +157,13 @@ impl FreeResponse {
     /// An empty block for [`FreeResponse::forward_block`].
     pub fn new_block(&self) -> Block {
         let (cols, n) = (self.block_size().max(1), self.n_dofs);
-        Block { first: 0, cols, n, loads: vec![0.0; cols * n], y: vec![0.0; cols * n] }
+        Block { first: 0, cols, n, loads: vec![0.0; cols * n], y: vec![0.0; cols * n], friction: (vec![], vec![]) }
     }
 
     /// Assemble lⁿ and solve the forward halves yⁿ for the steps `steps` that lie in the aligned block
-    /// holding the first of them (its other columns are zero). Returns the last step assembled and,
-    /// if the load of the step after it failed, that error: the caller completes the steps before it
-    /// first, as a run step by step would.
+    /// holding the first of them (its other columns are zero); with superposed loads nothing is done
+    /// here. Returns the last step of the block in `steps` and, if the load of the step after it
+    /// failed, that error: the caller completes the steps before it first, as a run step by step would.
     pub fn forward_block(
         &self,
         steps: RangeInclusive<usize>,
@@ -169,6 +172,9 @@ impl FreeResponse {
     ) -> Result<(usize, Option<Error>)> {
         let b = block.cols;
         block.first = (steps.start().max(&1) - 1) / b * b + 1;
+        if self.basis.is_some() {
+            return Ok(((block.first + b - 1).min(*steps.end()), None));
+        }
         block.loads.iter_mut().for_each(|v| *v = 0.0);
         let mut on_support = Vec::new();
         let steps: Vec<usize> = steps.filter(|&n| block.holds(n)).collect();
@@ -191,8 +197,11 @@ impl FreeResponse {
         Ok((last, failed))
     }
 
-    /// s_f = Wᵀyⁿ_c of a step in the block.
+    /// s_f of a step in the block: Wᵀyⁿ_c, or from the superposed responses.
     pub fn block_trace(&self, block: &Block, n: usize) -> Vec<f64> {
+        if let Some(b) = &self.basis {
+            return b.response_at(n, &self.contact_dofs);
+        }
         let y = &block.y[block.col(n)];
         self.trace_of(&y[self.n_dofs - self.contact_dofs.len()..])
     }
@@ -203,10 +212,15 @@ impl FreeResponse {
     }
 
     /// uⁿ = P L⁻ᵀ(yⁿ − [0; Wμⁿ]) for the steps and friction forces `mus` of the block, by one backward
-    /// solve; the block's forward halves are used up.
+    /// solve; the block's forward halves are used up. With superposed loads uⁿ = u_f − P L⁻ᵀ[0; Wμⁿ]
+    /// (one backward solve for the μⁿ that differ from the last one solved for) and lⁿ is formed for
+    /// [`Block::load`].
     pub fn finish_block(&self, block: &mut Block, mus: &[(usize, &[f64])]) -> Result<Vec<Vec<f64>>> {
         if mus.is_empty() {
             return Ok(vec![]);
+        }
+        if let Some(b) = &self.basis {
+            return self.finish_superposed(b, block, mus);
         }
         for &(n, mu) in mus {
             let range = block.col(n);
@@ -221,6 +235,58 @@ impl FreeResponse {
                 u.clone()
             })
             .collect())
+    }
+
+    fn finish_superposed(&self, b: &LoadBasis, block: &mut Block, mus: &[(usize, &[f64])]) -> Result<Vec<Vec<f64>>> {
+        let dofs = self.n_dofs;
+        let (old_mu, old_z) = std::mem::take(&mut block.friction);
+        let same = |mu: &[f64]| {
+            old_z.len() == dofs
+                && mu.len() == old_mu.len()
+                && mu.iter().zip(&old_mu).all(|(x, y)| x.to_bits() == y.to_bits())
+        };
+        let solve: Vec<bool> = mus.iter().map(|&(_, mu)| !same(mu)).collect();
+        if solve.iter().any(|&s| s) {
+            block.y.iter_mut().for_each(|v| *v = 0.0);
+            let n0 = dofs - self.contact_dofs.len();
+            for (&(n, mu), _) in mus.iter().zip(&solve).filter(|(_, &s)| s) {
+                let range = block.col(n);
+                let y = &mut block.y[range];
+                for i in 0..mu.len() {
+                    y[n0 + i] = (0..=i).map(|j| self.w[(i, j)] * mu[j]).sum::<f64>();
+                }
+            }
+            self.factor.backward_block(&mut block.y, block.cols)?;
+        }
+        let (mut z, mut l) = (vec![0.0; dofs], Vec::new());
+        let mut last = None;
+        let mut out = Vec::with_capacity(mus.len());
+        for (&(n, _), &s) in mus.iter().zip(&solve) {
+            let mut u = Vec::new();
+            b.response(n, dofs, &mut u);
+            let kinv_e_mu = if s {
+                // K⁻¹Eμ = P L⁻ᵀ[0; Wμ]
+                self.factor.permute_out(&block.y[block.col(n)], &mut z);
+                last = Some(n);
+                &z
+            } else {
+                &old_z
+            };
+            u.iter_mut().zip(kinv_e_mu).for_each(|(ui, a)| *ui -= a);
+            b.load(n, dofs, &mut l);
+            let range = block.col(n);
+            block.loads[range].copy_from_slice(&l);
+            out.push(u);
+        }
+        block.friction = match last {
+            Some(n) => {
+                let mu = mus.iter().find(|m| m.0 == n).map_or(vec![], |m| m.1.to_vec());
+                self.factor.permute_out(&block.y[block.col(n)], &mut z);
+                (mu, z)
+            }
+            None => (old_mu, old_z),
+        };
+        Ok(out)
     }
 
     /// y_c ← y_c − Wμ (L⁻¹Eμ = [0; Wμ]).
