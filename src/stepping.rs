@@ -12,7 +12,7 @@ use crate::fem::elasticity::Elasticity;
 use crate::fem::loads::Loads;
 use crate::fem::norms::{ErrorEvaluator, ErrorNorms};
 use crate::fem::space::CrSpace;
-use crate::friction::{EdgeState, Friction};
+use crate::friction::{EdgeState, Friction, FrictionSolution};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::solve::factor::Factor;
@@ -257,30 +257,71 @@ impl Problem {
             };
             return self.finish(r);
         };
-        let d: Vec<f64> = free.trace.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
-        let sol = friction.solve(&d, &prev.mu, n, t)?;
-        // s = s_f − Cμ
-        let slip: Vec<f64> = prev.slip.iter().zip(&sol.slip_increment).map(|(a, b)| a + b).collect();
+        let (sol, slip) = contact(friction, &free.trace, prev, n, t)?;
         let (mut u, mut energy) = (Vec::new(), f64::NAN);
         if want_u {
             u = self.free.with_friction(free, &sol.mu)?;
             // a_h(u, u) = (l, u) − Σ_e μ_e s_e, since K u = l − Eμ
             energy = dot(load, &u) - dot(&sol.mu, &slip);
         }
-        let r = StepResult {
-            n,
-            t,
-            u,
-            mu: sol.mu,
-            slip,
-            state: sol.state,
-            iterations: sol.iterations,
-            residual: sol.residual,
-            energy,
-            errors: None,
-            wall: start.elapsed().as_secs_f64(),
-        };
-        self.finish(r)
+        self.finish(contact_result(n, t, sol, slip, u, energy, start.elapsed().as_secs_f64()))
+    }
+
+    /// Steps prev.n + 1, …, N in blocks of steps sharing their triangular
+    /// solves (`solve::free::Block`); every completed step goes to `on_step`, in order, before a later
+    /// step's error is returned. Returns the last step's result.
+    fn run_blocks(
+        &self,
+        friction: &Friction,
+        mut prev: StepResult,
+        want: impl Fn(usize) -> bool,
+        on_step: &mut impl FnMut(&StepResult) -> Result<()>,
+    ) -> Result<StepResult> {
+        let mut block = self.free.new_block();
+        let mut first = prev.n + 1;
+        while first <= self.n_steps() {
+            let start = Instant::now();
+            let (last, mut failed) = self.free.forward_block(first..=self.n_steps(), &self.scene.times, &mut block)?;
+            let mut done = Vec::with_capacity(last + 1 - first);
+            let mut solves = start.elapsed().as_secs_f64();
+            for n in first..=last {
+                let start = Instant::now();
+                let t = self.scene.times[n];
+                let trace = self.free.block_trace(&block, n);
+                match contact(friction, &trace, done.last().unwrap_or(&prev), n, t) {
+                    Ok((sol, slip)) => {
+                        let wall = start.elapsed().as_secs_f64();
+                        done.push(contact_result(n, t, sol, slip, vec![], f64::NAN, wall));
+                    }
+                    Err(e) => {
+                        // an earlier step than a failed load's
+                        failed = Some(e);
+                        break;
+                    }
+                }
+            }
+            let start = Instant::now();
+            let wanted: Vec<(usize, &[f64])> = done.iter().filter(|r| want(r.n)).map(|r| (r.n, &r.mu[..])).collect();
+            let mut us = self.free.finish_block(&mut block, &wanted)?.into_iter();
+            solves += start.elapsed().as_secs_f64();
+            let share = solves / done.len().max(1) as f64;
+            for mut r in done {
+                if want(r.n) {
+                    r.u = us.next().unwrap_or_default();
+                    // a_h(u, u) = (l, u) − Σ_e μ_e s_e, since K u = l − Eμ
+                    r.energy = dot(block.load(r.n), &r.u) - dot(&r.mu, &r.slip);
+                }
+                r.wall += share;
+                let r = self.finish(r)?;
+                on_step(&r)?;
+                prev = r;
+            }
+            if let Some(e) = failed {
+                return Err(e);
+            }
+            first = last + 1;
+        }
+        Ok(prev)
     }
 
     /// Run steps from `from` to N, forming u only at the steps `want` selects (see [`Problem::step`]).
@@ -290,6 +331,9 @@ impl Problem {
         want: impl Fn(usize) -> bool,
         mut on_step: impl FnMut(&StepResult) -> Result<()>,
     ) -> Result<()> {
+        if let (Some(friction), true) = (&self.friction, self.free.block_size() > 0) {
+            return self.run_blocks(friction, from, want, &mut on_step).map(|_| ());
+        }
         let mut load = Vec::with_capacity(self.space.n_dofs);
         let mut prev = from;
         for n in prev.n + 1..=self.n_steps() {
@@ -310,5 +354,45 @@ impl Problem {
         let first = self.initial()?;
         on_step(&first)?;
         self.run_from(first, on_step)
+    }
+}
+
+/// The friction problem of step n for the free trace s_f: its solution and the slip
+/// sⁿ = sⁿ⁻¹ + Δs (with d = s_f − sⁿ⁻¹ and Δs = d − Cμ).
+fn contact(
+    friction: &Friction,
+    trace: &[f64],
+    prev: &StepResult,
+    n: usize,
+    t: f64,
+) -> Result<(FrictionSolution, Vec<f64>)> {
+    let d: Vec<f64> = trace.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
+    let sol = friction.solve(&d, &prev.mu, n, t)?;
+    let slip = prev.slip.iter().zip(&sol.slip_increment).map(|(a, b)| a + b).collect();
+    Ok((sol, slip))
+}
+
+/// A step's result from its friction solution.
+fn contact_result(
+    n: usize,
+    t: f64,
+    sol: FrictionSolution,
+    slip: Vec<f64>,
+    u: Vec<f64>,
+    energy: f64,
+    wall: f64,
+) -> StepResult {
+    StepResult {
+        n,
+        t,
+        u,
+        mu: sol.mu,
+        slip,
+        state: sol.state,
+        iterations: sol.iterations,
+        residual: sol.residual,
+        energy,
+        errors: None,
+        wall,
     }
 }

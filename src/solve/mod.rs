@@ -5,4 +5,5 @@
 pub mod condense;
 pub mod factor;
 pub mod free;
+pub mod ordering;
 pub mod superpose;

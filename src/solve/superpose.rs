@@ -13,6 +13,7 @@ use super::factor::Factor;
 use crate::error::{Error, Result};
 use crate::fem::loads::Loads;
 use crate::sparse::dot;
+use faer::MatMut;
 use std::borrow::Cow;
 
 /// Largest number of load patterns handled by superposition.
@@ -96,15 +97,20 @@ impl LoadBasis {
             }
             coef.push(c);
         }
-        let responses = b
-            .iter()
-            .map(|bj| {
-                let mut x = Vec::new();
-                loads.expand(bj, &mut x);
-                factor.solve_in_place(&mut x);
-                x
-            })
-            .collect();
+        // all responses by one solve with rank right-hand sides (the factor is read once)
+        let mut x = Vec::new();
+        let mut col = Vec::new();
+        for bj in &b {
+            loads.expand(bj, &mut col);
+            x.extend_from_slice(&col);
+        }
+        let n = col.len();
+        let responses = if n == 0 {
+            vec![vec![]; b.len()]
+        } else {
+            factor.solve_many(MatMut::from_column_major_slice_mut(&mut x, n, b.len()));
+            x.chunks_exact(n).map(|c| c.to_vec()).collect()
+        };
         Ok(Some(LoadBasis { b, support: loads.support().to_vec(), responses, coef }))
     }
 
