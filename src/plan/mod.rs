@@ -142,7 +142,8 @@ pub fn plan(scene: &Scene, options: &Options) -> Result<Plan> {
     // sampling time on nt steps is sound when the time grids change the solution on the time pilot's
     // mesh by at most SAMPLING_SHARE of that mesh's spatial error
     let moved = time_fit.distances.iter().copied().fold(0.0, f64::max);
-    let on_mesh = coarse.space.levels.iter().position(|l| l.refine == r0 + 2).and_then(|i| coarse.space_fit.errors.get(i));
+    let mesh = time.levels[0].refine;
+    let on_mesh = coarse.space.levels.iter().position(|l| l.refine == mesh).and_then(|i| coarse.space_fit.errors.get(i));
     match on_mesh {
         Some(&e) if moved <= SAMPLING_SHARE * e => Ok(coarse),
         _ => {

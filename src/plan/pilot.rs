@@ -5,7 +5,7 @@
 //! * **space**: the scene's mesh refined r₀, r₀+1, … at N/8 steps (`super::space_steps`): its estimates (Richardson
 //!   on the distances between levels, [`crate::study::estimate`]) give the spatial error C_h hᵖ of the
 //!   time-discrete problem, its wall times the cost model;
-//! * **time**: one mesh (r₀+2) at N₀, 2N₀, … up to 4N steps (N₀: `super::time_base`, N the scene's), or
+//! * **time**: one mesh (r₀+2) at N₀, 2N₀, … up to 2N steps (N₀: `super::time_base`, N the scene's), or
 //!   N₀, 4N₀, 16N₀, 64N₀ when the doubling sequence is not in the asymptotic range (a slip that stops inside a step gives an O(k) error θk‖W‖ whose
 //!   fraction θ of the step alternates under doubling, see `verification/cases/mms_stop.toml`): the time
 //!   error C_k k^q of the space-discrete problem.
@@ -197,11 +197,12 @@ impl Fit {
     }
 }
 
-/// The time pilot on mesh level `refine`: grids doubling from `first` steps up to 4 times the scene's
+/// The time pilot on mesh level `refine`: grids doubling from `first` steps up to twice the scene's
 /// `steps` (at least four), then N, 4N, 16N, 64N from `first` if the doubling sequence is not in the
 /// asymptotic range (module doc) and its distances do not already bound the time error of grids of
 /// `steps` steps or more by `enough` ([`Fit::time_bound`]). Returns the study, the ratio used and the
-/// seconds spent.
+/// seconds spent. (On a coarser mesh the time grids move the solution more — a stick–slip front crosses
+/// fewer, larger edges — so the bound would be looser and the space pilot could not sample time coarsely.)
 pub fn time_pilot(
     scene: &Scene,
     refine: u32,
@@ -215,7 +216,7 @@ pub fn time_pilot(
     let mut last = None;
     for ratio in [2usize, 4] {
         let mut grids = vec![first];
-        while grids.len() < 4 || (ratio == 2 && *grids.last().expect("grids") < 4 * steps) {
+        while grids.len() < 4 || (ratio == 2 && *grids.last().expect("grids") < 2 * steps) {
             let next = grids.last().expect("grids").checked_mul(ratio);
             grids.push(next.ok_or_else(|| Error::scene(&scene.file, "steps", "too many steps"))?);
         }
