@@ -9,8 +9,9 @@ For each manufactured case (exact solution known):
     cost: CPU time (user + sys) of the process, median of 3 (one run when it takes over 2 s). CPU time, not
     wall, because the machine is shared: waiting for a core is not a cost of the method.
  2. Sweep: nine targets a quarter decade apart, spanning two decades and ending at the finest quarter-decade
-    value 10^(-j/4) that some grid configuration meets (so that the truth decides every target: for the
-    default grids 3.16e-1 .. 3.16e-3, or 1.78e-1 .. 1.78e-3 where refine 6 reaches below 3.16e-3). For each,
+    value 10^(-j/4) that some grid configuration meets with a 10 % margin (MARGIN: so that the truth decides
+    every target robustly; for the default grids 3.16e-1 .. 3.16e-3, or 1.78e-1 .. 1.78e-3 where refine 6
+    reaches below 1.6e-3). For each,
     `tresca-cr plan SCENE --target T --csv F` (its CPU time is the planner's own cost: all pilot runs);
     the plan (refine, steps, ssn, tol) is then run like a grid point (true error with [exact], cost without).
  3. Requirements (per case):
@@ -46,9 +47,17 @@ CASES = {
 }
 
 
+# A target must be met by a grid point with this margin (error <= MARGIN x target) to end a sweep: the truth
+# then decides it robustly. A target that only the grid's best point meets, by less than the planner's
+# prediction uncertainty (the 10 % of the asymptotic-range check), tests the grid's granularity (x4 cost per
+# refinement or time-family step), not the planner.
+MARGIN = 0.9
+
+
 def targets(grid, count):
-    """`count` targets a quarter decade apart ending at the finest 10^(-j/4) that a grid point meets."""
-    j = math.floor(-4 * math.log10(min(g["error"] for g in grid)) + 1e-9)
+    """`count` targets a quarter decade apart ending at the finest 10^(-j/4) that a grid point meets with
+    the margin MARGIN."""
+    j = math.floor(-4 * math.log10(min(g["error"] for g in grid) / MARGIN) + 1e-9)
     return [10 ** (-(j - i) / 4) for i in reversed(range(count))]
 EX51 = case("paper_example_5_1")
 
