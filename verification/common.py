@@ -82,3 +82,15 @@ def rel_to(a, ref):
     diff = float(np.max(np.abs(a - ref), initial=0.0))
     scale = float(np.max(np.abs(ref), initial=0.0))
     return diff / scale if scale > 0 else diff
+
+
+def strip_exact(text):
+    """A scene's text without its ``[exact]`` table (a run of it costs what a user's run costs: no true
+    errors are evaluated)."""
+    out, skip = [], False
+    for line in text.splitlines():
+        if line.startswith("["):
+            skip = line.strip() == "[exact]"
+        if not skip:
+            out.append(line)
+    return "\n".join(out) + "\n"

@@ -37,7 +37,7 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, REF, ROOT, case, cmdline  # noqa: E402
+from common import BIN, REF, ROOT, case, cmdline, strip_exact  # noqa: E402
 
 # grid per case: steps N_s·2^j for j < len; refinements 0..R
 CASES = {
@@ -76,16 +76,6 @@ def timed(cmd):
     c0, t0 = child_cpu(), time.perf_counter()
     p = subprocess.run([str(c) for c in cmd], cwd=ROOT, capture_output=True, text=True)
     return p, time.perf_counter() - t0, child_cpu() - c0
-
-
-def strip_exact(text):
-    out, skip = [], False
-    for line in text.splitlines():
-        if line.startswith("["):
-            skip = line.strip() == "[exact]"
-        if not skip:
-            out.append(line)
-    return "\n".join(out) + "\n"
 
 
 def scene_steps(path):

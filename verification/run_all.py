@@ -388,42 +388,40 @@ def cross_check(quick):
         require(r["id"], r["statement"], r["passed"], r["measured"], r["command"], r.get("reference", "reference/cross_check.md"))
 
 
+def script_requirements(cmd, out, rid0, what, default_ref, keep=lambda r: True):
+    """Run a check script that writes its requirement list as JSON to `out` (removed first, so a crashed
+    run cannot report a stale list) and record every requirement `keep` accepts."""
+    if os.path.exists(out):
+        os.remove(out)
+    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    print(p.stdout[-3000:])
+    import json
+    try:
+        reqs = json.load(open(out))
+    except Exception as e:  # noqa: BLE001
+        require(rid0, f"the {what} check shall produce its requirement list", False, f"{e}; {p.stderr[-300:]}",
+                " ".join(cmd), "-")
+        return
+    for r in filter(keep, reqs):
+        require(r["id"], r["statement"], r["passed"], r["measured"], r["command"], r.get("reference", default_ref))
+
+
 def distributed(quick):
     """The distributed dolfinx/PETSc route (issue 16): D1 agreement at -n 1, 2, 3; D2 memory (full run only)."""
     out = os.path.join(ROOT, "out", "distributed.json")
     cmd = [PY, "verification/distributed.py", "--json", out, "--bin", BIN] + \
         (["--md", os.path.join(ROOT, "out", "distributed_quick.md")] if quick else ["--memory"])
-    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
-    print(p.stdout[-3000:])
-    import json
-    try:
-        reqs = json.load(open(out))
-    except Exception as e:  # noqa: BLE001
-        require("D0-distributed", "the distributed check shall produce its requirement list", False, f"{e}; {p.stderr[-300:]}",
-                " ".join(cmd), "-")
-        return
-    for r in reqs:
-        require(r["id"], r["statement"], r["passed"], r["measured"], r["command"], r.get("reference", "reference/distributed.md"))
+    script_requirements(cmd, out, "D0-distributed", "distributed", "reference/distributed.md")
 
 
 def planner(quick):
-    """The planner against the truth (issue 15): verification/planner.py, P1-P4 per manufactured case."""
+    """The planner against the truth (issue 15): verification/planner.py, P1-P4 per manufactured case. With
+    --quick P4 is left out: the planner's share is a claim about fine targets, which --quick does not reach."""
     out = os.path.join(ROOT, "out", "planner.json")
     cmd = [PY, "verification/planner.py", "--json", out] + \
         (["--quick", "--md", os.path.join(ROOT, "out", "planner_quick.md")] if quick else [])
-    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
-    print(p.stdout[-3000:])
-    import json
-    try:
-        reqs = json.load(open(out))
-    except Exception as e:  # noqa: BLE001
-        require("P0-planner", "the planner check shall produce its requirement list", False, f"{e}; {p.stderr[-300:]}",
-                " ".join(cmd), "-")
-        return
-    for r in reqs:
-        if quick and r["id"].startswith("P4"):
-            continue  # the planner's share is a claim about fine targets, which --quick does not reach
-        require(r["id"], r["statement"], r["passed"], r["measured"], r["command"], r["reference"])
+    script_requirements(cmd, out, "P0-planner", "planner", "reference/planner.md",
+                        keep=lambda r: not (quick and r["id"].startswith("P4")))
 
 
 def stability():

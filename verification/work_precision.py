@@ -29,7 +29,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, REF, ROOT  # noqa: E402
+from common import BIN, REF, ROOT, strip_exact  # noqa: E402
 CASES = {
     "mms_front": dict(path="verification/cases/mms_front.toml", h_N=32, h_r=3, k_r=2, k_N=[8, 16, 32, 64, 128, 256],
                       joint=[(0, 8), (1, 16), (2, 32), (3, 64)], tol_level=(2, 32)),
@@ -42,16 +42,6 @@ TOLS = [1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12]
 
 def load1():
     return float(open("/proc/loadavg").read().split()[0])
-
-
-def strip_exact(text):
-    out, skip = [], False
-    for line in text.splitlines():
-        if line.startswith("["):
-            skip = line.strip() == "[exact]"
-        if not skip:
-            out.append(line)
-    return "\n".join(out) + "\n"
 
 
 def prepare(case, tmp):
