@@ -15,10 +15,10 @@ For each manufactured case (exact solution known):
     `tresca-cr plan SCENE --target T --csv F` (its CPU time is the planner's own cost: all pilot runs);
     the plan (refine, steps, ssn, tol) is then run like a grid point (true error with [exact], cost without).
  3. Requirements (per case):
-    P1  the plan meets the target in truth (true error <= target) for >= 90 % of the sweep;
-    P2  it never misses by more than 25 % (true error <= 1.25 target);
-    P3  its cost is within 2x of the cheapest grid configuration whose true error meets the target;
-    P4  the planner's own cost is below 20 % of the plan's cost for the targets whose plan lies at the two
+    PL1 the plan meets the target in truth (true error <= target) for >= 90 % of the sweep;
+    PL2 it never misses by more than 25 % (true error <= 1.25 target);
+    PL3 its cost is within 2x of the cheapest grid configuration whose true error meets the target;
+    PL4 the planner's own cost is below 20 % of the plan's cost for the targets whose plan lies at the two
         finest refinements the sweep reaches.
  4. Example 5.1 (no exact solution): the plans for targets 1e-4 (run with --run: the achieved estimate) and
     1e-5, against what the paper's pairing N = 20 n (n = 2^(r+1)) costs at the same mesh.
@@ -197,20 +197,20 @@ def requirements(name, sweep, grid_cmd):
     met = [s for s in planned if s["error"] <= s["target"]]
     frac = len(met) / len(sweep)
     worst = max((s["error"] / s["target"] for s in planned), default=float("inf"))
-    reqs.append(dict(id=f"P1-{name}", statement=f"{name}: the plan shall meet the target in truth for >= 90 % of the sweep",
+    reqs.append(dict(id=f"PL1-{name}", statement=f"{name}: the plan shall meet the target in truth for >= 90 % of the sweep",
                      passed=frac >= 0.9, measured=f"{len(met)}/{len(sweep)} targets met ({100 * frac:.0f} %); "
                      f"{len(sweep) - len(planned)} refused"))
-    reqs.append(dict(id=f"P2-{name}", statement=f"{name}: the plan shall never miss the target by more than 25 %",
+    reqs.append(dict(id=f"PL2-{name}", statement=f"{name}: the plan shall never miss the target by more than 25 %",
                      passed=len(planned) == len(sweep) and worst <= 1.25, measured=f"worst true/target {worst:.3f}"))
     ratios = [s["cpu"] / s["cheapest"]["cpu"] for s in planned if s["cheapest"]]
-    reqs.append(dict(id=f"P3-{name}", statement=f"{name}: the plan's cost shall be within 2x of the cheapest grid configuration "
+    reqs.append(dict(id=f"PL3-{name}", statement=f"{name}: the plan's cost shall be within 2x of the cheapest grid configuration "
                      "meeting the target in truth", passed=bool(ratios) and max(ratios) <= 2.0,
                      measured=f"cost / cheapest: max {max(ratios, default=float('nan')):.2f}, median "
                      f"{statistics.median(ratios) if ratios else float('nan'):.2f} over {len(ratios)} targets"))
     levels = sorted({s["refine"] for s in planned})[-2:]
     fine = [s for s in planned if s["refine"] in levels]
     shares = [s["planner_cpu"] / s["cpu"] for s in fine]
-    reqs.append(dict(id=f"P4-{name}", statement=f"{name}: the planner's own runs shall cost < 20 % of the plan for targets at the "
+    reqs.append(dict(id=f"PL4-{name}", statement=f"{name}: the planner's own runs shall cost < 20 % of the plan for targets at the "
                      f"two finest levels of the sweep (refine {levels})", passed=bool(shares) and max(shares) < 0.2,
                      measured=f"planner CPU / plan CPU: max {max(shares, default=float('nan')):.3f} over {len(shares)} targets"))
     for r in reqs:

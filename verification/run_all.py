@@ -415,13 +415,13 @@ def distributed(quick):
 
 
 def planner(quick):
-    """The planner against the truth (issue 15): verification/planner.py, P1-P4 per manufactured case. With
-    --quick P4 is left out: the planner's share is a claim about fine targets, which --quick does not reach."""
+    """The planner against the truth (issue 15): verification/planner.py, PL1-PL4 per manufactured case. With
+    --quick PL4 is left out: the planner's share is a claim about fine targets, which --quick does not reach."""
     out = os.path.join(ROOT, "out", "planner.json")
     cmd = [PY, "verification/planner.py", "--json", out] + \
         (["--quick", "--md", os.path.join(ROOT, "out", "planner_quick.md")] if quick else [])
-    script_requirements(cmd, out, "P0-planner", "planner", "reference/planner.md",
-                        keep=lambda r: not (quick and r["id"].startswith("P4")))
+    script_requirements(cmd, out, "PL0-planner", "planner", "reference/planner.md",
+                        keep=lambda r: not (quick and r["id"].startswith("PL4")))
 
 
 def stability():
