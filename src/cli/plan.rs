@@ -29,7 +29,20 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool) 
         say!("\nNo plan: {why}");
         return Ok(REFUSED);
     }
-    say!("\n{:>8} {:>6} {:>7} {:>10} {:>6} {:>8} {:>11} {:>11} {:>11} {:>11} {:>9}", "", "refine", "steps", "unknowns", "solver", "tol", "pred error", "space", "time", "pred wall", "memory");
+    say!(
+        "\n{:>8} {:>6} {:>7} {:>10} {:>6} {:>8} {:>11} {:>11} {:>11} {:>11} {:>9}",
+        "",
+        "refine",
+        "steps",
+        "unknowns",
+        "solver",
+        "tol",
+        "pred error",
+        "space",
+        "time",
+        "pred wall",
+        "memory"
+    );
     for (i, c) in p.best.iter().enumerate() {
         let role = if i == 0 { "plan" } else { "runner-up" };
         say!(
@@ -65,7 +78,17 @@ fn print_evidence(p: &Plan) {
     say!("\nPilot runs (the scene without [exact]; wall = set-up + steps, seconds):");
     for (name, study, fit) in [("time", &p.time, &p.time_fit), ("space", &p.space, &p.space_fit)] {
         say!("  {name} sequence, sizes {}:", fit.size);
-        say!("  {:>6} {:>7} {:>9} {:>10} {:>9} {:>9} {:>7} {:>11}  verdict", "refine", "steps", "h", "unknowns", "set-up", "wall", "it/step", "est error");
+        say!(
+            "  {:>6} {:>7} {:>9} {:>10} {:>9} {:>9} {:>7} {:>11}  verdict",
+            "refine",
+            "steps",
+            "h",
+            "unknowns",
+            "set-up",
+            "wall",
+            "it/step",
+            "est error"
+        );
         for (i, r) in study.levels.iter().enumerate() {
             let est = fit.errors.get(i).map_or("-".into(), |e| format!("{e:.4e}"));
             let verdict = fit.verdicts.get(i).map_or(String::new(), |v| v.text());
@@ -113,7 +136,10 @@ fn print_evidence(p: &Plan) {
                 orders(&p.time_fit),
                 p.time_ratio
             ),
-            TimeError::Bound(b) => say!("             e_k ≤ {b:.3e} for every N ≥ {} (a bound from the time pilot's distances; see the note)", p.scene_steps),
+            TimeError::Bound(b) => say!(
+                "             e_k ≤ {b:.3e} for every N ≥ {} (a bound from the time pilot's distances; see the note)",
+                p.scene_steps
+            ),
         }
         say!(
             "             e = {}",
@@ -134,11 +160,23 @@ fn print_evidence(p: &Plan) {
 }
 
 fn csv_text(p: &Plan) -> String {
-    let mut s = String::from("role,refine,steps,unknowns,solver,tol,pred_error,space_error,time_error,pred_wall,memory,pilot_wall\n");
+    let mut s = String::from(
+        "role,refine,steps,unknowns,solver,tol,pred_error,space_error,time_error,pred_wall,memory,pilot_wall\n",
+    );
     let mut row = |role: &str, c: &Candidate| {
         s.push_str(&format!(
             "{role},{},{},{},{},{:e},{:e},{:e},{:e},{:e},{},{:e}\n",
-            c.refine, c.steps, c.unknowns, p.solver, p.tol, c.error, c.space_error, c.time_error, c.wall, c.memory, p.pilot_wall
+            c.refine,
+            c.steps,
+            c.unknowns,
+            p.solver,
+            p.tol,
+            c.error,
+            c.space_error,
+            c.time_error,
+            c.wall,
+            c.memory,
+            p.pilot_wall
         ));
     };
     for (i, c) in p.best.iter().enumerate() {
@@ -187,7 +225,11 @@ fn execute_plan(scene: &Scene, p: &Plan, b: &Candidate) -> Result<()> {
         if achieved <= p.options.target { "met" } else { "NOT met" }
     );
     if let (Quantity::Energy, Some(e)) = (&p.options.quantity, finest.max_err) {
-        say!("true energy error (max over the time nodes) {:.4e}: {}", e.energy, if e.energy <= p.options.target { "met" } else { "NOT met" });
+        say!(
+            "true energy error (max over the time nodes) {:.4e}: {}",
+            e.energy,
+            if e.energy <= p.options.target { "met" } else { "NOT met" }
+        );
     }
     say!("wall of the planned level {:.3} s (predicted {:.3} s)", finest.wall, b.wall);
     Ok(())

@@ -30,8 +30,8 @@ use crate::scene::budget::Estimate;
 use crate::scene::Scene;
 use crate::study::{Level, LevelResult, Study};
 use model::{CostModel, CostSample, ErrorModel, TimeError};
-use search::decide;
 use pilot::{fit, pilot_scene, time_pilot, Fit, Quantity, Runner};
+use search::decide;
 
 /// Levels of the space pilot before any extension (four: the asymptotic check needs a fourth level).
 pub const SPACE_LEVELS: u32 = 4;
@@ -139,7 +139,9 @@ pub fn plan(scene: &Scene, options: &Options) -> Result<Plan> {
     let (time, _, spent) = &time_pilot_run;
     let time_fit = fit(time, q)?;
     let mesh = time.levels[0].refine;
-    let on_mesh = |p: &Plan| p.space.levels.iter().position(|l| l.refine == mesh).and_then(|i| p.space_fit.errors.get(i).copied());
+    let on_mesh = |p: &Plan| {
+        p.space.levels.iter().position(|l| l.refine == mesh).and_then(|i| p.space_fit.errors.get(i).copied())
+    };
     if nt == n0 || time_fit.not_in_range().is_none() {
         // a time law: the spatial error of the time-discrete problem depends on the grid (a slip that stops
         // inside a step is partly missed on coarse grids, and so is its spatial error). The space pilot
@@ -243,7 +245,13 @@ fn space_pilot(
 /// it. If the time error follows a law instead, the space pilot runs the scene's N steps: the spatial
 /// error of the time-discrete problem then depends on the time grid (a slip that stops inside a step).
 fn time_base(n: usize) -> usize {
-    (0..=4).rev().map(|j| 1usize << j).filter(|d| n.is_multiple_of(*d)).map(|d| n / d).find(|&m| m >= n.min(4)).unwrap_or(n)
+    (0..=4)
+        .rev()
+        .map(|j| 1usize << j)
+        .filter(|d| n.is_multiple_of(*d))
+        .map(|d| n / d)
+        .find(|&m| m >= n.min(4))
+        .unwrap_or(n)
 }
 
 /// Unknowns at refinement r (the budget's count, exact for structured meshes).

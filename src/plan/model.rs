@@ -145,11 +145,18 @@ impl CostModel {
             m => {
                 let (a, b) = (s[m - 2], s[m - 1]);
                 let e = (floor(b.setup) / floor(a.setup)).ln() / (b.n / a.n).ln();
-                if e.is_finite() { e.clamp(SETUP_EXPONENT.0, SETUP_EXPONENT.1) } else { SETUP_EXPONENT.0 }
+                if e.is_finite() {
+                    e.clamp(SETUP_EXPONENT.0, SETUP_EXPONENT.1)
+                } else {
+                    SETUP_EXPONENT.0
+                }
             }
         };
         let (t, _) = time.iter().copied().filter(|(c, _)| c.n > 1.0).max_by_key(|&(_, steps)| steps)?;
-        Some(CostModel { setup: PowerLaw::through(last.n, floor(last.setup), alpha), step: floor(t.step) / (t.n * t.n.ln()) })
+        Some(CostModel {
+            setup: PowerLaw::through(last.n, floor(last.setup), alpha),
+            step: floor(t.step) / (t.n * t.n.ln()),
+        })
     }
 
     /// Seconds per step at n unknowns.

@@ -103,12 +103,17 @@ pub fn fit(study: &Study, q: &Quantity) -> Result<Fit> {
         }
         Quantity::Output(name) => {
             let i = study.output_names.iter().position(|n| n == name).ok_or_else(|| {
-                Error::scene("--quantity", name, format!("no such output; the scene has {}", study.output_names.join(", ")))
+                Error::scene(
+                    "--quantity",
+                    name,
+                    format!("no such output; the scene has {}", study.output_names.join(", ")),
+                )
             })?;
             let o = &study.outputs[i];
             let values: Vec<f64> = study.levels.iter().map(|r| r.outputs[i]).collect();
             let distances = std::iter::once(0.0).chain(values.windows(2).map(|w| (w[1] - w[0]).abs())).collect();
-            let refused = o.model.is_none().then(|| format!("{name}: no monotone convergence of the three finest levels"));
+            let refused =
+                o.model.is_none().then(|| format!("{name}: no monotone convergence of the three finest levels"));
             Ok(Fit {
                 size,
                 x,
@@ -126,7 +131,11 @@ pub fn fit(study: &Study, q: &Quantity) -> Result<Fit> {
 /// The scene the pilots run: without `[exact]`, with the quantity among its outputs.
 pub fn pilot_scene(scene: &Scene, q: &Quantity) -> Result<Scene> {
     if !scene.uniform_time {
-        return Err(Error::scene(&scene.file, "time", "the planner needs `T` and `steps` (uniform grids), not `times`"));
+        return Err(Error::scene(
+            &scene.file,
+            "time",
+            "the planner needs `T` and `steps` (uniform grids), not `times`",
+        ));
     }
     let mut s = scene.clone();
     s.exact = None;

@@ -158,7 +158,9 @@ pub(super) fn decide(
     ok.sort_by(|a, b| a.wall.total_cmp(&b.wall));
     ok.truncate(3);
     if ok.is_empty() {
-        let cheapest = |f: &dyn Fn(&Candidate) -> bool| all.iter().filter(|c| f(c)).min_by(|a, b| a.wall.total_cmp(&b.wall)).cloned();
+        let cheapest = |f: &dyn Fn(&Candidate) -> bool| {
+            all.iter().filter(|c| f(c)).min_by(|a, b| a.wall.total_cmp(&b.wall)).cloned()
+        };
         plan.over_budget = cheapest(&|c| fits(c)).or_else(|| cheapest(&|_| true));
         plan.refused = Some(match &plan.over_budget {
             Some(c) => format!(
@@ -193,7 +195,8 @@ pub(super) fn decide(
                 finest.outputs.get(i).map_or(0.0, |v| v.abs())
             }
         };
-        plan.tol = if scale > 0.0 { 10f64.powf((0.01 * target / scale).log10().floor()).clamp(1e-12, 1e-6) } else { 1e-12 };
+        plan.tol =
+            if scale > 0.0 { 10f64.powf((0.01 * target / scale).log10().floor()).clamp(1e-12, 1e-6) } else { 1e-12 };
     }
     plan.best = ok;
     plan.notes = notes;

@@ -15,6 +15,7 @@
 //! more separator). The supernodal kernel is always used: it exposes the triangular halves and the
 //! trailing block.
 
+use super::ordering::{amd_order, nested_dissection, ND_MIN_SIZE};
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
@@ -23,7 +24,6 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
     SymmetricOrdering,
 };
-use super::ordering::{amd_order, nested_dissection, ND_MIN_SIZE};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::SparseColMat;
 use faer::{Conj, MatMut, Par, Side};
@@ -357,7 +357,8 @@ mod tests {
         let f = Factor::with_last(&k, &[0, 2, 4, 6]).unwrap();
         let b: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
         let cols = 16;
-        let mut y: Vec<f64> = (0..n * cols).map(|i| if (i / n) % 2 == 0 { b[i % n] } else { ((i * 13) % 7) as f64 }).collect();
+        let mut y: Vec<f64> =
+            (0..n * cols).map(|i| if (i / n) % 2 == 0 { b[i % n] } else { ((i * 13) % 7) as f64 }).collect();
         f.forward_block(&mut y, cols).unwrap();
         f.backward_block(&mut y, cols).unwrap();
         let bits = |c: usize| y[c * n..(c + 1) * n].iter().map(|v| v.to_bits()).collect::<Vec<_>>();

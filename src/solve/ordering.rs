@@ -158,4 +158,3 @@ pub(super) fn nested_dissection(k: &SparseColMat<usize, f64>) -> Option<(Vec<usi
     }
     Some((fwd, inv))
 }
-

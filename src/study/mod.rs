@@ -187,7 +187,11 @@ impl<'a> Sequence<'a> {
         differences: Option<&'a Path>,
     ) -> Result<Sequence<'a>> {
         if !scene.uniform_time {
-            return Err(Error::scene(&scene.file, "time", "a study needs `T` and `steps` (uniform grids), not `times`"));
+            return Err(Error::scene(
+                &scene.file,
+                "time",
+                "a study needs `T` and `steps` (uniform grids), not `times`",
+            ));
         }
         let (t0, t1) = (scene.times[0], *scene.times.last().expect("nodes"));
         let common: Vec<f64> = (0..=min_steps).map(|i| t0 + (t1 - t0) * i as f64 / min_steps as f64).collect();
