@@ -252,9 +252,7 @@ impl FreeResponse {
             for (&(n, mu), _) in mus.iter().zip(&solve).filter(|(_, &s)| s) {
                 let range = block.col(n);
                 let y = &mut block.y[range];
-                for i in 0..mu.len() {
-                    y[n0 + i] = (0..=i).map(|j| self.w[(i, j)] * mu[j]).sum::<f64>();
-                }
+                y[n0..].copy_from_slice(&self.w_mu(mu));
             }
             self.factor.backward_block(&mut block.y, block.cols)?;
         }
@@ -289,12 +287,15 @@ impl FreeResponse {
         Ok(out)
     }
 
-    /// y_c ← y_c − Wμ (L⁻¹Eμ = [0; Wμ]).
+    /// Wμ (W = L_cc⁻¹ lower triangular), the contact part of L⁻¹Eμ = [0; Wμ].
+    fn w_mu(&self, mu: &[f64]) -> Vec<f64> {
+        (0..mu.len()).map(|i| (0..=i).map(|j| self.w[(i, j)] * mu[j]).sum::<f64>()).collect()
+    }
+
+    /// y_c ← y_c − Wμ.
     fn subtract_w_mu(&self, y: &mut [f64], mu: &[f64]) {
         let n0 = self.n_dofs - mu.len();
-        for i in 0..mu.len() {
-            y[n0 + i] -= (0..=i).map(|j| self.w[(i, j)] * mu[j]).sum::<f64>();
-        }
+        y[n0..].iter_mut().zip(self.w_mu(mu)).for_each(|(y, w)| *y -= w);
     }
 
     /// u_f and s_f at time node n (time t). `load` receives lⁿ whenever u is wanted (it is scratch
@@ -366,9 +367,7 @@ impl FreeResponse {
             zmu.clear();
             zmu.resize(n, 0.0);
             let n0 = n - mu.len();
-            for i in 0..mu.len() {
-                zmu[n0 + i] = (0..=i).map(|j| self.w[(i, j)] * mu[j]).sum::<f64>();
-            }
+            zmu[n0..].copy_from_slice(&self.w_mu(mu));
             self.factor.backward_solve(zmu)?;
             last_mu.clear();
             last_mu.extend_from_slice(mu);
