@@ -214,10 +214,7 @@ fn execute_plan(scene: &Scene, p: &Plan, b: &Candidate) -> Result<()> {
         }
     };
     let time = model.time_error(b.k);
-    let achieved = match model.combine {
-        Combine::Quadrature => space.hypot(time),
-        Combine::Sum => space + time,
-    };
+    let achieved = model.combine(space, time);
     let finest = study.levels.last().expect("levels");
     say!(
         "achieved estimate {achieved:.4e} (space {space:.4e} from the run's levels, time {time:.4e} from the model) against the target {:e}: {}",

@@ -220,12 +220,8 @@ fn space_pilot(
                 return Ok(done);
             }
         }
-        if !run.push(Level { refine: r, steps: nh }, predicted(r), options.pilot_budget - spent)? {
-            notes.push(format!(
-                "the pilot budget ({:.3} s) does not allow level {r} (predicted {:.3} s): raise --pilot-budget for more evidence",
-                options.pilot_budget,
-                predicted(r)
-            ));
+        if let Some(why) = run.push(Level { refine: r, steps: nh }, predicted(r), options.pilot_budget - spent)? {
+            notes.push(why);
             spent += run.spent;
             let mut done = decide(s, options, &run.study(), time, time_fit, *time_ratio, spent, notes)?;
             if done.refused.is_none() && (run.levels().len() as u32) < SPACE_LEVELS {

@@ -100,10 +100,14 @@ impl ErrorModel {
 
     /// The predicted error at mesh size h and time step k.
     pub fn predict(&self, h: f64, k: f64) -> f64 {
-        let (a, b) = (self.space_error(h), self.time_error(k));
+        self.combine(self.space_error(h), self.time_error(k))
+    }
+
+    /// e_h ⊕ e_k for given parts.
+    pub fn combine(&self, space: f64, time: f64) -> f64 {
         match self.combine {
-            Combine::Quadrature => a.hypot(b),
-            Combine::Sum => a + b,
+            Combine::Quadrature => space.hypot(time),
+            Combine::Sum => space + time,
         }
     }
 }

@@ -171,20 +171,31 @@ impl<'a> Runner<'a> {
     }
 
     /// Run `level`, unless `predicted` seconds would take the pilot past `budget` or the level would not
-    /// fit in the available memory together with the two levels a sequence keeps.
-    pub fn push(&mut self, level: Level, predicted: f64, budget: f64) -> Result<bool> {
+    /// fit in the available memory together with the two levels a sequence keeps: then the reason is
+    /// returned and nothing is run.
+    pub fn push(&mut self, level: Level, predicted: f64, budget: f64) -> Result<Option<String>> {
         if !self.seq.levels().is_empty() && self.spent + predicted > budget {
-            return Ok(false);
+            return Ok(Some(format!(
+                "the pilot budget ({budget:.3} s left) does not allow level {}:{} (predicted {predicted:.3} s): raise \
+                 --pilot-budget for more evidence",
+                level.refine, level.steps
+            )));
         }
         let mut s = self.seq.scene().clone();
         s.set_refine(level.refine)?;
         let need = crate::scene::budget::Estimate::of(&s, level.steps, false)?.memory.saturating_mul(3) / 2;
-        if crate::scene::budget::available_memory().is_some_and(|m| need > m) {
-            return Ok(false);
+        if let Some(m) = crate::scene::budget::available_memory().filter(|&m| need > m) {
+            return Ok(Some(format!(
+                "pilot level {}:{} would need ~{:.1} GB with the two levels kept, {:.1} GB are available",
+                level.refine,
+                level.steps,
+                need as f64 / 1e9,
+                m as f64 / 1e9
+            )));
         }
         let wall = self.seq.push(level)?.wall;
         self.spent += wall;
-        Ok(true)
+        Ok(None)
     }
 
     pub fn levels(&self) -> &[LevelResult] {
@@ -233,7 +244,10 @@ pub fn time_pilot(
         for &n in &grids {
             // a step costs about the same at every N: the next level costs ratio × the last one's steps
             let predicted = run.levels().last().map_or(0.0, |r| (r.wall - r.setup) * ratio as f64 + r.setup);
-            if !run.push(Level { refine, steps: n }, predicted, budget - spent)? {
+            if let Some(why) = run.push(Level { refine, steps: n }, predicted, budget - spent)? {
+                if run.levels().is_empty() {
+                    return Err(Error::scene(&scene.file, "plan", format!("no time pilot: {why}")));
+                }
                 break;
             }
         }
