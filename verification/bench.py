@@ -33,7 +33,6 @@ Sections:
 import argparse
 import csv
 import json
-import resource
 import os
 import re
 import shutil
@@ -47,14 +46,10 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, PY, REF, ROOT  # noqa: E402
+from common import BIN, PY, REF, ROOT, child_cpu, load1  # noqa: E402
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 ELASTIC = os.path.join(ROOT, "verification", "bench", "bench_elastic.toml")
 TIME = "/usr/bin/time"
-
-
-def load1():
-    return float(open("/proc/loadavg").read().split()[0])
 
 
 def cpu_model():
@@ -65,11 +60,6 @@ def cpu_model():
 
 
 LAST_CPU = [0.0]
-
-
-def child_cpu():
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
 
 
 def timed(cmd, env=None, mem=False):

@@ -12,6 +12,7 @@ two (symmetric; 0 for two zero vectors); ``rel_to(a, ref)`` is relative to the r
 """
 import math
 import os
+import resource
 import shlex
 import subprocess
 import sys
@@ -94,3 +95,15 @@ def strip_exact(text):
         if not skip:
             out.append(line)
     return "\n".join(out) + "\n"
+
+
+def load1():
+    """The 1-minute load average (recorded next to timings: the machine may be shared)."""
+    return float(open("/proc/loadavg").read().split()[0])
+
+
+def child_cpu():
+    """CPU seconds (user + sys) used so far by this process's finished children: the difference around a
+    subprocess is its CPU time."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime

@@ -29,7 +29,6 @@ import json
 import math
 import os
 import re
-import resource
 import statistics
 import subprocess
 import sys
@@ -37,7 +36,7 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, REF, ROOT, case, cmdline, strip_exact  # noqa: E402
+from common import BIN, REF, ROOT, case, cmdline, strip_exact, child_cpu, load1  # noqa: E402
 
 # grid per case: steps N_s·2^j for j < len; refinements 0..R
 CASES = {
@@ -60,15 +59,6 @@ def targets(grid, count):
     j = math.floor(-4 * math.log10(min(g["error"] for g in grid) / MARGIN) + 1e-9)
     return [10 ** (-(j - i) / 4) for i in reversed(range(count))]
 EX51 = case("paper_example_5_1")
-
-
-def load1():
-    return float(open("/proc/loadavg").read().split()[0])
-
-
-def child_cpu():
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
 
 
 def timed(cmd):

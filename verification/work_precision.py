@@ -15,7 +15,6 @@ the joint path. The cheapest configuration reaching each target accuracy is read
 import argparse
 import csv
 import os
-import resource
 import re
 import statistics
 import subprocess
@@ -29,7 +28,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, REF, ROOT, strip_exact  # noqa: E402
+from common import BIN, REF, ROOT, strip_exact, child_cpu, load1  # noqa: E402
 CASES = {
     "mms_front": dict(path="verification/cases/mms_front.toml", h_N=32, h_r=3, k_r=2, k_N=[8, 16, 32, 64, 128, 256],
                       joint=[(0, 8), (1, 16), (2, 32), (3, 64)], tol_level=(2, 32)),
@@ -38,10 +37,6 @@ CASES = {
                      joint=[(0, 4), (1, 16), (2, 64), (3, 256)], tol_level=(2, 16)),
 }
 TOLS = [1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12]
-
-
-def load1():
-    return float(open("/proc/loadavg").read().split()[0])
 
 
 def prepare(case, tmp):
@@ -53,11 +48,6 @@ def prepare(case, tmp):
     open(full, "w").write(text)
     open(bare, "w").write(strip_exact(text))
     return full, bare
-
-
-def child_cpu():
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
 
 
 def run(scene, r, N, solver, tol):
