@@ -141,7 +141,7 @@ impl Problem {
         let factor = Factor::with_last(&stiffness, &contact)?;
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
         // ranges) factorises without complaint but returns meaningless displacements: refuse it.
-        let kappa = factor.condition_estimate(&stiffness, 12);
+        let kappa = crate::solve::condition::condition_estimate(&factor, &stiffness, 12);
         if !(kappa < MAX_CONDITION) {
             return Err(Error::Linear(format!(
                 "the stiffness matrix is too ill-conditioned (condition number ≳ {kappa:.1e} > {MAX_CONDITION:.0e}; \

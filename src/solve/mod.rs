@@ -1,8 +1,9 @@
 //! Solving with the stiffness K, which never changes in time: the sparse Cholesky factor made once
-//! ([`factor`]), the condensation onto the contact unknowns ([`condense`]), superposed load patterns
+//! ([`factor`]) and its condition estimate ([`condition`]), the condensation onto the contact unknowns ([`condense`]), superposed load patterns
 //! ([`superpose`]) and the free response u_f = K⁻¹lⁿ of every step ([`free`]).
 
 pub mod condense;
+pub mod condition;
 pub mod factor;
 pub mod free;
 pub mod ordering;
