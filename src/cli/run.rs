@@ -155,11 +155,12 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     say!("unknowns {} (paper DOF {}), contact edges {}, steps {}", sp.n_dofs, sp.paper_dofs(), sp.contact.len(), n);
     let st = problem.setup;
     say!(
-        "set-up: mesh {:.3}s, assembly {:.3}s, factorisation {:.3}s, condensation {:.3}s",
+        "set-up: mesh {:.3}s, assembly {:.3}s, factorisation {:.3}s, condensation {:.3}s, load superposition {:.3}s",
         st.space,
         st.assembly,
         st.factorisation,
-        st.condensation
+        st.condensation,
+        st.superposition
     );
     say!(
         "solver {}: {} iterations in all, max residual {:.2e}; wall time {:.3}s",

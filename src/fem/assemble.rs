@@ -5,23 +5,66 @@
 //! the volume term from the one law ([`Elasticity::element_block`]), the jump [v] = v|T1 − v|T2 (v on a
 //! Dirichlet edge) integrated by 2-point Gauss — exact, whereas a midpoint rule would see nothing
 //! because the jump of two CR functions has zero mean on each edge.
+//!
+//! Assembled straight into compressed columns, without triplets: the midpoint values of edges a and b
+//! are coupled exactly when a and b lie in one triangle or in two triangles sharing an edge (the jump
+//! on that edge), so the pattern is known from the mesh. Each edge gets its sorted list of coupled
+//! edges (a block row of ≤ 13 edges), the 2 × 2 blocks of the midpoint values are summed in place
+//! (volume terms triangle by triangle, then jump terms edge by edge), and the blocks are mapped to the
+//! unknowns (two per free edge, the tangential one on Γ_C, none on Γ_D), whose numbering follows the
+//! edges, so every column comes out sorted. Entries that are exactly zero are not stored (the x–y
+//! coupling of two edges that meet only through a jump term is zero), so the pattern is the one of
+//! the nonzeros. Cost O(edges); the former triplet route (4M triplets sorted by column at 24,640
+//! unknowns) took 40 % of Example 5.1's set-up.
 
 use super::elasticity::Elasticity;
 use super::quadrature::GAUSS2;
 use super::space::{jump_terms, CrSpace, Element};
 use crate::mesh::Mesh;
-use crate::sparse::csc_from_triplets;
-use faer::sparse::SparseColMat;
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
-/// Add the coupling block between the midpoint values of edges a and b to the triplets:
-/// K[k, l] += Σ_cd v_k[c] block[c][d] w_l[d] over the terms of both edges.
-fn scatter(space: &CrSpace, a: usize, b: usize, block: [[f64; 2]; 2], trip: &mut Vec<(usize, usize, f64)>) {
-    for (k, v) in space.edge_dof[a].terms() {
-        for (l, w) in space.edge_dof[b].terms() {
-            let val =
-                v[0] * (block[0][0] * w[0] + block[0][1] * w[1]) + v[1] * (block[1][0] * w[0] + block[1][1] * w[1]);
-            if val != 0.0 {
-                trip.push((k, l, val));
+/// The edges coupled to each edge (itself included), sorted: the block pattern of K as compressed
+/// rows (`ptr`, `idx`).
+fn edge_pattern(mesh: &Mesh) -> (Vec<usize>, Vec<usize>) {
+    let ne = mesh.edges.len();
+    let (mut ptr, mut idx) = (Vec::with_capacity(ne + 1), Vec::with_capacity(14 * ne));
+    ptr.push(0);
+    let mut near: Vec<usize> = Vec::with_capacity(32);
+    for e in 0..ne {
+        near.clear();
+        let (t1, t2) = mesh.edge_tris[e];
+        for t in std::iter::once(t1).chain(t2) {
+            // the edges of t and of its neighbours across its edges
+            for &f in &mesh.tri_edges[t] {
+                let (s1, s2) = mesh.edge_tris[f];
+                for u in std::iter::once(s1).chain(s2) {
+                    near.extend_from_slice(&mesh.tri_edges[u]);
+                }
+            }
+        }
+        near.sort_unstable();
+        near.dedup();
+        idx.extend_from_slice(&near);
+        ptr.push(idx.len());
+    }
+    (ptr, idx)
+}
+
+/// The 2 × 2 blocks of the edge pattern, summed in place.
+struct Blocks {
+    ptr: Vec<usize>,
+    idx: Vec<usize>,
+    val: Vec<[[f64; 2]; 2]>,
+}
+
+impl Blocks {
+    /// block(a, b) += m.
+    fn add(&mut self, a: usize, b: usize, m: [[f64; 2]; 2]) {
+        let row = &self.idx[self.ptr[a]..self.ptr[a + 1]];
+        let p = self.ptr[a] + row.binary_search(&b).expect("edges of one patch are in the pattern");
+        for c in 0..2 {
+            for d in 0..2 {
+                self.val[p][c][d] += m[c][d];
             }
         }
     }
@@ -29,17 +72,16 @@ fn scatter(space: &CrSpace, a: usize, b: usize, block: [[f64; 2]; 2], trip: &mut
 
 /// Assemble K (both triangles of the symmetric matrix stored).
 pub fn stiffness(mesh: &Mesh, space: &CrSpace, law: &Elasticity, rho: f64) -> SparseColMat<usize, f64> {
-    let mut trip = Vec::with_capacity(36 * mesh.tris.len() + 100 * mesh.edges.len());
+    let (ptr, idx) = edge_pattern(mesh);
+    let mut k = Blocks { val: vec![[[0.0; 2]; 2]; idx.len()], ptr, idx };
     for t in 0..mesh.tris.len() {
         let el = Element::new(mesh, t);
         for i in 0..3 {
             for j in 0..3 {
-                scatter(
-                    space,
+                k.add(
                     mesh.tri_edges[t][i],
                     mesh.tri_edges[t][j],
                     law.element_block(el.area, el.grad_phi(i), el.grad_phi(j)),
-                    &mut trip,
                 );
             }
         }
@@ -51,29 +93,61 @@ pub fn stiffness(mesh: &Mesh, space: &CrSpace, law: &Elasticity, rho: f64) -> Sp
         }
         // (2ρμ/h_e) ∫_e [v]·[w] = 2ρμ Σ_q w_q [v](x_q)·[w](x_q)  (the weights sum to 1, ∫_e = h_e Σ_q w_q),
         // summed into the local matrix M_ab of the ≤ 6 basis functions of the two triangles first (the
-        // shared edge's function appears on both sides and is merged) and scattered once.
-        let mut idx: Vec<usize> = Vec::with_capacity(6);
+        // shared edge's function appears on both sides and is merged) and added once.
+        let mut idx = [0usize; 6];
+        let mut len = 0;
         let mut m = [[0.0f64; 6]; 6];
         for (s, w) in GAUSS2 {
             let mut p = [0.0f64; 6];
             for (a, pa) in jump_terms(mesh, e, s) {
-                let i = idx.iter().position(|&x| x == a).unwrap_or_else(|| {
-                    idx.push(a);
-                    idx.len() - 1
+                let i = idx[..len].iter().position(|&x| x == a).unwrap_or_else(|| {
+                    idx[len] = a;
+                    len += 1;
+                    len - 1
                 });
                 p[i] += pa;
             }
-            for i in 0..idx.len() {
-                for j in 0..idx.len() {
+            for i in 0..len {
+                for j in 0..len {
                     m[i][j] += pen * w * p[i] * p[j];
                 }
             }
         }
-        for (i, &a) in idx.iter().enumerate() {
-            for (j, &b) in idx.iter().enumerate() {
-                scatter(space, a, b, [[m[i][j], 0.0], [0.0, m[i][j]]], &mut trip);
+        for i in 0..len {
+            for j in 0..len {
+                k.add(idx[i], idx[j], [[m[i][j], 0.0], [0.0, m[i][j]]]);
             }
         }
     }
-    csc_from_triplets(space.n_dofs, &trip)
+    k.to_unknowns(space)
+}
+
+impl Blocks {
+    /// K on the unknowns: K[k, l] = v_kᵀ block(a, b) w_l for the unknowns k of edge a and l of edge b
+    /// (v, w their midpoint-value directions), exact zeros dropped. Symmetric pattern, so block row b
+    /// read as a column gives the column's rows in increasing order.
+    fn to_unknowns(&self, space: &CrSpace) -> SparseColMat<usize, f64> {
+        let n = space.n_dofs;
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let (mut row_idx, mut val) = (Vec::with_capacity(2 * self.idx.len()), Vec::with_capacity(2 * self.idx.len()));
+        col_ptr.push(0);
+        for (b, dof_b) in space.edge_dof.iter().enumerate() {
+            for (_, w) in dof_b.terms() {
+                for p in self.ptr[b]..self.ptr[b + 1] {
+                    // block(a, b) = block(b, a)ᵀ, stored in row b
+                    let blk = self.val[p];
+                    for (k, v) in space.edge_dof[self.idx[p]].terms() {
+                        let x =
+                            v[0] * (blk[0][0] * w[0] + blk[1][0] * w[1]) + v[1] * (blk[0][1] * w[0] + blk[1][1] * w[1]);
+                        if x != 0.0 {
+                            row_idx.push(k);
+                            val.push(x);
+                        }
+                    }
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        SparseColMat::new(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx), val)
+    }
 }

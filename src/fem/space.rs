@@ -165,6 +165,14 @@ impl CrSpace {
         2 * (self.edge_dof.len() - self.n_dirichlet)
     }
 
+    /// The unknowns of each edge that has any, as groups `first[g]..first[g + 1]` of consecutive unknowns
+    /// (the numbering follows the edges): the vertices of the factor's ordering graph.
+    pub fn unknown_groups(&self) -> Vec<usize> {
+        let mut first: Vec<usize> = self.edge_dof.iter().filter_map(|d| d.terms().next().map(|(k, _)| k)).collect();
+        first.push(self.n_dofs);
+        first
+    }
+
     /// Displacement at every edge midpoint from the unknowns.
     pub fn midpoint_values(&self, u: &[f64]) -> Vec<[f64; 2]> {
         self.edge_dof

@@ -174,7 +174,11 @@ impl Tresca {
         attr(loc, "paper_dofs", space.paper_dofs() as i64)?;
         attr(loc, "h", mesh.h_max())?;
         attr_vec(loc, "setup_times", &p.meta.setup.as_array())?;
-        attr_str(loc, "setup_times_meaning", "mesh+space, assembly, factorisation, condensation (s)")?;
+        attr_str(
+            loc,
+            "setup_times_meaning",
+            "mesh+space, assembly, factorisation, load superposition, condensation (s)",
+        )?;
         attr_str(loc, "status", "running")?;
         attr(&sg, "completed", 0i64)?;
         Ok(Tresca {

@@ -52,19 +52,33 @@ impl Factor {
 
     /// As [`Factor::new`], with the distinct unknowns `last` ordered last, in the given order.
     pub fn with_last(k: &SparseColMat<usize, f64>, last: &[usize]) -> Result<Factor> {
-        Factor::with_ordering(k, k.nrows() >= ND_MIN_SIZE, last)
+        let singletons: Vec<usize> = (0..=k.nrows()).collect();
+        Factor::with_groups(k, last, &singletons)
     }
 
-    /// As [`Factor::with_last`], with nested dissection tried (`nested`) or AMD.
-    fn with_ordering(k: &SparseColMat<usize, f64>, nested: bool, last: &[usize]) -> Result<Factor> {
+    /// As [`Factor::with_last`], with the fill-reducing ordering computed on the graph whose vertices are
+    /// the groups of consecutive unknowns `first[g]..first[g + 1]` (`first` increasing from 0 to n; the
+    /// two components of an edge's displacement, `CrSpace::unknown_groups`): see [`super::ordering`].
+    pub fn with_groups(k: &SparseColMat<usize, f64>, last: &[usize], first: &[usize]) -> Result<Factor> {
+        let n = k.nrows();
+        if first.first() != Some(&0) || first.last() != Some(&n) || first.windows(2).any(|w| w[0] >= w[1]) {
+            return Err(Error::Linear(
+                "internal: unknown groups must increase from 0 to the number of unknowns".into(),
+            ));
+        }
+        Factor::with_ordering(k, n >= ND_MIN_SIZE, last, first)
+    }
+
+    /// As [`Factor::with_groups`], with nested dissection tried (`nested`) or AMD.
+    fn with_ordering(k: &SparseColMat<usize, f64>, nested: bool, last: &[usize], first: &[usize]) -> Result<Factor> {
         let n = k.nrows();
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
         };
-        let base = match if nested { nested_dissection(k) } else { None } {
+        let base = match if nested { nested_dissection(k, first) } else { None } {
             Some((fwd, _)) => fwd,
-            None => amd_order(k, params.amd_params)?,
+            None => amd_order(k, first, params.amd_params)?,
         };
         let mut is_last = vec![false; n];
         for &i in last {
@@ -288,22 +302,31 @@ mod tests {
         }
     }
 
+    /// Groups of the two unknowns of a grid node.
+    fn pairs(n: usize) -> Vec<usize> {
+        (0..=n).step_by(2).collect()
+    }
+
+    fn singles(n: usize) -> Vec<usize> {
+        (0..=n).collect()
+    }
+
     #[test]
     fn nested_dissection_orders_and_solves() {
         let k = grid(40);
-        let (fwd, inv) = nested_dissection(&k).expect("METIS ordering");
+        let (fwd, inv) = nested_dissection(&k, &pairs(k.nrows())).expect("METIS ordering");
         assert!(fwd.iter().enumerate().all(|(new, &old)| inv[old] == new));
-        let nd = Factor::with_ordering(&k, true, &[]).unwrap();
-        let amd = Factor::with_ordering(&k, false, &[]).unwrap();
+        let nd = Factor::with_ordering(&k, true, &[], &pairs(k.nrows())).unwrap();
+        let amd = Factor::with_ordering(&k, false, &[], &pairs(k.nrows())).unwrap();
         assert!(residual(&k, &nd) < 1e-12 && residual(&k, &amd) < 1e-12);
     }
 
     #[test]
     fn nested_dissection_is_deterministic_across_threads() {
         let k = grid(30);
-        let reference = nested_dissection(&k).unwrap();
+        let reference = nested_dissection(&k, &pairs(k.nrows())).unwrap();
         let runs: Vec<_> = std::thread::scope(|s| {
-            let h: Vec<_> = (0..4).map(|_| s.spawn(|| nested_dissection(&k).unwrap())).collect();
+            let h: Vec<_> = (0..4).map(|_| s.spawn(|| nested_dissection(&k, &pairs(k.nrows())).unwrap())).collect();
             h.into_iter().map(|h| h.join().unwrap()).collect()
         });
         assert!(runs.iter().all(|r| *r == reference));
@@ -313,19 +336,19 @@ mod tests {
     fn degenerate_graphs_fall_back_to_amd() {
         let diag = |n: usize| csc_from_triplets(n, &(0..n).map(|i| (i, i, 2.0)).collect::<Vec<_>>());
         for n in [0, 1, 2, 5] {
-            assert!(nested_dissection(&diag(n)).is_none());
-            let f = Factor::with_ordering(&diag(n), true, &[]).unwrap();
+            assert!(nested_dissection(&diag(n), &singles(n)).is_none());
+            let f = Factor::with_ordering(&diag(n), true, &[], &singles(n)).unwrap();
             assert!(residual(&diag(n), &f) < 1e-15);
         }
         // One coupled pair: a single METIS vertex, no edges.
         let pair = csc_from_triplets(2, &[(0, 0, 2.0), (1, 1, 2.0), (0, 1, 1.0), (1, 0, 1.0)]);
-        assert!(nested_dissection(&pair).is_none());
-        assert!(residual(&pair, &Factor::with_ordering(&pair, true, &[]).unwrap()) < 1e-15);
+        assert!(nested_dissection(&pair, &[0, 2]).is_none());
+        assert!(residual(&pair, &Factor::with_ordering(&pair, true, &[], &[0, 2]).unwrap()) < 1e-15);
         // Three unknowns: METIS on a 2-vertex graph.
         let three = csc_from_triplets(
             3,
             &[(0, 0, 4.0), (1, 1, 4.0), (2, 2, 4.0), (1, 2, 1.0), (2, 1, 1.0), (0, 2, 1.0), (2, 0, 1.0)],
         );
-        assert!(residual(&three, &Factor::with_ordering(&three, true, &[]).unwrap()) < 1e-14);
+        assert!(residual(&three, &Factor::with_ordering(&three, true, &[], &[0, 1, 3]).unwrap()) < 1e-14);
     }
 }

@@ -107,8 +107,8 @@ impl FreeResponse {
     pub fn new(
         factor: Factor,
         loads: Loads,
+        basis: Option<LoadBasis>,
         space: &CrSpace,
-        times: &[f64],
     ) -> Result<(FreeResponse, Option<DMatrix<f64>>)> {
         let n = space.n_dofs;
         let contact_dofs: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
@@ -118,7 +118,6 @@ impl FreeResponse {
             let Condensation { c, w } = condense(&contact_dofs, &factor)?;
             (Some(c), w)
         };
-        let basis = LoadBasis::build(&loads, times, &factor)?;
         let free = FreeResponse {
             factor,
             loads,
