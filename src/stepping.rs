@@ -15,6 +15,7 @@ use crate::fem::space::CrSpace;
 use crate::friction::{EdgeState, Friction, FrictionSolution};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
+use crate::solve::condense::condense;
 use crate::solve::factor::Factor;
 use crate::solve::free::FreeResponse;
 use crate::solve::superpose::LoadBasis;
@@ -49,7 +50,8 @@ pub struct SetupTimes {
     pub space: f64,
     /// K and the load quadrature.
     pub assembly: f64,
-    /// Cholesky factorisation of K and its condition estimate.
+    /// Cholesky factorisation of K, and the wait for its condition estimate (which runs beside the
+    /// superposition and the condensation).
     pub factorisation: f64,
     /// The load superposition: its probe of the loads at the time nodes and the responses K⁻¹b_j.
     pub superposition: f64,
@@ -143,9 +145,22 @@ impl Problem {
         // contact unknowns last: the condensation then comes from the factor (solve::condense)
         let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
         let factor = Factor::with_groups(&stiffness, &contact, &space.unknown_groups())?;
+        let t3 = Instant::now();
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
-        // ranges) factorises without complaint but returns meaningless displacements: refuse it.
-        let kappa = crate::solve::condition::condition_estimate(&factor, &stiffness, 12);
+        // ranges) factorises without complaint but returns meaningless displacements: refuse it. The
+        // estimate (a few solves) runs on a second thread beside the load superposition and the
+        // condensation, which only read the factor; nothing is returned before it is known.
+        let (kappa, basis, condensation, t4, t5) = std::thread::scope(|s| {
+            let guard = s.spawn(|| crate::solve::condition::condition_estimate(&factor, &stiffness, 12));
+            let basis = LoadBasis::build(&loads, &scene.times, &factor);
+            let t4 = Instant::now();
+            let condensation = (!contact.is_empty()).then(|| condense(&contact, &factor)).transpose();
+            let t5 = Instant::now();
+            let kappa = guard.join().map_err(|_| Error::Linear("the condition estimate failed".into()));
+            (kappa, basis, condensation, t4, t5)
+        });
+        let kappa = kappa?;
+        let wait = t5.elapsed().as_secs_f64();
         if !(kappa < MAX_CONDITION) {
             return Err(Error::Linear(format!(
                 "the stiffness matrix is too ill-conditioned (condition number ≳ {kappa:.1e} > {MAX_CONDITION:.0e}; \
@@ -156,19 +171,15 @@ impl Problem {
                 ill_conditioning_cause(&scene, &mesh, &space)
             )));
         }
-        let t3 = Instant::now();
-        let basis = LoadBasis::build(&loads, &scene.times, &factor)?;
-        let t4 = Instant::now();
-        let (free, c) = FreeResponse::new(factor, loads, basis, &space)?;
+        let (free, c) = FreeResponse::new(factor, loads, basis?, condensation?, &space);
         let friction = c.map(|c| Friction::new(&space, c, scene.solver));
-        let t5 = Instant::now();
         let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(x));
         let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
         Ok(Problem {
             setup: SetupTimes {
                 space: d(t0, t1),
                 assembly: d(t1, t2),
-                factorisation: d(t2, t3),
+                factorisation: d(t2, t3) + wait,
                 superposition: d(t3, t4),
                 condensation: d(t4, t5),
             },

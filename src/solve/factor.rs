@@ -28,14 +28,15 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::SparseColMat;
 use faer::{Conj, MatMut, Par, Side};
 use nalgebra::DMatrix;
-use std::cell::RefCell;
+use std::sync::Mutex;
 
 /// The Cholesky factor of an SPD sparse matrix.
 pub struct Factor {
     symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
     /// Solve scratch, sized for this many right-hand sides.
-    scratch: RefCell<(usize, MemBuffer)>,
+    /// (A mutex, not a cell, so the factor can be shared with the condition estimate's thread.)
+    scratch: Mutex<(usize, MemBuffer)>,
     n: usize,
     /// The unknowns ordered last, in this order (see [`Factor::with_last`]).
     last: Vec<usize>,
@@ -106,7 +107,7 @@ impl Factor {
             })?;
         let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
             .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
-        Ok(Factor { symbolic, values, scratch: RefCell::new((1, scratch)), n, last: last.to_vec(), fwd })
+        Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last: last.to_vec(), fwd })
     }
 
     /// The unknowns ordered last (see [`Factor::with_last`]).
@@ -206,7 +207,7 @@ impl Factor {
         if y.len() != self.n * cols {
             return Err(Error::Linear(format!("internal: a block of {} values for {cols} columns", y.len())));
         }
-        let mut scratch = self.scratch.borrow_mut();
+        let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
         if scratch.0 < cols {
             scratch.1 = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq))
                 .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
@@ -224,7 +225,7 @@ impl Factor {
     /// x ← K⁻¹ x for one vector.
     pub fn solve_in_place(&self, x: &mut [f64]) {
         let llt = LltRef::new(&self.symbolic, &self.values);
-        let mut buf = self.scratch.borrow_mut();
+        let mut buf = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
         llt.solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(x, self.n, 1),

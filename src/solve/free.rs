@@ -25,7 +25,7 @@
 //! computes each column independently of the others, so every step gets the same arithmetic whether a
 //! run starts at step 0 or resumes, and results do not depend on where a run started.
 
-use super::condense::{condense, Condensation};
+use super::condense::Condensation;
 use super::factor::Factor;
 use super::superpose::LoadBasis;
 use crate::error::{Error, Result};
@@ -102,21 +102,21 @@ pub struct Free {
 }
 
 impl FreeResponse {
-    /// Condense onto the contact unknowns and superpose the loads of `times` where they span few
-    /// patterns. Returns the response and C = EᵀK⁻¹E (`None` without Γ_C).
+    /// The free response from the factor, the load superposition (`basis`, when the loads span few
+    /// patterns) and the condensation onto the contact unknowns (`None` without Γ_C). Returns the
+    /// response and C = EᵀK⁻¹E (`None` without Γ_C).
     pub fn new(
         factor: Factor,
         loads: Loads,
         basis: Option<LoadBasis>,
+        condensation: Option<Condensation>,
         space: &CrSpace,
-    ) -> Result<(FreeResponse, Option<DMatrix<f64>>)> {
+    ) -> (FreeResponse, Option<DMatrix<f64>>) {
         let n = space.n_dofs;
         let contact_dofs: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
-        let (c, w) = if contact_dofs.is_empty() {
-            (None, DMatrix::zeros(0, 0))
-        } else {
-            let Condensation { c, w } = condense(&contact_dofs, &factor)?;
-            (Some(c), w)
+        let (c, w) = match condensation {
+            Some(Condensation { c, w }) => (Some(c), w),
+            None => (None, DMatrix::zeros(0, 0)),
         };
         let free = FreeResponse {
             factor,
@@ -127,7 +127,7 @@ impl FreeResponse {
             w,
             friction_cache: RefCell::new((vec![], vec![])),
         };
-        Ok((free, c))
+        (free, c)
     }
 
     /// The factor of K.
