@@ -7,7 +7,7 @@
 //! callback (the writer), so nothing is lost if a later step fails.
 
 use crate::error::{Error, Result};
-use crate::fem::assemble::stiffness;
+use crate::fem::assemble::{stiffness_on, EdgePattern};
 use crate::fem::elasticity::Elasticity;
 use crate::fem::loads::Loads;
 use crate::fem::norms::{ErrorEvaluator, ErrorNorms};
@@ -16,8 +16,9 @@ use crate::friction::{EdgeState, Friction, FrictionSolution};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::solve::condense::condense;
-use crate::solve::factor::Factor;
+use crate::solve::factor::{fill_order, Factor};
 use crate::solve::free::FreeResponse;
+use crate::solve::ordering::{Graph, ND_MIN_SIZE};
 use crate::solve::superpose::LoadBasis;
 use crate::sparse::{dot, energy};
 use faer::sparse::SparseColMat;
@@ -48,7 +49,7 @@ pub struct Problem {
 pub struct SetupTimes {
     /// Mesh binding and numbering of V_h.
     pub space: f64,
-    /// K and the load quadrature.
+    /// K and the load quadrature (the fill-reducing ordering runs beside them).
     pub assembly: f64,
     /// Cholesky factorisation of K, and the wait for its condition estimate (which runs beside the
     /// superposition and the condensation).
@@ -139,12 +140,25 @@ impl Problem {
         let space = CrSpace::new(&mesh, &scene.parts)?;
         let t1 = Instant::now();
         let law = Elasticity::new(&scene.material);
-        let stiffness = stiffness(&mesh, &space, &law, scene.rho);
-        let loads = Loads::new(&scene, &mesh, &space);
+        // K's pattern is the mesh's: the fill-reducing ordering is computed from it on a second thread
+        // while K's values and the load quadrature are assembled
+        let pattern = EdgePattern::new(&mesh);
+        let (stiffness, loads, order) = std::thread::scope(|s| {
+            let order = s.spawn(|| {
+                let (first, start, adj) = pattern.unknown_graph(&space);
+                let graph = Graph::new(first, start, adj)
+                    .ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
+                fill_order(&graph, space.n_dofs >= ND_MIN_SIZE)
+            });
+            let stiffness = stiffness_on(&pattern, &mesh, &space, &law, scene.rho);
+            let loads = Loads::new(&scene, &mesh, &space);
+            let order = order.join().map_err(|_| Error::Linear("the fill-reducing ordering failed".into()));
+            (stiffness, loads, order)
+        });
         let t2 = Instant::now();
         // contact unknowns last: the condensation then comes from the factor (solve::condense)
         let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
-        let factor = Factor::with_groups(&stiffness, &contact, &space.unknown_groups())?;
+        let factor = Factor::with_order(&stiffness, &contact, order??)?;
         let t3 = Instant::now();
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
         // ranges) factorises without complaint but returns meaningless displacements: refuse it. The

@@ -299,3 +299,19 @@ fn compressed_assembly_equals_the_sum_of_contributions() {
         }
     }
 }
+
+/// Requirement (issue 13, ordering beside assembly): the graph of the unknowns taken from the mesh before
+/// K's values exist is the graph read from K, so the fill-reducing ordering computed from it (on a
+/// second thread while K is assembled) is the one K would give, and results do not change.
+#[test]
+fn graph_from_the_mesh_is_the_graph_of_k() {
+    use tresca_cr::fem::assemble::EdgePattern;
+    use tresca_cr::solve::ordering::Graph;
+    for case in ["mms_rotated", "paper_example_5_1", "mms_stop"] {
+        let path = format!("{}/verification/cases/{case}.toml", env!("CARGO_MANIFEST_DIR"));
+        let p = Problem::new(Scene::from_file(std::path::Path::new(&path)).unwrap()).unwrap();
+        let (first, start, adj) = EdgePattern::new(&p.mesh).unknown_graph(&p.space);
+        let from_mesh = Graph::new(first, start, adj).expect("consistent graph");
+        assert_eq!(from_mesh, Graph::of_matrix(&p.stiffness, &p.space.unknown_groups()), "{case}");
+    }
+}

@@ -23,45 +23,87 @@ use super::space::{jump_terms, CrSpace, Element};
 use crate::mesh::Mesh;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
-/// The edges coupled to each edge (itself included), sorted: the block pattern of K as compressed
-/// rows (`ptr`, `idx`).
-fn edge_pattern(mesh: &Mesh) -> (Vec<usize>, Vec<usize>) {
-    let ne = mesh.edges.len();
-    let (mut ptr, mut idx) = (Vec::with_capacity(ne + 1), Vec::with_capacity(14 * ne));
-    ptr.push(0);
-    let mut near: Vec<usize> = Vec::with_capacity(32);
-    for e in 0..ne {
-        near.clear();
-        let (t1, t2) = mesh.edge_tris[e];
-        for t in std::iter::once(t1).chain(t2) {
-            // the edges of t and of its neighbours across its edges
-            for &f in &mesh.tri_edges[t] {
-                let (s1, s2) = mesh.edge_tris[f];
-                for u in std::iter::once(s1).chain(s2) {
-                    near.extend_from_slice(&mesh.tri_edges[u]);
+/// The edges coupled to each edge (itself included), sorted: the block pattern of K as compressed rows
+/// (`ptr`, `idx`). Known from the mesh alone, so the fill-reducing ordering can be computed from it
+/// while K's values are assembled.
+pub struct EdgePattern {
+    ptr: Vec<usize>,
+    idx: Vec<usize>,
+}
+
+impl EdgePattern {
+    pub fn new(mesh: &Mesh) -> EdgePattern {
+        let ne = mesh.edges.len();
+        let (mut ptr, mut idx) = (Vec::with_capacity(ne + 1), Vec::with_capacity(14 * ne));
+        ptr.push(0);
+        let mut near: Vec<usize> = Vec::with_capacity(32);
+        for e in 0..ne {
+            near.clear();
+            let (t1, t2) = mesh.edge_tris[e];
+            for t in std::iter::once(t1).chain(t2) {
+                // the edges of t and of its neighbours across its edges
+                for &f in &mesh.tri_edges[t] {
+                    let (s1, s2) = mesh.edge_tris[f];
+                    for u in std::iter::once(s1).chain(s2) {
+                        near.extend_from_slice(&mesh.tri_edges[u]);
+                    }
                 }
             }
+            near.sort_unstable();
+            near.dedup();
+            idx.extend_from_slice(&near);
+            ptr.push(idx.len());
         }
-        near.sort_unstable();
-        near.dedup();
-        idx.extend_from_slice(&near);
-        ptr.push(idx.len());
+        EdgePattern { ptr, idx }
     }
-    (ptr, idx)
+
+    /// The graph of K's unknowns with the unknowns of an edge as one vertex, as (`first`, `start`,
+    /// `adj`) for `solve::ordering::Graph`: vertex g = the g-th edge with unknowns, holding the unknowns
+    /// `first[g]..first[g + 1]`, adjacent to the coupled edges with unknowns (sorted, no self loop).
+    /// Equal to the graph read from K as long as no 2 × 2 block of two coupled edges vanishes entirely
+    /// (on each side e of their triangles, two CR basis functions whose traces are ±(1, −1) have
+    /// ∫_e φ_a φ_b = ∓h_e/3 ≠ 0), so the ordering, hence every result, is the same either way
+    /// (tests/elasticity.rs checks the equality).
+    pub fn unknown_graph(&self, space: &CrSpace) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+        let first = space.unknown_groups();
+        let mut vertex = vec![usize::MAX; space.edge_dof.len()];
+        let mut g = 0;
+        for (e, d) in space.edge_dof.iter().enumerate() {
+            if d.terms().next().is_some() {
+                vertex[e] = g;
+                g += 1;
+            }
+        }
+        let (mut start, mut adj) = (Vec::with_capacity(g + 1), Vec::with_capacity(self.idx.len()));
+        start.push(0);
+        for e in 0..space.edge_dof.len() {
+            if vertex[e] == usize::MAX {
+                continue;
+            }
+            adj.extend(
+                self.idx[self.ptr[e]..self.ptr[e + 1]]
+                    .iter()
+                    .map(|&b| vertex[b])
+                    .filter(|&v| v != usize::MAX && v != vertex[e]),
+            );
+            start.push(adj.len());
+        }
+        (first, start, adj)
+    }
 }
 
 /// The 2 × 2 blocks of the edge pattern, summed in place.
-struct Blocks {
-    ptr: Vec<usize>,
-    idx: Vec<usize>,
+struct Blocks<'a> {
+    pattern: &'a EdgePattern,
     val: Vec<[[f64; 2]; 2]>,
 }
 
-impl Blocks {
+impl Blocks<'_> {
     /// block(a, b) += m.
     fn add(&mut self, a: usize, b: usize, m: [[f64; 2]; 2]) {
-        let row = &self.idx[self.ptr[a]..self.ptr[a + 1]];
-        let p = self.ptr[a] + row.binary_search(&b).expect("edges of one patch are in the pattern");
+        let (ptr, idx) = (&self.pattern.ptr, &self.pattern.idx);
+        let row = &idx[ptr[a]..ptr[a + 1]];
+        let p = ptr[a] + row.binary_search(&b).expect("edges of one patch are in the pattern");
         for c in 0..2 {
             for d in 0..2 {
                 self.val[p][c][d] += m[c][d];
@@ -72,8 +114,18 @@ impl Blocks {
 
 /// Assemble K (both triangles of the symmetric matrix stored).
 pub fn stiffness(mesh: &Mesh, space: &CrSpace, law: &Elasticity, rho: f64) -> SparseColMat<usize, f64> {
-    let (ptr, idx) = edge_pattern(mesh);
-    let mut k = Blocks { val: vec![[[0.0; 2]; 2]; idx.len()], ptr, idx };
+    stiffness_on(&EdgePattern::new(mesh), mesh, space, law, rho)
+}
+
+/// As [`stiffness`], on the mesh's pattern made beforehand.
+pub fn stiffness_on(
+    pattern: &EdgePattern,
+    mesh: &Mesh,
+    space: &CrSpace,
+    law: &Elasticity,
+    rho: f64,
+) -> SparseColMat<usize, f64> {
+    let mut k = Blocks { val: vec![[[0.0; 2]; 2]; pattern.idx.len()], pattern };
     for t in 0..mesh.tris.len() {
         let el = Element::new(mesh, t);
         for i in 0..3 {
@@ -122,21 +174,22 @@ pub fn stiffness(mesh: &Mesh, space: &CrSpace, law: &Elasticity, rho: f64) -> Sp
     k.to_unknowns(space)
 }
 
-impl Blocks {
+impl Blocks<'_> {
     /// K on the unknowns: K[k, l] = v_kᵀ block(a, b) w_l for the unknowns k of edge a and l of edge b
     /// (v, w their midpoint-value directions), exact zeros dropped. Symmetric pattern, so block row b
     /// read as a column gives the column's rows in increasing order.
     fn to_unknowns(&self, space: &CrSpace) -> SparseColMat<usize, f64> {
         let n = space.n_dofs;
         let mut col_ptr = Vec::with_capacity(n + 1);
-        let (mut row_idx, mut val) = (Vec::with_capacity(2 * self.idx.len()), Vec::with_capacity(2 * self.idx.len()));
+        let (ptr, idx) = (&self.pattern.ptr, &self.pattern.idx);
+        let (mut row_idx, mut val) = (Vec::with_capacity(2 * idx.len()), Vec::with_capacity(2 * idx.len()));
         col_ptr.push(0);
         for (b, dof_b) in space.edge_dof.iter().enumerate() {
             for (_, w) in dof_b.terms() {
-                for p in self.ptr[b]..self.ptr[b + 1] {
+                for p in ptr[b]..ptr[b + 1] {
                     // block(a, b) = block(b, a)ᵀ, stored in row b
                     let blk = self.val[p];
-                    for (k, v) in space.edge_dof[self.idx[p]].terms() {
+                    for (k, v) in space.edge_dof[idx[p]].terms() {
                         let x =
                             v[0] * (blk[0][0] * w[0] + blk[1][0] * w[1]) + v[1] * (blk[0][1] * w[0] + blk[1][1] * w[1]);
                         if x != 0.0 {

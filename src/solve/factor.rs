@@ -15,7 +15,7 @@
 //! more separator). The supernodal kernel is always used: it exposes the triangular halves and the
 //! trailing block.
 
-use super::ordering::{amd_order, nested_dissection, ND_MIN_SIZE};
+use super::ordering::{amd_order, nested_dissection, Graph, ND_MIN_SIZE};
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
@@ -44,6 +44,20 @@ pub struct Factor {
     fwd: Vec<usize>,
 }
 
+/// The fill-reducing ordering of the unknowns of `graph` (position → unknown): nested dissection when
+/// `nested` (falling back to AMD where METIS cannot be used), else AMD. See [`super::ordering`].
+pub fn fill_order(graph: &Graph, nested: bool) -> Result<Vec<usize>> {
+    match if nested { nested_dissection(graph) } else { None } {
+        Some((fwd, _)) => Ok(fwd),
+        None => amd_order(graph, CholeskySymbolicParams::default().amd_params),
+    }
+}
+
+fn is_permutation(p: &[usize]) -> bool {
+    let mut seen = vec![false; p.len()];
+    p.iter().all(|&i| i < p.len() && !std::mem::replace(&mut seen[i], true))
+}
+
 impl Factor {
     /// Factorise the SPD matrix `k` (lower triangle read); faer chooses the simplicial or supernodal
     /// kernel (supernodal for larger fill).
@@ -67,20 +81,22 @@ impl Factor {
                 "internal: unknown groups must increase from 0 to the number of unknowns".into(),
             ));
         }
-        Factor::with_ordering(k, n >= ND_MIN_SIZE, last, first)
+        Factor::with_order(k, last, fill_order(&Graph::of_matrix(k, first), n >= ND_MIN_SIZE)?)
     }
 
-    /// As [`Factor::with_groups`], with nested dissection tried (`nested`) or AMD.
-    fn with_ordering(k: &SparseColMat<usize, f64>, nested: bool, last: &[usize], first: &[usize]) -> Result<Factor> {
+    /// As [`Factor::with_last`], with the fill-reducing ordering `base` (position → unknown, a
+    /// permutation; from [`fill_order`]): the unknowns `last` are moved to its end.
+    pub fn with_order(k: &SparseColMat<usize, f64>, last: &[usize], base: Vec<usize>) -> Result<Factor> {
         let n = k.nrows();
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
         };
-        let base = match if nested { nested_dissection(k, first) } else { None } {
-            Some((fwd, _)) => fwd,
-            None => amd_order(k, first, params.amd_params)?,
-        };
+        if base.len() != n || !is_permutation(&base) {
+            return Err(Error::Linear(
+                "internal: the fill-reducing ordering is not a permutation of the unknowns".into(),
+            ));
+        }
         let mut is_last = vec![false; n];
         for &i in last {
             if i >= n || std::mem::replace(&mut is_last[i], true) {
@@ -303,6 +319,11 @@ mod tests {
         }
     }
 
+    /// The factor with the ordering of `fill_order` on the groups `first`.
+    fn ordered(k: &SparseColMat<usize, f64>, nested: bool, first: &[usize]) -> Result<Factor> {
+        Factor::with_order(k, &[], fill_order(&Graph::of_matrix(k, first), nested)?)
+    }
+
     /// Groups of the two unknowns of a grid node.
     fn pairs(n: usize) -> Vec<usize> {
         (0..=n).step_by(2).collect()
@@ -315,19 +336,21 @@ mod tests {
     #[test]
     fn nested_dissection_orders_and_solves() {
         let k = grid(40);
-        let (fwd, inv) = nested_dissection(&k, &pairs(k.nrows())).expect("METIS ordering");
+        let (fwd, inv) = nested_dissection(&Graph::of_matrix(&k, &pairs(k.nrows()))).expect("METIS ordering");
         assert!(fwd.iter().enumerate().all(|(new, &old)| inv[old] == new));
-        let nd = Factor::with_ordering(&k, true, &[], &pairs(k.nrows())).unwrap();
-        let amd = Factor::with_ordering(&k, false, &[], &pairs(k.nrows())).unwrap();
+        let nd = ordered(&k, true, &pairs(k.nrows())).unwrap();
+        let amd = ordered(&k, false, &pairs(k.nrows())).unwrap();
         assert!(residual(&k, &nd) < 1e-12 && residual(&k, &amd) < 1e-12);
     }
 
     #[test]
     fn nested_dissection_is_deterministic_across_threads() {
         let k = grid(30);
-        let reference = nested_dissection(&k, &pairs(k.nrows())).unwrap();
+        let reference = nested_dissection(&Graph::of_matrix(&k, &pairs(k.nrows()))).unwrap();
         let runs: Vec<_> = std::thread::scope(|s| {
-            let h: Vec<_> = (0..4).map(|_| s.spawn(|| nested_dissection(&k, &pairs(k.nrows())).unwrap())).collect();
+            let h: Vec<_> = (0..4)
+                .map(|_| s.spawn(|| nested_dissection(&Graph::of_matrix(&k, &pairs(k.nrows()))).unwrap()))
+                .collect();
             h.into_iter().map(|h| h.join().unwrap()).collect()
         });
         assert!(runs.iter().all(|r| *r == reference));
@@ -337,19 +360,19 @@ mod tests {
     fn degenerate_graphs_fall_back_to_amd() {
         let diag = |n: usize| csc_from_triplets(n, &(0..n).map(|i| (i, i, 2.0)).collect::<Vec<_>>());
         for n in [0, 1, 2, 5] {
-            assert!(nested_dissection(&diag(n), &singles(n)).is_none());
-            let f = Factor::with_ordering(&diag(n), true, &[], &singles(n)).unwrap();
+            assert!(nested_dissection(&Graph::of_matrix(&diag(n), &singles(n))).is_none());
+            let f = ordered(&diag(n), true, &singles(n)).unwrap();
             assert!(residual(&diag(n), &f) < 1e-15);
         }
         // One coupled pair: a single METIS vertex, no edges.
         let pair = csc_from_triplets(2, &[(0, 0, 2.0), (1, 1, 2.0), (0, 1, 1.0), (1, 0, 1.0)]);
-        assert!(nested_dissection(&pair, &[0, 2]).is_none());
-        assert!(residual(&pair, &Factor::with_ordering(&pair, true, &[], &[0, 2]).unwrap()) < 1e-15);
+        assert!(nested_dissection(&Graph::of_matrix(&pair, &[0, 2])).is_none());
+        assert!(residual(&pair, &ordered(&pair, true, &[0, 2]).unwrap()) < 1e-15);
         // Three unknowns: METIS on a 2-vertex graph.
         let three = csc_from_triplets(
             3,
             &[(0, 0, 4.0), (1, 1, 4.0), (2, 2, 4.0), (1, 2, 1.0), (2, 1, 1.0), (0, 2, 1.0), (2, 0, 1.0)],
         );
-        assert!(residual(&three, &Factor::with_ordering(&three, true, &[], &[0, 1, 3]).unwrap()) < 1e-14);
+        assert!(residual(&three, &ordered(&three, true, &[0, 1, 3]).unwrap()) < 1e-14);
     }
 }

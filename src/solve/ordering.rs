@@ -21,11 +21,10 @@ use faer::sparse::{SparseColMat, SymbolicSparseColMatRef};
 use std::sync::Mutex;
 
 /// faer's approximate minimum degree ordering of K (position → unknown), computed on the graph with the
-/// groups merged ([`Quotient`]; with the two components of an edge as a group): half the vertices and a quarter of the edges of
+/// groups merged ([`Graph`]; with the two components of an edge as a group): half the vertices and a quarter of the edges of
 /// K's graph, so AMD runs about 3× faster (22 → 7 ms at 24,640 unknowns) for the same fill within a few
 /// percent (AMD merges indistinguishable vertices itself, but only after reading the whole graph).
-pub(super) fn amd_order(k: &SparseColMat<usize, f64>, first: &[usize], control: amd::Control) -> Result<Vec<usize>> {
-    let q = Quotient::new(k, first);
+pub(super) fn amd_order(q: &Graph, control: amd::Control) -> Result<Vec<usize>> {
     let ng = q.len();
     let (mut fwd, mut inv) = (vec![0usize; ng], vec![0usize; ng]);
     let graph = SymbolicSparseColMatRef::new_checked(ng, ng, &q.start, None, &q.adj);
@@ -48,18 +47,37 @@ const ND_SEED: i32 = 42;
 /// each call, so concurrent calls (parallel tests) would interleave their draws and break determinism.
 static METIS_LOCK: Mutex<()> = Mutex::new(());
 
-/// The graph of K with the unknowns of one group merged into one vertex: `first[g]..first[g + 1]` are the
+/// The graph of K with the unknowns of one group merged into one vertex (built from K, or from the mesh
+/// before K's values exist, see `fem::assemble::EdgePattern`): `first[g]..first[g + 1]` are the
 /// unknowns of vertex g (the two components of an edge's displacement, from the space: see
 /// [`super::factor::Factor::with_groups`]), and `start`/`adj` the symmetric adjacency of the vertices
 /// as compressed rows, sorted, without self loops.
-struct Quotient<'a> {
-    first: &'a [usize],
+#[derive(Debug, PartialEq)]
+pub struct Graph {
+    first: Vec<usize>,
     start: Vec<usize>,
     adj: Vec<usize>,
 }
 
-impl<'a> Quotient<'a> {
-    fn new(k: &SparseColMat<usize, f64>, first: &'a [usize]) -> Quotient<'a> {
+impl Graph {
+    /// The graph given by its parts: vertex g holds the unknowns `first[g]..first[g + 1]` and is adjacent
+    /// to `adj[start[g]..start[g + 1]]` (sorted, symmetric, no self loops); `None` if the parts are not
+    /// consistent.
+    pub fn new(first: Vec<usize>, start: Vec<usize>, adj: Vec<usize>) -> Option<Graph> {
+        let ng = first.len().checked_sub(1)?;
+        let ok = first.first() == Some(&0)
+            && first.windows(2).all(|w| w[0] < w[1])
+            && start.len() == ng + 1
+            && start.first() == Some(&0)
+            && start.windows(2).all(|w| w[0] <= w[1])
+            && start[ng] == adj.len()
+            && (0..ng).all(|g| adj[start[g]..start[g + 1]].windows(2).all(|w| w[0] < w[1]))
+            && (0..ng).all(|g| adj[start[g]..start[g + 1]].iter().all(|&h| h < ng && h != g));
+        ok.then_some(Graph { first, start, adj })
+    }
+
+    /// The graph of K with the groups `first` merged.
+    pub fn of_matrix(k: &SparseColMat<usize, f64>, first: &[usize]) -> Graph {
         let n = k.nrows();
         let (col_ptr, row_idx) = (k.symbolic().col_ptr(), k.symbolic().row_idx());
         let ng = first.len() - 1;
@@ -110,14 +128,20 @@ impl<'a> Quotient<'a> {
             }
             start.push(adj.len());
         }
-        Quotient { first, start, adj }
+        Graph { first: first.to_vec(), start, adj }
     }
 
-    fn len(&self) -> usize {
+    /// Number of vertices.
+    pub fn len(&self) -> usize {
         self.first.len() - 1
     }
 
     /// The unknowns of the vertices in the order `order` (position → vertex).
+    /// Unknowns in all.
+    pub fn unknowns(&self) -> usize {
+        self.first[self.len()]
+    }
+
     fn expand(&self, order: impl Iterator<Item = usize>) -> Vec<usize> {
         let mut fwd = Vec::with_capacity(self.first[self.len()]);
         for g in order {
@@ -129,9 +153,8 @@ impl<'a> Quotient<'a> {
 
 /// Nested-dissection ordering (forward, inverse) of the graph of K by METIS_NodeND, or `None` when
 /// METIS cannot be used: the caller then falls back to AMD.
-pub(super) fn nested_dissection(k: &SparseColMat<usize, f64>, first: &[usize]) -> Option<(Vec<usize>, Vec<usize>)> {
-    let n = k.nrows();
-    let q = Quotient::new(k, first);
+pub(super) fn nested_dissection(q: &Graph) -> Option<(Vec<usize>, Vec<usize>)> {
+    let n = q.unknowns();
     let ng = q.len();
     let xadj: Vec<i32> = q.start.iter().map(|&v| i32::try_from(v).ok()).collect::<Option<_>>()?;
     let adjncy: Vec<i32> = q.adj.iter().map(|&v| i32::try_from(v).ok()).collect::<Option<_>>()?;
