@@ -1,5 +1,5 @@
 # tresca-cr: `make verify` (the verification suite) and `make test` (the tests). Both install what they
-# need, idempotently: Debian packages (HDF5, pkg-config), the Rust release build, and a Python 3.12 venv
+# need, idempotently: CMake (for the static HDF5 build), the Rust release build, and a Python 3.12 venv
 # with the pinned versions of requirements.txt.
 
 SHELL := /bin/bash
@@ -14,13 +14,24 @@ PY312 := $(shell for p in $$(pyenv root 2>/dev/null)/versions/3.12*/bin/python3.
 
 all: build
 
-# Debian packages: HDF5 headers for the hdf5-metno crate (apt needs an index update on a fresh machine).
-deps:
-	@if ! pkg-config --exists hdf5 2>/dev/null; then \
-	  echo "installing libhdf5-dev pkg-config"; \
-	  (apt-get update -qq && apt-get install -y -qq libhdf5-dev pkg-config) >/dev/null || \
-	  (sudo apt-get update -qq && sudo apt-get install -y -qq libhdf5-dev pkg-config) >/dev/null; \
-	fi
+# HDF5 is compiled from source and linked statically (Cargo.toml: hdf5-metno's `static` feature; Debian's
+# shared libhdf5 pulled 37 libraries and cost ~8 ms of every process start). Its CMake project needs
+# CMake >= 3.26 and Debian bookworm has 3.25, so a pinned CMake from PyPI goes into a small venv,
+# .tools/, which .cargo/config.toml names to the `cmake` crate (CMAKE). The C compiler and make that
+# it also needs come with the Rust toolchain's linker set-up (build-essential).
+CMAKE_VERSION := 3.31.6
+TOOLS := .tools
+TOOLS_PY := $(or $(PY312),python3)
+
+deps: $(TOOLS)/.cmake-$(CMAKE_VERSION)
+
+$(TOOLS)/.cmake-$(CMAKE_VERSION):
+	@echo "installing cmake $(CMAKE_VERSION) into $(TOOLS)"
+	rm -rf $(TOOLS)
+	$(TOOLS_PY) -m venv $(TOOLS)
+	$(TOOLS)/bin/pip install -q cmake==$(CMAKE_VERSION)
+	$(TOOLS)/bin/cmake --version >/dev/null
+	touch $@
 
 # Debian's ParaView 5.11 (pvpython) and a virtual X server, for verification/paraview_check.py (make verify).
 paraview:

@@ -124,8 +124,14 @@ impl Raw {
 /// per step (~5,000 virtual datasets for Example 5.1) the per-step flush of the counters cost more
 /// than the step: a small cache halved the whole run (measured, `--frame-every 1`). Nothing in a
 /// results file is read back during a run, so the cache gains nothing from being larger.
+///
+/// The earliest file format that holds the data (superblock 0, symbol-table groups), as HDF5 1.10
+/// wrote by default: HDF5 2 (linked statically, see Cargo.toml) defaults to the 1.8 format, whose
+/// compact groups list their members in a different order after `--resume` re-creates a series.
 pub fn file_access(p: &mut FileAccessBuilder) -> &mut FileAccessBuilder {
-    use hdf5::plist::file_access::{CacheDecreaseMode, CacheIncreaseMode, FlashIncreaseMode, MetadataCacheConfig};
+    use hdf5::plist::file_access::{
+        CacheDecreaseMode, CacheIncreaseMode, FlashIncreaseMode, LibraryVersion, MetadataCacheConfig,
+    };
     const MDC_BYTES: usize = 64 << 10;
     let mdc = MetadataCacheConfig {
         initial_size: MDC_BYTES,
@@ -136,7 +142,7 @@ pub fn file_access(p: &mut FileAccessBuilder) -> &mut FileAccessBuilder {
         decr_mode: CacheDecreaseMode::Off,
         ..Default::default()
     };
-    p.mdc_config(&mdc).sieve_buf_size(0)
+    p.mdc_config(&mdc).sieve_buf_size(0).libver_bounds(LibraryVersion::Earliest, LibraryVersion::latest())
 }
 
 fn create_contiguous<T: H5Type>(g: &Group, name: &str, shape: &[usize]) -> hdf5::Result<Dataset> {

@@ -21,7 +21,7 @@ use crate::fem::norms::ErrorNorms;
 use crate::fem::space::{CrSpace, EdgeDof};
 use crate::friction::EdgeState;
 use crate::stepping::StepResult;
-use hdf5::{File, Group};
+use hdf5::{Attribute, File, Group};
 
 /// Rows of consecutive steps buffered for one write.
 #[derive(Default)]
@@ -76,6 +76,8 @@ impl Rows {
 pub struct Tresca {
     pub group: Group,
     steps_group: Group,
+    /// `steps` attribute `completed`, kept open: it is rewritten at every commit.
+    completed: Attribute,
     times: Series,
     u: Series,
     energy: Series,
@@ -193,6 +195,7 @@ impl Tresca {
             wall: Series::create::<f64>(&sg, "wall_time", 1, &[], sc)?,
             contact,
             errors,
+            completed: sg.attr("completed")?,
             steps_group: sg,
             group: g,
         })
@@ -228,6 +231,7 @@ impl Tresca {
             wall: Series::open(&g, "steps/wall_time", 1)?,
             contact,
             errors,
+            completed: sg.attr("completed")?,
             steps_group: sg,
             group: g,
         })
@@ -330,7 +334,7 @@ impl Tresca {
 
     /// Mark `count` steps complete.
     pub fn set_completed(&self, count: usize) -> hdf5::Result<()> {
-        attr(&self.steps_group, "completed", count as i64)
+        self.completed.write_scalar(&(count as i64))
     }
 
     /// Give every series room for exactly `steps` steps, keeping the first `kept` (see

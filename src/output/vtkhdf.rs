@@ -21,7 +21,7 @@
 use super::fields::{Fields, StepFields, TENSOR};
 use super::h5::{attr, attr_fixed_ascii, attr_vec, put, Raw, Series};
 use hdf5::plist::group_create::LinkCreationOrder;
-use hdf5::{Dataset, Extent, Extents, File, Group};
+use hdf5::{Attribute, Dataset, Extent, Extents, File, Group};
 
 /// Cell arrays of the body block with their components (f32).
 pub const BODY_CELLS: [(&str, usize); 3] = [("strain", TENSOR), ("stress", TENSOR), ("von_mises", 1)];
@@ -85,7 +85,8 @@ impl FrameRows {
 
 /// One `UnstructuredGrid` block: its `Steps` group and its time series.
 struct Block {
-    steps: Group,
+    /// `Steps` attribute `NSteps`, kept open: it is rewritten at every commit.
+    nsteps: Attribute,
     /// `Steps/Values`, the one per-frame array whose length must equal `NSteps` at every commit: VTK
     /// 9.7's reader corrupts its heap on a longer one (measured; a killed run's file crashed it). It is
     /// chunked and grown frame by frame, in the same flush as `NSteps`.
@@ -148,6 +149,7 @@ impl Block {
             });
         }
         Ok(Block {
+            nsteps: steps.attr("NSteps")?,
             values: steps
                 .new_dataset::<f64>()
                 .chunk(1024)
@@ -155,7 +157,6 @@ impl Block {
                 .create("Values")?,
             displacement: Series::create::<f32>(&pd, "displacement", np, &[3], m)?,
             cells,
-            steps,
         })
     }
 
@@ -166,10 +167,10 @@ impl Block {
         let cells = arrays.iter().map(|(name, _)| Series::open(&cd, name, ncell)).collect::<hdf5::Result<Vec<_>>>()?;
         let steps = g.group("Steps")?;
         Ok(Block {
+            nsteps: steps.attr("NSteps")?,
             values: steps.dataset("Values")?,
             displacement: Series::open(&g.group("PointData")?, "displacement", np)?,
             cells,
-            steps,
         })
     }
 
@@ -239,7 +240,7 @@ impl VtkHdf {
 
     /// Set `NSteps` of every block (they always hold the same frames).
     pub fn set_nsteps(&self, n: usize) -> hdf5::Result<()> {
-        std::iter::once(&self.body).chain(&self.contact).try_for_each(|b| attr(&b.steps, "NSteps", n as i64))
+        std::iter::once(&self.body).chain(&self.contact).try_for_each(|b| b.nsteps.write_scalar(&(n as i64)))
     }
 
     /// Give every frame series room for exactly `frames` frames, keeping the first `kept`; `Values`
