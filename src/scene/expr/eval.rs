@@ -100,6 +100,27 @@ impl Program {
         finite.into_inner()
     }
 
+    /// As [`Program::eval`] on `points[start..start + n]` with the cache of all `points`, on this thread
+    /// (for callers that split the points themselves). `start` is a multiple of [`LANES`].
+    pub fn eval_range(
+        &self,
+        points: &[[f64; 2]],
+        start: usize,
+        n: usize,
+        t: f64,
+        cache: &[f64],
+        out: &mut Vec<f64>,
+    ) -> bool {
+        assert_eq!(start % LANES, 0, "a range starts at a batch");
+        let m = self.outputs.len();
+        out.resize(n * m, 0.0);
+        if m == 0 || n == 0 {
+            return true;
+        }
+        let at = start / LANES * LANES * self.cached.len();
+        run(self, &points[start..start + n], &self.uniform(t), Path::Cached(&cache[at.min(cache.len())..]), out)
+    }
+
     /// The cached spatial values at `points` (batch by batch, slot by slot), for [`Program::eval`].
     pub fn fill_cache(&self, points: &[[f64; 2]]) -> Vec<f64> {
         let n_batches = points.len().div_ceil(LANES);

@@ -240,6 +240,13 @@ impl BoundSet {
         let finite = self.set.program.eval(&self.points, t, Some(&self.cache), out);
         self.set.check_all(finite, &self.points, t, out)
     }
+
+    /// As [`BoundSet::eval`] at the points `start..start + n` only, on this thread; `start` must be a
+    /// multiple of [`program::LANES`]. Same values as the whole evaluation.
+    pub fn eval_range(&self, start: usize, n: usize, t: f64, out: &mut Vec<f64>) -> Result<()> {
+        let finite = self.set.program.eval_range(&self.points, start, n, t, &self.cache, out);
+        self.set.check_all(finite, &self.points[start..start + n], t, out)
+    }
 }
 
 /// A vector expression (two components).

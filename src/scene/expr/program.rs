@@ -25,7 +25,7 @@ use super::sym::{Bin, Sym, Un};
 use std::collections::HashMap;
 
 /// Points per batch (see [`super::eval`]).
-pub const LANES: usize = 32;
+pub const LANES: usize = 64;
 /// Largest |n| of an integer power a^n compiled into products (beyond, `powf`).
 pub const MAX_INT_POWER: f64 = 64.0;
 
