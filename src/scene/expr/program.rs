@@ -14,9 +14,9 @@
 //!   cache and run the other instructions. Which ones is a cost model ([`plan_cache`]): a cached value is
 //!   read from main memory at every time (the cache of a fine mesh is far larger than the processor's
 //!   caches), about as dear as [`LOAD_COST`] vectorised products, so a spatial value is cached only if
-//!   recomputing it costs more — sin, cos, exp, `powf`, divisions and longer chains of products are
-//!   cached, `1-y` or `x*y` are recomputed. Either way a value comes from the same operations, so the
-//!   choice changes no bit.
+//!   recomputing it costs more — sin, cos, exp, `powf` and long chains of products and divisions are
+//!   cached, polynomial factors such as `(1-y)^2*(2*y+1)` or `x/5` are recomputed. Either way a value comes from the same
+//!   operations, so the choice changes no bit.
 //!
 //! Evaluation (batches of points, the cache read in place, the finiteness check on the way out) is in
 //! [`super::eval`]; this module only lowers and schedules.
@@ -41,7 +41,7 @@ pub(super) enum Op {
 
 /// Cost of reading a cached value at a time node, in vectorised additions or products (streaming it
 /// from memory, against ~0.1 ns per point for a product over a batch).
-const LOAD_COST: u32 = 6;
+const LOAD_COST: u32 = 16;
 
 /// Cost of recomputing an operation (same unit as [`LOAD_COST`]).
 fn op_cost(op: &Op) -> u32 {
