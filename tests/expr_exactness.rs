@@ -7,6 +7,7 @@ use std::path::Path;
 use tresca_cr::fem::quadrature::{edge_point, tri_point, GAUSS2, GAUSS3, TRI4};
 use tresca_cr::mesh::Mesh;
 use tresca_cr::scene::expr::{Expr, ExprSet};
+use tresca_cr::scene::PartKind;
 use tresca_cr::Scene;
 
 /// Every expression string of a scene file (the keys that hold expressions).
@@ -73,4 +74,58 @@ fn compiled_agrees_with_interpreter_on_all_cases() {
     }
     println!("max relative difference compiled vs interpreted over {n_values} values: {worst:.3e} ({worst_at})");
     assert!(worst <= 1e-13, "max relative difference {worst:e}: {worst_at}");
+}
+
+/// The expressions compiled together as runs compile them (f, each traction, the exact u and ∇u), bound
+/// to the degree-4 triangle points at refinement 2 (the spatial part cached, its choice made by the cost
+/// model): every value has the bits of the expression compiled alone and evaluated without a cache.
+#[test]
+fn sets_as_runs_bind_them_match_single_expressions_bit_for_bit() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/cases");
+    let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    files.sort();
+    let mut n_values = 0usize;
+    for file in files.iter().filter(|p| p.extension().is_some_and(|e| e == "toml")) {
+        let mut scene = Scene::from_file(file).unwrap();
+        scene.set_refine(2).unwrap();
+        let mesh = Mesh::from_spec(&scene.mesh).unwrap();
+        let pts: Vec<[f64; 2]> =
+            mesh.tris.iter().flat_map(|t| TRI4.map(|(l, _)| tri_point(t.map(|v| mesh.points[v]), l))).collect();
+        let mut sets: Vec<Vec<&Expr>> = Vec::new();
+        if let Some(f) = &scene.f {
+            sets.push(f.0.iter().collect());
+        }
+        for part in &scene.parts {
+            if let PartKind::Neumann(Some(g)) = &part.kind {
+                sets.push(g.0.iter().collect());
+            }
+        }
+        if let Some(x) = &scene.exact {
+            sets.push(x.u.0.iter().chain(x.grad.iter().flatten()).collect());
+        }
+        for exprs in sets {
+            let bound = ExprSet::new(&exprs).bind(pts.clone());
+            let (mut together, mut alone) = (Vec::new(), Vec::new());
+            for &t in &scene.times {
+                bound.eval(t, &mut together).unwrap();
+                for (k, e) in exprs.iter().enumerate() {
+                    ExprSet::new(&[e]).eval(&pts, t, &mut alone).unwrap();
+                    for (i, a) in alone.iter().enumerate() {
+                        let b = together[i * exprs.len() + k];
+                        assert_eq!(
+                            a.to_bits(),
+                            b.to_bits(),
+                            "{} `{}` at {:?}, t={t}",
+                            file.display(),
+                            e.text(),
+                            pts[i]
+                        );
+                        n_values += 1;
+                    }
+                }
+            }
+        }
+    }
+    println!("{n_values} values of sets bound to points: bit-identical to single expressions");
+    assert!(n_values > 0);
 }

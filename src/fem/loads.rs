@@ -2,6 +2,11 @@
 //!   (lⁿ, v) = ∫_Ω f(tₙ)·v (Dunavant degree 4) + Σ_{Neumann e} ∫_e g(tₙ)·v (3-point Gauss).
 //! Quadrature points and the weights w·φ feeding each unknown are stored once, so each step evaluates the
 //! (compiled) load expressions at all points of a term in one batch, then scatters sequentially.
+//!
+//! Storage is what a time node streams through memory, so it is compact: the points of one triangle
+//! (or one Neumann edge) feed the same three edges, stored once per such group; per point only its three
+//! weights w·φᵢ; the unknowns and vector coefficients of an edge come from one table shared by all terms.
+//! The sums are those of a plain point-by-point scatter, in the same order (the same bits).
 
 use super::quadrature::{edge_point, tri_point, GAUSS3, TRI4};
 use super::space::{CrSpace, Element};
@@ -17,28 +22,29 @@ struct LoadPoint {
     edges: [(usize, f64); 3],
 }
 
-/// One contribution of a point's value v: `out[slot] += w · (c·v)`.
-#[derive(Clone, Copy, Debug)]
-struct Scatter {
-    slot: usize,
-    w: f64,
-    c: [f64; 2],
-}
-
 /// Precomputed quadrature for one vector load (body force or one Neumann part).
 #[derive(Clone, Debug)]
 struct LoadTerm {
     /// Both components, compiled together and bound to the quadrature points.
     expr: BoundSet,
-    /// The contributions of point i: `scatter[first[i]..first[i + 1]]`.
-    first: Vec<usize>,
-    scatter: Vec<Scatter>,
+    /// Consecutive points feeding the same three edges: the edges and the number of points.
+    groups: Vec<([u32; 3], u32)>,
+    /// Per point: the weight w·φᵢ of each of its group's edges.
+    weights: Vec<[f64; 3]>,
+}
+
+thread_local! {
+    /// The expression values of a term, kept from one time node to the next (megabytes on fine meshes).
+    static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// The load functional t ↦ l(t) on the unknowns.
 #[derive(Clone, Debug)]
 pub struct Loads {
     terms: Vec<LoadTerm>,
+    /// The (support slot, vector coefficient) pairs of edge e: `edge_terms[edge_first[e]..edge_first[e + 1]]`.
+    edge_first: Vec<u32>,
+    edge_terms: Vec<(u32, [f64; 2])>,
     n_dofs: usize,
     /// The unknowns any load can touch, increasing (all of them with a body force, only boundary ones
     /// with tractions alone).
@@ -97,22 +103,29 @@ impl Loads {
         for (i, &k) in support.iter().enumerate() {
             slot[k] = i;
         }
+        let mut edge_first = vec![0u32];
+        let mut edge_terms = Vec::new();
+        for dof in &space.edge_dof {
+            edge_terms.extend(dof.terms().map(|(k, c)| (slot[k] as u32, c)));
+            edge_first.push(edge_terms.len() as u32);
+        }
         let terms = raw
             .into_iter()
             .map(|(e, pts)| {
-                let mut first = vec![0];
-                let mut scatter = Vec::new();
+                let mut groups: Vec<([u32; 3], u32)> = Vec::new();
                 for p in &pts {
-                    for &(e, w) in &p.edges {
-                        scatter.extend(space.edge_dof[e].terms().map(|(k, c)| Scatter { slot: slot[k], w, c }));
+                    let edges = p.edges.map(|(e, _)| e as u32);
+                    match groups.last_mut() {
+                        Some((g, n)) if *g == edges => *n += 1,
+                        _ => groups.push((edges, 1)),
                     }
-                    first.push(scatter.len());
                 }
+                let weights = pts.iter().map(|p| p.edges.map(|(_, w)| w)).collect();
                 let points = pts.iter().map(|p| p.x).collect();
-                LoadTerm { expr: ExprSet::new(&[&e.0[0], &e.0[1]]).bind(points), first, scatter }
+                LoadTerm { expr: ExprSet::new(&[&e.0[0], &e.0[1]]).bind(points), groups, weights }
             })
             .collect();
-        Loads { terms, n_dofs: space.n_dofs, support }
+        Loads { terms, edge_first, edge_terms, n_dofs: space.n_dofs, support }
     }
 
     /// The unknowns a load can be nonzero on (increasing).
@@ -124,17 +137,30 @@ impl Loads {
     pub fn assemble_on_support(&self, t: f64, out: &mut Vec<f64>) -> Result<()> {
         out.clear();
         out.resize(self.support.len(), 0.0);
-        let mut values = Vec::new();
-        for term in &self.terms {
-            // the expression values in parallel batches, the sums sequentially: bit-identical results
-            term.expr.eval(t, &mut values)?;
-            for (i, v) in values.chunks_exact(2).enumerate() {
-                for s in &term.scatter[term.first[i]..term.first[i + 1]] {
-                    out[s.slot] += s.w * (s.c[0] * v[0] + s.c[1] * v[1]);
+        SCRATCH.with(|cell| {
+            // a nested call on this thread (none today) would get a buffer of its own
+            let mut own = Vec::new();
+            let mut borrowed = cell.try_borrow_mut();
+            let values = borrowed.as_deref_mut().unwrap_or(&mut own);
+            for term in &self.terms {
+                // the expression values in parallel batches, the sums sequentially: bit-identical results
+                term.expr.eval(t, values)?;
+                let mut points = values.chunks_exact(2).zip(&term.weights);
+                for &(edges, n) in &term.groups {
+                    let terms = edges.map(|e| {
+                        &self.edge_terms[self.edge_first[e as usize] as usize..self.edge_first[e as usize + 1] as usize]
+                    });
+                    for (v, w) in points.by_ref().take(n as usize) {
+                        for (terms, w) in terms.iter().zip(w) {
+                            for &(slot, c) in *terms {
+                                out[slot as usize] += w * (c[0] * v[0] + c[1] * v[1]);
+                            }
+                        }
+                    }
                 }
             }
-        }
-        Ok(())
+            Ok(())
+        })
     }
 
     /// Scatter values on the support into a full vector of unknowns.

@@ -5,16 +5,25 @@
 //! * broken H¹ seminorm |u − u_h|_{1,h} and L² norm ‖u − u_h‖,
 //!
 //! by the degree-4 triangle rule and the exact 2-point edge rule. The exact u and ∇u (six expressions,
-//! compiled together so shared subterms are computed once) are evaluated at all quadrature points of a
-//! time node in one batch.
+//! compiled together so shared subterms are computed once, bound to the quadrature points so their parts
+//! that do not depend on t are evaluated once) are evaluated chunk of elements by chunk of elements, each
+//! chunk's values used at once while they are in the processor's cache (not written out for the whole
+//! mesh and read back). Chunks run in parallel; the per-element contributions are summed in element
+//! order, so the norms are bit-identical for any thread count.
 
 use super::elasticity::Elasticity;
 use super::quadrature::{tri_point, GAUSS2, TRI4};
 use super::space::{jump_terms, CrSpace, Element};
+use crate::error::Error;
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::scene::expr::{BoundSet, ExprSet};
+use crate::scene::expr::{program::LANES, BoundSet, ExprSet};
 use crate::scene::Exact;
+use std::sync::Mutex;
+
+/// Elements per chunk of work: their 6 points each make whole batches of [`LANES`] points, and their
+/// values (36 per element) stay in the first-level cache.
+const CHUNK_ELEMENTS: usize = 2 * LANES;
 
 /// The three error norms at one time.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -69,17 +78,35 @@ impl ErrorEvaluator {
 
     /// Errors of the CR field with midpoint values `mid` against `exact` at time t.
     pub fn errors(&self, mesh: &Mesh, exact: &Exact, mid: &[[f64; 2]], t: f64) -> Result<ErrorNorms> {
-        let mut values = Vec::new();
-        match &self.bound {
-            Some(b) => b.eval(t, &mut values)?,
-            None => exact_set(exact).eval(&self.points, t, &mut values)?,
-        }
-        // per-element contributions in parallel, summed in element order (bit-identical for any thread count)
-        let idx: Vec<usize> = (0..self.elements.len()).collect();
-        let per_element = TRI4.len() * 6;
-        let parts = crate::parallel::map(&idx, |&k| {
-            self.element_errors(mesh, &values[k * per_element..(k + 1) * per_element], mid, k)
+        let owned;
+        let bound = match &self.bound {
+            Some(b) => b,
+            None => {
+                owned = exact_set(exact).bind(self.points.clone());
+                &owned
+            }
+        };
+        let per_element = TRI4.len();
+        let mut parts = vec![[0.0f64; 3]; self.elements.len()];
+        // the error of the first chunk (in point order) that has a non-finite value
+        let failed: Mutex<Option<(usize, Error)>> = Mutex::new(None);
+        crate::parallel::for_chunks(&mut parts, CHUNK_ELEMENTS, |c, chunk| {
+            let first = c * CHUNK_ELEMENTS;
+            let mut values = Vec::with_capacity(chunk.len() * per_element * 6);
+            if let Err(e) = bound.eval_range(first * per_element, chunk.len() * per_element, t, &mut values) {
+                let mut f = failed.lock().unwrap_or_else(|p| p.into_inner());
+                if f.as_ref().is_none_or(|(at, _)| c < *at) {
+                    *f = Some((c, e));
+                }
+                return;
+            }
+            for (k, (part, v)) in chunk.iter_mut().zip(values.chunks_exact(per_element * 6)).enumerate() {
+                *part = self.element_errors(mesh, v, mid, first + k);
+            }
         });
+        if let Some((_, e)) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
+            return Err(e);
+        }
         let (mut en, mut h1, mut l2) = (0.0f64, 0.0f64, 0.0f64);
         for [e, h, l] in parts {
             en += e;

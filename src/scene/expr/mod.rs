@@ -11,6 +11,7 @@
 //! Every evaluation is checked for finiteness, so a division by zero or `sqrt(-1)` at a quadrature point
 //! becomes an error naming the expression and the point instead of a NaN in the results.
 
+mod eval;
 mod lint;
 pub mod program;
 pub mod sym;
@@ -182,6 +183,11 @@ impl ExprSet {
         self.exprs.is_empty()
     }
 
+    /// The compiled program.
+    pub fn program(&self) -> &Program {
+        &self.program
+    }
+
     /// Varying instructions per point (the compiled work).
     pub fn n_instructions(&self) -> usize {
         self.program.n_instructions()
@@ -190,12 +196,16 @@ impl ExprSet {
     /// Every expression at every point at time t, point-major (`out[i * len + k]`). A non-finite value
     /// is an error naming the expression and the point (the first point in order that has one).
     pub fn eval(&self, points: &[[f64; 2]], t: f64, out: &mut Vec<f64>) -> Result<()> {
-        self.program.eval(points, t, None, out);
-        self.check_all(points, t, out)
+        let finite = self.program.eval(points, t, None, out);
+        self.check_all(finite, points, t, out)
     }
 
-    fn check_all(&self, points: &[[f64; 2]], t: f64, out: &[f64]) -> Result<()> {
+    /// The error for the first non-finite value, if the evaluation found one.
+    fn check_all(&self, finite: bool, points: &[[f64; 2]], t: f64, out: &[f64]) -> Result<()> {
         let m = self.exprs.len();
+        if finite {
+            return Ok(());
+        }
         if let Some(i) = out.iter().position(|v| !v.is_finite()) {
             check(&self.exprs[i % m], out[i], points[i / m], t)?;
         }
@@ -227,8 +237,15 @@ impl BoundSet {
 
     /// As [`ExprSet::eval`] at the bound points.
     pub fn eval(&self, t: f64, out: &mut Vec<f64>) -> Result<()> {
-        self.set.program.eval(&self.points, t, Some(&self.cache), out);
-        self.set.check_all(&self.points, t, out)
+        let finite = self.set.program.eval(&self.points, t, Some(&self.cache), out);
+        self.set.check_all(finite, &self.points, t, out)
+    }
+
+    /// As [`BoundSet::eval`] at the points `start..start + n` only, on this thread; `start` must be a
+    /// multiple of [`program::LANES`]. Same values as the whole evaluation.
+    pub fn eval_range(&self, start: usize, n: usize, t: f64, out: &mut Vec<f64>) -> Result<()> {
+        let finite = self.set.program.eval_range(&self.points, start, n, t, &self.cache, out);
+        self.set.check_all(finite, &self.points[start..start + n], t, out)
     }
 }
 

@@ -10,32 +10,94 @@
 //! * nodes that depend on neither x nor y ("uniform": constants, t and what is computed from them) are
 //!   evaluated once per call, as scalars, and broadcast;
 //! * nodes that depend on x, y but not t ("spatial") can be evaluated once for a fixed set of points
-//!   ([`Program::fill_cache`]); the evaluations at each time then read the spatial values that the rest
-//!   of the program uses from that cache and run only the instructions that involve both.
+//!   ([`Program::fill_cache`]); the evaluations at each time then read some spatial values from that
+//!   cache and run the other instructions. Which ones is a cost model ([`plan_cache`]): a cached value is
+//!   read from main memory at every time (the cache of a fine mesh is far larger than the processor's
+//!   caches), about as dear as [`LOAD_COST`] vectorised products, so a spatial value is cached only if
+//!   recomputing it costs more — sin, cos, exp, `powf` and long chains of products and divisions are
+//!   cached, polynomial factors such as `(1-y)^2*(2*y+1)` or `x/5` are recomputed. Either way a value comes from the same
+//!   operations, so the choice changes no bit.
 //!
-//! The remaining instructions run over batches of [`LANES`] points: each instruction is one simple loop
-//! over the lanes (vectorised by the compiler for + − × ÷, min, max, abs). Values are register slots of
-//! `LANES` numbers, reused once their last reader has run. Every point's value comes from the same
-//! sequence of operations whatever the batching or the thread count, so results are bit-reproducible.
+//! Evaluation (batches of points, the cache read in place, the finiteness check on the way out) is in
+//! [`super::eval`]; this module only lowers and schedules.
 
 use super::sym::{Bin, Sym, Un};
 use std::collections::HashMap;
 
-/// Points per batch.
-pub const LANES: usize = 32;
-/// Points per chunk of parallel work (a whole number of batches).
-const CHUNK: usize = 16 * LANES;
+/// Points per batch (see [`super::eval`]).
+pub const LANES: usize = 64;
 /// Largest |n| of an integer power a^n compiled into products (beyond, `powf`).
 pub const MAX_INT_POWER: f64 = 64.0;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Op {
+pub(super) enum Op {
     Const(f64),
     X,
     Y,
     T,
     Un(Un, u32),
     Bin(Bin, u32, u32),
+}
+
+/// Cost of reading a cached value at a time node, in vectorised additions or products (streaming it
+/// from memory, against ~0.1 ns per point for a product over a batch).
+const LOAD_COST: u32 = 16;
+
+/// Cost of recomputing an operation (same unit as [`LOAD_COST`]).
+fn op_cost(op: &Op) -> u32 {
+    match *op {
+        Op::Const(_) | Op::X | Op::Y | Op::T => 0,
+        Op::Un(Un::Neg | Un::Abs, _) => 1,
+        Op::Un(Un::Sqrt | Un::Floor | Un::Ceil | Un::Trunc | Un::Round | Un::Fract | Un::Signum, _) => 4,
+        Op::Un(..) => 40,
+        Op::Bin(Bin::Add | Bin::Sub | Bin::Mul | Bin::Min | Bin::Max, ..) => 1,
+        Op::Bin(Bin::Div, ..) => 4,
+        Op::Bin(..) => 60,
+    }
+}
+
+/// Which spatial nodes to cache, and which nodes to compute at each time when the cache is used.
+///
+/// Bottom-up, c(n) = cost(n) + Σ over n's spatial inputs i of min(c(i), LOAD_COST) estimates what
+/// computing n at a time costs when its dear inputs are cached. Top-down from what the time part needs
+/// (the inputs of nodes that depend on t, and the outputs), a needed spatial node is cached if
+/// c(n) > LOAD_COST, else computed at each time and its spatial inputs are needed in turn. x and y are
+/// never cached (they are the points).
+fn plan_cache(nodes: &[Op], varying: &[bool], timed: &[bool], outputs: &[u32]) -> (Vec<bool>, Vec<bool>) {
+    let n = nodes.len();
+    let spatial = |i: usize| varying[i] && !timed[i];
+    let reads = |op: &Op| -> ([u32; 2], usize) {
+        match *op {
+            Op::Un(_, a) => ([a, a], 1),
+            Op::Bin(_, a, c) => ([a, c], 2),
+            _ => ([0, 0], 0),
+        }
+    };
+    let mut cost = vec![0u32; n];
+    for (i, op) in nodes.iter().enumerate() {
+        let (r, k) = reads(op);
+        let inputs: u32 =
+            r[..k].iter().filter(|&&a| spatial(a as usize)).map(|&a| cost[a as usize].min(LOAD_COST)).sum();
+        cost[i] = op_cost(op).saturating_add(inputs);
+    }
+    let mut needed = vec![false; n];
+    for &o in outputs {
+        needed[o as usize] = true;
+    }
+    let (mut cache_it, mut at_time) = (vec![false; n], vec![false; n]);
+    for i in (0..n).rev() {
+        if !varying[i] || !(timed[i] || needed[i]) || matches!(nodes[i], Op::X | Op::Y) {
+            continue;
+        }
+        if !timed[i] && cost[i] > LOAD_COST {
+            cache_it[i] = true;
+            continue;
+        }
+        at_time[i] = true;
+        let (r, k) = reads(&nodes[i]);
+        r[..k].iter().for_each(|&a| needed[a as usize] = true);
+    }
+    (cache_it, at_time)
 }
 
 /// Hash key of a node: the operation with the constant's bits.
@@ -49,7 +111,7 @@ enum Key {
 
 /// One varying instruction: `dst ← op(a, b)` on slots.
 #[derive(Clone, Copy, Debug)]
-enum Instr {
+pub(super) enum Instr {
     Un(Un, u32, u32),
     Bin(Bin, u32, u32, u32),
 }
@@ -57,22 +119,26 @@ enum Instr {
 /// A compiled program with one or more outputs.
 #[derive(Clone, Debug)]
 pub struct Program {
-    nodes: Vec<Op>,
+    pub(super) nodes: Vec<Op>,
     /// Per node: depends on x or y.
-    varying: Vec<bool>,
-    /// The varying instructions in order, each with whether it is spatial (no t).
-    instrs: Vec<(Instr, bool)>,
-    /// Slots of the cached spatial nodes (read by a node that depends on t, or outputs), each its own.
-    cached: Vec<u32>,
+    pub(super) varying: Vec<bool>,
+    /// Every varying instruction, in order (evaluation without a cache).
+    pub(super) all: Vec<Instr>,
+    /// The spatial ones (no t: filling a cache) and the others (evaluating from a cache), in order.
+    pub(super) spatial: Vec<Instr>,
+    pub(super) timed: Vec<Instr>,
+    /// Slots of the cached spatial nodes (read by a node that depends on t, or outputs), each its own
+    /// and never written by a timed instruction.
+    pub(super) cached: Vec<u32>,
     /// (slot, node) of every uniform node a varying instruction reads.
-    broadcast: Vec<(u32, u32)>,
-    n_slots: usize,
+    pub(super) broadcast: Vec<(u32, u32)>,
+    pub(super) n_slots: usize,
     /// Per output: its node and, if varying, its slot.
-    outputs: Vec<(u32, Option<u32>)>,
+    pub(super) outputs: Vec<(u32, Option<u32>)>,
 }
 
-const SLOT_X: u32 = 0;
-const SLOT_Y: u32 = 1;
+pub(super) const SLOT_X: u32 = 0;
+pub(super) const SLOT_Y: u32 = 1;
 
 struct Builder {
     nodes: Vec<Op>,
@@ -193,23 +259,7 @@ impl Program {
             }
             v
         };
-        // spatial nodes (not x, y themselves) read by a node that also depends on t, or outputs: cached
-        let mut cache_it = vec![false; nodes.len()];
-        for (i, op) in nodes.iter().enumerate() {
-            if varying[i] && timed[i] {
-                let reads: &[u32] = match op {
-                    Op::Un(_, a) => &[*a][..],
-                    Op::Bin(_, a, c) => &[*a, *c][..],
-                    _ => &[],
-                };
-                reads.iter().for_each(|&r| cache_it[r as usize] = varying[r as usize] && !timed[r as usize]);
-            }
-        }
-        for &o in &out_nodes {
-            cache_it[o as usize] = varying[o as usize] && !timed[o as usize];
-        }
-        cache_it[0] = false;
-        cache_it[1] = false;
+        let (cache_it, at_time) = plan_cache(&nodes, &varying, &timed, &out_nodes);
         // last varying reader of each node (outputs are read at the end)
         let mut last = vec![0usize; nodes.len()];
         for (i, op) in nodes.iter().enumerate() {
@@ -253,7 +303,7 @@ impl Program {
                 }
             }
         }
-        let mut instrs = Vec::new();
+        let (mut all, mut spatial, mut timed_instrs) = (Vec::new(), Vec::new(), Vec::new());
         let mut cached = Vec::new();
         for (i, op) in nodes.iter().enumerate() {
             if !varying[i] || matches!(op, Op::X | Op::Y) {
@@ -265,29 +315,37 @@ impl Program {
                 cached.push(dst);
             }
             slot[i] = dst;
-            let spatial = !timed[i];
             let release = |r: u32, free: &mut Vec<u32>| {
                 if varying[r as usize] && !cache_it[r as usize] && last[r as usize] == i && r > 1 {
                     free.push(slot[r as usize]);
                 }
             };
-            match *op {
+            let ins = match *op {
                 Op::Un(f, a) => {
-                    instrs.push((Instr::Un(f, dst, slot[a as usize]), spatial));
+                    let ins = Instr::Un(f, dst, slot[a as usize]);
                     release(a, &mut free);
+                    ins
                 }
                 Op::Bin(f, a, c) => {
-                    instrs.push((Instr::Bin(f, dst, slot[a as usize], slot[c as usize]), spatial));
+                    let ins = Instr::Bin(f, dst, slot[a as usize], slot[c as usize]);
                     release(a, &mut free);
                     if c != a {
                         release(c, &mut free);
                     }
+                    ins
                 }
-                _ => {}
+                _ => continue,
+            };
+            all.push(ins);
+            if !timed[i] {
+                spatial.push(ins);
+            }
+            if at_time[i] {
+                timed_instrs.push(ins);
             }
         }
         let outputs = out_nodes.iter().map(|&o| (o, Some(slot[o as usize]).filter(|_| varying[o as usize]))).collect();
-        Program { nodes, varying, instrs, cached, broadcast, n_slots, outputs }
+        Program { nodes, varying, all, spatial, timed: timed_instrs, cached, broadcast, n_slots, outputs }
     }
 
     /// Number of outputs.
@@ -297,185 +355,16 @@ impl Program {
 
     /// Number of varying instructions (work per point).
     pub fn n_instructions(&self) -> usize {
-        self.instrs.len()
+        self.all.len()
     }
 
-    /// Values of the uniform nodes at time t (NaN for varying nodes, which are never read here).
-    fn uniform(&self, t: f64) -> Vec<f64> {
-        let mut v = vec![f64::NAN; self.nodes.len()];
-        for (i, op) in self.nodes.iter().enumerate() {
-            if self.varying[i] {
-                continue;
-            }
-            v[i] = match *op {
-                Op::Const(c) => c,
-                Op::T => t,
-                Op::Un(f, a) => f.apply(v[a as usize]),
-                Op::Bin(f, a, b) => f.apply(v[a as usize], v[b as usize]),
-                Op::X | Op::Y => f64::NAN,
-            };
-        }
-        v
+    /// Instructions per point at each time once the spatial part is cached.
+    pub fn n_timed_instructions(&self) -> usize {
+        self.timed.len()
     }
 
-    /// All outputs at one point, evaluating node by node (for single evaluations).
-    pub fn eval_point(&self, x: f64, y: f64, t: f64, out: &mut [f64]) {
-        let mut v = vec![0.0; self.nodes.len()];
-        for (i, op) in self.nodes.iter().enumerate() {
-            v[i] = match *op {
-                Op::Const(c) => c,
-                Op::X => x,
-                Op::Y => y,
-                Op::T => t,
-                Op::Un(f, a) => f.apply(v[a as usize]),
-                Op::Bin(f, a, b) => f.apply(v[a as usize], v[b as usize]),
-            };
-        }
-        for (o, &(node, _)) in out.iter_mut().zip(&self.outputs) {
-            *o = v[node as usize];
-        }
-    }
-
-    /// All outputs at every point at time t, point-major: `out[i * n_outputs + k]`. Points are split
-    /// into chunks evaluated in parallel (pointwise, so the values do not depend on the split). With
-    /// `cache` (from [`Program::fill_cache`] on the same points) the spatial part is read, not computed:
-    /// the same operations were done there, so the values are the same.
-    pub fn eval(&self, points: &[[f64; 2]], t: f64, cache: Option<&[f64]>, out: &mut Vec<f64>) {
-        let m = self.outputs.len();
-        out.clear();
-        out.resize(points.len() * m, 0.0);
-        if m == 0 || points.is_empty() {
-            return;
-        }
-        let uniform = self.uniform(t);
-        let per_chunk = CHUNK / LANES * self.cached.len() * LANES;
-        crate::parallel::for_chunks(out, CHUNK * m, |c, chunk| {
-            let pts = &points[c * CHUNK..(c * CHUNK + chunk.len() / m)];
-            let cache = cache.map(|cc| &cc[c * per_chunk..(c * per_chunk + per_chunk).min(cc.len())]);
-            self.eval_chunk(pts, &uniform, Some(chunk), cache, None);
-        });
-    }
-
-    /// The cached spatial values at `points` (batch by batch, slot by slot), for [`Program::eval`].
-    pub fn fill_cache(&self, points: &[[f64; 2]]) -> Vec<f64> {
-        let n_batches = points.len().div_ceil(LANES);
-        let mut cache = vec![0.0; n_batches * self.cached.len() * LANES];
-        if self.cached.is_empty() {
-            return cache;
-        }
-        // spatial nodes do not depend on t: any t gives their values
-        let uniform = self.uniform(0.0);
-        let per_chunk = CHUNK / LANES * self.cached.len() * LANES;
-        crate::parallel::for_chunks(&mut cache, per_chunk, |c, chunk| {
-            let pts = &points[c * CHUNK..(c * CHUNK + CHUNK).min(points.len())];
-            self.eval_chunk(pts, &uniform, None, None, Some(chunk));
-        });
-        cache
-    }
-
-    /// Evaluate batches of points: everything into `out` (no cache), the time-dependent part into `out`
-    /// from `cache`, or only the spatial part into `fill`.
-    fn eval_chunk(
-        &self,
-        points: &[[f64; 2]],
-        uniform: &[f64],
-        out: Option<&mut [f64]>,
-        cache: Option<&[f64]>,
-        mut fill: Option<&mut [f64]>,
-    ) {
-        let m = self.outputs.len();
-        let nc = self.cached.len();
-        let mut out = out;
-        let mut regs = vec![[0.0f64; LANES]; self.n_slots];
-        for &(s, n) in &self.broadcast {
-            regs[s as usize] = [uniform[n as usize]; LANES];
-        }
-        for (b, pts) in points.chunks(LANES).enumerate() {
-            // a partial batch repeats its first point in the unused lanes (never read back)
-            for l in 0..LANES {
-                let p = pts.get(l).unwrap_or(&pts[0]);
-                regs[SLOT_X as usize][l] = p[0];
-                regs[SLOT_Y as usize][l] = p[1];
-            }
-            if let Some(cache) = cache {
-                for (k, &s) in self.cached.iter().enumerate() {
-                    let at = (b * nc + k) * LANES;
-                    regs[s as usize].copy_from_slice(&cache[at..at + LANES]);
-                }
-            }
-            let r = regs.as_mut_ptr();
-            for &(ref ins, spatial) in &self.instrs {
-                // with a cache the spatial instructions were done when it was filled; filling, the others wait
-                if (cache.is_some() && spatial) || (fill.is_some() && !spatial) {
-                    continue;
-                }
-                // SAFETY: every slot index is < n_slots = regs.len() (assigned in `Program::new`), and an
-                // instruction's destination slot is taken while its operands still hold theirs, so it
-                // differs from both: the mutable and the shared references never overlap.
-                unsafe {
-                    match *ins {
-                        Instr::Un(f, d, a) => un_lanes(f, &*r.add(a as usize), &mut *r.add(d as usize)),
-                        Instr::Bin(f, d, a, c) => {
-                            bin_lanes(f, &*r.add(a as usize), &*r.add(c as usize), &mut *r.add(d as usize))
-                        }
-                    }
-                }
-            }
-            if let Some(fill) = fill.as_deref_mut() {
-                for (k, &s) in self.cached.iter().enumerate() {
-                    let at = (b * nc + k) * LANES;
-                    fill[at..at + LANES].copy_from_slice(&regs[s as usize]);
-                }
-                continue;
-            }
-            let Some(out) = out.as_deref_mut() else { continue };
-            let base = b * LANES * m;
-            for (k, &(node, s)) in self.outputs.iter().enumerate() {
-                for l in 0..pts.len() {
-                    out[base + l * m + k] = match s {
-                        Some(s) => regs[s as usize][l],
-                        None => uniform[node as usize],
-                    };
-                }
-            }
-        }
-    }
-}
-
-/// d ← f(a) lane by lane; a separate loop per operation so each is vectorised where it can be.
-#[inline(always)]
-fn un_lanes(f: Un, a: &[f64; LANES], d: &mut [f64; LANES]) {
-    macro_rules! each {
-        ($e:expr) => {
-            for l in 0..LANES {
-                d[l] = $e(a[l]);
-            }
-        };
-    }
-    match f {
-        Un::Neg => each!(|v: f64| -v),
-        Un::Abs => each!(|v: f64| v.abs()),
-        _ => each!(|v| f.apply(v)),
-    }
-}
-
-/// d ← f(a, c) lane by lane.
-#[inline(always)]
-fn bin_lanes(f: Bin, a: &[f64; LANES], c: &[f64; LANES], d: &mut [f64; LANES]) {
-    macro_rules! each {
-        ($e:expr) => {
-            for l in 0..LANES {
-                d[l] = $e(a[l], c[l]);
-            }
-        };
-    }
-    match f {
-        Bin::Add => each!(|u: f64, v: f64| u + v),
-        Bin::Sub => each!(|u: f64, v: f64| u - v),
-        Bin::Mul => each!(|u: f64, v: f64| u * v),
-        Bin::Div => each!(|u: f64, v: f64| u / v),
-        Bin::Min => each!(|u: f64, v: f64| u.min(v)),
-        Bin::Max => each!(|u: f64, v: f64| u.max(v)),
-        _ => each!(|u, v| f.apply(u, v)),
+    /// Cached values per point (the spatial nodes the timed part reads).
+    pub fn n_cached(&self) -> usize {
+        self.cached.len()
     }
 }

@@ -1,0 +1,45 @@
+//! The true error norms evaluate the exact solution chunk of elements by chunk in parallel: a
+//! non-finite exact value is still reported for the first quadrature point in order that has one, naming
+//! the expression, whatever chunk finds it first; and the norms do not depend on the thread count.
+
+use std::path::Path;
+use tresca_cr::fem::elasticity::Elasticity;
+use tresca_cr::fem::norms::ErrorEvaluator;
+use tresca_cr::fem::quadrature::{tri_point, TRI4};
+use tresca_cr::fem::space::CrSpace;
+use tresca_cr::mesh::Mesh;
+use tresca_cr::scene::expr::Expr;
+use tresca_cr::Scene;
+
+#[test]
+fn non_finite_exact_value_names_expression_and_first_point() {
+    let mut scene =
+        Scene::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/cases/mms_stop.toml")).unwrap();
+    scene.set_refine(4).unwrap();
+    let mesh = Mesh::from_spec(&scene.mesh).unwrap();
+    let space = CrSpace::new(&mesh, &scene.parts).unwrap();
+    let law = Elasticity::new(&scene.material);
+    let mut exact = scene.exact.clone().unwrap();
+    // infinite where x >= 0.9: in many chunks of elements, none of them the first
+    exact.grad[1][0] = Expr::parse("exact.grad[1][0]", "1/max(0.9-x, 0)").unwrap();
+    let ev = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(&exact);
+    let mid = vec![[0.0; 2]; mesh.edges.len()];
+    let first = mesh
+        .tris
+        .iter()
+        .flat_map(|t| TRI4.map(|(l, _)| tri_point(t.map(|v| mesh.points[v]), l)))
+        .find(|p| p[0] >= 0.9)
+        .unwrap();
+    for _ in 0..3 {
+        let e = ev.errors(&mesh, &exact, &mid, 0.5).unwrap_err().to_string();
+        let at = format!("value inf at (x={}, y={}, t=0.5)", first[0], first[1]);
+        assert!(e.contains("1/max(0.9-x, 0)") && e.contains(&at), "{e}\nexpected {at}");
+    }
+    // the exact solution itself: finite norms, the same bits every time
+    let exact = scene.exact.clone().unwrap();
+    let ev = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(&exact);
+    let a = ev.errors(&mesh, &exact, &mid, 0.5).unwrap();
+    let b = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).errors(&mesh, &exact, &mid, 0.5).unwrap();
+    assert!(a.energy.is_finite() && a.energy > 0.0);
+    assert_eq!([a.energy, a.h1, a.l2].map(f64::to_bits), [b.energy, b.h1, b.l2].map(f64::to_bits));
+}
