@@ -14,6 +14,7 @@
 mod eval;
 mod lint;
 pub mod program;
+mod regroup;
 pub mod sym;
 
 use crate::error::{Error, Result};

@@ -7,12 +7,7 @@
 //! * integer powers a^n, |n| ≤ [`MAX_INT_POWER`], become products by binary powering (a^{-n} = 1/a^n)
 //!   instead of `powf`; within a few ulps of `powf` (each product rounds once);
 //! * operations on constants are computed at compile time (exmex's own folding already did most);
-//! * products are regrouped so the time-dependent factors come last ([`Builder::product`]): exmex
-//!   groups `35*(y^2)*(1-y)*(t+1)*cos(x)/52` as ((((35·y²)·(1−y))·(t+1))·cos x)/52, so everything after
-//!   (t+1) had to be redone at every time node; as (35·y²·(1−y)·cos x / 52)·(t+1) the spatial factor is
-//!   computed (or cached) once and a time node costs one product per term. This reassociates
-//!   products and divisions by time-independent values, so values move by a few ulps of the term
-//!   (tests/expr_exactness.rs: ≤ 1e-13 of the expression's size, measured 5e-15);
+//! * products are regrouped with their time-dependent factors last ([`super::regroup`]);
 //! * nodes that depend on neither x nor y ("uniform": constants, t and what is computed from them) are
 //!   evaluated once per call, as scalars, and broadcast;
 //! * nodes that depend on x, y but not t ("spatial") can be evaluated once for a fixed set of points
@@ -27,6 +22,7 @@
 //! Evaluation (batches of points, the cache read in place, the finiteness check on the way out) is in
 //! [`super::eval`]; this module only lowers and schedules.
 
+use super::regroup;
 use super::sym::{Bin, Sym, Un};
 use std::collections::HashMap;
 
@@ -224,12 +220,7 @@ impl Builder {
     /// as (the t-independent factors, in their order) × (the t-dependent ones, in their order); `None`
     /// when all factors are of one kind (then the product is lowered as written).
     fn product(&mut self, s: &Sym) -> Option<u32> {
-        let mut factors = Vec::new();
-        collect_factors(s, false, &mut factors);
-        let timed: Vec<bool> = factors.iter().map(|(f, _)| has_t(f)).collect();
-        if !(timed.contains(&true) && timed.contains(&false)) {
-            return None;
-        }
+        let (factors, timed) = regroup::factors(s)?;
         let mut acc: Option<u32> = None;
         for pass_timed in [false, true] {
             for ((f, divide), _) in factors.iter().zip(&timed).filter(|(_, &tm)| tm == pass_timed) {
@@ -262,32 +253,6 @@ impl Builder {
                 self.intern(Op::Bin(Bin::Mul, h, a))
             }
         }
-    }
-}
-
-/// The factors of the product tree at `s`: through products, and through divisions whose divisor does
-/// not depend on t (pushed as divisors, `true`); anything else is one factor.
-fn collect_factors<'a>(s: &'a Sym, divide: bool, out: &mut Vec<(&'a Sym, bool)>) {
-    match s {
-        Sym::Bin(Bin::Mul, a, b) if !divide => {
-            collect_factors(a, false, out);
-            collect_factors(b, false, out);
-        }
-        Sym::Bin(Bin::Div, a, b) if !divide && !has_t(b) => {
-            collect_factors(a, false, out);
-            out.push((b, true));
-        }
-        _ => out.push((s, divide)),
-    }
-}
-
-/// True if the tree depends on t.
-fn has_t(s: &Sym) -> bool {
-    match s {
-        Sym::Num(_) => false,
-        Sym::Var(v) => *v >= 2,
-        Sym::Un(_, a) => has_t(a),
-        Sym::Bin(_, a, b) => has_t(a) || has_t(b),
     }
 }
 
