@@ -5,26 +5,24 @@
 
 use rayon::prelude::*;
 
-/// Inputs shorter than this are mapped sequentially: handing work to the pool and waking its workers
-/// costs tens of µs, and on small meshes (a planner's pilot levels evaluate loads at every time node
-/// of 100–6,000-unknown problems) that overhead and the workers' yielding cost more CPU than the
-/// evaluation (2048 → 32768: the planner's CPU on mms_stop 0.21–0.23 → 0.18–0.19 s).
+/// Work below this many values (expression values at points) is done sequentially: handing work to the
+/// pool and waking its workers costs tens of µs, and on small meshes (a planner's pilot levels evaluate
+/// loads at every time node of 100–6,000-unknown problems) that overhead and the workers' yielding
+/// cost more CPU than the evaluation (2048 → 32768: the planner's CPU on mms_stop 0.21–0.23 →
+/// 0.18–0.19 s).
 const MIN_PARALLEL: usize = 32768;
 
-/// `items.iter().map(f).collect()`, in parallel for long inputs, results in input order.
-pub fn map<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync + Send) -> Vec<R> {
-    if items.len() < MIN_PARALLEL {
-        items.iter().map(f).collect()
-    } else {
-        items.par_iter().with_min_len(256).map(f).collect()
-    }
-}
-
 /// `f(i, chunk_i)` for the consecutive chunks of `chunk` entries of `out` (the last may be shorter), in
-/// parallel when there are several chunks and `out` is long. Each chunk is written by one call only.
-pub fn for_chunks<R: Send>(out: &mut [R], chunk: usize, f: impl Fn(usize, &mut [R]) + Sync + Send) {
+/// parallel when there are several chunks and the work, `values_per_entry` values for each entry of
+/// `out`, is at least [`MIN_PARALLEL`]. Each chunk is written by one call only.
+pub fn for_chunks<R: Send>(
+    out: &mut [R],
+    chunk: usize,
+    values_per_entry: usize,
+    f: impl Fn(usize, &mut [R]) + Sync + Send,
+) {
     let chunk = chunk.max(1);
-    if out.len() <= chunk || out.len() < MIN_PARALLEL {
+    if out.len() <= chunk || out.len().saturating_mul(values_per_entry) < MIN_PARALLEL {
         out.chunks_mut(chunk).enumerate().for_each(|(i, c)| f(i, c));
     } else {
         out.par_chunks_mut(chunk).enumerate().for_each(|(i, c)| f(i, c));

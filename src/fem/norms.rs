@@ -90,7 +90,7 @@ impl ErrorEvaluator {
         let mut parts = vec![[0.0f64; 3]; self.elements.len()];
         // the error of the first chunk (in point order) that has a non-finite value
         let failed: Mutex<Option<(usize, Error)>> = Mutex::new(None);
-        crate::parallel::for_chunks(&mut parts, CHUNK_ELEMENTS, |c, chunk| {
+        crate::parallel::for_chunks(&mut parts, CHUNK_ELEMENTS, per_element * 6, |c, chunk| {
             let first = c * CHUNK_ELEMENTS;
             let mut values = Vec::with_capacity(chunk.len() * per_element * 6);
             if let Err(e) = bound.eval_range(first * per_element, chunk.len() * per_element, t, &mut values) {

@@ -87,7 +87,7 @@ impl Program {
         let uniform = self.uniform(t);
         let per_chunk = CHUNK * self.cached.len();
         let finite = AtomicBool::new(true);
-        crate::parallel::for_chunks(out, CHUNK * m, |c, chunk| {
+        crate::parallel::for_chunks(out, CHUNK * m, 1, |c, chunk| {
             let pts = &points[c * CHUNK..(c * CHUNK + chunk.len() / m)];
             let path = match cache {
                 Some(cc) => Path::Cached(&cc[c * per_chunk..(c * per_chunk + per_chunk).min(cc.len())]),
@@ -130,7 +130,7 @@ impl Program {
         }
         // spatial nodes do not depend on t: any t gives their values
         let uniform = self.uniform(0.0);
-        crate::parallel::for_chunks(&mut cache, CHUNK * self.cached.len(), |c, chunk| {
+        crate::parallel::for_chunks(&mut cache, CHUNK * self.cached.len(), 1, |c, chunk| {
             let pts = &points[c * CHUNK..(c * CHUNK + CHUNK).min(points.len())];
             run(self, pts, &uniform, Path::Fill, chunk);
         });
