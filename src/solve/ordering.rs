@@ -156,10 +156,8 @@ impl Graph {
 pub(super) fn nested_dissection(q: &Graph) -> Option<(Vec<usize>, Vec<usize>)> {
     let n = q.unknowns();
     let ng = q.len();
-    let xadj: Vec<i32> = q.start.iter().map(|&v| i32::try_from(v).ok()).collect::<Option<_>>()?;
-    let adjncy: Vec<i32> = q.adj.iter().map(|&v| i32::try_from(v).ok()).collect::<Option<_>>()?;
-    let mut xadj = xadj;
-    let mut adjncy = adjncy;
+    let mut xadj: Vec<i32> = q.start.iter().map(|&v| i32::try_from(v).ok()).collect::<Option<_>>()?;
+    let mut adjncy: Vec<i32> = q.adj.iter().map(|&v| i32::try_from(v).ok()).collect::<Option<_>>()?;
     if adjncy.is_empty() {
         return None;
     }
