@@ -4,6 +4,8 @@
 //! binding) is timed apart. Prints one JSON line per case; median of 5 passes over all time nodes.
 //!
 //! `RAYON_NUM_THREADS=1 cargo run --release --example mms_node_cost [SCENE REFINE STEPS]...`
+//! `loads_unseparated` is the same load with every term evaluated at every node (`Loads::with_separation`
+//! with `false`), the route of scenes whose loads do not separate.
 //! (default: mms_stop r4/16 and r5/64, mms_front r2/256, mms_rotated r3/16, bench_mms_poly r0/16, its own 256×128 mesh).
 //! Wall and CPU (user + system, all threads) milliseconds per node.
 
@@ -40,7 +42,8 @@ fn main() {
         let space = CrSpace::new(&mesh, &scene.parts).unwrap();
         let law = Elasticity::new(&scene.material);
         let t0 = Instant::now();
-        let loads = Loads::new(&scene, &mesh, &space);
+        let loads = Loads::new(&scene, &mesh, &space).unwrap();
+        let direct = Loads::with_separation(&scene, &mesh, &space, false).unwrap();
         let exact = scene.exact.clone().unwrap();
         let ev = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(&exact);
         let setup = t0.elapsed().as_secs_f64();
@@ -50,6 +53,7 @@ fn main() {
             v[v.len() / 2]
         };
         let (mut l, mut e, mut lc, mut ec, mut sink) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), 0.0);
+        let mut ld = Vec::new();
         let mut out = Vec::new();
         let n = scene.times.len() as f64;
         for _ in 0..5 {
@@ -62,16 +66,23 @@ fn main() {
             for &t in &scene.times {
                 sink += ev.errors(&mesh, &exact, &mid, t).unwrap().l2;
             }
+            let t2 = Instant::now();
+            for &t in &scene.times {
+                direct.assemble_on_support(t, &mut out).unwrap();
+                sink += out[0];
+            }
+            ld.push(t2.elapsed().as_secs_f64() / n);
             l.push((t1 - t0).as_secs_f64() / n);
-            e.push(t1.elapsed().as_secs_f64() / n);
+            e.push((t2 - t1).as_secs_f64() / n);
             lc.push((c1 - c0) / n);
             ec.push((cpu_seconds() - c1) / n);
         }
         println!(
-            "{{\"scene\": \"{file}\", \"refine\": {refine}, \"steps\": {steps}, \"triangles\": {}, \"setup_ms\": {:.2}, \"loads_ms_per_node\": {:.3}, \"errors_ms_per_node\": {:.3}, \"loads_cpu_ms_per_node\": {:.3}, \"errors_cpu_ms_per_node\": {:.3}, \"sink\": {}}}",
+            "{{\"scene\": \"{file}\", \"refine\": {refine}, \"steps\": {steps}, \"triangles\": {}, \"setup_ms\": {:.2}, \"loads_ms_per_node\": {:.3}, \"loads_unseparated_ms_per_node\": {:.3}, \"errors_ms_per_node\": {:.3}, \"loads_cpu_ms_per_node\": {:.3}, \"errors_cpu_ms_per_node\": {:.3}, \"sink\": {}}}",
             mesh.tris.len(),
             setup * 1e3,
             median(l) * 1e3,
+            median(ld) * 1e3,
             median(e) * 1e3,
             median(lc) * 1e3,
             median(ec) * 1e3,

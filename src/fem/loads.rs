@@ -3,6 +3,13 @@
 //! Quadrature points and the weights w·φ feeding each unknown are stored once, so each step evaluates the
 //! (compiled) load expressions at all points of a term in one batch, then scatters sequentially.
 //!
+//! **Separated loads.** A term whose components are sums of time factors times space parts,
+//! f = Σ_j τ_j(t) s_j(x) (`Expr::separate`; every manufactured load of `verification/cases/` but
+//! mms_front's moving front), is assembled once per distinct τ_j into a pattern P_j at set-up, and a
+//! time node costs l = Σ_j τ_j(tₙ) P_j: [`MAX_FACTORS`] multiply-adds per unknown of the support instead
+//! of the expressions at every quadrature point. The two routes compute the same integrals with the
+//! products reassociated (a test bounds the difference at 1e-14 of the load's size).
+//!
 //! Storage is what a time node streams through memory, so it is compact: the points of one triangle
 //! (or one Neumann edge) feed the same three edges, stored once per such group; per point only its three
 //! weights w·φᵢ; the unknowns and vector coefficients of an edge come from one table shared by all terms.
@@ -12,7 +19,9 @@ use super::quadrature::{edge_point, tri_point, GAUSS3, TRI4};
 use super::space::{CrSpace, Element};
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::scene::expr::{BoundSet, ExprSet, Vec2Expr};
+use crate::scene::expr::program::Program;
+use crate::scene::expr::sym::Sym;
+use crate::scene::expr::{BoundSet, Expr, ExprSet, Vec2Expr};
 use crate::scene::{PartKind, Scene};
 
 /// A quadrature point of a load term: position, and the (edge, weight · φ) pairs it feeds.
@@ -22,15 +31,36 @@ struct LoadPoint {
     edges: [(usize, f64); 3],
 }
 
-/// Precomputed quadrature for one vector load (body force or one Neumann part).
+/// Largest number of distinct time factors assembled as patterns (a node then costs at most this many
+/// multiply-adds per unknown of the support); terms beyond it are evaluated at every node.
+pub const MAX_FACTORS: usize = 8;
+
+/// The quadrature of one vector load (body force or one Neumann part) in scatter form.
 #[derive(Clone, Debug)]
-struct LoadTerm {
-    /// Both components, compiled together and bound to the quadrature points.
-    expr: BoundSet,
+struct Quad {
     /// Consecutive points feeding the same three edges: the edges and the number of points.
     groups: Vec<([u32; 3], u32)>,
     /// Per point: the weight w·φᵢ of each of its group's edges.
     weights: Vec<[f64; 3]>,
+}
+
+/// A load term evaluated at every time node.
+#[derive(Clone, Debug)]
+struct LoadTerm {
+    /// Both components, compiled together and bound to the quadrature points.
+    expr: BoundSet,
+    quad: Quad,
+}
+
+/// The separated terms: l_sep(t) = Σ_j τ_j(t) P_j.
+#[derive(Clone, Debug)]
+struct Patterns {
+    /// The time factors τ_j, compiled together (output j).
+    factors: Program,
+    /// An expression each factor came from (for messages).
+    names: Vec<Expr>,
+    /// P_j on the support.
+    vectors: Vec<Vec<f64>>,
 }
 
 thread_local! {
@@ -41,7 +71,9 @@ thread_local! {
 /// The load functional t ↦ l(t) on the unknowns.
 #[derive(Clone, Debug)]
 pub struct Loads {
+    /// Terms evaluated at every node.
     terms: Vec<LoadTerm>,
+    patterns: Patterns,
     /// The (support slot, vector coefficient) pairs of edge e: `edge_terms[edge_first[e]..edge_first[e + 1]]`.
     edge_first: Vec<u32>,
     edge_terms: Vec<(u32, [f64; 2])>,
@@ -52,8 +84,15 @@ pub struct Loads {
 }
 
 impl Loads {
-    /// Quadrature points of the body force (if any) and of every Neumann part with a traction.
-    pub fn new(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Loads {
+    /// Quadrature points of the body force (if any) and of every Neumann part with a traction; the
+    /// terms that separate are assembled into patterns now (an error if a space part is not finite).
+    pub fn new(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<Loads> {
+        Self::with_separation(scene, mesh, space, true)
+    }
+
+    /// As [`Loads::new`]; with `separate = false` every term is evaluated at every node (the reference
+    /// route the patterns are tested against).
+    pub fn with_separation(scene: &Scene, mesh: &Mesh, space: &CrSpace, separate: bool) -> Result<Loads> {
         let mut raw: Vec<(&Vec2Expr, Vec<LoadPoint>)> = Vec::new();
         if let Some(f) = &scene.f {
             let mut points = Vec::with_capacity(6 * mesh.tris.len());
@@ -109,23 +148,41 @@ impl Loads {
             edge_terms.extend(dof.terms().map(|(k, c)| (slot[k] as u32, c)));
             edge_first.push(edge_terms.len() as u32);
         }
-        let terms = raw
-            .into_iter()
-            .map(|(e, pts)| {
-                let mut groups: Vec<([u32; 3], u32)> = Vec::new();
-                for p in &pts {
-                    let edges = p.edges.map(|(e, _)| e as u32);
-                    match groups.last_mut() {
-                        Some((g, n)) if *g == edges => *n += 1,
-                        _ => groups.push((edges, 1)),
-                    }
+        let mut loads = Loads {
+            terms: Vec::new(),
+            patterns: Patterns { factors: Program::new(&[]), names: Vec::new(), vectors: Vec::new() },
+            edge_first,
+            edge_terms,
+            n_dofs: space.n_dofs,
+            support,
+        };
+        let mut factors: Vec<(String, Sym)> = Vec::new();
+        let mut values = Vec::new();
+        for (e, pts) in raw {
+            let quad = Quad::new(&pts);
+            let points: Vec<[f64; 2]> = pts.iter().map(|p| p.x).collect();
+            let Some(parts) = separated(e, &mut factors, separate) else {
+                loads.terms.push(LoadTerm { expr: ExprSet::new(&[&e.0[0], &e.0[1]]).bind(points), quad });
+                continue;
+            };
+            for (j, [sx, sy]) in parts {
+                if j == loads.patterns.vectors.len() {
+                    loads.patterns.vectors.push(vec![0.0; loads.support.len()]);
+                    loads.patterns.names.push(e.0[0].clone());
                 }
-                let weights = pts.iter().map(|p| p.edges.map(|(_, w)| w)).collect();
-                let points = pts.iter().map(|p| p.x).collect();
-                LoadTerm { expr: ExprSet::new(&[&e.0[0], &e.0[1]]).bind(points), groups, weights }
-            })
-            .collect();
-        Loads { terms, edge_first, edge_terms, n_dofs: space.n_dofs, support }
+                ExprSet::derived(&[&e.0[0], &e.0[1]], &[&sx, &sy]).eval(&points, 0.0, &mut values)?;
+                let mut p = std::mem::take(&mut loads.patterns.vectors[j]);
+                loads.scatter(&quad, &values, &mut p);
+                loads.patterns.vectors[j] = p;
+            }
+        }
+        loads.patterns.factors = Program::new(&factors.iter().map(|(_, tau)| tau).collect::<Vec<_>>());
+        Ok(loads)
+    }
+
+    /// Number of load patterns (distinct time factors of the separated terms).
+    pub fn n_patterns(&self) -> usize {
+        self.patterns.vectors.len()
     }
 
     /// The unknowns a load can be nonzero on (increasing).
@@ -137,6 +194,17 @@ impl Loads {
     pub fn assemble_on_support(&self, t: f64, out: &mut Vec<f64>) -> Result<()> {
         out.clear();
         out.resize(self.support.len(), 0.0);
+        let p = &self.patterns;
+        if !p.vectors.is_empty() {
+            let mut tau = vec![0.0; p.vectors.len()];
+            p.factors.eval_point(0.0, 0.0, t, &mut tau);
+            for ((&c, v), name) in tau.iter().zip(&p.vectors).zip(&p.names) {
+                if !c.is_finite() {
+                    return Err(name.error(format!("value {c} at t = {t} (of a time factor, at every point)")));
+                }
+                out.iter_mut().zip(v).for_each(|(o, x)| *o += c * x);
+            }
+        }
         SCRATCH.with(|cell| {
             // a nested call on this thread (none today) would get a buffer of its own
             let mut own = Vec::new();
@@ -145,22 +213,27 @@ impl Loads {
             for term in &self.terms {
                 // the expression values in parallel batches, the sums sequentially: bit-identical results
                 term.expr.eval(t, values)?;
-                let mut points = values.chunks_exact(2).zip(&term.weights);
-                for &(edges, n) in &term.groups {
-                    let terms = edges.map(|e| {
-                        &self.edge_terms[self.edge_first[e as usize] as usize..self.edge_first[e as usize + 1] as usize]
-                    });
-                    for (v, w) in points.by_ref().take(n as usize) {
-                        for (terms, w) in terms.iter().zip(w) {
-                            for &(slot, c) in *terms {
-                                out[slot as usize] += w * (c[0] * v[0] + c[1] * v[1]);
-                            }
-                        }
-                    }
-                }
+                self.scatter(&term.quad, values, out);
             }
             Ok(())
         })
+    }
+
+    /// out += the quadrature sums of `values` (two per point, point-major) over the points of `quad`.
+    fn scatter(&self, quad: &Quad, values: &[f64], out: &mut [f64]) {
+        let mut points = values.chunks_exact(2).zip(&quad.weights);
+        for &(edges, n) in &quad.groups {
+            let terms = edges.map(|e| {
+                &self.edge_terms[self.edge_first[e as usize] as usize..self.edge_first[e as usize + 1] as usize]
+            });
+            for (v, w) in points.by_ref().take(n as usize) {
+                for (terms, w) in terms.iter().zip(w) {
+                    for &(slot, c) in *terms {
+                        out[slot as usize] += w * (c[0] * v[0] + c[1] * v[1]);
+                    }
+                }
+            }
+        }
     }
 
     /// Scatter values on the support into a full vector of unknowns.
@@ -179,4 +252,50 @@ impl Loads {
         self.expand(&s, out);
         Ok(())
     }
+}
+
+impl Quad {
+    fn new(pts: &[LoadPoint]) -> Quad {
+        let mut groups: Vec<([u32; 3], u32)> = Vec::new();
+        for p in pts {
+            let edges = p.edges.map(|(e, _)| e as u32);
+            match groups.last_mut() {
+                Some((g, n)) if *g == edges => *n += 1,
+                _ => groups.push((edges, 1)),
+            }
+        }
+        Quad { groups, weights: pts.iter().map(|p| p.edges.map(|(_, w)| w)).collect() }
+    }
+}
+
+/// The parts of `e` by time factor, (index into `factors`, [x part, y part]), when both components
+/// separate and the factors (new ones appended to `factors`, keyed by their tree) stay within
+/// [`MAX_FACTORS`]; `None` (and `factors` unchanged) otherwise.
+fn separated(e: &Vec2Expr, factors: &mut Vec<(String, Sym)>, separate: bool) -> Option<Vec<(usize, [Sym; 2])>> {
+    if !separate {
+        return None;
+    }
+    let comps = [e.0[0].separate()?, e.0[1].separate()?];
+    let mut known = factors.clone();
+    let mut out: Vec<(usize, [Sym; 2])> = Vec::new();
+    for (c, parts) in comps.into_iter().enumerate() {
+        for (tau, space) in parts {
+            let key = format!("{tau:?}");
+            let j = known.iter().position(|(k, _)| *k == key).unwrap_or_else(|| {
+                known.push((key, tau));
+                known.len() - 1
+            });
+            let at = out.iter().position(|(i, _)| *i == j).unwrap_or_else(|| {
+                out.push((j, [Sym::Num(0.0), Sym::Num(0.0)]));
+                out.len() - 1
+            });
+            out[at].1[c] = space;
+        }
+    }
+    if known.len() > MAX_FACTORS {
+        return None;
+    }
+    *factors = known;
+    out.sort_by_key(|(j, _)| *j);
+    Some(out)
 }

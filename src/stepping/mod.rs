@@ -125,6 +125,7 @@ impl Problem {
             let order = order.join().map_err(|_| Error::Linear("the fill-reducing ordering failed".into()));
             (stiffness, loads, order)
         });
+        let loads = loads?;
         let t2 = Instant::now();
         // contact unknowns last: the condensation then comes from the factor (solve::condense)
         let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();

@@ -15,6 +15,7 @@ mod eval;
 mod lint;
 pub mod program;
 mod regroup;
+mod separate;
 pub mod sym;
 
 use crate::error::{Error, Result};
@@ -86,6 +87,17 @@ impl Expr {
     /// True if the expression depends on `t`.
     pub fn depends_on_t(&self) -> bool {
         self.uses[2]
+    }
+
+    /// The expression tree (as exmex groups it).
+    pub fn tree(&self) -> &Sym {
+        &self.tree
+    }
+
+    /// The parts (τ_j(t), s_j(x, y)) with e = Σ_j τ_j s_j and distinct τ_j, if the expression separates
+    /// ([`separate`]).
+    pub fn separate(&self) -> Option<Vec<(Sym, Sym)>> {
+        separate::separate(&self.tree)
     }
 
     /// The source text.
@@ -172,6 +184,13 @@ impl ExprSet {
     pub fn new(exprs: &[&Expr]) -> ExprSet {
         let trees: Vec<&Sym> = exprs.iter().map(|e| &*e.tree).collect();
         ExprSet { exprs: exprs.iter().map(|&e| e.clone()).collect(), program: Program::new(&trees) }
+    }
+
+    /// Trees derived from `names` (parts of them, [`Expr::separate`]) compiled together; output k is
+    /// `trees[k]`, and a non-finite value is reported as one of `names[k]`.
+    pub fn derived(names: &[&Expr], trees: &[&Sym]) -> ExprSet {
+        assert_eq!(names.len(), trees.len(), "one name per derived tree");
+        ExprSet { exprs: names.iter().map(|&e| e.clone()).collect(), program: Program::new(trees) }
     }
 
     /// Number of expressions.

@@ -34,7 +34,7 @@ fn collect_factors<'a>(s: &'a Sym, divide: bool, out: &mut Vec<(&'a Sym, bool)>)
 }
 
 /// True if the tree depends on t.
-fn has_t(s: &Sym) -> bool {
+pub(super) fn has_t(s: &Sym) -> bool {
     match s {
         Sym::Num(_) => false,
         Sym::Var(v) => *v >= 2,
