@@ -13,7 +13,7 @@
 use super::quadrature::{edge_point, GAUSS3};
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::scene::expr::Vec2Expr;
+use crate::scene::expr::{ExprSet, Vec2Expr};
 use crate::scene::{Part, PartKind};
 
 /// Geometry of one triangle: constant barycentric gradients.
@@ -181,21 +181,26 @@ impl CrSpace {
             .collect()
     }
 
-    /// I_CR v: edge means by 3-point Gauss, restricted to V_h (tangential part on contact edges).
+    /// I_CR v: edge means by 3-point Gauss, restricted to V_h (tangential part on contact edges). The
+    /// expressions are evaluated at all Gauss points in one batch (the same bits as point by point).
     pub fn interpolate(&self, mesh: &Mesh, v: &Vec2Expr, t: f64) -> Result<Vec<f64>> {
+        let edges: Vec<usize> = (0..self.edge_dof.len()).filter(|&e| self.edge_dof[e] != EdgeDof::Fixed).collect();
+        let points: Vec<[f64; 2]> = edges
+            .iter()
+            .flat_map(|&e| {
+                let [a, b] = mesh.edges[e].map(|p| mesh.points[p]);
+                GAUSS3.map(|(s, _)| edge_point(a, b, s))
+            })
+            .collect();
+        let mut vals = Vec::new();
+        ExprSet::new(&[&v.0[0], &v.0[1]]).eval(&points, t, &mut vals)?;
         let mut u = vec![0.0; self.n_dofs];
-        for (e, d) in self.edge_dof.iter().enumerate() {
-            if *d == EdgeDof::Fixed {
-                continue;
-            }
-            let [a, b] = mesh.edges[e].map(|p| mesh.points[p]);
+        for (&e, val) in edges.iter().zip(vals.chunks_exact(6)) {
             let mut mean = [0.0; 2];
-            for (s, w) in GAUSS3 {
-                let x = edge_point(a, b, s);
-                let val = v.eval(x[0], x[1], t)?;
-                mean = [mean[0] + w * val[0], mean[1] + w * val[1]];
+            for (i, (_, w)) in GAUSS3.iter().enumerate() {
+                mean = [mean[0] + w * val[2 * i], mean[1] + w * val[2 * i + 1]];
             }
-            for (k, c) in d.terms() {
+            for (k, c) in self.edge_dof[e].terms() {
                 u[k] = c[0] * mean[0] + c[1] * mean[1];
             }
         }
