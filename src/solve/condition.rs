@@ -1,6 +1,6 @@
 //! The condition number of K, estimated from its factor: a cheap guard against nearly singular
 //! stiffness matrices (floating pieces, slivers, weak jump terms), checked once per run by `stepping`
-//! (on a second thread, while the load superposition and the condensation are formed).
+//! (the solves on a second thread, while the load superposition and the condensation are formed).
 
 use super::factor::Factor;
 use faer::sparse::SparseColMat;
@@ -12,27 +12,35 @@ use nalgebra::DMatrix;
 /// a percent is ample.
 const COND_TOL: f64 = 1e-2;
 
-/// Estimate of the 2-norm condition number λ_max/λ_min of K, a lower bound: λ_max as the largest Ritz
-/// value of the Lanczos process for K (matrix products) and 1/λ_min = λ_max(K⁻¹) as the largest Ritz
-/// value of the Lanczos process for K⁻¹ (solves with the factor), each from a fixed start vector so
-/// the estimate is deterministic. Ritz values lie in the spectrum and converge from below, faster
-/// than power iteration (at 24,640 unknowns 4 solves instead of 7 of inverse iteration, and about 5
-/// products instead of 12 of power iteration). Each process stops once its Ritz value changes by
-/// less than [`COND_TOL`] relative (at least 3, at most `iters` steps): each solve streams the whole
-/// factor (5 ms at 24,640 unknowns, 1.4 s at 1.57M), and the huge gap of a nearly singular K shows
-/// up within a few.
-pub fn condition_estimate(factor: &Factor, k: &SparseColMat<usize, f64>, iters: usize) -> f64 {
+/// The condition-number estimate is λ_max · (1/λ_min), a lower bound of the 2-norm condition number of
+/// K: λ_max as the largest Ritz value of the Lanczos process for K (matrix products,
+/// [`largest_eigenvalue`]) and 1/λ_min = λ_max(K⁻¹) as the largest Ritz value of the Lanczos process
+/// for K⁻¹ (solves with the factor, [`largest_inverse_eigenvalue`]), each from a fixed start vector so
+/// the estimate is deterministic. The two are independent, so `stepping` runs the solves on a second
+/// thread and the products on the main one once its own set-up work is done. Ritz values lie in the
+/// spectrum and converge from below, faster than power iteration (at 24,640 unknowns 4 solves instead
+/// of 7 of inverse iteration, and about 5 products instead of 12 of power iteration). Each process
+/// stops once its Ritz value changes by less than [`COND_TOL`] relative (at least 3, at most `iters`
+/// steps): each solve streams the whole factor (5 ms at 24,640 unknowns, 1.4 s at 1.57M), and the huge
+/// gap of a nearly singular K shows up within a few.
+pub fn largest_eigenvalue(k: &SparseColMat<usize, f64>, iters: usize) -> f64 {
     let n = k.nrows();
     if n == 0 {
         return 1.0;
     }
-    let hi = lanczos_max(n, iters, |v, w| crate::sparse::matvec(k, v, w));
-    let lo_inv = lanczos_max(n, iters, |v, w| {
+    lanczos_max(n, iters, |v, w| crate::sparse::matvec(k, v, w))
+}
+
+/// λ_max(K⁻¹) = 1/λ_min(K) by the Lanczos process with solves (see [`largest_eigenvalue`]).
+pub fn largest_inverse_eigenvalue(factor: &Factor, n: usize, iters: usize) -> f64 {
+    if n == 0 {
+        return 1.0;
+    }
+    lanczos_max(n, iters, |v, w| {
         w.copy_from_slice(v);
         // a private scratch (solve_many), so this may run beside the factor's other users
         factor.solve_many(MatMut::from_column_major_slice_mut(w, n, 1));
-    });
-    hi * lo_inv
+    })
 }
 
 /// The largest Ritz value of the Lanczos process for the SPD operator `apply` (w ← A v) from a fixed

@@ -16,6 +16,7 @@
 //! trailing block.
 
 use super::ordering::{amd_order, nested_dissection, Graph, ND_MIN_SIZE};
+use super::pages::Pages;
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
@@ -33,7 +34,7 @@ use std::sync::Mutex;
 /// The Cholesky factor of an SPD sparse matrix.
 pub struct Factor {
     symbolic: SymbolicCholesky<usize>,
-    values: Vec<f64>,
+    values: Pages,
     /// Solve scratch, sized for this many right-hand sides.
     /// (A mutex, not a cell, so the factor can be shared with the condition estimate's thread.)
     scratch: Mutex<(usize, MemBuffer)>,
@@ -111,16 +112,29 @@ impl Factor {
         let ordering = SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n));
         let symbolic = factorize_symbolic_cholesky(k.symbolic(), Side::Lower, ordering, params)
             .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))?;
-        let mut values = vec![0.0; symbolic.len_val()];
+        let oom = || Error::Linear("out of memory for the Cholesky factorisation".into());
+        let mut values = Pages::zeroed(symbolic.len_val()).ok_or_else(oom)?;
         let mut buf = MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
-            .map_err(|_| Error::Linear("out of memory for the Cholesky factorisation".into()))?;
-        symbolic
-            .factorize_numeric_llt(&mut values, k.as_ref(), Side::Lower, Default::default(), Par::Seq, MemStack::new(&mut buf), Default::default())
-            .map_err(|e| {
-                Error::Linear(format!(
-                    "the stiffness matrix is not positive definite ({e:?}): are rigid motions fixed by a Dirichlet part?"
-                ))
-            })?;
+            .map_err(|_| oom())?;
+        // the factor's pages are mapped on a second thread while this one computes (solve::pages)
+        let range = values.range();
+        std::thread::scope(|s| {
+            s.spawn(move || Pages::populate(range));
+            symbolic.factorize_numeric_llt(
+                &mut values,
+                k.as_ref(),
+                Side::Lower,
+                Default::default(),
+                Par::Seq,
+                MemStack::new(&mut buf),
+                Default::default(),
+            )
+        })
+        .map_err(|e| {
+            Error::Linear(format!(
+                "the stiffness matrix is not positive definite ({e:?}): are rigid motions fixed by a Dirichlet part?"
+            ))
+        })?;
         let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
             .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
         Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last: last.to_vec(), fwd })

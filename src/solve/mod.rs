@@ -7,4 +7,5 @@ pub mod condition;
 pub mod factor;
 pub mod free;
 pub mod ordering;
+pub mod pages;
 pub mod superpose;

@@ -16,6 +16,7 @@ use crate::friction::{EdgeState, Friction, FrictionSolution};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::solve::condense::condense;
+use crate::solve::condition;
 use crate::solve::factor::{fill_order, Factor};
 use crate::solve::free::FreeResponse;
 use crate::solve::ordering::{Graph, ND_MIN_SIZE};
@@ -133,15 +134,19 @@ impl Problem {
         let t3 = Instant::now();
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
         // ranges) factorises without complaint but returns meaningless displacements: refuse it. The
-        // estimate (a few solves) runs on a second thread beside the load superposition and the
-        // condensation, which only read the factor; nothing is returned before it is known.
+        // estimate's solves (the longer half) run on a second thread beside the load superposition and
+        // the condensation, which only read the factor, and its matrix products on this thread after
+        // them; nothing is returned before it is known.
         let (kappa, basis, condensation, t4, t5) = std::thread::scope(|s| {
-            let guard = s.spawn(|| crate::solve::condition::condition_estimate(&factor, &stiffness, 12));
+            let (n, f) = (stiffness.nrows(), &factor);
+            let inverse = s.spawn(move || condition::largest_inverse_eigenvalue(f, n, 12));
             let basis = LoadBasis::build(&loads, &scene.times, &factor);
             let t4 = Instant::now();
             let condensation = (!contact.is_empty()).then(|| condense(&contact, &factor)).transpose();
             let t5 = Instant::now();
-            let kappa = guard.join().map_err(|_| Error::Linear("the condition estimate failed".into()));
+            let top = condition::largest_eigenvalue(&stiffness, 12);
+            let kappa =
+                inverse.join().map(|inv| top * inv).map_err(|_| Error::Linear("the condition estimate failed".into()));
             (kappa, basis, condensation, t4, t5)
         });
         let kappa = kappa?;
