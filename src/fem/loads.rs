@@ -4,8 +4,9 @@
 //! (compiled) load expressions at all points of a term in one batch, then scatters sequentially.
 //!
 //! **Separated loads.** A term whose components are sums of time factors times space parts,
-//! f = Σ_j τ_j(t) s_j(x) (`Expr::separate`; every manufactured load of `verification/cases/` but
-//! mms_front's moving front), is assembled once per distinct τ_j into a pattern P_j at set-up, and a
+//! f = Σ_j τ_j(t) s_j(x) (`Expr::separate`: the loads of 10 of the 13 scenes of `verification/cases/`
+//! and of the polynomial benchmark; not the moving fronts of mms_front, mms_rotated and
+//! mms_stick_to_slip), is assembled once per distinct τ_j into a pattern P_j at set-up, and a
 //! time node costs l = Σ_j τ_j(tₙ) P_j: [`MAX_FACTORS`] multiply-adds per unknown of the support instead
 //! of the expressions at every quadrature point. The two routes compute the same integrals with the
 //! products reassociated (a test bounds the difference at 1e-14 of the load's size).
