@@ -49,7 +49,7 @@ pub struct OutputArgs {
 }
 
 pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> {
-    use tresca_cr::output::{Options, Run, Writer};
+    use tresca_cr::output::{Background, Options, Run, Writer};
     let start = std::time::Instant::now();
     let path = out.output.clone().or_else(|| scene.output.clone());
     anyhow::ensure!(!(out.resume && path.is_none()), "--resume needs a results file: give -o FILE");
@@ -64,10 +64,25 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     }
     // the run owns its output path from here on (refused at once if another run has it)
     let lock = path.as_deref().map(tresca_cr::output::OutputLock::acquire).transpose()?;
-    let problem = Problem::new(scene)?;
+    // A new results file is created on a second thread while the solver is set up (its set-up times are
+    // recorded once known); the steps are then written by a writer thread while the solver goes on.
+    let opts = Options { force: out.force, frame_every: out.frame_every, commit_interval: out.commit_interval };
+    let (problem, lock, created) = match lock {
+        Some(lock) if !out.resume => {
+            let (p, w) = Problem::new_beside(scene, move |p0| Writer::create_locked(lock, &Run::before_setup(p0), &opts));
+            (p, None, w)
+        }
+        lock => (Problem::new(scene), lock, None),
+    };
+    let problem = problem?;
     let info = Run::of(&problem);
-    let (mut writer, first) = match (&path, lock) {
-        (Some(p), Some(lock)) if out.resume => {
+    let (writer, first) = match (&path, lock, created) {
+        (_, _, Some(w)) => {
+            let mut w = w?;
+            w.set_setup_times(&problem.setup)?;
+            (Some(w), None)
+        }
+        (Some(p), Some(lock), None) => {
             let (mut w, last) = Writer::resume_locked(lock, &info)?;
             w.set_commit_interval(out.commit_interval);
             if let Some(k) = out.frame_every {
@@ -79,12 +94,9 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
             }
             (Some(w), last)
         }
-        (Some(_), Some(lock)) => {
-            let opts = Options { force: out.force, frame_every: out.frame_every, commit_interval: out.commit_interval };
-            (Some(Writer::create_locked(lock, &info, &opts)?), None)
-        }
         _ => (None, None),
     };
+    let mut writer = writer.map(Background::spawn).transpose()?;
     let n = problem.n_steps();
     let all = writer.is_some() || problem.scene.exact.is_some() || verbose;
     let bar = if quiet || verbose || n < 50 {

@@ -40,6 +40,7 @@
 //! `paper_dofs`, `h`, `setup_times` (4 wall times, s), `status` ("running", then what
 //! [`Writer::finish`] records: "completed" or the error of the failed step).
 
+mod background;
 mod create;
 pub mod fields;
 mod h5;
@@ -54,7 +55,7 @@ use crate::fem::elasticity::Elasticity;
 use crate::fem::space::CrSpace;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
-use crate::stepping::{Problem, SetupTimes, StepResult};
+use crate::stepping::{Problem, Problem0, SetupTimes, StepResult};
 use fields::{Fields, StepFields};
 use h5::{io, Raw};
 use std::path::{Path, PathBuf};
@@ -63,6 +64,7 @@ use tresca::{Rows, Tresca};
 use vtkhdf::{FrameRows, Frames, VtkHdf};
 use xdmf::Xdmf;
 
+pub use background::Background;
 pub use lock::{lock_path, OutputLock};
 pub use xdmf::sidecar;
 
@@ -122,6 +124,23 @@ impl<'a> Run<'a> {
                 commit: env!("TRESCA_BUILD_COMMIT"),
                 setup: p.setup,
                 true_errors: p.errors.is_some(),
+            },
+        }
+    }
+
+    /// The run of a problem whose set-up is still under way ([`Problem::new_beside`]): its set-up times
+    /// are zeros until [`Writer::set_setup_times`].
+    pub fn before_setup(p: &'a Problem0) -> Run<'a> {
+        Run {
+            scene: &p.scene,
+            mesh: &p.mesh,
+            space: &p.space,
+            law: p.law,
+            meta: RunMeta {
+                version: env!("CARGO_PKG_VERSION"),
+                commit: env!("TRESCA_BUILD_COMMIT"),
+                setup: SetupTimes::default(),
+                true_errors: p.scene.exact.is_some(),
             },
         }
     }

@@ -391,6 +391,11 @@ impl Tresca {
         })
     }
 
+    /// Overwrite the values of `setup_times` (a file created beside the set-up holds zeros until then).
+    pub fn set_setup_times(&self, times: &[f64; 5]) -> hdf5::Result<()> {
+        self.group.attr("setup_times")?.write_raw(times)
+    }
+
     /// Record why the run stopped.
     pub fn set_status(&self, status: &str) -> hdf5::Result<()> {
         attr_str(&self.group, "status", status)
