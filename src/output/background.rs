@@ -47,17 +47,25 @@ pub struct Background {
 /// The writer thread: take steps until told to finish; after the first error, ignore the steps.
 fn serve(mut w: Writer, rx: Receiver<Msg>, failure: Arc<Mutex<Failure>>) -> Result<usize> {
     let mut stopped: Option<String> = None;
-    while let Ok(msg) = rx.recv() {
+    let mut next = rx.recv().ok();
+    while let Some(msg) = next.take() {
         match msg {
-            Msg::Step(r) if stopped.is_none() => {
-                if let Err(e) = w.write_step(&r) {
-                    stopped = Some(format!("stopped: {e}"));
-                    if let Ok(mut f) = failure.lock() {
-                        *f = Failure { error: Some(e), failed: true };
+            Msg::Step(r) => {
+                // a step already queued behind this one: commit them together (group commit)
+                next = rx.try_recv().ok();
+                let more = matches!(next, Some(Msg::Step(_)));
+                if stopped.is_none() {
+                    if let Err(e) = w.write_step_then(&r, more) {
+                        stopped = Some(format!("stopped: {e}"));
+                        if let Ok(mut f) = failure.lock() {
+                            *f = Failure { error: Some(e), failed: true };
+                        }
                     }
                 }
+                if next.is_none() {
+                    next = rx.recv().ok();
+                }
             }
-            Msg::Step(_) => {}
             Msg::Finish(status) => return w.finish(stopped.as_deref().unwrap_or(&status)),
         }
     }

@@ -241,12 +241,24 @@ impl Writer {
     /// Take step `r` (the step after the last one taken): checked for non-finite values, buffered, and
     /// committed (see the module doc) once the commit interval has passed or at the last step.
     pub fn write_step(&mut self, r: &StepResult) -> Result<()> {
+        self.write_step_then(r, false)
+    }
+
+    /// Steps taken but not committed yet.
+    pub fn buffered(&self) -> usize {
+        self.rows.count
+    }
+
+    /// [`Writer::write_step`], but with `more` (another step is at hand, see [`Background`]) the commit
+    /// waits for it: it is then made once the commit interval has passed *and* either no further step is
+    /// at hand or [`background::QUEUE`] steps are buffered, and always at the last step.
+    pub fn write_step_then(&mut self, r: &StepResult, more: bool) -> Result<()> {
         let start = Instant::now();
         let out = self.take(r);
+        let due = self.last_commit.elapsed().as_secs_f64() >= self.interval
+            && (!more || self.rows.count >= background::QUEUE);
         let out = match out {
-            Ok(()) if self.last_commit.elapsed().as_secs_f64() >= self.interval || r.n == self.frames.last => {
-                self.commit()
-            }
+            Ok(()) if due || r.n == self.frames.last => self.commit(),
             Ok(()) => Ok(()),
             Err(e) => {
                 // keep what was good
