@@ -93,6 +93,7 @@ impl Writer {
             frames: o.frames,
             interval: Options::default().commit_interval,
             buf: StepFields::default(),
+            mid: Vec::new(),
             rows,
             frame_rows,
             frame_steps: Vec::new(),

@@ -175,6 +175,8 @@ pub struct Writer {
     frames: Frames,
     interval: f64,
     buf: StepFields,
+    /// Midpoint values of the step being taken (memory reused from step to step).
+    mid: Vec<[f64; 2]>,
     rows: Rows,
     frame_rows: FrameRows,
     /// Step numbers of the buffered frames.
@@ -212,8 +214,13 @@ fn ioerr(path: &Path, what: &'static str) -> impl FnOnce(std::io::Error) -> Erro
     move |e| Error::Io { path, msg: format!("{what}: {e}") }
 }
 
-fn check_finite<'a>(path: &Path, n: usize, what: &str, v: impl IntoIterator<Item = &'a f64>) -> Result<()> {
-    match v.into_iter().position(|x| !x.is_finite()) {
+fn check_finite(path: &Path, n: usize, what: &str, v: &[f64]) -> Result<()> {
+    // x · 0 is 0 for every finite x and NaN otherwise: one vectorised pass finds whether any value is not
+    // finite, the position is looked for only then
+    if v.iter().fold(0.0, |a, x| a + x * 0.0) == 0.0 {
+        return Ok(());
+    }
+    match v.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
         Some(k) => Err(Error::Io {
             path: path.to_path_buf(),
@@ -287,17 +294,18 @@ impl Writer {
                 ),
             });
         }
-        check_finite(path, n, "t", [&r.t])?;
+        check_finite(path, n, "t", &[r.t])?;
         check_finite(path, n, "u", &r.u)?;
         check_finite(path, n, "mu", &r.mu)?;
         check_finite(path, n, "slip", &r.slip)?;
-        check_finite(path, n, "energy/residual/wall", [&r.energy, &r.residual, &r.wall])?;
+        check_finite(path, n, "energy/residual/wall", &[r.energy, r.residual, r.wall])?;
         if let Some(e) = &r.errors {
-            check_finite(path, n, "errors", [&e.energy, &e.h1, &e.l2])?;
+            check_finite(path, n, "errors", &[e.energy, e.h1, e.l2])?;
         }
         let sigma_t: Vec<f64> = r.mu.iter().zip(&self.space.contact).map(|(m, c)| -m / c.length).collect();
         check_finite(path, n, "sigma_t", &sigma_t)?;
-        let mid = self.space.midpoint_values(&r.u);
+        let mut mid = std::mem::take(&mut self.mid);
+        self.space.midpoint_values_into(&r.u, &mut mid);
         if self.frames.is_frame(n) {
             self.fields.eval(&mid, r, self.prev_slip.as_deref(), &mut self.buf);
             let b = &self.buf;
@@ -308,6 +316,10 @@ impl Writer {
                 ("von_mises", &b.von_mises),
                 ("slip_increment", &b.slip_increment),
             ] {
+                // as in check_finite: one vectorised pass, the position only when there is one
+                if v.iter().fold(0.0f32, |a, x| a + x * 0.0) == 0.0 {
+                    continue;
+                }
                 if let Some(k) = v.iter().position(|x| !x.is_finite()) {
                     return Err(Error::Io {
                         path: path.to_path_buf(),
@@ -323,6 +335,7 @@ impl Writer {
         }
         let dof: Vec<f64> = self.space.contact.iter().map(|c| r.u[c.dof]).collect();
         self.rows.push(r, &mid, &sigma_t, &dof);
+        self.mid = mid;
         self.prev_slip = Some(r.slip.clone());
         Ok(())
     }
