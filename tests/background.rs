@@ -4,7 +4,7 @@
 
 mod common;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use tresca_cr::output::{Background, Run, Writer};
 use tresca_cr::{Problem, Scene, StepResult};
 
@@ -31,7 +31,7 @@ fn steps(p: &Problem) -> Vec<StepResult> {
     out
 }
 
-fn completed(path: &PathBuf) -> (i64, String) {
+fn completed(path: &Path) -> (i64, String) {
     let f = hdf5::File::open(path).unwrap();
     let n = f.group("tresca/steps").unwrap().attr("completed").unwrap().read_scalar::<i64>().unwrap();
     let s = f.group("tresca").unwrap().attr("status").unwrap().read_scalar::<hdf5::types::VarLenUnicode>().unwrap();
@@ -40,7 +40,7 @@ fn completed(path: &PathBuf) -> (i64, String) {
 
 /// Hand `rs` to a background writer of a new file at `path`, step `bad` with a non-finite u; returns
 /// the errors of `write_step` and of `finish`.
-fn write(p: &Problem, path: &PathBuf, rs: &[StepResult], bad: Option<usize>) -> (Vec<String>, Result<usize, String>) {
+fn write(p: &Problem, path: &Path, rs: &[StepResult], bad: Option<usize>) -> (Vec<String>, Result<usize, String>) {
     let mut w = Background::spawn(Writer::create(path, &Run::of(p), true).unwrap()).unwrap();
     let mut errors = Vec::new();
     for r in rs {
@@ -67,9 +67,8 @@ fn a_background_run_commits_every_step() {
     assert!(errors.is_empty(), "{errors:?}");
     assert_eq!(done, Ok(41));
     assert_eq!(completed(&b), (41, "completed".to_string()));
-    let read = |path: &PathBuf, name: &str| {
-        hdf5::File::open(path).unwrap().dataset(name).unwrap().read_raw::<f64>().unwrap()
-    };
+    let read =
+        |path: &Path, name: &str| hdf5::File::open(path).unwrap().dataset(name).unwrap().read_raw::<f64>().unwrap();
     for name in ["tresca/u", "tresca/contact/mu", "tresca/times", "tresca/energy"] {
         assert_eq!(read(&a, name), read(&b, name), "{name}");
     }

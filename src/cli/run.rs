@@ -43,7 +43,8 @@ pub struct OutputArgs {
     /// Visualisation frame (VTKHDF/XDMF) every k steps, plus the last; default about 50 frames in all.
     #[arg(long)]
     pub frame_every: Option<usize>,
-    /// Seconds between commits (write + flush) of completed steps; 0 (default) commits every step.
+    /// Seconds between commits (write + flush) of completed steps; 0 (default) commits every step as soon
+    /// as the writer thread has it (with the steps queued behind it).
     #[arg(long, default_value_t = 0.0)]
     pub commit_interval: f64,
 }
@@ -69,7 +70,8 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     let opts = Options { force: out.force, frame_every: out.frame_every, commit_interval: out.commit_interval };
     let (problem, lock, created) = match lock {
         Some(lock) if !out.resume => {
-            let (p, w) = Problem::new_beside(scene, move |p0| Writer::create_locked(lock, &Run::before_setup(p0), &opts));
+            let (p, w) =
+                Problem::new_beside(scene, move |p0| Writer::create_locked(lock, &Run::before_setup(p0), &opts));
             (p, None, w)
         }
         lock => (Problem::new(scene), lock, None),

@@ -12,7 +12,11 @@
 //!
 //! **Crash safety.** Steps handed to [`Writer::write_step`] are committed in batches: a batch is written
 //! as soon as [`Options::commit_interval`] seconds have passed since the previous commit (default
-//! 0: every step), at the last step, and by [`Writer::finish`] / drop. A commit appends the
+//! 0: every step), at the last step, and by [`Writer::finish`] / drop. `tresca-cr run` hands the steps
+//! to a writer thread ([`Background`]) so that the solver goes on while they are written; there a step
+//! is committed as soon as the thread gets to it, together with the steps that queued up behind it
+//! (at most [`background::QUEUE`]; [`Writer::write_step_then`]), and [`Background::finish`] returns
+//! only when every step handed over is committed and the file closed. A commit appends the
 //! batch to every time-dependent dataset (allocated for the whole run at creation, contiguous, written
 //! straight to the kernel: [`h5::Series`]), then sets `tresca/steps` attribute `completed` and
 //! `NSteps` of each `VTKHDF/<block>/Steps`, flushes the file (H5Fflush: only these counters are dirty
@@ -46,6 +50,7 @@ pub mod fields;
 mod h5;
 mod lock;
 mod resume;
+mod take;
 pub mod tresca;
 pub mod vtkhdf;
 pub mod xdmf;
@@ -78,7 +83,8 @@ pub struct Options {
     pub force: bool,
     /// Visualisation frame every k steps (plus the last step); `None`: ⌈N / (AUTO_FRAMES − 1)⌉.
     pub frame_every: Option<usize>,
-    /// Seconds between commits (write + flush); 0 commits every step.
+    /// Seconds between commits (write + flush); 0 commits every step (on a writer thread: every step
+    /// together with those queued behind it, see [`Background`]).
     pub commit_interval: f64,
 }
 
@@ -114,35 +120,24 @@ pub struct Run<'a> {
 impl<'a> Run<'a> {
     /// The run of `p` with this build's version and commit.
     pub fn of(p: &'a Problem) -> Run<'a> {
-        Run {
-            scene: &p.scene,
-            mesh: &p.mesh,
-            space: &p.space,
-            law: p.law,
-            meta: RunMeta {
-                version: env!("CARGO_PKG_VERSION"),
-                commit: env!("TRESCA_BUILD_COMMIT"),
-                setup: p.setup,
-                true_errors: p.errors.is_some(),
-            },
-        }
+        Run::new(&p.scene, &p.mesh, &p.space, p.law, p.setup)
     }
 
     /// The run of a problem whose set-up is still under way ([`Problem::new_beside`]): its set-up times
     /// are zeros until [`Writer::set_setup_times`].
     pub fn before_setup(p: &'a Problem0) -> Run<'a> {
-        Run {
-            scene: &p.scene,
-            mesh: &p.mesh,
-            space: &p.space,
-            law: p.law,
-            meta: RunMeta {
-                version: env!("CARGO_PKG_VERSION"),
-                commit: env!("TRESCA_BUILD_COMMIT"),
-                setup: SetupTimes::default(),
-                true_errors: p.scene.exact.is_some(),
-            },
-        }
+        Run::new(&p.scene, &p.mesh, &p.space, p.law, SetupTimes::default())
+    }
+
+    /// With this build's version and commit; true errors are computed when the scene gives `[exact]`.
+    fn new(scene: &'a Scene, mesh: &'a Mesh, space: &'a CrSpace, law: Elasticity, setup: SetupTimes) -> Run<'a> {
+        let meta = RunMeta {
+            version: env!("CARGO_PKG_VERSION"),
+            commit: env!("TRESCA_BUILD_COMMIT"),
+            setup,
+            true_errors: scene.exact.is_some(),
+        };
+        Run { scene, mesh, space, law, meta }
     }
 
     /// Number of time steps N.
@@ -214,21 +209,6 @@ fn ioerr(path: &Path, what: &'static str) -> impl FnOnce(std::io::Error) -> Erro
     move |e| Error::Io { path, msg: format!("{what}: {e}") }
 }
 
-fn check_finite(path: &Path, n: usize, what: &str, v: &[f64]) -> Result<()> {
-    // x · 0 is 0 for every finite x and NaN otherwise: one vectorised pass finds whether any value is not
-    // finite, the position is looked for only then
-    if v.iter().fold(0.0, |a, x| a + x * 0.0) == 0.0 {
-        return Ok(());
-    }
-    match v.iter().position(|x| !x.is_finite()) {
-        None => Ok(()),
-        Some(k) => Err(Error::Io {
-            path: path.to_path_buf(),
-            msg: format!("step {n}: {what}[{k}] is not finite; the step was not written"),
-        }),
-    }
-}
-
 impl Writer {
     /// Number of steps committed to the file.
     pub fn completed(&self) -> usize {
@@ -275,69 +255,6 @@ impl Writer {
         };
         self.seconds[0] += start.elapsed().as_secs_f64();
         out
-    }
-
-    fn take(&mut self, r: &StepResult) -> Result<()> {
-        let (path, n) = (self.path.as_path(), r.n);
-        let expected = self.completed + self.rows.count;
-        if n != expected {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: format!("step {n} handed to the writer, but the next step is {expected}"),
-            });
-        }
-        if r.u.len() != self.space.n_dofs {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: format!(
-                    "step {n} carries no displacement (solved with want_u = false); every written step needs u"
-                ),
-            });
-        }
-        check_finite(path, n, "t", &[r.t])?;
-        check_finite(path, n, "u", &r.u)?;
-        check_finite(path, n, "mu", &r.mu)?;
-        check_finite(path, n, "slip", &r.slip)?;
-        check_finite(path, n, "energy/residual/wall", &[r.energy, r.residual, r.wall])?;
-        if let Some(e) = &r.errors {
-            check_finite(path, n, "errors", &[e.energy, e.h1, e.l2])?;
-        }
-        let sigma_t: Vec<f64> = r.mu.iter().zip(&self.space.contact).map(|(m, c)| -m / c.length).collect();
-        check_finite(path, n, "sigma_t", &sigma_t)?;
-        let mut mid = std::mem::take(&mut self.mid);
-        self.space.midpoint_values_into(&r.u, &mut mid);
-        if self.frames.is_frame(n) {
-            self.fields.eval(&mid, r, self.prev_slip.as_deref(), &mut self.buf);
-            let b = &self.buf;
-            for (what, v) in [
-                ("displacement", &b.displacement),
-                ("strain", &b.strain),
-                ("stress", &b.stress),
-                ("von_mises", &b.von_mises),
-                ("slip_increment", &b.slip_increment),
-            ] {
-                // as in check_finite: one vectorised pass, the position only when there is one
-                if v.iter().fold(0.0f32, |a, x| a + x * 0.0) == 0.0 {
-                    continue;
-                }
-                if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-                    return Err(Error::Io {
-                        path: path.to_path_buf(),
-                        msg: format!(
-                            "step {n}: {what}[{k}] exceeds the single-precision range (3.4e38) of the VTKHDF/XDMF \
-                             views; the step was not written (u is linear in the loads, u₀ and g_a: scale them down)"
-                        ),
-                    });
-                }
-            }
-            self.frame_rows.push(r.t, &self.buf);
-            self.frame_steps.push(n);
-        }
-        let dof: Vec<f64> = self.space.contact.iter().map(|c| r.u[c.dof]).collect();
-        self.rows.push(r, &mid, &sigma_t, &dof);
-        self.mid = mid;
-        self.prev_slip = Some(r.slip.clone());
-        Ok(())
     }
 
     /// Write the buffered steps, mark them complete, flush, extend the XDMF text.
