@@ -108,6 +108,7 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     };
     let mut max_err = tresca_cr::fem::norms::ErrorNorms::default();
     let (mut iters, mut max_res) = (0usize, 0.0f64);
+    // stick and slip edges of the last step (for the summary; not the whole step, whose u is large)
     let mut last = None;
     let on_step = |r: &tresca_cr::StepResult| -> tresca_cr::Result<()> {
         if let Some(w) = writer.as_mut() {
@@ -132,7 +133,7 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
             );
         }
         bar.inc(u64::from(r.n > 0));
-        last = Some(r.clone());
+        last = (!r.state.is_empty()).then(|| (r.n_stick(), r.n_slip()));
         Ok(())
     };
     // Without a results file and without true errors, u is formed only at the last step: every step still
@@ -183,10 +184,8 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
         max_res,
         start.elapsed().as_secs_f64()
     );
-    if let Some(r) = last {
-        if !r.state.is_empty() {
-            say!("final step: {} stick, {} slip contact edges", r.n_stick(), r.n_slip());
-        }
+    if let Some((stick, slip)) = last {
+        say!("final step: {stick} stick, {slip} slip contact edges");
     }
     if problem.scene.exact.is_some() {
         say!(
