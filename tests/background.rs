@@ -38,15 +38,23 @@ fn completed(path: &Path) -> (i64, String) {
     (n, s.as_str().to_string())
 }
 
-/// Hand `rs` to a background writer of a new file at `path`, step `bad` with a non-finite u; returns
-/// the errors of `write_step` and of `finish`.
-fn write(p: &Problem, path: &Path, rs: &[StepResult], bad: Option<usize>) -> (Vec<String>, Result<usize, String>) {
+/// Hand `rs` to a background writer of a new file at `path`, step `bad` with a non-finite u[1] (found on
+/// the caller's thread) or μ[0] (found on the writer thread); returns the errors of `write_step` and of
+/// `finish`.
+fn write(
+    p: &Problem,
+    path: &Path,
+    rs: &[StepResult],
+    bad: Option<(usize, &str)>,
+) -> (Vec<String>, Result<usize, String>) {
     let mut w = Background::spawn(Writer::create(path, &Run::of(p), true).unwrap()).unwrap();
     let mut errors = Vec::new();
     for r in rs {
         let mut r = r.clone();
-        if Some(r.n) == bad {
-            r.u[1] = f64::NAN;
+        match bad {
+            Some((n, "u")) if n == r.n => r.u[1] = f64::NAN,
+            Some((n, _)) if n == r.n => r.mu[0] = f64::INFINITY,
+            _ => {}
         }
         if let Err(e) = w.write_step(&r) {
             errors.push(e.to_string());
@@ -78,15 +86,16 @@ fn a_background_run_commits_every_step() {
 fn a_write_error_on_the_writer_thread_stops_the_run() {
     let p = example(40);
     let rs = steps(&p);
-    for bad in [5, 40] {
-        let path = tmp(&format!("bad{bad}.h5"));
-        let (errors, done) = write(&p, &path, &rs, Some(bad));
+    for (bad, what) in [(5, "u"), (40, "u"), (5, "mu"), (40, "mu")] {
+        let path = tmp(&format!("bad{bad}{what}.h5"));
+        let (errors, done) = write(&p, &path, &rs, Some((bad, what)));
         // the error is reported exactly once: by a later write_step, or by finish
         let all: Vec<String> = errors.into_iter().chain(done.clone().err()).collect();
         assert_eq!(all.len(), 1, "bad step {bad}: {all:?}");
-        assert!(all[0].contains(&format!("step {bad}: u[1] is not finite")), "{}", all[0]);
-        if bad == 40 {
-            assert!(done.is_err(), "an error at the last step must fail finish");
+        let index = if what == "u" { 1 } else { 0 };
+        assert!(all[0].contains(&format!("step {bad}: {what}[{index}] is not finite")), "{}", all[0]);
+        if (bad, what) == (40, "mu") {
+            assert!(done.is_err(), "an error of the writer thread at the last step must fail finish");
         }
         let (n, status) = completed(&path);
         assert_eq!(n, bad as i64, "the steps before the bad one are committed, none after it");

@@ -71,6 +71,7 @@ use xdmf::Xdmf;
 
 pub use background::Background;
 pub use lock::{lock_path, OutputLock};
+pub use take::Unknowns;
 pub use xdmf::sidecar;
 
 /// Default upper bound on the number of visualisation frames.
@@ -241,20 +242,29 @@ impl Writer {
     /// at hand or [`background::QUEUE`] steps are buffered, and always at the last step.
     pub fn write_step_then(&mut self, r: &StepResult, more: bool) -> Result<()> {
         let start = Instant::now();
-        let out = self.take(r);
+        let u = Unknowns::of(&self.path, &self.space, r, std::mem::take(&mut self.mid));
+        let out = self.write_unknowns(u, more);
+        self.seconds[0] += start.elapsed().as_secs_f64();
+        out
+    }
+
+    /// [`Writer::write_step_then`] of a step whose unknowns were evaluated already ([`Unknowns::of`]).
+    pub fn write_unknowns(&mut self, u: Result<Unknowns>, more: bool) -> Result<()> {
+        let out = u.and_then(|u| {
+            let n = u.n();
+            self.take(u).map(|()| n)
+        });
         let due = self.last_commit.elapsed().as_secs_f64() >= self.interval
             && (!more || self.rows.count >= background::QUEUE);
-        let out = match out {
-            Ok(()) if due || r.n == self.frames.last => self.commit(),
-            Ok(()) => Ok(()),
+        match out {
+            Ok(n) if due || n == self.frames.last => self.commit(),
+            Ok(_) => Ok(()),
             Err(e) => {
                 // keep what was good
                 let _ = self.commit();
                 Err(e)
             }
-        };
-        self.seconds[0] += start.elapsed().as_secs_f64();
-        out
+        }
     }
 
     /// Write the buffered steps, mark them complete, flush, extend the XDMF text.

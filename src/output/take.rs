@@ -20,10 +20,46 @@ fn check_finite(path: &Path, n: usize, what: &str, v: &[f64]) -> Result<()> {
     }
 }
 
+/// The part of taking a step that needs only its unknowns and the space: the check of u, and the
+/// midpoint values and contact unknowns written of it. [`Background`] evaluates it on the caller's
+/// thread, beside the writer thread, and hands the writer this instead of u.
+pub struct Unknowns {
+    /// The step without u.
+    r: StepResult,
+    mid: Vec<[f64; 2]>,
+    dof: Vec<f64>,
+}
+
+impl Unknowns {
+    /// Check u of step `r` and evaluate what is written of it (`mid`: memory to reuse).
+    pub fn of(path: &Path, space: &CrSpace, r: &StepResult, mut mid: Vec<[f64; 2]>) -> Result<Unknowns> {
+        let n = r.n;
+        if r.u.len() != space.n_dofs {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: format!(
+                    "step {n} carries no displacement (solved with want_u = false); every written step needs u"
+                ),
+            });
+        }
+        check_finite(path, n, "u", &r.u)?;
+        space.midpoint_values_into(&r.u, &mut mid);
+        let dof = space.contact.iter().map(|c| r.u[c.dof]).collect();
+        let r = StepResult { u: Vec::new(), mu: r.mu.clone(), slip: r.slip.clone(), state: r.state.clone(), ..*r };
+        Ok(Unknowns { r, mid, dof })
+    }
+
+    /// The step's number.
+    pub fn n(&self) -> usize {
+        self.r.n
+    }
+}
+
 impl Writer {
-    /// Check step `r` and append it to the buffered rows (and frames); an error leaves the buffers as
+    /// Check step `u.r` and append it to the buffered rows (and frames); an error leaves the buffers as
     /// they were.
-    pub(super) fn take(&mut self, r: &StepResult) -> Result<()> {
+    pub(super) fn take(&mut self, u: Unknowns) -> Result<()> {
+        let Unknowns { r, mid, dof } = u;
         let (path, n) = (self.path.as_path(), r.n);
         let expected = self.completed + self.rows.count;
         if n != expected {
@@ -32,16 +68,7 @@ impl Writer {
                 msg: format!("step {n} handed to the writer, but the next step is {expected}"),
             });
         }
-        if r.u.len() != self.space.n_dofs {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: format!(
-                    "step {n} carries no displacement (solved with want_u = false); every written step needs u"
-                ),
-            });
-        }
         check_finite(path, n, "t", &[r.t])?;
-        check_finite(path, n, "u", &r.u)?;
         check_finite(path, n, "mu", &r.mu)?;
         check_finite(path, n, "slip", &r.slip)?;
         check_finite(path, n, "energy/residual/wall", &[r.energy, r.residual, r.wall])?;
@@ -50,10 +77,8 @@ impl Writer {
         }
         let sigma_t: Vec<f64> = r.mu.iter().zip(&self.space.contact).map(|(m, c)| -m / c.length).collect();
         check_finite(path, n, "sigma_t", &sigma_t)?;
-        let mut mid = std::mem::take(&mut self.mid);
-        self.space.midpoint_values_into(&r.u, &mut mid);
         if self.frames.is_frame(n) {
-            self.fields.eval(&mid, r, self.prev_slip.as_deref(), &mut self.buf);
+            self.fields.eval(&mid, &r, self.prev_slip.as_deref(), &mut self.buf);
             let b = &self.buf;
             for (what, v) in [
                 ("displacement", &b.displacement),
@@ -79,10 +104,9 @@ impl Writer {
             self.frame_rows.push(r.t, &self.buf);
             self.frame_steps.push(n);
         }
-        let dof: Vec<f64> = self.space.contact.iter().map(|c| r.u[c.dof]).collect();
-        self.rows.push(r, &mid, &sigma_t, &dof);
+        self.rows.push(&r, &mid, &sigma_t, &dof);
         self.mid = mid;
-        self.prev_slip = Some(r.slip.clone());
+        self.prev_slip = Some(r.slip);
         Ok(())
     }
 }
