@@ -243,20 +243,20 @@ impl Writer {
     pub fn write_step_then(&mut self, r: &StepResult, more: bool) -> Result<()> {
         let start = Instant::now();
         let u = Unknowns::of(&self.path, &self.space, r, std::mem::take(&mut self.mid));
-        let out = self.write_unknowns(u, more);
         self.seconds[0] += start.elapsed().as_secs_f64();
-        out
+        self.write_unknowns(u, more)
     }
 
     /// [`Writer::write_step_then`] of a step whose unknowns were evaluated already ([`Unknowns::of`]).
     pub fn write_unknowns(&mut self, u: Result<Unknowns>, more: bool) -> Result<()> {
+        let start = Instant::now();
         let out = u.and_then(|u| {
             let n = u.n();
             self.take(u).map(|()| n)
         });
         let due = self.last_commit.elapsed().as_secs_f64() >= self.interval
             && (!more || self.rows.count >= background::QUEUE);
-        match out {
+        let out = match out {
             Ok(n) if due || n == self.frames.last => self.commit(),
             Ok(_) => Ok(()),
             Err(e) => {
@@ -264,7 +264,9 @@ impl Writer {
                 let _ = self.commit();
                 Err(e)
             }
-        }
+        };
+        self.seconds[0] += start.elapsed().as_secs_f64();
+        out
     }
 
     /// Write the buffered steps, mark them complete, flush, extend the XDMF text.
