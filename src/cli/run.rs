@@ -43,13 +43,14 @@ pub struct OutputArgs {
     /// Visualisation frame (VTKHDF/XDMF) every k steps, plus the last; default about 50 frames in all.
     #[arg(long)]
     pub frame_every: Option<usize>,
-    /// Seconds between commits (write + flush) of completed steps; 0 (default) commits every step.
+    /// Seconds between commits (write + flush) of completed steps; 0 (default) commits every step as soon
+    /// as the writer thread has it (with the steps queued behind it).
     #[arg(long, default_value_t = 0.0)]
     pub commit_interval: f64,
 }
 
 pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> {
-    use tresca_cr::output::{Options, Run, Writer};
+    use tresca_cr::output::{Background, Options, Run, Writer};
     let start = std::time::Instant::now();
     let path = out.output.clone().or_else(|| scene.output.clone());
     anyhow::ensure!(!(out.resume && path.is_none()), "--resume needs a results file: give -o FILE");
@@ -64,10 +65,26 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     }
     // the run owns its output path from here on (refused at once if another run has it)
     let lock = path.as_deref().map(tresca_cr::output::OutputLock::acquire).transpose()?;
-    let problem = Problem::new(scene)?;
+    // A new results file is created on a second thread while the solver is set up (its set-up times are
+    // recorded once known); the steps are then written by a writer thread while the solver goes on.
+    let opts = Options { force: out.force, frame_every: out.frame_every, commit_interval: out.commit_interval };
+    let (problem, lock, created) = match lock {
+        Some(lock) if !out.resume => {
+            let (p, w) =
+                Problem::new_beside(scene, move |p0| Writer::create_locked(lock, &Run::before_setup(p0), &opts));
+            (p, None, w)
+        }
+        lock => (Problem::new(scene), lock, None),
+    };
+    let problem = problem?;
     let info = Run::of(&problem);
-    let (mut writer, first) = match (&path, lock) {
-        (Some(p), Some(lock)) if out.resume => {
+    let (writer, first) = match (&path, lock, created) {
+        (_, _, Some(w)) => {
+            let mut w = w?;
+            w.set_setup_times(&problem.setup)?;
+            (Some(w), None)
+        }
+        (Some(p), Some(lock), None) => {
             let (mut w, last) = Writer::resume_locked(lock, &info)?;
             w.set_commit_interval(out.commit_interval);
             if let Some(k) = out.frame_every {
@@ -79,12 +96,9 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
             }
             (Some(w), last)
         }
-        (Some(_), Some(lock)) => {
-            let opts = Options { force: out.force, frame_every: out.frame_every, commit_interval: out.commit_interval };
-            (Some(Writer::create_locked(lock, &info, &opts)?), None)
-        }
         _ => (None, None),
     };
+    let mut writer = writer.map(Background::spawn).transpose()?;
     let n = problem.n_steps();
     let all = writer.is_some() || problem.scene.exact.is_some() || verbose;
     let bar = if quiet || verbose || n < 50 {
@@ -94,6 +108,7 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     };
     let mut max_err = tresca_cr::fem::norms::ErrorNorms::default();
     let (mut iters, mut max_res) = (0usize, 0.0f64);
+    // stick and slip edges of the last step (for the summary; not the whole step, whose u is large)
     let mut last = None;
     let on_step = |r: &tresca_cr::StepResult| -> tresca_cr::Result<()> {
         if let Some(w) = writer.as_mut() {
@@ -118,7 +133,7 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
             );
         }
         bar.inc(u64::from(r.n > 0));
-        last = Some(r.clone());
+        last = (!r.state.is_empty()).then(|| (r.n_stick(), r.n_slip()));
         Ok(())
     };
     // Without a results file and without true errors, u is formed only at the last step: every step still
@@ -169,10 +184,8 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
         max_res,
         start.elapsed().as_secs_f64()
     );
-    if let Some(r) = last {
-        if !r.state.is_empty() {
-            say!("final step: {} stick, {} slip contact edges", r.n_stick(), r.n_slip());
-        }
+    if let Some((stick, slip)) = last {
+        say!("final step: {stick} stick, {slip} slip contact edges");
     }
     if problem.scene.exact.is_some() {
         say!(

@@ -175,10 +175,19 @@ impl CrSpace {
 
     /// Displacement at every edge midpoint from the unknowns.
     pub fn midpoint_values(&self, u: &[f64]) -> Vec<[f64; 2]> {
-        self.edge_dof
-            .iter()
-            .map(|d| d.terms().fold([0.0; 2], |acc, (k, c)| [acc[0] + c[0] * u[k], acc[1] + c[1] * u[k]]))
-            .collect()
+        let mut out = Vec::with_capacity(self.edge_dof.len());
+        self.midpoint_values_into(u, &mut out);
+        out
+    }
+
+    /// [`CrSpace::midpoint_values`] into `out` (its previous content replaced, its memory reused).
+    pub fn midpoint_values_into(&self, u: &[f64], out: &mut Vec<[f64; 2]>) {
+        out.clear();
+        out.extend(
+            self.edge_dof
+                .iter()
+                .map(|d| d.terms().fold([0.0; 2], |acc, (k, c)| [acc[0] + c[0] * u[k], acc[1] + c[1] * u[k]])),
+        );
     }
 
     /// I_CR v: edge means by 3-point Gauss, restricted to V_h (tangential part on contact edges). The

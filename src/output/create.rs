@@ -61,6 +61,11 @@ impl Writer {
         Ok(w)
     }
 
+    /// Record the set-up times of a file created before they were known ([`crate::Problem::new_beside`]).
+    pub fn set_setup_times(&mut self, setup: &crate::stepping::SetupTimes) -> Result<()> {
+        self.tresca.set_setup_times(&setup.as_array()).map_err(io(&self.path, "attribute setup_times"))
+    }
+
     /// The writer of an open file whose first `completed` steps are committed (the last one's slip
     /// `prev_slip`), committing every step until told otherwise.
     pub(super) fn from_opened(
@@ -88,6 +93,7 @@ impl Writer {
             frames: o.frames,
             interval: Options::default().commit_interval,
             buf: StepFields::default(),
+            mid: Vec::new(),
             rows,
             frame_rows,
             frame_steps: Vec::new(),

@@ -12,7 +12,11 @@
 //!
 //! **Crash safety.** Steps handed to [`Writer::write_step`] are committed in batches: a batch is written
 //! as soon as [`Options::commit_interval`] seconds have passed since the previous commit (default
-//! 0: every step), at the last step, and by [`Writer::finish`] / drop. A commit appends the
+//! 0: every step), at the last step, and by [`Writer::finish`] / drop. `tresca-cr run` hands the steps
+//! to a writer thread ([`Background`]) so that the solver goes on while they are written; there a step
+//! is committed as soon as the thread gets to it, together with the steps that queued up behind it
+//! (at most [`background::QUEUE`]; [`Writer::write_step_then`]), and [`Background::finish`] returns
+//! only when every step handed over is committed and the file closed. A commit appends the
 //! batch to every time-dependent dataset (allocated for the whole run at creation, contiguous, written
 //! straight to the kernel: [`h5::Series`]), then sets `tresca/steps` attribute `completed` and
 //! `NSteps` of each `VTKHDF/<block>/Steps`, flushes the file (H5Fflush: only these counters are dirty
@@ -40,11 +44,13 @@
 //! `paper_dofs`, `h`, `setup_times` (4 wall times, s), `status` ("running", then what
 //! [`Writer::finish`] records: "completed" or the error of the failed step).
 
+mod background;
 mod create;
 pub mod fields;
 mod h5;
 mod lock;
 mod resume;
+mod take;
 pub mod tresca;
 pub mod vtkhdf;
 pub mod xdmf;
@@ -54,7 +60,7 @@ use crate::fem::elasticity::Elasticity;
 use crate::fem::space::CrSpace;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
-use crate::stepping::{Problem, SetupTimes, StepResult};
+use crate::stepping::{Problem, Problem0, SetupTimes, StepResult};
 use fields::{Fields, StepFields};
 use h5::{io, Raw};
 use std::path::{Path, PathBuf};
@@ -63,7 +69,9 @@ use tresca::{Rows, Tresca};
 use vtkhdf::{FrameRows, Frames, VtkHdf};
 use xdmf::Xdmf;
 
+pub use background::Background;
 pub use lock::{lock_path, OutputLock};
+pub use take::Unknowns;
 pub use xdmf::sidecar;
 
 /// Default upper bound on the number of visualisation frames.
@@ -76,7 +84,8 @@ pub struct Options {
     pub force: bool,
     /// Visualisation frame every k steps (plus the last step); `None`: ⌈N / (AUTO_FRAMES − 1)⌉.
     pub frame_every: Option<usize>,
-    /// Seconds between commits (write + flush); 0 commits every step.
+    /// Seconds between commits (write + flush); 0 commits every step (on a writer thread: every step
+    /// together with those queued behind it, see [`Background`]).
     pub commit_interval: f64,
 }
 
@@ -112,18 +121,24 @@ pub struct Run<'a> {
 impl<'a> Run<'a> {
     /// The run of `p` with this build's version and commit.
     pub fn of(p: &'a Problem) -> Run<'a> {
-        Run {
-            scene: &p.scene,
-            mesh: &p.mesh,
-            space: &p.space,
-            law: p.law,
-            meta: RunMeta {
-                version: env!("CARGO_PKG_VERSION"),
-                commit: env!("TRESCA_BUILD_COMMIT"),
-                setup: p.setup,
-                true_errors: p.errors.is_some(),
-            },
-        }
+        Run::new(&p.scene, &p.mesh, &p.space, p.law, p.setup)
+    }
+
+    /// The run of a problem whose set-up is still under way ([`Problem::new_beside`]): its set-up times
+    /// are zeros until [`Writer::set_setup_times`].
+    pub fn before_setup(p: &'a Problem0) -> Run<'a> {
+        Run::new(&p.scene, &p.mesh, &p.space, p.law, SetupTimes::default())
+    }
+
+    /// With this build's version and commit; true errors are computed when the scene gives `[exact]`.
+    fn new(scene: &'a Scene, mesh: &'a Mesh, space: &'a CrSpace, law: Elasticity, setup: SetupTimes) -> Run<'a> {
+        let meta = RunMeta {
+            version: env!("CARGO_PKG_VERSION"),
+            commit: env!("TRESCA_BUILD_COMMIT"),
+            setup,
+            true_errors: scene.exact.is_some(),
+        };
+        Run { scene, mesh, space, law, meta }
     }
 
     /// Number of time steps N.
@@ -156,6 +171,8 @@ pub struct Writer {
     frames: Frames,
     interval: f64,
     buf: StepFields,
+    /// Midpoint values of the step being taken (memory reused from step to step).
+    mid: Vec<[f64; 2]>,
     rows: Rows,
     frame_rows: FrameRows,
     /// Step numbers of the buffered frames.
@@ -193,16 +210,6 @@ fn ioerr(path: &Path, what: &'static str) -> impl FnOnce(std::io::Error) -> Erro
     move |e| Error::Io { path, msg: format!("{what}: {e}") }
 }
 
-fn check_finite<'a>(path: &Path, n: usize, what: &str, v: impl IntoIterator<Item = &'a f64>) -> Result<()> {
-    match v.into_iter().position(|x| !x.is_finite()) {
-        None => Ok(()),
-        Some(k) => Err(Error::Io {
-            path: path.to_path_buf(),
-            msg: format!("step {n}: {what}[{k}] is not finite; the step was not written"),
-        }),
-    }
-}
-
 impl Writer {
     /// Number of steps committed to the file.
     pub fn completed(&self) -> usize {
@@ -222,13 +229,36 @@ impl Writer {
     /// Take step `r` (the step after the last one taken): checked for non-finite values, buffered, and
     /// committed (see the module doc) once the commit interval has passed or at the last step.
     pub fn write_step(&mut self, r: &StepResult) -> Result<()> {
+        self.write_step_then(r, false)
+    }
+
+    /// Steps taken but not committed yet.
+    pub fn buffered(&self) -> usize {
+        self.rows.count
+    }
+
+    /// [`Writer::write_step`], but with `more` (another step is at hand, see [`Background`]) the commit
+    /// waits for it: it is then made once the commit interval has passed *and* either no further step is
+    /// at hand or [`background::QUEUE`] steps are buffered, and always at the last step.
+    pub fn write_step_then(&mut self, r: &StepResult, more: bool) -> Result<()> {
         let start = Instant::now();
-        let out = self.take(r);
+        let u = Unknowns::of(&self.path, &self.space, r, std::mem::take(&mut self.mid));
+        self.seconds[0] += start.elapsed().as_secs_f64();
+        self.write_unknowns(u, more)
+    }
+
+    /// [`Writer::write_step_then`] of a step whose unknowns were evaluated already ([`Unknowns::of`]).
+    pub fn write_unknowns(&mut self, u: Result<Unknowns>, more: bool) -> Result<()> {
+        let start = Instant::now();
+        let out = u.and_then(|u| {
+            let n = u.n();
+            self.take(u).map(|()| n)
+        });
+        let due = self.last_commit.elapsed().as_secs_f64() >= self.interval
+            && (!more || self.rows.count >= background::QUEUE);
         let out = match out {
-            Ok(()) if self.last_commit.elapsed().as_secs_f64() >= self.interval || r.n == self.frames.last => {
-                self.commit()
-            }
-            Ok(()) => Ok(()),
+            Ok(n) if due || n == self.frames.last => self.commit(),
+            Ok(_) => Ok(()),
             Err(e) => {
                 // keep what was good
                 let _ = self.commit();
@@ -237,63 +267,6 @@ impl Writer {
         };
         self.seconds[0] += start.elapsed().as_secs_f64();
         out
-    }
-
-    fn take(&mut self, r: &StepResult) -> Result<()> {
-        let (path, n) = (self.path.as_path(), r.n);
-        let expected = self.completed + self.rows.count;
-        if n != expected {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: format!("step {n} handed to the writer, but the next step is {expected}"),
-            });
-        }
-        if r.u.len() != self.space.n_dofs {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: format!(
-                    "step {n} carries no displacement (solved with want_u = false); every written step needs u"
-                ),
-            });
-        }
-        check_finite(path, n, "t", [&r.t])?;
-        check_finite(path, n, "u", &r.u)?;
-        check_finite(path, n, "mu", &r.mu)?;
-        check_finite(path, n, "slip", &r.slip)?;
-        check_finite(path, n, "energy/residual/wall", [&r.energy, &r.residual, &r.wall])?;
-        if let Some(e) = &r.errors {
-            check_finite(path, n, "errors", [&e.energy, &e.h1, &e.l2])?;
-        }
-        let sigma_t: Vec<f64> = r.mu.iter().zip(&self.space.contact).map(|(m, c)| -m / c.length).collect();
-        check_finite(path, n, "sigma_t", &sigma_t)?;
-        let mid = self.space.midpoint_values(&r.u);
-        if self.frames.is_frame(n) {
-            self.fields.eval(&mid, r, self.prev_slip.as_deref(), &mut self.buf);
-            let b = &self.buf;
-            for (what, v) in [
-                ("displacement", &b.displacement),
-                ("strain", &b.strain),
-                ("stress", &b.stress),
-                ("von_mises", &b.von_mises),
-                ("slip_increment", &b.slip_increment),
-            ] {
-                if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-                    return Err(Error::Io {
-                        path: path.to_path_buf(),
-                        msg: format!(
-                            "step {n}: {what}[{k}] exceeds the single-precision range (3.4e38) of the VTKHDF/XDMF \
-                             views; the step was not written (u is linear in the loads, u₀ and g_a: scale them down)"
-                        ),
-                    });
-                }
-            }
-            self.frame_rows.push(r.t, &self.buf);
-            self.frame_steps.push(n);
-        }
-        let dof: Vec<f64> = self.space.contact.iter().map(|c| r.u[c.dof]).collect();
-        self.rows.push(r, &mid, &sigma_t, &dof);
-        self.prev_slip = Some(r.slip.clone());
-        Ok(())
     }
 
     /// Write the buffered steps, mark them complete, flush, extend the XDMF text.

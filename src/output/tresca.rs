@@ -67,9 +67,19 @@ impl Rows {
         }
     }
 
-    /// Empty the buffer; the next row is step `first`.
+    /// Empty the buffer, keeping its memory for the next rows; the next row is step `first`.
     pub fn reset(&mut self, first: usize) {
-        *self = Rows { first, ..Default::default() };
+        self.first = first;
+        self.count = 0;
+        let f64s = [&mut self.times, &mut self.u, &mut self.energy, &mut self.residual, &mut self.wall, &mut self.slip];
+        for v in f64s.into_iter().chain([&mut self.sigma_t, &mut self.mu, &mut self.dof]) {
+            v.clear();
+        }
+        for v in [&mut self.iterations, &mut self.n_stick, &mut self.n_slip] {
+            v.clear();
+        }
+        self.state.clear();
+        self.errors.iter_mut().for_each(Vec::clear);
     }
 }
 
@@ -389,6 +399,11 @@ impl Tresca {
             errors,
             wall: self.wall.read::<f64>(n)?[0],
         })
+    }
+
+    /// Overwrite the values of `setup_times` (a file created beside the set-up holds zeros until then).
+    pub fn set_setup_times(&self, times: &[f64; 5]) -> hdf5::Result<()> {
+        self.group.attr("setup_times")?.write_raw(times)
     }
 
     /// Record why the run stopped.

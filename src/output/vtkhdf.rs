@@ -78,8 +78,15 @@ impl FrameRows {
     pub fn count(&self) -> usize {
         self.times.len()
     }
+    /// Empty the buffer, keeping its memory; the next frame is frame `first`.
     pub fn reset(&mut self, first: usize) {
-        *self = FrameRows { first, ..Default::default() };
+        self.first = first;
+        self.times.clear();
+        let f32s = [&mut self.displacement, &mut self.contact_displacement];
+        for v in f32s.into_iter().chain(&mut self.cells).chain(&mut self.contact_cells) {
+            v.clear();
+        }
+        self.stick_slip.clear();
     }
 }
 

@@ -26,7 +26,9 @@ use faer::sparse::SparseColMat;
 use std::time::Instant;
 
 mod conditioning;
+mod setup;
 pub use conditioning::MAX_CONDITION;
+pub use setup::Problem0;
 
 /// Everything assembled once per run.
 pub struct Problem {
@@ -107,72 +109,7 @@ impl Problem {
 
     /// As [`Problem::new`] on a given mesh (the scene's `[mesh]` table is ignored).
     pub fn with_mesh(scene: Scene, mesh: Mesh) -> Result<Problem> {
-        let t0 = Instant::now();
-        let space = CrSpace::new(&mesh, &scene.parts)?;
-        let t1 = Instant::now();
-        let law = Elasticity::new(&scene.material);
-        // K's pattern is the mesh's: the fill-reducing ordering is computed from it on a second thread
-        // while K's values and the load quadrature are assembled
-        let pattern = EdgePattern::new(&mesh);
-        let (stiffness, loads, order) = std::thread::scope(|s| {
-            let order = s.spawn(|| {
-                let (first, start, adj) = pattern.unknown_graph(&space);
-                let graph = Graph::new(first, start, adj)
-                    .ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
-                fill_order(&graph, space.n_dofs >= ND_MIN_SIZE)
-            });
-            let stiffness = stiffness_on(&pattern, &mesh, &space, &law, scene.rho);
-            let loads = Loads::new(&scene, &mesh, &space);
-            let order = order.join().map_err(|_| Error::Linear("the fill-reducing ordering failed".into()));
-            (stiffness, loads, order)
-        });
-        let loads = loads?;
-        let t2 = Instant::now();
-        // contact unknowns last: the condensation then comes from the factor (solve::condense)
-        let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
-        let factor = Factor::with_order(&stiffness, &contact, order??)?;
-        let t3 = Instant::now();
-        // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
-        // ranges) factorises without complaint but returns meaningless displacements: refuse it. The
-        // estimate's solves (the longer half) run on a second thread beside the load superposition and
-        // the condensation, which only read the factor, and its matrix products on this thread after
-        // them; nothing is returned before it is known.
-        let (kappa, basis, condensation, t4, t5) = std::thread::scope(|s| {
-            let (n, f) = (stiffness.nrows(), &factor);
-            let inverse = s.spawn(move || condition::largest_inverse_eigenvalue(f, n, 12));
-            let basis = LoadBasis::build(&loads, &scene.times, &factor);
-            let t4 = Instant::now();
-            let condensation = (!contact.is_empty()).then(|| condense(&contact, &factor)).transpose();
-            let t5 = Instant::now();
-            let top = condition::largest_eigenvalue(&stiffness, 12);
-            let kappa =
-                inverse.join().map(|inv| top * inv).map_err(|_| Error::Linear("the condition estimate failed".into()));
-            (kappa, basis, condensation, t4, t5)
-        });
-        let kappa = kappa?;
-        let wait = t5.elapsed().as_secs_f64();
-        conditioning::check(kappa, &scene, &mesh, &space)?;
-        let (free, c) = FreeResponse::new(factor, loads, basis?, condensation?, &space);
-        let friction = c.map(|c| Friction::new(&space, c, scene.solver));
-        let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(x));
-        let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
-        Ok(Problem {
-            setup: SetupTimes {
-                space: d(t0, t1),
-                assembly: d(t1, t2),
-                factorisation: d(t2, t3) + wait,
-                superposition: d(t3, t4),
-                condensation: d(t4, t5),
-            },
-            scene,
-            mesh,
-            space,
-            law,
-            stiffness,
-            free,
-            friction,
-            errors,
-        })
+        Problem::with_mesh_beside(scene, mesh, None::<fn(&Problem0)>).map(|(p, _)| p).map_err(|(e, _)| e)
     }
 
     /// Number of time steps N.

@@ -1,0 +1,112 @@
+//! Taking a step into the writer's buffers: the checks that refuse a step with a value a results file
+//! cannot hold (nothing of such a step is written), its rows of `/tresca` and, for a frame, its VTKHDF
+//! fields.
+
+use super::*;
+
+/// An error naming the first non-finite value of `v`, if any.
+fn check_finite(path: &Path, n: usize, what: &str, v: &[f64]) -> Result<()> {
+    // x · 0 is 0 for every finite x and NaN otherwise: one vectorised pass finds whether any value is not
+    // finite, the position is looked for only then
+    if v.iter().fold(0.0, |a, x| a + x * 0.0) == 0.0 {
+        return Ok(());
+    }
+    match v.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(k) => Err(Error::Io {
+            path: path.to_path_buf(),
+            msg: format!("step {n}: {what}[{k}] is not finite; the step was not written"),
+        }),
+    }
+}
+
+/// The part of taking a step that needs only its unknowns and the space: the check of u, and the
+/// midpoint values and contact unknowns written of it. [`Background`] evaluates it on the caller's
+/// thread, beside the writer thread, and hands the writer this instead of u.
+pub struct Unknowns {
+    /// The step without u.
+    r: StepResult,
+    mid: Vec<[f64; 2]>,
+    dof: Vec<f64>,
+}
+
+impl Unknowns {
+    /// Check u of step `r` and evaluate what is written of it (`mid`: memory to reuse).
+    pub fn of(path: &Path, space: &CrSpace, r: &StepResult, mut mid: Vec<[f64; 2]>) -> Result<Unknowns> {
+        let n = r.n;
+        if r.u.len() != space.n_dofs {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: format!(
+                    "step {n} carries no displacement (solved with want_u = false); every written step needs u"
+                ),
+            });
+        }
+        check_finite(path, n, "u", &r.u)?;
+        space.midpoint_values_into(&r.u, &mut mid);
+        let dof = space.contact.iter().map(|c| r.u[c.dof]).collect();
+        let r = StepResult { u: Vec::new(), mu: r.mu.clone(), slip: r.slip.clone(), state: r.state.clone(), ..*r };
+        Ok(Unknowns { r, mid, dof })
+    }
+
+    /// The step's number.
+    pub fn n(&self) -> usize {
+        self.r.n
+    }
+}
+
+impl Writer {
+    /// Check step `u.r` and append it to the buffered rows (and frames); an error leaves the buffers as
+    /// they were.
+    pub(super) fn take(&mut self, u: Unknowns) -> Result<()> {
+        let Unknowns { r, mid, dof } = u;
+        let (path, n) = (self.path.as_path(), r.n);
+        let expected = self.completed + self.rows.count;
+        if n != expected {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: format!("step {n} handed to the writer, but the next step is {expected}"),
+            });
+        }
+        check_finite(path, n, "t", &[r.t])?;
+        check_finite(path, n, "mu", &r.mu)?;
+        check_finite(path, n, "slip", &r.slip)?;
+        check_finite(path, n, "energy/residual/wall", &[r.energy, r.residual, r.wall])?;
+        if let Some(e) = &r.errors {
+            check_finite(path, n, "errors", &[e.energy, e.h1, e.l2])?;
+        }
+        let sigma_t: Vec<f64> = r.mu.iter().zip(&self.space.contact).map(|(m, c)| -m / c.length).collect();
+        check_finite(path, n, "sigma_t", &sigma_t)?;
+        if self.frames.is_frame(n) {
+            self.fields.eval(&mid, &r, self.prev_slip.as_deref(), &mut self.buf);
+            let b = &self.buf;
+            for (what, v) in [
+                ("displacement", &b.displacement),
+                ("strain", &b.strain),
+                ("stress", &b.stress),
+                ("von_mises", &b.von_mises),
+                ("slip_increment", &b.slip_increment),
+            ] {
+                // as in check_finite: one vectorised pass, the position only when there is one
+                if v.iter().fold(0.0f32, |a, x| a + x * 0.0) == 0.0 {
+                    continue;
+                }
+                if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+                    return Err(Error::Io {
+                        path: path.to_path_buf(),
+                        msg: format!(
+                            "step {n}: {what}[{k}] exceeds the single-precision range (3.4e38) of the VTKHDF/XDMF \
+                             views; the step was not written (u is linear in the loads, u₀ and g_a: scale them down)"
+                        ),
+                    });
+                }
+            }
+            self.frame_rows.push(r.t, &self.buf);
+            self.frame_steps.push(n);
+        }
+        self.rows.push(&r, &mid, &sigma_t, &dof);
+        self.mid = mid;
+        self.prev_slip = Some(r.slip);
+        Ok(())
+    }
+}
