@@ -62,3 +62,22 @@ fn free_response_matches_a_direct_solve_on_every_route() {
     factor.solve_in_place(&mut load);
     assert!(rel_diff(&u, &load) <= TOL, "u_f − K⁻¹Eμ: {:e}", rel_diff(&u, &load));
 }
+
+/// Separated loads (`fem::loads`) are superposed from their patterns, without forming a load at a node:
+/// mms_stop's four time factors (1 + t, 1 + t/2, and two kinks at t* = 1/3) give rank 4; the polynomial
+/// benchmark's factors 1, t, …, t⁴ and 1 + t/2 span more than 4 and its steps assemble their loads.
+#[test]
+fn separated_loads_are_superposed_from_their_patterns() {
+    let p = Problem::new(scene("verification/cases/mms_stop.toml")).unwrap();
+    assert!(p.free.loads().separated().is_some_and(|v| v.len() == 4));
+    assert!(p.free.superposed());
+    check(&p, "patterns");
+    let mut s = scene("verification/bench/bench_mms_poly.toml");
+    if let tresca_cr::mesh::MeshSpec::Structured { cells, .. } = &mut s.mesh {
+        *cells = [8, 4];
+    }
+    s.set_steps(8).unwrap();
+    let q = Problem::new(s).unwrap();
+    assert!(q.free.loads().separated().is_some() && !q.free.superposed());
+    check(&q, "patterns beyond the rank");
+}

@@ -186,6 +186,25 @@ impl Loads {
         self.patterns.vectors.len()
     }
 
+    /// The patterns P_j on the support when every term is separated (l(t) = Σ_j τ_j(t) P_j exactly);
+    /// `None` when a term is evaluated at every node.
+    pub fn separated(&self) -> Option<&[Vec<f64>]> {
+        self.terms.is_empty().then_some(&self.patterns.vectors[..])
+    }
+
+    /// The time factors τ_j(t) of the patterns; a non-finite one is an error naming its expression.
+    pub fn time_factors(&self, t: f64) -> Result<Vec<f64>> {
+        let p = &self.patterns;
+        let mut tau = vec![0.0; p.vectors.len()];
+        if !tau.is_empty() {
+            p.factors.eval_point(0.0, 0.0, t, &mut tau);
+        }
+        match tau.iter().zip(&p.names).find(|(c, _)| !c.is_finite()) {
+            Some((c, name)) => Err(name.error(format!("value {c} at t = {t} (of a time factor, at every point)"))),
+            None => Ok(tau),
+        }
+    }
+
     /// The unknowns a load can be nonzero on (increasing).
     pub fn support(&self) -> &[usize] {
         &self.support
@@ -195,16 +214,8 @@ impl Loads {
     pub fn assemble_on_support(&self, t: f64, out: &mut Vec<f64>) -> Result<()> {
         out.clear();
         out.resize(self.support.len(), 0.0);
-        let p = &self.patterns;
-        if !p.vectors.is_empty() {
-            let mut tau = vec![0.0; p.vectors.len()];
-            p.factors.eval_point(0.0, 0.0, t, &mut tau);
-            for ((&c, v), name) in tau.iter().zip(&p.vectors).zip(&p.names) {
-                if !c.is_finite() {
-                    return Err(name.error(format!("value {c} at t = {t} (of a time factor, at every point)")));
-                }
-                out.iter_mut().zip(v).for_each(|(o, x)| *o += c * x);
-            }
+        for (c, v) in self.time_factors(t)?.into_iter().zip(&self.patterns.vectors) {
+            out.iter_mut().zip(v).for_each(|(o, x)| *o += c * x);
         }
         SCRATCH.with(|cell| {
             // a nested call on this thread (none today) would get a buffer of its own
