@@ -298,6 +298,9 @@ impl Writer {
                 .append_text(self.frames_done + k, n, t)
                 .map_err(ioerr(&self.xdmf.path.clone(), "appending to the XDMF sidecar"))?;
         }
+        if !self.frame_steps.is_empty() {
+            self.xdmf.write_text().map_err(ioerr(&self.xdmf.path.clone(), "writing the XDMF sidecar"))?;
+        }
         self.publish()?;
         self.completed = steps;
         self.frames_done = nf;

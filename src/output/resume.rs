@@ -118,7 +118,7 @@ impl Writer {
             tresca.read_step(run.space, completed - 1)
         };
         let last = fix().map_err(io(path, "--resume"))?;
-        let xdmf = Xdmf::resume(&file, path, &frame_list, contact, frames.total())
+        let mut xdmf = Xdmf::resume(&file, path, &frame_list, contact, frames.total())
             .map_err(ioerr(path, "rewriting the XDMF sidecar"))?;
         file.flush().map_err(io(path, "flush"))?;
         xdmf.publish().map_err(ioerr(path, "cannot move the XDMF sidecar into place"))?;
