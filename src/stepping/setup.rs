@@ -35,12 +35,7 @@ impl Problem {
         let law = Elasticity::new(&scene.material);
         let p0 = Problem0 { scene, mesh, space, law };
         let (rest, r) = std::thread::scope(|s| {
-            let r = beside.map(|f| {
-                s.spawn(|| {
-                    background_priority();
-                    f(&p0)
-                })
-            });
+            let r = beside.map(|f| s.spawn(|| f(&p0)));
             let rest = p0.set_up();
             (rest, r.map(|r| r.join().unwrap_or_else(|e| std::panic::resume_unwind(e))))
         });
@@ -69,18 +64,6 @@ impl Problem {
             errors,
         };
         Ok((p, r))
-    }
-}
-
-/// Lower this thread's scheduling priority (nice +10): the work beside the set-up (creating the results
-/// file, ~25 ms of CPU at 24,640 unknowns) then takes a core when the set-up's own two threads (assembly
-/// and ordering, factorisation and page mapping, superposition and condition estimate) leave one idle,
-/// instead of slowing them down; once the set-up waits for it, it runs alone at full speed. Best
-/// effort: a refusal leaves the priority as it was.
-fn background_priority() {
-    // SAFETY: setpriority on this thread's own id only changes its nice value.
-    unsafe {
-        libc::setpriority(libc::PRIO_PROCESS, libc::gettid() as libc::id_t, 10);
     }
 }
 
