@@ -16,6 +16,7 @@
 //! edges hold the two unknowns verbatim) and `contact/dof` (the one unknown of a contact edge).
 
 use super::h5::{attr, attr_str, attr_vec, put, Raw, Series};
+use super::rows::Rows;
 use super::Run;
 use crate::fem::norms::ErrorNorms;
 use crate::fem::space::{CrSpace, EdgeDof};
@@ -23,69 +24,8 @@ use crate::friction::EdgeState;
 use crate::stepping::StepResult;
 use hdf5::{Attribute, File, Group};
 
-/// Rows of consecutive steps buffered for one write.
-#[derive(Default)]
-pub struct Rows {
-    pub first: usize,
-    pub count: usize,
-    times: Vec<f64>,
-    u: Vec<f64>,
-    energy: Vec<f64>,
-    iterations: Vec<i64>,
-    residual: Vec<f64>,
-    n_stick: Vec<i64>,
-    n_slip: Vec<i64>,
-    wall: Vec<f64>,
-    slip: Vec<f64>,
-    sigma_t: Vec<f64>,
-    state: Vec<u8>,
-    mu: Vec<f64>,
-    dof: Vec<f64>,
-    errors: [Vec<f64>; 3],
-}
-
-impl Rows {
-    pub fn push(&mut self, r: &StepResult, mid: &[[f64; 2]], sigma_t: &[f64], dof: &[f64]) {
-        self.count += 1;
-        self.times.push(r.t);
-        self.u.extend_from_slice(mid.as_flattened());
-        self.energy.push(r.energy);
-        self.iterations.push(r.iterations as i64);
-        self.residual.push(r.residual);
-        self.n_stick.push(r.n_stick() as i64);
-        self.n_slip.push(r.n_slip() as i64);
-        self.wall.push(r.wall);
-        self.slip.extend_from_slice(&r.slip);
-        self.sigma_t.extend_from_slice(sigma_t);
-        self.state.extend(r.state.iter().map(|&s| s as u8));
-        self.mu.extend_from_slice(&r.mu);
-        self.dof.extend_from_slice(dof);
-        if let Some(e) = &r.errors {
-            self.errors[0].push(e.energy);
-            self.errors[1].push(e.h1);
-            self.errors[2].push(e.l2);
-        }
-    }
-
-    /// Empty the buffer, keeping its memory for the next rows; the next row is step `first`.
-    pub fn reset(&mut self, first: usize) {
-        self.first = first;
-        self.count = 0;
-        let f64s = [&mut self.times, &mut self.u, &mut self.energy, &mut self.residual, &mut self.wall, &mut self.slip];
-        for v in f64s.into_iter().chain([&mut self.sigma_t, &mut self.mu, &mut self.dof]) {
-            v.clear();
-        }
-        for v in [&mut self.iterations, &mut self.n_stick, &mut self.n_slip] {
-            v.clear();
-        }
-        self.state.clear();
-        self.errors.iter_mut().for_each(Vec::clear);
-    }
-}
-
 pub struct Tresca {
     pub group: Group,
-    steps_group: Group,
     /// `steps` attribute `completed`, kept open: it is rewritten at every commit.
     completed: Attribute,
     times: Series,
@@ -206,7 +146,6 @@ impl Tresca {
             contact,
             errors,
             completed: sg.attr("completed")?,
-            steps_group: sg,
             group: g,
         })
     }
@@ -242,7 +181,6 @@ impl Tresca {
             contact,
             errors,
             completed: sg.attr("completed")?,
-            steps_group: sg,
             group: g,
         })
     }
@@ -310,7 +248,7 @@ impl Tresca {
 
     /// The `completed` attribute.
     pub fn completed(&self) -> hdf5::Result<usize> {
-        Ok(self.steps_group.attr("completed")?.read_scalar::<i64>()?.max(0) as usize)
+        Ok(self.completed.read_scalar::<i64>()?.max(0) as usize)
     }
 
     /// Append buffered rows (all series; `completed` is not changed).
