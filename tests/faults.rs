@@ -351,3 +351,35 @@ fn a_stale_lock_is_taken_over() {
     assert_complete(&out, 8);
     assert!(!lock.exists());
 }
+
+/// Requirement (issue 13, the condition estimate beside the first steps): the solves of K's condition
+/// estimate run while the set-up ends and the first steps are computed, but an ill-conditioned K
+/// (ρ = 1e-12: plain CR fails Korn's inequality) is still refused before any step is handed out: the
+/// library hands no result to the caller, and `run -o` exits 1 naming the cause and writes no results
+/// file. A well-conditioned run hands out step 0 first, then every step in order.
+#[test]
+fn an_ill_conditioned_stiffness_is_refused_before_any_step_is_handed_out() {
+    let weak = scene_with("weak.toml", "rho = 10.0", "rho = 1e-12");
+    let p = tresca_cr::Problem::new(tresca_cr::Scene::from_file(std::path::Path::new(&weak)).unwrap()).unwrap();
+    let mut handed = 0;
+    let e = p.run(|_| {
+        handed += 1;
+        Ok(())
+    });
+    assert!(e.as_ref().is_err_and(|e| e.to_string().contains("ill-conditioned")), "{:?}", e.map(|_| ()));
+    assert_eq!(handed, 0);
+    assert!(p.initial().is_err() && p.conditioned().is_err());
+    let out = tmp("weak.h5");
+    let o = run(&["run", &weak, "-o", &out.display().to_string(), "-q"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("ill-conditioned") && stderr(&o).contains("rho < 1"), "{}", stderr(&o));
+    assert!(!out.exists(), "a results file was written for a refused K");
+    let good = tresca_cr::Problem::new(tresca_cr::Scene::from_file(std::path::Path::new(&base())).unwrap()).unwrap();
+    let mut steps = Vec::new();
+    good.run(|r| {
+        steps.push(r.n);
+        Ok(())
+    })
+    .unwrap();
+    assert_eq!(steps, (0..=good.n_steps()).collect::<Vec<_>>());
+}

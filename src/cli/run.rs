@@ -141,11 +141,7 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     let want = |k: usize| all || k == n;
     let result = match first {
         Some(f) => problem.run_selected(f, want, on_step),
-        None => problem.initial().and_then(|f| {
-            let mut on_step = on_step;
-            on_step(&f)?;
-            problem.run_selected(f, want, on_step)
-        }),
+        None => problem.run_all_selected(want, on_step),
     };
     if let Some(z) = problem.friction.as_ref().map(|f| f.zeroed_steps()).filter(|&z| z > 0) {
         note!(

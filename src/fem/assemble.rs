@@ -175,32 +175,55 @@ pub fn stiffness_on(
 }
 
 impl Blocks<'_> {
-    /// K on the unknowns: K[k, l] = v_kᵀ block(a, b) w_l for the unknowns k of edge a and l of edge b
-    /// (v, w their midpoint-value directions), exact zeros dropped. Symmetric pattern, so block row b
-    /// read as a column gives the column's rows in increasing order.
+    /// K on the unknowns, on the pattern [`EdgePattern::unknown_pattern`].
     fn to_unknowns(&self, space: &CrSpace) -> SparseColMat<usize, f64> {
+        let (pattern, val) = self.pattern.expand(space, |p, v, w| {
+            // block(a, b) = block(b, a)ᵀ, stored in row b
+            let blk = self.val[p];
+            v[0] * (blk[0][0] * w[0] + blk[1][0] * w[1]) + v[1] * (blk[0][1] * w[0] + blk[1][1] * w[1])
+        });
+        SparseColMat::new(pattern, val)
+    }
+}
+
+impl EdgePattern {
+    /// The pattern of K on the unknowns: K[k, l] for every unknown k of an edge a and l of an edge b
+    /// coupled to a, known before K's values (the symbolic factorisation is computed from it beside
+    /// the assembly). Entries that are zero for every mesh are stored too (the x–y coupling of two
+    /// edges that meet only through a jump term): with them K's pattern is this one whatever its
+    /// values. Symmetric, every column sorted (block row b read as a column gives the column's rows in
+    /// increasing order, since the unknowns are numbered edge by edge).
+    pub fn unknown_pattern(&self, space: &CrSpace) -> SymbolicSparseColMat<usize> {
+        self.expand(space, |_, _, _| ()).0
+    }
+
+    /// The columns of K's pattern in order, with `value(p, v, w)` for each entry: p the position of
+    /// the block of the two edges in the edge pattern, v and w the midpoint-value directions of the
+    /// row's and the column's unknown.
+    fn expand<T>(
+        &self,
+        space: &CrSpace,
+        mut value: impl FnMut(usize, [f64; 2], [f64; 2]) -> T,
+    ) -> (SymbolicSparseColMat<usize>, Vec<T>) {
         let n = space.n_dofs;
         let mut col_ptr = Vec::with_capacity(n + 1);
-        let (ptr, idx) = (&self.pattern.ptr, &self.pattern.idx);
-        let (mut row_idx, mut val) = (Vec::with_capacity(2 * idx.len()), Vec::with_capacity(2 * idx.len()));
+        let (ptr, idx) = (&self.ptr, &self.idx);
+        let count: Vec<usize> = space.edge_dof.iter().map(|d| d.terms().count()).collect();
+        let nnz = (0..count.len()).map(|b| count[b] * idx[ptr[b]..ptr[b + 1]].iter().map(|&a| count[a]).sum::<usize>());
+        let nnz = nnz.sum();
+        let (mut row_idx, mut val) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
         col_ptr.push(0);
         for (b, dof_b) in space.edge_dof.iter().enumerate() {
             for (_, w) in dof_b.terms() {
                 for p in ptr[b]..ptr[b + 1] {
-                    // block(a, b) = block(b, a)ᵀ, stored in row b
-                    let blk = self.val[p];
                     for (k, v) in space.edge_dof[idx[p]].terms() {
-                        let x =
-                            v[0] * (blk[0][0] * w[0] + blk[1][0] * w[1]) + v[1] * (blk[0][1] * w[0] + blk[1][1] * w[1]);
-                        if x != 0.0 {
-                            row_idx.push(k);
-                            val.push(x);
-                        }
+                        row_idx.push(k);
+                        val.push(value(p, v, w));
                     }
                 }
                 col_ptr.push(row_idx.len());
             }
         }
-        SparseColMat::new(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx), val)
+        (SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx), val)
     }
 }

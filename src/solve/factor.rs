@@ -26,7 +26,7 @@ use faer::sparse::linalg::cholesky::{
     SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::SparseColMat;
+use faer::sparse::{SparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use nalgebra::DMatrix;
 use std::sync::Mutex;
@@ -43,6 +43,55 @@ pub struct Factor {
     last: Vec<usize>,
     /// The fill-reducing permutation: position → unknown.
     fwd: Vec<usize>,
+}
+
+/// The symbolic factorisation of a sparsity pattern: the ordering (fill-reducing, with the unknowns
+/// `last` moved to its end) and the structure of L. It needs only K's pattern, so it is computed
+/// while K's values are assembled ([`Factor::numeric`] then fills it).
+pub struct Symbolic {
+    symbolic: SymbolicCholesky<usize>,
+    fwd: Vec<usize>,
+    last: Vec<usize>,
+    /// Entries of the pattern (the matrix factorised must have the same pattern).
+    pattern_nnz: usize,
+}
+
+impl Symbolic {
+    /// The symbolic factorisation of the symmetric `pattern` (both triangles stored) with the
+    /// fill-reducing ordering `base` (position → unknown, a permutation; from [`fill_order`]) and the
+    /// distinct unknowns `last` moved to its end, in the given order.
+    pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>, last: &[usize], base: Vec<usize>) -> Result<Symbolic> {
+        let n = pattern.nrows();
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        };
+        if base.len() != n || !is_permutation(&base) {
+            return Err(Error::Linear(
+                "internal: the fill-reducing ordering is not a permutation of the unknowns".into(),
+            ));
+        }
+        let mut is_last = vec![false; n];
+        for &i in last {
+            if i >= n || std::mem::replace(&mut is_last[i], true) {
+                return Err(Error::Linear(format!("unknown {i} cannot be ordered last (out of range or repeated)")));
+            }
+        }
+        let fwd: Vec<usize> = base.into_iter().filter(|&i| !is_last[i]).chain(last.iter().copied()).collect();
+        let mut inv = vec![0usize; n];
+        for (new, &old) in fwd.iter().enumerate() {
+            inv[old] = new;
+        }
+        let ordering = SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n));
+        let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, ordering, params)
+            .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))?;
+        Ok(Symbolic { symbolic, fwd, last: last.to_vec(), pattern_nnz: pattern.compute_nnz() })
+    }
+
+    /// Entries of L (supernodal blocks included).
+    pub fn len_val(&self) -> usize {
+        self.symbolic.len_val()
+    }
 }
 
 /// The fill-reducing ordering of the unknowns of `graph` (position → unknown): nested dissection when
@@ -88,39 +137,44 @@ impl Factor {
     /// As [`Factor::with_last`], with the fill-reducing ordering `base` (position → unknown, a
     /// permutation; from [`fill_order`]): the unknowns `last` are moved to its end.
     pub fn with_order(k: &SparseColMat<usize, f64>, last: &[usize], base: Vec<usize>) -> Result<Factor> {
+        Factor::numeric(Symbolic::new(k.symbolic(), last, base)?, k)
+    }
+
+    /// The numeric factorisation of `k`, whose pattern is the one `symbolic` was computed from.
+    pub fn numeric(symbolic: Symbolic, k: &SparseColMat<usize, f64>) -> Result<Factor> {
+        Factor::numeric_beside(symbolic, k, || ()).0
+    }
+
+    /// As [`Factor::numeric`], running `beside` on the second thread that maps the factor's pages
+    /// (solve::pages) once they are mapped: the caller's work that needs neither the factor nor the
+    /// whole of a core. Its result is returned whether the factorisation succeeds or not (`None` if
+    /// the factorisation could not start).
+    pub fn numeric_beside<R: Send>(
+        symbolic: Symbolic,
+        k: &SparseColMat<usize, f64>,
+        beside: impl FnOnce() -> R + Send,
+    ) -> (Result<Factor>, Option<R>) {
+        let Symbolic { symbolic, fwd, last, pattern_nnz } = symbolic;
         let n = k.nrows();
-        let params = CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-            ..Default::default()
-        };
-        if base.len() != n || !is_permutation(&base) {
-            return Err(Error::Linear(
-                "internal: the fill-reducing ordering is not a permutation of the unknowns".into(),
-            ));
+        if symbolic.nrows() != n || k.compute_nnz() != pattern_nnz {
+            let e = "internal: the matrix does not have the pattern of its symbolic factorisation";
+            return (Err(Error::Linear(e.into())), None);
         }
-        let mut is_last = vec![false; n];
-        for &i in last {
-            if i >= n || std::mem::replace(&mut is_last[i], true) {
-                return Err(Error::Linear(format!("unknown {i} cannot be ordered last (out of range or repeated)")));
-            }
-        }
-        let fwd: Vec<usize> = base.into_iter().filter(|&i| !is_last[i]).chain(last.iter().copied()).collect();
-        let mut inv = vec![0usize; n];
-        for (new, &old) in fwd.iter().enumerate() {
-            inv[old] = new;
-        }
-        let ordering = SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n));
-        let symbolic = factorize_symbolic_cholesky(k.symbolic(), Side::Lower, ordering, params)
-            .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))?;
         let oom = || Error::Linear("out of memory for the Cholesky factorisation".into());
-        let mut values = Pages::zeroed(symbolic.len_val()).ok_or_else(oom)?;
-        let mut buf = MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
-            .map_err(|_| oom())?;
+        let Some(mut values) = Pages::zeroed(symbolic.len_val()) else { return (Err(oom()), None) };
+        let Ok(mut buf) =
+            MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
+        else {
+            return (Err(oom()), None);
+        };
         // the factor's pages are mapped on a second thread while this one computes (solve::pages)
         let range = values.range();
-        std::thread::scope(|s| {
-            s.spawn(move || Pages::populate(range));
-            symbolic.factorize_numeric_llt(
+        let (numeric, r) = std::thread::scope(|s| {
+            let r = s.spawn(move || {
+                Pages::populate(range);
+                beside()
+            });
+            let numeric = symbolic.factorize_numeric_llt(
                 &mut values,
                 k.as_ref(),
                 Side::Lower,
@@ -128,16 +182,28 @@ impl Factor {
                 Par::Seq,
                 MemStack::new(&mut buf),
                 Default::default(),
-            )
-        })
-        .map_err(|e| {
+            );
+            (numeric.map(|_| ()), r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+        });
+        (Factor::finish(symbolic, values, numeric, n, last, fwd), Some(r))
+    }
+
+    fn finish(
+        symbolic: SymbolicCholesky<usize>,
+        values: Pages,
+        numeric: std::result::Result<(), faer::linalg::solvers::LltError>,
+        n: usize,
+        last: Vec<usize>,
+        fwd: Vec<usize>,
+    ) -> Result<Factor> {
+        numeric.map_err(|e| {
             Error::Linear(format!(
                 "the stiffness matrix is not positive definite ({e:?}): are rigid motions fixed by a Dirichlet part?"
             ))
         })?;
         let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
             .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
-        Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last: last.to_vec(), fwd })
+        Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last, fwd })
     }
 
     /// The unknowns ordered last (see [`Factor::with_last`]).

@@ -34,6 +34,7 @@ use crate::fem::space::CrSpace;
 use nalgebra::DMatrix;
 use std::cell::RefCell;
 use std::ops::RangeInclusive;
+use std::sync::Arc;
 
 /// Right-hand sides of a block: at most this many values (B·n ≤ 2^24, 128 MiB per buffer).
 const BLOCK_VALUES: usize = 1 << 24;
@@ -77,7 +78,7 @@ impl Block {
 
 /// u_f and s_f of one step at any time node.
 pub struct FreeResponse {
-    factor: Factor,
+    factor: Arc<Factor>,
     loads: Loads,
     basis: Option<LoadBasis>,
     n_dofs: usize,
@@ -106,7 +107,7 @@ impl FreeResponse {
     /// patterns) and the condensation onto the contact unknowns (`None` without Γ_C). Returns the
     /// response and C = EᵀK⁻¹E (`None` without Γ_C).
     pub fn new(
-        factor: Factor,
+        factor: Arc<Factor>,
         loads: Loads,
         basis: Option<LoadBasis>,
         condensation: Option<Condensation>,

@@ -1,10 +1,52 @@
 //! The guard against a nearly singular stiffness matrix: a K whose condition-number estimate
 //! (`solve::condition`) exceeds [`MAX_CONDITION`] is refused with the likeliest cause named.
+//!
+//! The estimate's solves (λ_max(K⁻¹), a few passes over the factor) run on a thread of their own
+//! ([`Pending`]) while the set-up ends and the first steps are computed; no step result is handed out
+//! before the verdict (`Problem::conditioned`), and a run that fails before that reports a refused K
+//! rather than what followed from it.
 
 use crate::error::{Error, Result};
 use crate::fem::space::CrSpace;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
+use crate::solve::condition;
+use crate::solve::factor::Factor;
+use std::sync::{Arc, Mutex, OnceLock};
+use std::thread::JoinHandle;
+
+/// The condition estimate λ_max(K) · λ_max(K⁻¹) of a run, its solves under way on their own thread.
+pub(super) struct Pending {
+    /// λ_max(K).
+    top: f64,
+    solves: Mutex<Option<JoinHandle<f64>>>,
+    /// `None` once K is accepted, else the message it was refused with.
+    verdict: OnceLock<Option<String>>,
+}
+
+impl Pending {
+    /// Start the solves for λ_max(K⁻¹) with the factor of the n × n matrix K (λ_max(K) = `top`).
+    pub(super) fn start(factor: &Arc<Factor>, n: usize, top: f64) -> Pending {
+        let f = Arc::clone(factor);
+        let solves = std::thread::spawn(move || condition::largest_inverse_eigenvalue(&f, n, 12));
+        Pending { top, solves: Mutex::new(Some(solves)), verdict: OnceLock::new() }
+    }
+
+    /// Wait for the estimate (once) and refuse K if it is too large.
+    pub(super) fn verdict(&self, scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<()> {
+        let v = self.verdict.get_or_init(|| {
+            let solves = self.solves.lock().unwrap_or_else(|e| e.into_inner()).take();
+            match solves.map(|h| h.join()) {
+                Some(Ok(inverse)) => check(self.top * inverse, scene, mesh, space).err(),
+                _ => Some("the condition estimate failed".into()),
+            }
+        });
+        match v {
+            None => Ok(()),
+            Some(msg) => Err(Error::Linear(msg.clone())),
+        }
+    }
+}
 
 /// Largest accepted condition-number estimate of K: beyond it fewer than 4 of the 16 digits survive.
 pub const MAX_CONDITION: f64 = 1e12;
@@ -12,18 +54,18 @@ pub const MAX_CONDITION: f64 = 1e12;
 /// Refuse the run when `kappa` (the estimate, a lower bound) is not below [`MAX_CONDITION`]: ρ → 0 (plain CR
 /// fails Korn's inequality) or ν → ½ far beyond locking-free ranges factorise without complaint but give
 /// meaningless displacements.
-pub(super) fn check(kappa: f64, scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<()> {
+fn check(kappa: f64, scene: &Scene, mesh: &Mesh, space: &CrSpace) -> std::result::Result<(), String> {
     if kappa < MAX_CONDITION {
         return Ok(());
     }
-    Err(Error::Linear(format!(
+    Err(format!(
         "the stiffness matrix is too ill-conditioned (condition number ≳ {kappa:.1e} > {MAX_CONDITION:.0e}; \
          rho = {}, E = {}, nu = {}): results would keep fewer than 4 correct digits. Likely cause: {}",
         scene.rho,
         scene.material.e,
         scene.material.nu,
         ill_conditioning_cause(scene, mesh, space)
-    )))
+    ))
 }
 
 /// The likeliest reason for an ill-conditioned K, for its message: a piece of the body held by no

@@ -17,12 +17,14 @@ use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::solve::condense::condense;
 use crate::solve::condition;
-use crate::solve::factor::{fill_order, Factor};
+use crate::solve::factor::{fill_order, Factor, Symbolic};
 use crate::solve::free::FreeResponse;
 use crate::solve::ordering::{Graph, ND_MIN_SIZE};
 use crate::solve::superpose::LoadBasis;
 use crate::sparse::{dot, energy};
+use conditioning::Pending;
 use faer::sparse::SparseColMat;
+use std::sync::Arc;
 use std::time::Instant;
 
 mod conditioning;
@@ -45,6 +47,8 @@ pub struct Problem {
     /// True errors (when the scene gives `[exact]`).
     pub errors: Option<ErrorEvaluator>,
     pub setup: SetupTimes,
+    /// The condition estimate of K, known by the time a step result is handed out.
+    conditioning: conditioning::Pending,
 }
 
 /// Wall times of the set-up phases (seconds).
@@ -54,8 +58,7 @@ pub struct SetupTimes {
     pub space: f64,
     /// K and the load quadrature (the fill-reducing ordering runs beside them).
     pub assembly: f64,
-    /// Cholesky factorisation of K, and the wait for its condition estimate (which runs beside the
-    /// superposition and the condensation).
+    /// Cholesky factorisation of K (its condition estimate runs beside what follows).
     pub factorisation: f64,
     /// The load superposition: its probe of the loads at the time nodes and the responses K⁻¹b_j.
     pub superposition: f64,
@@ -119,6 +122,27 @@ impl Problem {
 
     /// The step-0 state u⁰ = I_CR u₀.
     pub fn initial(&self) -> Result<StepResult> {
+        let r = self.initial_unchecked().map_err(|e| self.prefer_conditioning(e))?;
+        self.conditioned()?;
+        Ok(r)
+    }
+
+    /// K's condition estimate accepted (it waits for the estimate the first time): every step result
+    /// passes this before it is handed out (see `conditioning`).
+    pub fn conditioned(&self) -> Result<()> {
+        self.conditioning.verdict(&self.scene, &self.mesh, &self.space)
+    }
+
+    /// A failure of the run, or the refusal of K if that is what it followed from.
+    fn prefer_conditioning(&self, e: Error) -> Error {
+        match self.conditioned() {
+            Err(c) => c,
+            Ok(()) => e,
+        }
+    }
+
+    /// [`Problem::initial`] before the condition estimate is known.
+    fn initial_unchecked(&self) -> Result<StepResult> {
         let t = self.scene.times[0];
         let u = match &self.scene.u0 {
             Some(u0) => self.space.interpolate(&self.mesh, u0, t)?,
@@ -171,6 +195,13 @@ impl Problem {
     /// empty, `energy` NaN and no errors: with superposed loads such a step costs O(n_c²), independent of
     /// the mesh.
     pub fn step(&self, n: usize, prev: &StepResult, load: &mut Vec<f64>, want_u: bool) -> Result<StepResult> {
+        let r = self.step_unchecked(n, prev, load, want_u).map_err(|e| self.prefer_conditioning(e))?;
+        self.conditioned()?;
+        Ok(r)
+    }
+
+    /// [`Problem::step`] before the condition estimate is known.
+    fn step_unchecked(&self, n: usize, prev: &StepResult, load: &mut Vec<f64>, want_u: bool) -> Result<StepResult> {
         let start = Instant::now();
         let t = self.scene.times[n];
         let free = self.free.at(n, t, want_u, load)?;
@@ -265,19 +296,70 @@ impl Problem {
         &self,
         from: StepResult,
         want: impl Fn(usize) -> bool,
+        on_step: impl FnMut(&StepResult) -> Result<()>,
+    ) -> Result<()> {
+        self.run_handing(from, None, want, on_step)
+    }
+
+    /// Step 0 and all steps, handing every result to `on_step` (step 0 included), forming u only at
+    /// the steps `want` selects. Step 0 is handed out with the first step: both are computed while K's
+    /// condition estimate may still be under way.
+    pub fn run_all_selected(
+        &self,
+        want: impl Fn(usize) -> bool,
+        on_step: impl FnMut(&StepResult) -> Result<()>,
+    ) -> Result<()> {
+        let first = self.initial_unchecked().map_err(|e| self.prefer_conditioning(e))?;
+        self.run_handing(first.clone(), Some(first), want, on_step)
+    }
+
+    /// Run steps from `from` to N; `first`, if given, is handed out before them. Every result is handed
+    /// out only once K's condition estimate is accepted.
+    fn run_handing(
+        &self,
+        from: StepResult,
+        first: Option<StepResult>,
+        want: impl Fn(usize) -> bool,
         mut on_step: impl FnMut(&StepResult) -> Result<()>,
     ) -> Result<()> {
-        if let (Some(friction), true) = (&self.friction, self.free.block_size() > 0) {
-            return self.run_blocks(friction, from, want, &mut on_step).map(|_| ());
+        let mut first = first;
+        let mut hand = |r: &StepResult| -> Result<()> {
+            self.conditioned()?;
+            if let Some(f) = first.take() {
+                on_step(&f)?;
+            }
+            on_step(r)
+        };
+        let result = if from.n >= self.n_steps() {
+            // nothing to step: `first` alone (handed out as the last result)
+            match first.take() {
+                Some(f) => {
+                    self.conditioned()?;
+                    on_step(&f)
+                }
+                None => Ok(()),
+            }
+        } else if let (Some(friction), true) = (&self.friction, self.free.block_size() > 0) {
+            self.run_blocks(friction, from, want, &mut hand).map(|_| ())
+        } else {
+            let mut load = Vec::with_capacity(self.space.n_dofs);
+            let mut prev = from;
+            (|| {
+                for n in prev.n + 1..=self.n_steps() {
+                    let r = self.step_unchecked(n, &prev, &mut load, want(n))?;
+                    hand(&r)?;
+                    prev = r;
+                }
+                Ok(())
+            })()
+        };
+        if let (Err(_), Some(f)) = (&result, first.take()) {
+            // a run that fails before handing out a step still hands out step 0, as step by step
+            if self.conditioned().is_ok() {
+                on_step(&f)?;
+            }
         }
-        let mut load = Vec::with_capacity(self.space.n_dofs);
-        let mut prev = from;
-        for n in prev.n + 1..=self.n_steps() {
-            let r = self.step(n, &prev, &mut load, want(n))?;
-            on_step(&r)?;
-            prev = r;
-        }
-        Ok(())
+        result.map_err(|e| self.prefer_conditioning(e))
     }
 
     /// Run steps from `from` (whose result is given) to N, handing every result to `on_step`.
@@ -286,10 +368,8 @@ impl Problem {
     }
 
     /// Run all steps, including step 0, handing every result to `on_step`.
-    pub fn run(&self, mut on_step: impl FnMut(&StepResult) -> Result<()>) -> Result<()> {
-        let first = self.initial()?;
-        on_step(&first)?;
-        self.run_from(first, on_step)
+    pub fn run(&self, on_step: impl FnMut(&StepResult) -> Result<()>) -> Result<()> {
+        self.run_all_selected(|_| true, on_step)
     }
 }
 

@@ -5,10 +5,10 @@
 use super::*;
 
 impl Problem {
-    /// As [`Problem::new`], running `beside` on a second thread once the mesh and the space are known,
-    /// while the rest of the set-up (assembly, factorisation, condensation) runs: the results file is
-    /// created there. `beside` sees no set-up times (they are not known yet) and its result is returned
-    /// even when the set-up fails, after it (a writer then closes its file as it would have).
+    /// As [`Problem::new`], running `beside` on a thread of its own while the rest of the set-up
+    /// (assembly, factorisation, condensation) runs: the results file is created there. `beside` sees
+    /// no set-up times (they are not known yet) and its result is returned even when the set-up fails,
+    /// after it (a writer then closes its file as it would have).
     pub fn new_beside<R: Send>(
         scene: Scene,
         beside: impl FnOnce(&Problem0) -> R + Send,
@@ -34,23 +34,19 @@ impl Problem {
         let t1 = Instant::now();
         let law = Elasticity::new(&scene.material);
         let p0 = Problem0 { scene, mesh, space, law };
-        let (rest, r) = std::thread::scope(|s| {
-            let r = beside.map(|f| s.spawn(|| f(&p0)));
-            let rest = p0.set_up();
-            (rest, r.map(|r| r.join().unwrap_or_else(|e| std::panic::resume_unwind(e))))
-        });
+        let (rest, r) = p0.set_up(beside);
         let Problem0 { scene, mesh, space, law } = p0;
         let rest = match rest {
             Ok(rest) => rest,
             Err(e) => return Err((e, r)),
         };
-        let SetUp { stiffness, free, friction, errors, t2, t3, t4, t5, wait } = rest;
+        let SetUp { stiffness, free, friction, errors, conditioning, t2, t3, t4, t5 } = rest;
         let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
         let p = Problem {
             setup: SetupTimes {
                 space: d(t0, t1),
                 assembly: d(t1, t2),
-                factorisation: d(t2, t3) + wait,
+                factorisation: d(t2, t3),
                 superposition: d(t3, t4),
                 condensation: d(t4, t5),
             },
@@ -62,6 +58,7 @@ impl Problem {
             free,
             friction,
             errors,
+            conditioning,
         };
         Ok((p, r))
     }
@@ -81,61 +78,81 @@ struct SetUp {
     free: FreeResponse,
     friction: Option<Friction>,
     errors: Option<ErrorEvaluator>,
+    conditioning: Pending,
     t2: Instant,
     t3: Instant,
     t4: Instant,
     t5: Instant,
-    wait: f64,
 }
 
 impl Problem0 {
-    /// Assembly, factorisation, superposition and condensation.
-    fn set_up(&self) -> Result<SetUp> {
+    /// Assembly, factorisation, superposition and condensation, in three phases:
+    /// 1. K's values; beside them the loads, and the ordering and the symbolic factorisation (they need
+    ///    only K's pattern, which is the mesh's);
+    /// 2. the numeric factorisation; beside it the factor's pages are mapped, then λ_max(K) of the
+    ///    condition estimate is computed and the exact solution bound to the error quadrature;
+    /// 3. the load superposition and the condensation; beside them, and beside the first steps, the
+    ///    solves of the condition estimate (see `conditioning`).
+    ///
+    /// `beside` runs on a thread of its own from the start (on small meshes it is the longest part, for
+    /// example creating the results file); its result is returned even when the set-up fails.
+    fn set_up<R: Send>(&self, beside: Option<impl FnOnce(&Problem0) -> R + Send>) -> (Result<SetUp>, Option<R>) {
+        std::thread::scope(|s| {
+            let r = beside.map(|f| s.spawn(|| f(self)));
+            let rest = self.assemble().and_then(|(k, loads, symbolic)| self.factorise(k, loads, symbolic));
+            (rest, r.map(|r| r.join().unwrap_or_else(|e| std::panic::resume_unwind(e))))
+        })
+    }
+
+    /// Phase 1: K, the loads and the symbolic factorisation.
+    fn assemble(&self) -> Result<(SparseColMat<usize, f64>, Loads, Symbolic)> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
-        // K's pattern is the mesh's: the fill-reducing ordering is computed from it on a second thread
-        // while K's values and the load quadrature are assembled
         let pattern = EdgePattern::new(mesh);
-        let (stiffness, loads, order) = std::thread::scope(|s| {
-            let order = s.spawn(|| {
+        // contact unknowns last: the condensation then comes from the factor (solve::condense)
+        let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
+        std::thread::scope(|s| {
+            let symbolic = s.spawn(|| {
                 let (first, start, adj) = pattern.unknown_graph(space);
                 let graph = Graph::new(first, start, adj)
                     .ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
-                fill_order(&graph, space.n_dofs >= ND_MIN_SIZE)
+                let order = fill_order(&graph, space.n_dofs >= ND_MIN_SIZE)?;
+                Symbolic::new(pattern.unknown_pattern(space).as_ref(), &contact, order)
             });
+            let loads = s.spawn(|| Loads::new(scene, mesh, space));
             let stiffness = stiffness_on(&pattern, mesh, space, law, scene.rho);
-            let loads = Loads::new(scene, mesh, space);
-            let order = order.join().map_err(|_| Error::Linear("the fill-reducing ordering failed".into()));
-            (stiffness, loads, order)
-        });
-        let loads = loads?;
+            let loads = loads.join().map_err(|_| Error::Linear("the load assembly failed".into())).and_then(|r| r)?;
+            let symbolic = symbolic
+                .join()
+                .map_err(|_| Error::Linear("the symbolic factorisation failed".into()))
+                .and_then(|r| r)?;
+            Ok((stiffness, loads, symbolic))
+        })
+    }
+
+    /// Phases 2 and 3: the factor, the superposition, the condensation, the condition estimate under way.
+    fn factorise(&self, stiffness: SparseColMat<usize, f64>, loads: Loads, symbolic: Symbolic) -> Result<SetUp> {
+        let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         let t2 = Instant::now();
-        // contact unknowns last: the condensation then comes from the factor (solve::condense)
-        let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
-        let factor = Factor::with_order(&stiffness, &contact, order??)?;
+        let (factor, aside) = Factor::numeric_beside(symbolic, &stiffness, || {
+            let top = condition::largest_eigenvalue(&stiffness, 12);
+            let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, law, scene.rho).with_exact(x));
+            (top, errors)
+        });
+        let factor = factor?;
+        let (top, errors) = aside.unwrap_or((f64::NAN, None));
         let t3 = Instant::now();
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
-        // ranges) factorises without complaint but returns meaningless displacements: refuse it. The
-        // estimate's solves (the longer half) run on a second thread beside the load superposition and
-        // the condensation, which only read the factor, and its matrix products on this thread after
-        // them; nothing is returned before it is known.
-        let (kappa, basis, condensation, t4, t5) = std::thread::scope(|s| {
-            let (n, f) = (stiffness.nrows(), &factor);
-            let inverse = s.spawn(move || condition::largest_inverse_eigenvalue(f, n, 12));
-            let basis = LoadBasis::build(&loads, &scene.times, &factor);
-            let t4 = Instant::now();
-            let condensation = (!contact.is_empty()).then(|| condense(&contact, &factor)).transpose();
-            let t5 = Instant::now();
-            let top = condition::largest_eigenvalue(&stiffness, 12);
-            let kappa =
-                inverse.join().map(|inv| top * inv).map_err(|_| Error::Linear("the condition estimate failed".into()));
-            (kappa, basis, condensation, t4, t5)
-        });
-        let kappa = kappa?;
-        let wait = t5.elapsed().as_secs_f64();
-        conditioning::check(kappa, scene, mesh, space)?;
-        let (free, c) = FreeResponse::new(factor, loads, basis?, condensation?, space);
+        // ranges) factorises without complaint but returns meaningless displacements: it is refused
+        // by the condition estimate, whose solves run on their own thread from here on (conditioning).
+        let factor = Arc::new(factor);
+        let conditioning = Pending::start(&factor, stiffness.nrows(), top);
+        let basis = LoadBasis::build(&loads, &scene.times, &factor)?;
+        let t4 = Instant::now();
+        let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
+        let condensation = (!contact.is_empty()).then(|| condense(&contact, &factor)).transpose()?;
+        let t5 = Instant::now();
+        let (free, c) = FreeResponse::new(factor, loads, basis, condensation, space);
         let friction = c.map(|c| Friction::new(space, c, scene.solver));
-        let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, law, scene.rho).with_exact(x));
-        Ok(SetUp { stiffness, free, friction, errors, t2, t3, t4, t5, wait })
+        Ok(SetUp { stiffness, free, friction, errors, conditioning, t2, t3, t4, t5 })
     }
 }
