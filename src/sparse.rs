@@ -56,9 +56,11 @@ pub fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
 }
 
-/// xᵀ K x.
+/// xᵀ K x, as Σ_j x_j (column j of K)·x: one pass over K that only reads (no K x vector is formed).
 pub fn energy(k: &SparseColMat<usize, f64>, x: &[f64]) -> f64 {
-    let mut kx = vec![0.0; x.len()];
-    matvec(k, x, &mut kx);
-    dot(x, &kx)
+    let s = k.symbolic();
+    let (cp, ri, val) = (s.col_ptr(), s.row_idx(), k.val());
+    (0..s.ncols())
+        .map(|j| x[j] * ri[cp[j]..cp[j + 1]].iter().zip(&val[cp[j]..cp[j + 1]]).map(|(&i, v)| v * x[i]).sum::<f64>())
+        .sum()
 }

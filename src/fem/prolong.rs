@@ -93,33 +93,65 @@ pub fn prolong(coarse: (&Mesh, &CrSpace), u_c: &[f64], fine: (&Mesh, &CrSpace)) 
 
 /// [`prolong`] with the coarse parent of every fine triangle ([`parent_triangles`]) computed once.
 pub fn prolong_with(parent: &[usize], coarse: (&Mesh, &CrSpace), u_c: &[f64], fine: (&Mesh, &CrSpace)) -> Vec<f64> {
-    let (cm, cs) = coarse;
-    let (fm, fs) = fine;
-    let mid = cs.midpoint_values(u_c);
-    let mut u = vec![0.0; fs.n_dofs];
-    for (e, dof) in fs.edge_dof.iter().enumerate() {
-        if dof.terms().next().is_none() {
-            continue;
+    Prolongation::new(parent, coarse.0, fine).apply(coarse.1, u_c, fine.1)
+}
+
+/// P as an operator, for prolonging many fields between the same two meshes: for every fine edge with
+/// unknowns, the values φ_i(m) of the CR basis functions of its (one or two) fine triangles' coarse
+/// parents at its midpoint m, with their coarse edges. Each field then costs a gather; the values are
+/// the same, bit for bit, as computing the geometry anew for it.
+pub struct Prolongation {
+    /// Fine edge e's terms are `terms[start[e]..start[e + 1]]`, three per parent triangle.
+    start: Vec<usize>,
+    /// (coarse edge, φ value).
+    terms: Vec<(usize, f64)>,
+}
+
+impl Prolongation {
+    /// The operator from the coarse mesh to the fine space (`parent`: [`parent_triangles`]).
+    pub fn new(parent: &[usize], coarse: &Mesh, fine: (&Mesh, &CrSpace)) -> Prolongation {
+        let (fm, fs) = fine;
+        let mut start = Vec::with_capacity(fs.edge_dof.len() + 1);
+        let mut terms = Vec::with_capacity(6 * fs.edge_dof.len());
+        start.push(0);
+        for (e, dof) in fs.edge_dof.iter().enumerate() {
+            if dof.terms().next().is_some() {
+                let m = fm.midpoint(e);
+                let (t1, t2) = fm.edge_tris[e];
+                for t in [Some(t1), t2].into_iter().flatten() {
+                    let ct = parent[t];
+                    let phi = Element::phi(Element::new(coarse, ct).bary(m));
+                    terms.extend(phi.iter().enumerate().map(|(i, &p)| (coarse.tri_edges[ct][i], p)));
+                }
+            }
+            start.push(terms.len());
         }
-        let m = fm.midpoint(e);
-        let (t1, t2) = fm.edge_tris[e];
-        let mut sum = [0.0; 2];
-        let mut count = 0.0;
-        for t in [Some(t1), t2].into_iter().flatten() {
-            let ct = parent[t];
-            let phi = Element::phi(Element::new(cm, ct).bary(m));
-            for (i, p) in phi.iter().enumerate() {
-                let v = mid[cm.tri_edges[ct][i]];
+        Prolongation { start, terms }
+    }
+
+    /// P u_c on the fine space, from the coarse unknowns `u_c`: on each fine edge the mean over its
+    /// parents of Σ_i φ_i(m) u_c(coarse edge i).
+    pub fn apply(&self, coarse: &CrSpace, u_c: &[f64], fine: &CrSpace) -> Vec<f64> {
+        let mid = coarse.midpoint_values(u_c);
+        let mut u = vec![0.0; fine.n_dofs];
+        for (e, dof) in fine.edge_dof.iter().enumerate() {
+            let terms = &self.terms[self.start[e]..self.start[e + 1]];
+            if terms.is_empty() {
+                continue;
+            }
+            let mut sum = [0.0; 2];
+            for &(c, p) in terms {
+                let v = mid[c];
                 sum = [sum[0] + p * v[0], sum[1] + p * v[1]];
             }
-            count += 1.0;
+            let count = (terms.len() / 3) as f64;
+            let v = [sum[0] / count, sum[1] / count];
+            for (k, c) in dof.terms() {
+                u[k] = c[0] * v[0] + c[1] * v[1];
+            }
         }
-        let v = [sum[0] / count, sum[1] / count];
-        for (k, c) in dof.terms() {
-            u[k] = c[0] * v[0] + c[1] * v[1];
-        }
+        u
     }
-    u
 }
 
 #[cfg(test)]

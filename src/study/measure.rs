@@ -1,7 +1,7 @@
 //! Distances between the levels of a study, at the time nodes common to all levels.
 //!
 //! * consecutive error (the paper's): |||u_l − P u_{l−1}|||, the discrete energy norm a_h(·,·)^{1/2} of the
-//!   finer level (P: [`prolong_with`]; its jumps on coarse edges are charged with the fine penalty);
+//!   finer level (P: [`Prolongation`]; its jumps on coarse edges are charged with the fine penalty);
 //! * error against a finer reference run u_ref, the true error with u replaced by u_ref:
 //!   |||u_ref − u_l|||² = Σ_{T ∈ reference mesh} ∫_T σ(u_ref − u_l):ε(u_ref − u_l) + Σ_{e ∈ E_l⁰} (2ρμ/h_e) ∫_e |[u_l]|²
 //!   (u_l is linear on each reference triangle of nested meshes; the exact u has no jumps), or
@@ -13,7 +13,7 @@
 
 use crate::error::Result;
 use crate::fem::norms::ErrorEvaluator;
-use crate::fem::prolong::{parent_triangles, prolong_with};
+use crate::fem::prolong::{parent_triangles, Prolongation};
 use crate::fem::space::Element;
 use crate::sparse::energy;
 use crate::stepping::Problem;
@@ -56,13 +56,13 @@ fn integrate(p: &Problem, dens: &[f64]) -> f64 {
 /// ‖u_fine − P u_coarse‖ (a_h of the finer level) at every common node.
 pub fn consecutive(fine: &Kept, coarse: &Kept) -> Result<Vec<f64>> {
     let (c, f) = (&coarse.problem, &fine.problem);
-    let parent = parent_triangles(&c.mesh, &f.mesh)?;
+    let p = Prolongation::new(&parent_triangles(&c.mesh, &f.mesh)?, &c.mesh, (&f.mesh, &f.space));
     Ok(fine
         .u
         .iter()
         .zip(&coarse.u)
         .map(|(uf, uc)| {
-            let pu = prolong_with(&parent, (&c.mesh, &c.space), uc, (&f.mesh, &f.space));
+            let pu = p.apply(&c.space, uc, &f.space);
             let d: Vec<f64> = uf.iter().zip(&pu).map(|(a, b)| a - b).collect();
             energy_norm(f, &d)
         })
