@@ -19,7 +19,7 @@
 
 use super::elasticity::Elasticity;
 use super::quadrature::GAUSS2;
-use super::space::{jump_terms, CrSpace, Element};
+use super::space::{jump_terms_with, CrSpace, Element};
 use crate::mesh::Mesh;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
@@ -126,8 +126,8 @@ pub fn stiffness_on(
     rho: f64,
 ) -> SparseColMat<usize, f64> {
     let mut k = Blocks { val: vec![[[0.0; 2]; 2]; pattern.idx.len()], pattern };
-    for t in 0..mesh.tris.len() {
-        let el = Element::new(mesh, t);
+    let elements: Vec<Element> = (0..mesh.tris.len()).map(|t| Element::new(mesh, t)).collect();
+    for (t, el) in elements.iter().enumerate() {
         for i in 0..3 {
             for j in 0..3 {
                 k.add(
@@ -151,7 +151,8 @@ pub fn stiffness_on(
         let mut m = [[0.0f64; 6]; 6];
         for (s, w) in GAUSS2 {
             let mut p = [0.0f64; 6];
-            for (a, pa) in jump_terms(mesh, e, s) {
+            let (terms, n_terms) = jump_terms_with(mesh, e, s, |t| elements[t]);
+            for &(a, pa) in &terms[..n_terms] {
                 let i = idx[..len].iter().position(|&x| x == a).unwrap_or_else(|| {
                     idx[len] = a;
                     len += 1;

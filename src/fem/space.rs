@@ -219,20 +219,32 @@ impl CrSpace {
 
 /// The jump of the CR basis across edge e at parameter s: (edge, signed basis value) for both sides.
 pub fn jump_terms(mesh: &Mesh, e: usize, s: f64) -> Vec<(usize, f64)> {
+    let (terms, len) = jump_terms_with(mesh, e, s, |t| Element::new(mesh, t));
+    terms[..len].to_vec()
+}
+
+/// [`jump_terms`] with the elements of the mesh's triangles given by `element` (made once for many
+/// edges), as a fixed array and its length.
+pub fn jump_terms_with(
+    mesh: &Mesh,
+    e: usize,
+    s: f64,
+    element: impl Fn(usize) -> Element,
+) -> ([(usize, f64); 6], usize) {
     let [a, b] = mesh.edges[e].map(|v| mesh.points[v]);
     let x = edge_point(a, b, s);
     let (t1, t2) = mesh.edge_tris[e];
-    let mut out = Vec::with_capacity(6);
+    let (mut out, mut len) = ([(0usize, 0.0f64); 6], 0);
     for (t, sign) in [(Some(t1), 1.0), (t2, -1.0)] {
         if let Some(t) = t {
-            let el = Element::new(mesh, t);
-            let phi = Element::phi(el.bary(x));
+            let phi = Element::phi(element(t).bary(x));
             for i in 0..3 {
-                out.push((mesh.tri_edges[t][i], sign * phi[i]));
+                out[len] = (mesh.tri_edges[t][i], sign * phi[i]);
+                len += 1;
             }
         }
     }
-    out
+    (out, len)
 }
 
 #[cfg(test)]
