@@ -8,20 +8,22 @@
 //!
 //! Assembled straight into compressed columns, without triplets: the midpoint values of edges a and b
 //! are coupled exactly when a and b lie in one triangle or in two triangles sharing an edge (the jump
-//! on that edge), so the pattern is known from the mesh. Each edge gets its sorted list of coupled
-//! edges (a block row of ≤ 13 edges), the 2 × 2 blocks of the midpoint values are summed in place
-//! (volume terms triangle by triangle, then jump terms edge by edge), and the blocks are mapped to the
-//! unknowns (two per free edge, the tangential one on Γ_C, none on Γ_D), whose numbering follows the
-//! edges, so every column comes out sorted. Entries that are exactly zero are not stored (the x–y
-//! coupling of two edges that meet only through a jump term is zero), so the pattern is the one of
-//! the nonzeros. Cost O(edges); the former triplet route (4M triplets sorted by column at 24,640
-//! unknowns) took 40 % of Example 5.1's set-up.
+//! on that edge), so the pattern is known from the mesh ([`EdgePattern`]): each edge gets its sorted
+//! list of coupled edges (a block row of ≤ 13 edges), mapped to the unknowns (two per free edge, the
+//! tangential one on Γ_C, none on Γ_D), whose numbering follows the edges, so every column comes out
+//! sorted. Entries that are zero for every mesh (the x–y coupling of two edges that meet only through
+//! a jump term) are stored too, so the pattern is known before the values: the symbolic factorisation
+//! is computed from it while the values are assembled. The 2 × 2 blocks of the midpoint values (volume
+//! terms triangle by triangle, then jump terms edge by edge) are added straight into K's values, those
+//! of a tangential Γ_C edge projected once summed. Cost O(edges); the former triplet route (4M triplets
+//! sorted by column at 24,640 unknowns) took 40 % of Example 5.1's set-up.
 
 use super::elasticity::Elasticity;
 use super::quadrature::GAUSS2;
-use super::space::{jump_terms_with, CrSpace, Element};
+use super::space::{jump_terms_with, CrSpace, EdgeDof, Element};
 use crate::mesh::Mesh;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use std::collections::HashMap;
 
 /// The edges coupled to each edge (itself included), sorted: the block pattern of K as compressed rows
 /// (`ptr`, `idx`). Known from the mesh alone, so the fill-reducing ordering can be computed from it
@@ -92,23 +94,65 @@ impl EdgePattern {
     }
 }
 
-/// The 2 × 2 blocks of the edge pattern, summed in place.
-struct Blocks<'a> {
+/// K's values, summed in place in the mesh's pattern ([`EdgePattern::unknown_pattern`]).
+///
+/// `add(a, b, m)` adds the 2 × 2 block m of midpoint values (columns: edge a's components, rows: edge
+/// b's) to K[unknown of b, unknown of a]. Between two free edges (unknowns along the axes) that is one
+/// entry per component pair, added straight into K. A block with a tangential Γ_C edge (an unknown along
+/// τ) is summed as a block and projected once at the end, K[k, l] = w_lᵀ block v_k, so every entry is the
+/// same sum as with all blocks summed first.
+struct Values<'a> {
     pattern: &'a EdgePattern,
-    val: Vec<[[f64; 2]; 2]>,
+    space: &'a CrSpace,
+    col_ptr: &'a [usize],
+    /// Where block p's rows start within a column of its edge (the same in both columns).
+    off: Vec<usize>,
+    val: Vec<f64>,
+    /// Blocks of a tangential edge: position p → (column edge, sum).
+    projected: HashMap<usize, (usize, [[f64; 2]; 2])>,
 }
 
-impl Blocks<'_> {
-    /// block(a, b) += m.
+impl Values<'_> {
     fn add(&mut self, a: usize, b: usize, m: [[f64; 2]; 2]) {
+        let (da, db) = (self.space.edge_dof[a], self.space.edge_dof[b]);
+        if matches!(da, EdgeDof::Fixed) || matches!(db, EdgeDof::Fixed) {
+            return;
+        }
         let (ptr, idx) = (&self.pattern.ptr, &self.pattern.idx);
-        let row = &idx[ptr[a]..ptr[a + 1]];
-        let p = ptr[a] + row.binary_search(&b).expect("edges of one patch are in the pattern");
-        for c in 0..2 {
-            for d in 0..2 {
-                self.val[p][c][d] += m[c][d];
+        let p = ptr[a] + idx[ptr[a]..ptr[a + 1]].binary_search(&b).expect("edges of one patch are in the pattern");
+        match da {
+            EdgeDof::Free(cols) if matches!(db, EdgeDof::Free(_)) => {
+                for (c, &col) in cols.iter().enumerate() {
+                    let at = self.col_ptr[col] + self.off[p];
+                    for d in 0..2 {
+                        self.val[at + d] += m[c][d];
+                    }
+                }
+            }
+            _ => {
+                let blk = &mut self.projected.entry(p).or_insert((a, [[0.0; 2]; 2])).1;
+                for c in 0..2 {
+                    for d in 0..2 {
+                        blk[c][d] += m[c][d];
+                    }
+                }
             }
         }
+    }
+
+    /// The entries of the projected blocks.
+    fn finish(mut self) -> Vec<f64> {
+        for (&p, &(a, blk)) in &self.projected {
+            let b = self.pattern.idx[p];
+            for (l, w) in self.space.edge_dof[a].terms() {
+                let at = self.col_ptr[l] + self.off[p];
+                for (i, (_, v)) in self.space.edge_dof[b].terms().enumerate() {
+                    self.val[at + i] =
+                        v[0] * (blk[0][0] * w[0] + blk[1][0] * w[1]) + v[1] * (blk[0][1] * w[0] + blk[1][1] * w[1]);
+                }
+            }
+        }
+        self.val
     }
 }
 
@@ -125,7 +169,24 @@ pub fn stiffness_on(
     law: &Elasticity,
     rho: f64,
 ) -> SparseColMat<usize, f64> {
-    let mut k = Blocks { val: vec![[[0.0; 2]; 2]; pattern.idx.len()], pattern };
+    let k_pattern = pattern.unknown_pattern(space);
+    let count: Vec<usize> = space.edge_dof.iter().map(|d| d.terms().count()).collect();
+    let mut off = vec![0usize; pattern.idx.len()];
+    for a in 0..count.len() {
+        let mut at = 0;
+        for p in pattern.ptr[a]..pattern.ptr[a + 1] {
+            off[p] = at;
+            at += count[pattern.idx[p]];
+        }
+    }
+    let mut k = Values {
+        pattern,
+        space,
+        col_ptr: k_pattern.col_ptr(),
+        off,
+        val: vec![0.0; k_pattern.compute_nnz()],
+        projected: HashMap::new(),
+    };
     let elements: Vec<Element> = (0..mesh.tris.len()).map(|t| Element::new(mesh, t)).collect();
     for (t, el) in elements.iter().enumerate() {
         for i in 0..3 {
@@ -172,19 +233,8 @@ pub fn stiffness_on(
             }
         }
     }
-    k.to_unknowns(space)
-}
-
-impl Blocks<'_> {
-    /// K on the unknowns, on the pattern [`EdgePattern::unknown_pattern`].
-    fn to_unknowns(&self, space: &CrSpace) -> SparseColMat<usize, f64> {
-        let (pattern, val) = self.pattern.expand(space, |p, v, w| {
-            // block(a, b) = block(b, a)ᵀ, stored in row b
-            let blk = self.val[p];
-            v[0] * (blk[0][0] * w[0] + blk[1][0] * w[1]) + v[1] * (blk[0][1] * w[0] + blk[1][1] * w[1])
-        });
-        SparseColMat::new(pattern, val)
-    }
+    let val = k.finish();
+    SparseColMat::new(k_pattern, val)
 }
 
 impl EdgePattern {
@@ -195,36 +245,21 @@ impl EdgePattern {
     /// values. Symmetric, every column sorted (block row b read as a column gives the column's rows in
     /// increasing order, since the unknowns are numbered edge by edge).
     pub fn unknown_pattern(&self, space: &CrSpace) -> SymbolicSparseColMat<usize> {
-        self.expand(space, |_, _, _| ()).0
-    }
-
-    /// The columns of K's pattern in order, with `value(p, v, w)` for each entry: p the position of
-    /// the block of the two edges in the edge pattern, v and w the midpoint-value directions of the
-    /// row's and the column's unknown.
-    fn expand<T>(
-        &self,
-        space: &CrSpace,
-        mut value: impl FnMut(usize, [f64; 2], [f64; 2]) -> T,
-    ) -> (SymbolicSparseColMat<usize>, Vec<T>) {
         let n = space.n_dofs;
-        let mut col_ptr = Vec::with_capacity(n + 1);
         let (ptr, idx) = (&self.ptr, &self.idx);
         let count: Vec<usize> = space.edge_dof.iter().map(|d| d.terms().count()).collect();
         let nnz = (0..count.len()).map(|b| count[b] * idx[ptr[b]..ptr[b + 1]].iter().map(|&a| count[a]).sum::<usize>());
-        let nnz = nnz.sum();
-        let (mut row_idx, mut val) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
+        let mut row_idx = Vec::with_capacity(nnz.sum());
+        let mut col_ptr = Vec::with_capacity(n + 1);
         col_ptr.push(0);
         for (b, dof_b) in space.edge_dof.iter().enumerate() {
-            for (_, w) in dof_b.terms() {
-                for p in ptr[b]..ptr[b + 1] {
-                    for (k, v) in space.edge_dof[idx[p]].terms() {
-                        row_idx.push(k);
-                        val.push(value(p, v, w));
-                    }
+            for _ in dof_b.terms() {
+                for &a in &idx[ptr[b]..ptr[b + 1]] {
+                    row_idx.extend(space.edge_dof[a].terms().map(|(k, _)| k));
                 }
                 col_ptr.push(row_idx.len());
             }
         }
-        (SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx), val)
+        SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx)
     }
 }
