@@ -22,7 +22,7 @@ use super::elasticity::Elasticity;
 use super::quadrature::GAUSS2;
 use super::space::{jump_terms_with, CrSpace, EdgeDof, Element};
 use crate::mesh::Mesh;
-use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use faer::sparse::{SparseColMat, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use std::collections::HashMap;
 
 /// The edges coupled to each edge (itself included), sorted: the block pattern of K as compressed rows
@@ -158,18 +158,22 @@ impl Values<'_> {
 
 /// Assemble K (both triangles of the symmetric matrix stored).
 pub fn stiffness(mesh: &Mesh, space: &CrSpace, law: &Elasticity, rho: f64) -> SparseColMat<usize, f64> {
-    stiffness_on(&EdgePattern::new(mesh), mesh, space, law, rho)
+    let pattern = EdgePattern::new(mesh);
+    let k = pattern.unknown_pattern(space);
+    let val = stiffness_values(&pattern, k.as_ref(), mesh, space, law, rho);
+    SparseColMat::new(k, val)
 }
 
-/// As [`stiffness`], on the mesh's pattern made beforehand.
-pub fn stiffness_on(
+/// K's values in its pattern `k_pattern` ([`EdgePattern::unknown_pattern`] of `pattern`), both made
+/// beforehand (the set-up shares K's pattern with the symbolic factorisation).
+pub fn stiffness_values(
     pattern: &EdgePattern,
+    k_pattern: SymbolicSparseColMatRef<'_, usize>,
     mesh: &Mesh,
     space: &CrSpace,
     law: &Elasticity,
     rho: f64,
-) -> SparseColMat<usize, f64> {
-    let k_pattern = pattern.unknown_pattern(space);
+) -> Vec<f64> {
     let count: Vec<usize> = space.edge_dof.iter().map(|d| d.terms().count()).collect();
     let mut off = vec![0usize; pattern.idx.len()];
     for a in 0..count.len() {
@@ -233,8 +237,7 @@ pub fn stiffness_on(
             }
         }
     }
-    let val = k.finish();
-    SparseColMat::new(k_pattern, val)
+    k.finish()
 }
 
 impl EdgePattern {

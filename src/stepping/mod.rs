@@ -7,7 +7,7 @@
 //! callback (the writer), so nothing is lost if a later step fails.
 
 use crate::error::{Error, Result};
-use crate::fem::assemble::{stiffness_on, EdgePattern};
+use crate::fem::assemble::{stiffness_values, EdgePattern};
 use crate::fem::elasticity::Elasticity;
 use crate::fem::loads::Loads;
 use crate::fem::norms::{ErrorEvaluator, ErrorNorms};

@@ -108,25 +108,27 @@ impl Problem0 {
     fn assemble(&self) -> Result<(SparseColMat<usize, f64>, Loads, Symbolic)> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         let pattern = EdgePattern::new(mesh);
+        let k_pattern = pattern.unknown_pattern(space);
         // contact unknowns last: the condensation then comes from the factor (solve::condense)
         let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
-        std::thread::scope(|s| {
+        let (val, loads, symbolic) = std::thread::scope(|s| {
             let symbolic = s.spawn(|| {
                 let (first, start, adj) = pattern.unknown_graph(space);
                 let graph = Graph::new(first, start, adj)
                     .ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
                 let order = fill_order(&graph, space.n_dofs >= ND_MIN_SIZE)?;
-                Symbolic::new(pattern.unknown_pattern(space).as_ref(), &contact, order)
+                Symbolic::new(k_pattern.as_ref(), &contact, order)
             });
             let loads = s.spawn(|| Loads::new(scene, mesh, space));
-            let stiffness = stiffness_on(&pattern, mesh, space, law, scene.rho);
+            let val = stiffness_values(&pattern, k_pattern.as_ref(), mesh, space, law, scene.rho);
             let loads = loads.join().map_err(|_| Error::Linear("the load assembly failed".into())).and_then(|r| r)?;
             let symbolic = symbolic
                 .join()
                 .map_err(|_| Error::Linear("the symbolic factorisation failed".into()))
                 .and_then(|r| r)?;
-            Ok((stiffness, loads, symbolic))
-        })
+            Ok((val, loads, symbolic))
+        })?;
+        Ok((SparseColMat::new(k_pattern, val), loads, symbolic))
     }
 
     /// Phases 2 and 3: the factor, the superposition, the condensation, the condition estimate under way.
