@@ -43,3 +43,35 @@ fn non_finite_exact_value_names_expression_and_first_point() {
     assert!(a.energy.is_finite() && a.energy > 0.0);
     assert_eq!([a.energy, a.h1, a.l2].map(f64::to_bits), [b.energy, b.h1, b.l2].map(f64::to_bits));
 }
+
+/// Requirement (issue 13, error norms of several time nodes at once): `errors_at` gives the same norms,
+/// bit for bit, as `errors` node by node, and where the exact solution is not finite at a later node it
+/// returns the norms of the nodes before it and that node's error (a run hands out the steps before).
+#[test]
+fn error_norms_of_several_nodes_at_once_equal_node_by_node() {
+    let mut scene =
+        Scene::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/cases/mms_stop.toml")).unwrap();
+    scene.set_refine(3).unwrap();
+    let mesh = Mesh::from_spec(&scene.mesh).unwrap();
+    let space = CrSpace::new(&mesh, &scene.parts).unwrap();
+    let law = Elasticity::new(&scene.material);
+    let exact = scene.exact.clone().unwrap();
+    let ev = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(&exact);
+    let mids: Vec<Vec<[f64; 2]>> = (0..3)
+        .map(|k| (0..mesh.edges.len()).map(|e| [(e * (k + 1)) as f64 * 1e-5, 1e-3 * k as f64]).collect())
+        .collect();
+    let times = [0.1, 0.5, 0.9];
+    let fields: Vec<(&[[f64; 2]], f64)> = mids.iter().zip(times).map(|(m, t)| (&m[..], t)).collect();
+    let (norms, failed) = ev.errors_at(&mesh, &exact, &fields);
+    assert!(failed.is_none());
+    for (n, (m, t)) in norms.iter().zip(&fields) {
+        assert_eq!(*n, ev.errors(&mesh, &exact, m, *t).unwrap());
+    }
+    // not finite from t = 0.7 on: the first two nodes' norms, then the error
+    let mut late = exact.clone();
+    late.u.0[0] = Expr::parse("exact.u[0]", "x/max(0.7-t, 0)").unwrap();
+    let ev = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(&late);
+    let (norms, failed) = ev.errors_at(&mesh, &late, &fields);
+    assert_eq!(norms.len(), 2);
+    assert!(failed.is_some_and(|e| e.to_string().contains("x/max(0.7-t, 0)")));
+}
