@@ -11,14 +11,20 @@ use tresca_cr::mesh::Mesh;
 use tresca_cr::scene::expr::Expr;
 use tresca_cr::Scene;
 
-#[test]
-fn non_finite_exact_value_names_expression_and_first_point() {
+/// mms_stop at refinement `refine`: its scene, mesh, space and law.
+fn mms_stop(refine: u32) -> (Scene, Mesh, CrSpace, Elasticity) {
     let mut scene =
         Scene::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/cases/mms_stop.toml")).unwrap();
-    scene.set_refine(4).unwrap();
+    scene.set_refine(refine).unwrap();
     let mesh = Mesh::from_spec(&scene.mesh).unwrap();
     let space = CrSpace::new(&mesh, &scene.parts).unwrap();
     let law = Elasticity::new(&scene.material);
+    (scene, mesh, space, law)
+}
+
+#[test]
+fn non_finite_exact_value_names_expression_and_first_point() {
+    let (scene, mesh, space, law) = mms_stop(4);
     let mut exact = scene.exact.clone().unwrap();
     // infinite where x >= 0.9: in many chunks of elements, none of them the first
     exact.grad[1][0] = Expr::parse("exact.grad[1][0]", "1/max(0.9-x, 0)").unwrap();
@@ -49,12 +55,7 @@ fn non_finite_exact_value_names_expression_and_first_point() {
 /// returns the norms of the nodes before it and that node's error (a run hands out the steps before).
 #[test]
 fn error_norms_of_several_nodes_at_once_equal_node_by_node() {
-    let mut scene =
-        Scene::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/cases/mms_stop.toml")).unwrap();
-    scene.set_refine(3).unwrap();
-    let mesh = Mesh::from_spec(&scene.mesh).unwrap();
-    let space = CrSpace::new(&mesh, &scene.parts).unwrap();
-    let law = Elasticity::new(&scene.material);
+    let (scene, mesh, space, law) = mms_stop(3);
     let exact = scene.exact.clone().unwrap();
     let ev = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(&exact);
     let mids: Vec<Vec<[f64; 2]>> = (0..3)
