@@ -119,7 +119,8 @@ impl Values<'_> {
             return;
         }
         let (ptr, idx) = (&self.pattern.ptr, &self.pattern.idx);
-        let p = ptr[a] + idx[ptr[a]..ptr[a + 1]].binary_search(&b).expect("edges of one patch are in the pattern");
+        let p = ptr[a]
+            + idx[ptr[a]..ptr[a + 1]].iter().position(|&x| x == b).expect("edges of one patch are in the pattern");
         match da {
             EdgeDof::Free(cols) if matches!(db, EdgeDof::Free(_)) => {
                 for (c, &col) in cols.iter().enumerate() {
