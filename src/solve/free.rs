@@ -21,9 +21,12 @@
 //! ([`FreeResponse::finish_block`]). A single-vector supernodal solve is memory-bound (it streams all of
 //! L for 2 flops an entry); with B columns L is read once per block and the work becomes dense
 //! matrix products. Blocks are aligned to the step numbers (block q holds steps qB+1, …, qB+B in
-//! columns 0, …, B−1) and always solved with B columns (steps outside the run are zero columns): faer
-//! computes each column independently of the others, so every step gets the same arithmetic whether a
-//! run starts at step 0 or resumes, and results do not depend on where a run started.
+//! columns 0, …, B−1) and solved with B columns, the run's last block with as many as it has steps
+//! (N − qB when that is fewer: a 4-step run solves 4 columns, not 16); steps before a resumed run's first
+//! are zero columns. The widths are fixed by the step numbers, and faer computes each column
+//! independently of the others' values (though not of the width), so every step gets the same
+//! arithmetic whether a run starts at step 0 or resumes, and results do not depend on where a run
+//! started.
 
 use super::condense::Condensation;
 use super::factor::Factor;
@@ -46,7 +49,10 @@ const MAX_BLOCK: usize = 16;
 pub struct Block {
     /// Step of column 0 (0: none computed yet).
     first: usize,
+    /// Steps per block, B.
     cols: usize,
+    /// Columns solved: B, fewer for the run's last block if it has fewer steps (module doc).
+    width: usize,
     n: usize,
     /// lⁿ, column by column, in the unknowns' order.
     loads: Vec<f64>,
@@ -157,7 +163,8 @@ impl FreeResponse {
     /// An empty block for [`FreeResponse::forward_block`].
     pub fn new_block(&self) -> Block {
         let (cols, n) = (self.block_size().max(1), self.n_dofs);
-        Block { first: 0, cols, n, loads: vec![0.0; cols * n], y: vec![0.0; cols * n], friction: (vec![], vec![]) }
+        let (loads, y) = (vec![0.0; cols * n], vec![0.0; cols * n]);
+        Block { first: 0, cols, width: cols, n, loads, y, friction: (vec![], vec![]) }
     }
 
     /// Assemble lⁿ and solve the forward halves yⁿ for the steps `steps` that lie in the aligned block
@@ -172,10 +179,12 @@ impl FreeResponse {
     ) -> Result<(usize, Option<Error>)> {
         let b = block.cols;
         block.first = (steps.start().max(&1) - 1) / b * b + 1;
+        block.width = b.min((steps.end() + 1).saturating_sub(block.first)).max(1);
         if self.basis.is_some() {
             return Ok(((block.first + b - 1).min(*steps.end()), None));
         }
-        block.loads.iter_mut().for_each(|v| *v = 0.0);
+        let w = block.width * block.n;
+        block.loads[..w].iter_mut().for_each(|v| *v = 0.0);
         let mut on_support = Vec::new();
         let steps: Vec<usize> = steps.filter(|&n| block.holds(n)).collect();
         let mut last = steps.first().map_or(0, |&n| n - 1);
@@ -192,8 +201,8 @@ impl FreeResponse {
             }
             last = n;
         }
-        self.factor.permute_in(&block.loads, &mut block.y);
-        self.factor.forward_block(&mut block.y, b)?;
+        self.factor.permute_in(&block.loads[..w], &mut block.y[..w]);
+        self.factor.forward_block(&mut block.y[..w], block.width)?;
         Ok((last, failed))
     }
 
@@ -226,7 +235,8 @@ impl FreeResponse {
             let range = block.col(n);
             self.subtract_w_mu(&mut block.y[range], mu);
         }
-        self.factor.backward_block(&mut block.y, block.cols)?;
+        let w = block.width * block.n;
+        self.factor.backward_block(&mut block.y[..w], block.width)?;
         let mut u = vec![0.0; self.n_dofs];
         Ok(mus
             .iter()
@@ -247,14 +257,15 @@ impl FreeResponse {
         };
         let solve: Vec<bool> = mus.iter().map(|&(_, mu)| !same(mu)).collect();
         if solve.iter().any(|&s| s) {
-            block.y.iter_mut().for_each(|v| *v = 0.0);
+            let w = block.width * block.n;
+            block.y[..w].iter_mut().for_each(|v| *v = 0.0);
             let n0 = dofs - self.contact_dofs.len();
             for (&(n, mu), _) in mus.iter().zip(&solve).filter(|(_, &s)| s) {
                 let range = block.col(n);
                 let y = &mut block.y[range];
                 y[n0..].copy_from_slice(&self.w_mu(mu));
             }
-            self.factor.backward_block(&mut block.y, block.cols)?;
+            self.factor.backward_block(&mut block.y[..w], block.width)?;
         }
         let (mut z, mut l) = (vec![0.0; dofs], Vec::new());
         let mut last = None;
