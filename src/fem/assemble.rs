@@ -125,9 +125,7 @@ impl Values<'_> {
             EdgeDof::Free(cols) if matches!(db, EdgeDof::Free(_)) => {
                 for (c, &col) in cols.iter().enumerate() {
                     let at = self.col_ptr[col] + self.off[p];
-                    for d in 0..2 {
-                        self.val[at + d] += m[c][d];
-                    }
+                    self.val[at..at + 2].iter_mut().zip(m[c]).for_each(|(v, x)| *v += x);
                 }
             }
             _ => {

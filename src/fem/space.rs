@@ -238,8 +238,8 @@ pub fn jump_terms_with(
     for (t, sign) in [(Some(t1), 1.0), (t2, -1.0)] {
         if let Some(t) = t {
             let phi = Element::phi(element(t).bary(x));
-            for i in 0..3 {
-                out[len] = (mesh.tri_edges[t][i], sign * phi[i]);
+            for (&edge, p) in mesh.tri_edges[t].iter().zip(phi) {
+                out[len] = (edge, sign * p);
                 len += 1;
             }
         }
