@@ -5,7 +5,7 @@
 //! (max over the common time nodes) and `energy_T` (density × area, the element's share of
 //! |||d(T)|||² without the jump term). Where these are large, refinement still changes the solution.
 
-use super::measure::{density, Kept};
+use super::measure::{Kept, Pair};
 use crate::error::{Error, Result};
 use crate::fem::prolong::parent_triangles;
 use std::fmt::Write as _;
@@ -14,16 +14,16 @@ use std::path::Path;
 /// Write the file of level `fine` against `coarse` into `dir`; returns its path.
 pub fn write(dir: &Path, fine: &Kept, coarse: &Kept) -> Result<std::path::PathBuf> {
     let (fp, cp) = (&fine.problem, &coarse.problem);
-    let parent = parent_triangles(&cp.mesh, &fp.mesh)?;
     let nt = fp.mesh.tris.len();
+    let pair = if fp.scene.mesh_level() == cp.scene.mesh_level() {
+        Pair::new(fp, fp, (0..nt).collect())
+    } else {
+        Pair::new(fp, cp, parent_triangles(&cp.mesh, &fp.mesh)?)
+    };
     let mut dmax = vec![0.0f64; nt];
     let mut dlast = vec![0.0; nt];
     for (uf, uc) in fine.u.iter().zip(&coarse.u) {
-        dlast = if fp.scene.mesh_level() == cp.scene.mesh_level() {
-            density(fp, fp, &(0..nt).collect::<Vec<_>>(), uf, uc)
-        } else {
-            density(fp, cp, &parent, uf, uc)
-        };
+        dlast = pair.density(uf, uc);
         for (m, d) in dmax.iter_mut().zip(&dlast) {
             *m = m.max(*d);
         }

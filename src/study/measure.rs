@@ -33,19 +33,36 @@ fn same_mesh(a: &Kept, b: &Kept) -> bool {
     a.problem.scene.mesh_level() == b.problem.scene.mesh_level()
 }
 
-/// Elementwise energy density σ(u_f − u_c):ε(u_f − u_c) on the triangles of the finer of two nested meshes
-/// (`parent[t]`: the coarse triangle of fine triangle t) for unknowns `uf`, `uc`.
-pub fn density(fine: &Problem, coarse: &Problem, parent: &[usize], uf: &[f64], uc: &[f64]) -> Vec<f64> {
-    let (mf, mc) = (fine.space.midpoint_values(uf), coarse.space.midpoint_values(uc));
-    (0..fine.mesh.tris.len())
-        .map(|t| {
-            let gf = Element::new(&fine.mesh, t).gradient(fine.mesh.tri_edges[t].map(|e| mf[e]));
-            let pt = parent[t];
-            let gc = Element::new(&coarse.mesh, pt).gradient(coarse.mesh.tri_edges[pt].map(|e| mc[e]));
-            let d = [[gf[0][0] - gc[0][0], gf[0][1] - gc[0][1]], [gf[1][0] - gc[1][0], gf[1][1] - gc[1][1]]];
-            fine.law.energy_density(d)
-        })
-        .collect()
+/// Two levels on nested meshes (`parent[t]`: the coarse triangle of fine triangle t; the same mesh with
+/// t ↦ t), with the elements of both made once for the densities at many time nodes.
+pub struct Pair<'a> {
+    fine: &'a Problem,
+    coarse: &'a Problem,
+    parent: Vec<usize>,
+    fine_elements: Vec<Element>,
+    coarse_elements: Vec<Element>,
+}
+
+impl<'a> Pair<'a> {
+    pub fn new(fine: &'a Problem, coarse: &'a Problem, parent: Vec<usize>) -> Pair<'a> {
+        let elements = |p: &Problem| (0..p.mesh.tris.len()).map(|t| Element::new(&p.mesh, t)).collect();
+        Pair { fine, coarse, parent, fine_elements: elements(fine), coarse_elements: elements(coarse) }
+    }
+
+    /// Elementwise energy density σ(u_f − u_c):ε(u_f − u_c) on the fine triangles for unknowns `uf`, `uc`.
+    pub fn density(&self, uf: &[f64], uc: &[f64]) -> Vec<f64> {
+        let (fine, coarse) = (self.fine, self.coarse);
+        let (mf, mc) = (fine.space.midpoint_values(uf), coarse.space.midpoint_values(uc));
+        (0..fine.mesh.tris.len())
+            .map(|t| {
+                let gf = self.fine_elements[t].gradient(fine.mesh.tri_edges[t].map(|e| mf[e]));
+                let pt = self.parent[t];
+                let gc = self.coarse_elements[pt].gradient(coarse.mesh.tri_edges[pt].map(|e| mc[e]));
+                let d = [[gf[0][0] - gc[0][0], gf[0][1] - gc[0][1]], [gf[1][0] - gc[1][0], gf[1][1] - gc[1][1]]];
+                fine.law.energy_density(d)
+            })
+            .collect()
+    }
 }
 
 /// Σ_T |T| density_T.
@@ -75,13 +92,8 @@ pub fn distance(fine: &Kept, coarse: &Kept) -> Result<Vec<f64>> {
     if same_mesh(fine, coarse) {
         return Ok(fine.u.iter().zip(&coarse.u).map(|(a, b)| energy_norm(fp, &diff(a, b))).collect());
     }
-    let parent = parent_triangles(&cp.mesh, &fp.mesh)?;
-    Ok(fine
-        .u
-        .iter()
-        .zip(&coarse.u)
-        .map(|(uf, uc)| integrate(fp, &density(fp, cp, &parent, uf, uc)).max(0.0).sqrt())
-        .collect())
+    let pair = Pair::new(fp, cp, parent_triangles(&cp.mesh, &fp.mesh)?);
+    Ok(fine.u.iter().zip(&coarse.u).map(|(uf, uc)| integrate(fp, &pair.density(uf, uc)).max(0.0).sqrt()).collect())
 }
 
 fn diff(a: &[f64], b: &[f64]) -> Vec<f64> {
