@@ -167,7 +167,7 @@ pub struct Runner<'a> {
 
 impl<'a> Runner<'a> {
     pub fn new(scene: &'a Scene, min_steps: usize) -> Result<Runner<'a>> {
-        Ok(Runner { seq: Sequence::new(scene, min_steps, None, None)?, spent: 0.0 })
+        Ok(Runner { seq: Sequence::new(scene, min_steps, None, None)?.without_consecutive(), spent: 0.0 })
     }
 
     /// Run `level`, unless `predicted` seconds would take the pilot past `budget` or the level would not

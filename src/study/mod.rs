@@ -174,6 +174,9 @@ pub struct Sequence<'a> {
     results: Vec<LevelResult>,
     prev: Option<Kept>,
     prev2: Option<Kept>,
+    /// Measure the paper's consecutive-level error |||u_l − P u_{l−1}||| (reported by studies; the
+    /// planner does not use it).
+    consecutive: bool,
 }
 
 impl<'a> Sequence<'a> {
@@ -208,7 +211,15 @@ impl<'a> Sequence<'a> {
             results: vec![],
             prev: None,
             prev2: None,
+            consecutive: true,
         })
+    }
+
+    /// The sequence without the paper's consecutive-level error (a prolongation and an energy norm at
+    /// every common node of every level, which only studies report).
+    pub fn without_consecutive(mut self) -> Self {
+        self.consecutive = false;
+        self
     }
 
     /// Run one more level and compare it with the previous two (and the reference run).
@@ -217,7 +228,9 @@ impl<'a> Sequence<'a> {
         let kept = run_level(self.scene, level, &self.common, true, &mut r)?;
         r.jumps = measure::jumps(&kept);
         if let Some(p) = &self.prev {
-            r.consecutive = Some(max_last(&measure::consecutive(&kept, p)?));
+            if self.consecutive {
+                r.consecutive = Some(max_last(&measure::consecutive(&kept, p)?));
+            }
             r.increment = Some(measure::distance(&kept, p)?);
             if let Some(dir) = self.differences {
                 self.difference_files.push(differences::write(dir, &kept, p)?);
