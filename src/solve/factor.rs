@@ -3,7 +3,7 @@
 //! triangular solves L Lᵀ x = b, with a scratch buffer allocated once. Sequential: the per-step solves
 //! of a 2D problem are too small to profit from threads, and sequential kernels keep runs bit-identical.
 //!
-//! Fill-reducing ordering P: see [`super::ordering`].
+//! Fill-reducing ordering P: see [`super::ordering`]; the symbolic half: [`super::symbolic`].
 //!
 //! Unknowns ordered last ([`Factor::with_last`], the contact unknowns): with K's permuted form
 //! [K_oo K_ol; K_lo K_ll] = L Lᵀ, the trailing block of L satisfies L_ll L_llᵀ = K_ll − K_lo K_oo⁻¹ K_ol,
@@ -15,18 +15,14 @@
 //! more separator). The supernodal kernel is always used: it exposes the triangular halves and the
 //! trailing block.
 
-use super::ordering::{amd_order, nested_dissection, Graph, ND_MIN_SIZE};
+use super::ordering::{Graph, ND_MIN_SIZE};
 use super::pages::Pages;
+pub use super::symbolic::{fill_order, Symbolic};
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
-    SymmetricOrdering,
-};
-use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{SparseColMat, SymbolicSparseColMatRef};
+use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, SymbolicCholeskyRaw};
+use faer::sparse::SparseColMat;
 use faer::{Conj, MatMut, Par, Side};
 use nalgebra::DMatrix;
 use std::sync::Mutex;
@@ -43,69 +39,6 @@ pub struct Factor {
     last: Vec<usize>,
     /// The fill-reducing permutation: position → unknown.
     fwd: Vec<usize>,
-}
-
-/// The symbolic factorisation of a sparsity pattern: the ordering (fill-reducing, with the unknowns
-/// `last` moved to its end) and the structure of L. It needs only K's pattern, so it is computed
-/// while K's values are assembled ([`Factor::numeric`] then fills it).
-pub struct Symbolic {
-    symbolic: SymbolicCholesky<usize>,
-    fwd: Vec<usize>,
-    last: Vec<usize>,
-    /// Entries of the pattern (the matrix factorised must have the same pattern).
-    pattern_nnz: usize,
-}
-
-impl Symbolic {
-    /// The symbolic factorisation of the symmetric `pattern` (both triangles stored) with the
-    /// fill-reducing ordering `base` (position → unknown, a permutation; from [`fill_order`]) and the
-    /// distinct unknowns `last` moved to its end, in the given order.
-    pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>, last: &[usize], base: Vec<usize>) -> Result<Symbolic> {
-        let n = pattern.nrows();
-        let params = CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-            ..Default::default()
-        };
-        if base.len() != n || !is_permutation(&base) {
-            return Err(Error::Linear(
-                "internal: the fill-reducing ordering is not a permutation of the unknowns".into(),
-            ));
-        }
-        let mut is_last = vec![false; n];
-        for &i in last {
-            if i >= n || std::mem::replace(&mut is_last[i], true) {
-                return Err(Error::Linear(format!("unknown {i} cannot be ordered last (out of range or repeated)")));
-            }
-        }
-        let fwd: Vec<usize> = base.into_iter().filter(|&i| !is_last[i]).chain(last.iter().copied()).collect();
-        let mut inv = vec![0usize; n];
-        for (new, &old) in fwd.iter().enumerate() {
-            inv[old] = new;
-        }
-        let ordering = SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n));
-        let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, ordering, params)
-            .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))?;
-        Ok(Symbolic { symbolic, fwd, last: last.to_vec(), pattern_nnz: pattern.compute_nnz() })
-    }
-
-    /// Entries of L (supernodal blocks included).
-    pub fn len_val(&self) -> usize {
-        self.symbolic.len_val()
-    }
-}
-
-/// The fill-reducing ordering of the unknowns of `graph` (position → unknown): nested dissection when
-/// `nested` (falling back to AMD where METIS cannot be used), else AMD. See [`super::ordering`].
-pub fn fill_order(graph: &Graph, nested: bool) -> Result<Vec<usize>> {
-    match if nested { nested_dissection(graph) } else { None } {
-        Some((fwd, _)) => Ok(fwd),
-        None => amd_order(graph, CholeskySymbolicParams::default().amd_params),
-    }
-}
-
-fn is_permutation(p: &[usize]) -> bool {
-    let mut seen = vec![false; p.len()];
-    p.iter().all(|&i| i < p.len() && !std::mem::replace(&mut seen[i], true))
 }
 
 impl Factor {
@@ -340,6 +273,7 @@ impl Factor {
 
 #[cfg(test)]
 mod tests {
+    use super::super::ordering::nested_dissection;
     use super::*;
     use crate::sparse::{csc_from_triplets, matvec};
 

@@ -9,3 +9,4 @@ pub mod free;
 pub mod ordering;
 pub mod pages;
 pub mod superpose;
+pub mod symbolic;

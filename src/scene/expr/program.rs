@@ -41,12 +41,8 @@ pub(super) enum Op {
     Bin(Bin, u32, u32),
 }
 
-/// Cost of reading a cached value at a time node, in vectorised additions or products (streaming it
-/// from memory, against ~0.1 ns per point for a product over a batch). The cache is read in order, so
-/// the hardware prefetcher hides most of its latency: 4 rather than the 16 a random read would suggest
-/// (measured interleaved with `examples/mms_node_cost`, the error norms of mms_stop per time node: r4
-/// 1.13–1.16 → 0.68–1.08 ms, r5 3.5–3.8 → 3.1–3.7 ms, mms_rotated r3 0.44–0.54 → 0.37–0.49 ms; binding
-/// the points, which fills the larger cache once, takes a few ms more and runs beside the factorisation).
+/// Cost of reading a cached value at a time, in vectorised products (read in order: 4, not 16; mms_stop's
+/// error norms per node −10–40 %, mms_front's loads at r5 +11 %: the right value depends on cache size).
 const LOAD_COST: u32 = 4;
 
 /// Cost of recomputing an operation (same unit as [`LOAD_COST`]).

@@ -1,0 +1,190 @@
+//! Running the steps: blocks of steps sharing their triangular solves, their true errors evaluated a
+//! few time nodes at a time, and every result handed out in order once K's condition estimate is
+//! accepted.
+
+use super::*;
+
+/// Steps whose true errors are evaluated together (`Problem::finish_block`): the exact solution's
+/// spatial values bound to a chunk of elements are then read from memory once for this many time nodes.
+/// Few enough that the writer thread gets the first steps of a block early (with all 16 steps of a
+/// block at once, mms_stop r4 written took 6 ms longer: the writing no longer overlapped the errors).
+const ERROR_BATCH: usize = 4;
+
+impl Problem {
+    /// [`Problem::finish`] for the steps of a block: their true errors evaluated [`ERROR_BATCH`] steps
+    /// at a time (`ErrorEvaluator::errors_at`, the same values). Each step is checked and handed to `hand`
+    /// in turn; the first failure is returned after the steps before it were handed out.
+    fn finish_block(&self, done: Vec<StepResult>, hand: &mut impl FnMut(StepResult) -> Result<()>) -> Result<()> {
+        let mut done = done.into_iter().peekable();
+        while done.peek().is_some() {
+            self.finish_batch(done.by_ref().take(ERROR_BATCH).collect(), hand)?;
+        }
+        Ok(())
+    }
+
+    fn finish_batch(&self, done: Vec<StepResult>, hand: &mut impl FnMut(StepResult) -> Result<()>) -> Result<()> {
+        let (mut norms, mut failed) = (Vec::new(), None);
+        if let (Some(ev), Some(ex)) = (&self.errors, &self.scene.exact) {
+            let with_u: Vec<&StepResult> = done.iter().filter(|r| self.has_u(r)).collect();
+            let mids: Vec<Vec<[f64; 2]>> = with_u.iter().map(|r| self.space.midpoint_values(&r.u)).collect();
+            let fields: Vec<(&[[f64; 2]], f64)> = mids.iter().zip(&with_u).map(|(m, r)| (&m[..], r.t)).collect();
+            (norms, failed) = ev.errors_at(&self.mesh, ex, &fields);
+        }
+        let mut norms = norms.into_iter();
+        for r in done {
+            let mut r = self.checked(r)?;
+            if self.errors.is_some() && self.scene.exact.is_some() && self.has_u(&r) {
+                match norms.next() {
+                    Some(e) => r.errors = Some(e),
+                    None => {
+                        return Err(failed
+                            .take()
+                            .unwrap_or_else(|| Error::Linear("internal: missing error norms".into())))
+                    }
+                }
+            }
+            hand(r)?;
+        }
+        Ok(())
+    }
+
+    /// Steps prev.n + 1, …, N in blocks of steps sharing their triangular
+    /// solves (`solve::free::Block`); every completed step goes to `on_step`, in order, before a later
+    /// step's error is returned. Returns the last step's result.
+    fn run_blocks(
+        &self,
+        friction: &Friction,
+        mut prev: StepResult,
+        want: impl Fn(usize) -> bool,
+        on_step: &mut impl FnMut(&StepResult) -> Result<()>,
+    ) -> Result<StepResult> {
+        let mut block = self.free.new_block();
+        let mut first = prev.n + 1;
+        while first <= self.n_steps() {
+            let start = Instant::now();
+            let (last, mut failed) = self.free.forward_block(first..=self.n_steps(), &self.scene.times, &mut block)?;
+            let mut done = Vec::with_capacity(last + 1 - first);
+            let mut solves = start.elapsed().as_secs_f64();
+            for n in first..=last {
+                let start = Instant::now();
+                let t = self.scene.times[n];
+                let trace = self.free.block_trace(&block, n);
+                match contact(friction, &trace, done.last().unwrap_or(&prev), n, t) {
+                    Ok((sol, slip)) => {
+                        let wall = start.elapsed().as_secs_f64();
+                        done.push(contact_result(n, t, sol, slip, vec![], f64::NAN, wall));
+                    }
+                    Err(e) => {
+                        // an earlier step than a failed load's
+                        failed = Some(e);
+                        break;
+                    }
+                }
+            }
+            let start = Instant::now();
+            let wanted: Vec<(usize, &[f64])> = done.iter().filter(|r| want(r.n)).map(|r| (r.n, &r.mu[..])).collect();
+            let mut us = self.free.finish_block(&mut block, &wanted)?.into_iter();
+            solves += start.elapsed().as_secs_f64();
+            let share = solves / done.len().max(1) as f64;
+            for r in done.iter_mut() {
+                if want(r.n) {
+                    r.u = us.next().unwrap_or_default();
+                    // a_h(u, u) = (l, u) − Σ_e μ_e s_e, since K u = l − Eμ
+                    r.energy = dot(block.load(r.n), &r.u) - dot(&r.mu, &r.slip);
+                }
+                r.wall += share;
+            }
+            self.finish_block(done, &mut |r| {
+                on_step(&r)?;
+                prev = r;
+                Ok(())
+            })?;
+            if let Some(e) = failed {
+                return Err(e);
+            }
+            first = last + 1;
+        }
+        Ok(prev)
+    }
+
+    /// Run steps from `from` to N, forming u only at the steps `want` selects (see [`Problem::step`]).
+    pub fn run_selected(
+        &self,
+        from: StepResult,
+        want: impl Fn(usize) -> bool,
+        on_step: impl FnMut(&StepResult) -> Result<()>,
+    ) -> Result<()> {
+        self.run_handing(from, None, want, on_step)
+    }
+
+    /// Step 0 and all steps, handing every result to `on_step` (step 0 included), forming u only at
+    /// the steps `want` selects. Step 0 is handed out with the first step: both are computed while K's
+    /// condition estimate may still be under way.
+    pub fn run_all_selected(
+        &self,
+        want: impl Fn(usize) -> bool,
+        on_step: impl FnMut(&StepResult) -> Result<()>,
+    ) -> Result<()> {
+        let first = self.initial_unchecked().map_err(|e| self.prefer_conditioning(e))?;
+        self.run_handing(first.clone(), Some(first), want, on_step)
+    }
+
+    /// Run steps from `from` to N; `first`, if given, is handed out before them. Every result is handed
+    /// out only once K's condition estimate is accepted.
+    fn run_handing(
+        &self,
+        from: StepResult,
+        first: Option<StepResult>,
+        want: impl Fn(usize) -> bool,
+        mut on_step: impl FnMut(&StepResult) -> Result<()>,
+    ) -> Result<()> {
+        let mut first = first;
+        let mut hand = |r: &StepResult| -> Result<()> {
+            self.conditioned()?;
+            if let Some(f) = first.take() {
+                on_step(&f)?;
+            }
+            on_step(r)
+        };
+        let result = if from.n >= self.n_steps() {
+            // nothing to step: `first` alone (handed out as the last result)
+            match first.take() {
+                Some(f) => {
+                    self.conditioned()?;
+                    on_step(&f)
+                }
+                None => Ok(()),
+            }
+        } else if let (Some(friction), true) = (&self.friction, self.free.block_size() > 0) {
+            self.run_blocks(friction, from, want, &mut hand).map(|_| ())
+        } else {
+            let mut load = Vec::with_capacity(self.space.n_dofs);
+            let mut prev = from;
+            (|| {
+                for n in prev.n + 1..=self.n_steps() {
+                    let r = self.step_unchecked(n, &prev, &mut load, want(n))?;
+                    hand(&r)?;
+                    prev = r;
+                }
+                Ok(())
+            })()
+        };
+        if let (Err(_), Some(f)) = (&result, first.take()) {
+            // a run that fails before handing out a step still hands out step 0, as step by step
+            if self.conditioned().is_ok() {
+                on_step(&f)?;
+            }
+        }
+        result.map_err(|e| self.prefer_conditioning(e))
+    }
+
+    /// Run steps from `from` (whose result is given) to N, handing every result to `on_step`.
+    pub fn run_from(&self, from: StepResult, on_step: impl FnMut(&StepResult) -> Result<()>) -> Result<()> {
+        self.run_selected(from, |_| true, on_step)
+    }
+
+    /// Run all steps, including step 0, handing every result to `on_step`.
+    pub fn run(&self, on_step: impl FnMut(&StepResult) -> Result<()>) -> Result<()> {
+        self.run_all_selected(|_| true, on_step)
+    }
+}
