@@ -15,8 +15,12 @@ fn tmp(name: &str) -> PathBuf {
 }
 
 fn example(steps: usize) -> Problem {
+    example_at(0, steps)
+}
+
+fn example_at(refine: u32, steps: usize) -> Problem {
     let mut s: Scene = common::scene("verification/cases/paper_example_5_1.toml");
-    s.set_refine(0).unwrap();
+    s.set_refine(refine).unwrap();
     s.set_steps(steps).unwrap();
     Problem::new(s).unwrap()
 }
@@ -63,11 +67,13 @@ fn write(
     (errors, w.finish("completed").map_err(|e| e.to_string()))
 }
 
-#[test]
-fn a_background_run_commits_every_step() {
-    let p = example(40);
+/// Write the 40 steps of Example 5.1 at `refine` with a writer on this thread, step by step, and with a
+/// background writer, all steps handed over at once; both files must hold 41 completed steps. Returns
+/// the two files.
+fn sync_and_background(refine: u32, name: &str) -> (hdf5::File, hdf5::File) {
+    let p = example_at(refine, 40);
     let rs = steps(&p);
-    let (a, b) = (tmp("sync.h5"), tmp("thread.h5"));
+    let (a, b) = (tmp(&format!("{name}_sync.h5")), tmp(&format!("{name}_thread.h5")));
     let mut w = Writer::create(&a, &Run::of(&p), true).unwrap();
     rs.iter().try_for_each(|r| w.write_step(r)).unwrap();
     w.finish("completed").unwrap();
@@ -75,11 +81,43 @@ fn a_background_run_commits_every_step() {
     assert!(errors.is_empty(), "{errors:?}");
     assert_eq!(done, Ok(41));
     assert_eq!(completed(&b), (41, "completed".to_string()));
-    let read =
-        |path: &Path, name: &str| hdf5::File::open(path).unwrap().dataset(name).unwrap().read_raw::<f64>().unwrap();
+    (hdf5::File::open(&a).unwrap(), hdf5::File::open(&b).unwrap())
+}
+
+fn f64s(f: &hdf5::File, name: &str) -> Vec<f64> {
+    f.dataset(name).unwrap().read_raw::<f64>().unwrap()
+}
+
+#[test]
+fn a_background_run_commits_every_step() {
+    let (a, b) = sync_and_background(0, "steps");
     for name in ["tresca/u", "tresca/contact/mu", "tresca/times", "tresca/energy"] {
-        assert_eq!(read(&a, name), read(&b, name), "{name}");
+        assert_eq!(f64s(&a, name), f64s(&b, name), "{name}");
     }
+}
+
+/// Requirement: the writer commits a group of queued steps in pieces once it holds 4 MB of rows and frames
+/// (`output::rows::BUDGET`, so its buffers stay small), and the file is the one a writer on the caller's
+/// thread writes step by step. At refine 4 a step is about 0.23 MB of rows and frames, and the 40 steps,
+/// handed over at once, queue up far beyond 4 MB (the group is cut after 19 steps).
+#[test]
+fn a_group_beyond_the_byte_budget_is_committed_in_pieces_to_the_same_file() {
+    let (a, b) = sync_and_background(4, "budget");
+    for name in ["tresca/u", "tresca/contact/mu", "tresca/times", "VTKHDF/body/Steps/Values"] {
+        assert_eq!(f64s(&a, name), f64s(&b, name), "{name}");
+    }
+    let f32s = |f: &hdf5::File, name: &str| f.dataset(name).unwrap().read_raw::<f32>().unwrap();
+    for name in [
+        "VTKHDF/body/PointData/displacement",
+        "VTKHDF/body/CellData/stress",
+        "VTKHDF/contact/PointData/displacement",
+        "VTKHDF/contact/CellData/slip",
+    ] {
+        assert_eq!(f32s(&a, name), f32s(&b, name), "{name}");
+    }
+    let nsteps =
+        |f: &hdf5::File| f.group("VTKHDF/body/Steps").unwrap().attr("NSteps").unwrap().read_scalar::<i64>().unwrap();
+    assert_eq!((nsteps(&a), nsteps(&b)), (41, 41));
 }
 
 #[test]

@@ -15,7 +15,7 @@
 //! 0: every step), at the last step, and by [`Writer::finish`] / drop. `tresca-cr run` hands the steps
 //! to a writer thread ([`Background`]) so that the solver goes on while they are written; there a step
 //! is committed as soon as the thread gets to it, together with the steps that queued up behind it
-//! (at most [`background::QUEUE`]; [`Writer::write_step_then`]), and [`Background::finish`] returns
+//! (at most [`background::QUEUE`] steps or [`rows::BUDGET`] bytes; [`Writer::write_step_then`]), and [`Background::finish`] returns
 //! only when every step handed over is committed and the file closed. A commit appends the
 //! batch to every time-dependent dataset (allocated for the whole run at creation, contiguous, written
 //! straight to the kernel: [`h5::Series`]), then sets `tresca/steps` attribute `completed` and
@@ -257,7 +257,9 @@ impl Writer {
             self.take(u).map(|()| n)
         });
         let due = self.last_commit.elapsed().as_secs_f64() >= self.interval
-            && (!more || self.rows.count >= background::QUEUE);
+            && (!more
+                || self.rows.count >= background::QUEUE
+                || self.rows.bytes() + self.frame_rows.bytes() >= rows::BUDGET);
         let out = match out {
             Ok(n) if due || n == self.frames.last => self.commit(),
             Ok(_) => Ok(()),

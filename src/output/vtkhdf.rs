@@ -20,6 +20,7 @@
 
 use super::fields::{Fields, StepFields, TENSOR};
 use super::h5::{attr, attr_fixed_ascii, attr_vec, put, Raw, Series};
+use super::rows::{append, bytes};
 use hdf5::plist::group_create::LinkCreationOrder;
 use hdf5::{Attribute, Dataset, Extent, Extents, File, Group};
 
@@ -65,18 +66,24 @@ pub struct FrameRows {
 impl FrameRows {
     pub fn push(&mut self, t: f64, s: &StepFields) {
         self.times.push(t);
-        self.displacement.extend_from_slice(&s.displacement);
+        append(&mut self.displacement, &s.displacement);
         for (d, v) in self.cells.iter_mut().zip([&s.strain, &s.stress, &s.von_mises]) {
-            d.extend_from_slice(v);
+            append(d, v);
         }
-        self.contact_displacement.extend_from_slice(&s.contact_displacement);
+        append(&mut self.contact_displacement, &s.contact_displacement);
         for (d, v) in self.contact_cells.iter_mut().zip([&s.sigma_t, &s.slip, &s.slip_increment]) {
-            d.extend_from_slice(v);
+            append(d, v);
         }
-        self.stick_slip.extend_from_slice(&s.stick_slip);
+        append(&mut self.stick_slip, &s.stick_slip);
     }
     pub fn count(&self) -> usize {
         self.times.len()
+    }
+    /// Bytes buffered in the frames' arrays.
+    pub fn bytes(&self) -> usize {
+        let f32s =
+            [&self.displacement, &self.contact_displacement].into_iter().chain(&self.cells).chain(&self.contact_cells);
+        bytes(f32s) + self.stick_slip.len()
     }
     /// Empty the buffer, keeping its memory; the next frame is frame `first`.
     pub fn reset(&mut self, first: usize) {
