@@ -51,6 +51,9 @@ pub struct Problem {
     pub setup: SetupTimes,
     /// The condition estimate of K, known by the time a step result is handed out.
     conditioning: conditioning::Pending,
+    /// Step 0, computed during the set-up beside the numeric factorisation (`None` if that failed: it is
+    /// then computed again when asked for, and fails with its error).
+    step0: Option<StepResult>,
 }
 
 /// Wall times of the set-up phases (seconds).
@@ -145,61 +148,20 @@ impl Problem {
 
     /// [`Problem::initial`] before the condition estimate is known.
     fn initial_unchecked(&self) -> Result<StepResult> {
-        let t = self.scene.times[0];
-        let u = match &self.scene.u0 {
-            Some(u0) => self.space.interpolate(&self.mesh, u0, t)?,
-            None => vec![0.0; self.space.n_dofs],
-        };
-        let nc = self.space.contact.len();
-        let slip = self.space.contact.iter().map(|c| u[c.dof]).collect();
-        let energy = energy(&self.stiffness, &u);
-        let r = StepResult {
-            n: 0,
-            t,
-            u,
-            mu: vec![0.0; nc],
-            slip,
-            state: vec![EdgeState::Stick; nc],
-            iterations: 0,
-            residual: 0.0,
-            energy,
-            errors: None,
-            wall: 0.0,
-        };
-        self.finish(r)
+        match &self.step0 {
+            Some(r) => Ok(r.clone()),
+            None => initial_state(&self.scene, &self.mesh, &self.space, &self.stiffness, self.errors.as_ref()),
+        }
     }
 
     /// Finiteness check and true errors.
     fn finish(&self, r: StepResult) -> Result<StepResult> {
-        let mut r = self.checked(r)?;
-        if let (Some(ev), Some(ex), true) = (&self.errors, &self.scene.exact, self.has_u(&r)) {
-            r.errors = Some(ev.errors(&self.mesh, ex, &self.space.midpoint_values(&r.u), r.t)?);
-        }
-        Ok(r)
+        finish(r, &self.scene, &self.mesh, &self.space, self.errors.as_ref())
     }
 
     /// True if `r` carries u (it is formed only at the steps a run wants; an empty space has none).
     fn has_u(&self, r: &StepResult) -> bool {
-        !r.u.is_empty() || self.space.n_dofs == 0
-    }
-
-    /// The finiteness checks of a step result.
-    fn checked(&self, r: StepResult) -> Result<StepResult> {
-        if r.u.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Linear(format!(
-                "step {}: the solution is not finite (singular or ill-conditioned system)",
-                r.n
-            )));
-        }
-        if !r.u.is_empty() && !r.energy.is_finite() {
-            let umax = r.u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            return Err(Error::Linear(format!(
-                "step {}: the energy a_h(u, u) overflows f64 (max |u| = {umax:.3e}): the loads are too large for \
-                 the answer to be representable; u is linear in the loads, u₀ and g_a together, so scale them down",
-                r.n
-            )));
-        }
-        Ok(r)
+        has_u(&self.space, r)
     }
 
     /// Solve step n from the previous step's result. `load` is scratch space. With `want_u = false` only
@@ -285,4 +247,75 @@ fn contact_result(
         errors: None,
         wall,
     }
+}
+
+/// Step 0: u⁰ = I_CR u₀ (zero without u₀), its energy, finiteness check and true errors.
+fn initial_state(
+    scene: &Scene,
+    mesh: &Mesh,
+    space: &CrSpace,
+    stiffness: &SparseColMat<usize, f64>,
+    errors: Option<&ErrorEvaluator>,
+) -> Result<StepResult> {
+    let t = scene.times[0];
+    let u = match &scene.u0 {
+        Some(u0) => space.interpolate(mesh, u0, t)?,
+        None => vec![0.0; space.n_dofs],
+    };
+    let nc = space.contact.len();
+    let slip = space.contact.iter().map(|c| u[c.dof]).collect();
+    let energy = energy(stiffness, &u);
+    let r = StepResult {
+        n: 0,
+        t,
+        u,
+        mu: vec![0.0; nc],
+        slip,
+        state: vec![EdgeState::Stick; nc],
+        iterations: 0,
+        residual: 0.0,
+        energy,
+        errors: None,
+        wall: 0.0,
+    };
+    finish(r, scene, mesh, space, errors)
+}
+
+/// Finiteness check and true errors (when the scene gives `[exact]`).
+fn finish(
+    r: StepResult,
+    scene: &Scene,
+    mesh: &Mesh,
+    space: &CrSpace,
+    errors: Option<&ErrorEvaluator>,
+) -> Result<StepResult> {
+    let mut r = checked(r)?;
+    if let (Some(ev), Some(ex), true) = (errors, &scene.exact, has_u(space, &r)) {
+        r.errors = Some(ev.errors(mesh, ex, &space.midpoint_values(&r.u), r.t)?);
+    }
+    Ok(r)
+}
+
+/// True if `r` carries u (it is formed only at the steps a run wants; an empty space has none).
+fn has_u(space: &CrSpace, r: &StepResult) -> bool {
+    !r.u.is_empty() || space.n_dofs == 0
+}
+
+/// The finiteness checks of a step result.
+fn checked(r: StepResult) -> Result<StepResult> {
+    if r.u.iter().any(|v| !v.is_finite()) {
+        return Err(Error::Linear(format!(
+            "step {}: the solution is not finite (singular or ill-conditioned system)",
+            r.n
+        )));
+    }
+    if !r.u.is_empty() && !r.energy.is_finite() {
+        let umax = r.u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        return Err(Error::Linear(format!(
+            "step {}: the energy a_h(u, u) overflows f64 (max |u| = {umax:.3e}): the loads are too large for \
+             the answer to be representable; u is linear in the loads, u₀ and g_a together, so scale them down",
+            r.n
+        )));
+    }
+    Ok(r)
 }

@@ -32,7 +32,7 @@ impl Problem {
         }
         let mut norms = norms.into_iter();
         for r in done {
-            let mut r = self.checked(r)?;
+            let mut r = checked(r)?;
             if self.errors.is_some() && self.scene.exact.is_some() && self.has_u(&r) {
                 match norms.next() {
                     Some(e) => r.errors = Some(e),

@@ -40,7 +40,7 @@ impl Problem {
             Ok(rest) => rest,
             Err(e) => return Err((e, r)),
         };
-        let SetUp { stiffness, free, friction, errors, conditioning, t2, t3, t4, t5 } = rest;
+        let SetUp { stiffness, free, friction, errors, conditioning, step0, t2, t3, t4, t5 } = rest;
         let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
         let p = Problem {
             setup: SetupTimes {
@@ -59,6 +59,7 @@ impl Problem {
             friction,
             errors,
             conditioning,
+            step0,
         };
         Ok((p, r))
     }
@@ -79,6 +80,7 @@ struct SetUp {
     friction: Option<Friction>,
     errors: Option<ErrorEvaluator>,
     conditioning: Pending,
+    step0: Option<StepResult>,
     t2: Instant,
     t3: Instant,
     t4: Instant,
@@ -92,7 +94,8 @@ impl Problem0 {
     ///    creation, beside from the start, got less of the two cores: Example 5.1 n = 32 written
     ///    65.5 → 63.4 ms, mms_stop r4 written 136.7 → 134.4 ms, interleaved);
     /// 2. the numeric factorisation; beside it the factor's pages are mapped, then λ_max(K) of the
-    ///    condition estimate is computed and the exact solution bound to the error quadrature;
+    ///    condition estimate is computed, the exact solution bound to the error quadrature and step 0
+    ///    (u⁰ = I_CR u₀ with its true errors) computed;
     /// 3. the load superposition and the condensation; beside them, and beside the first steps, the
     ///    solves of the condition estimate (see `conditioning`).
     ///
@@ -139,10 +142,11 @@ impl Problem0 {
         let (factor, aside) = Factor::numeric_beside(symbolic, &stiffness, || {
             let top = condition::largest_eigenvalue(&stiffness, 12);
             let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, law, scene.rho).with_exact(x));
-            (top, errors)
+            let step0 = initial_state(scene, mesh, space, &stiffness, errors.as_ref()).ok();
+            (top, errors, step0)
         });
         let factor = factor?;
-        let (top, errors) = aside.unwrap_or((f64::NAN, None));
+        let (top, errors, step0) = aside.unwrap_or((f64::NAN, None, None));
         let t3 = Instant::now();
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
         // ranges) factorises without complaint but returns meaningless displacements: it is refused
@@ -156,6 +160,6 @@ impl Problem0 {
         let t5 = Instant::now();
         let (free, c) = FreeResponse::new(factor, loads, basis, condensation, space);
         let friction = c.map(|c| Friction::new(space, c, scene.solver));
-        Ok(SetUp { stiffness, free, friction, errors, conditioning, t2, t3, t4, t5 })
+        Ok(SetUp { stiffness, free, friction, errors, conditioning, step0, t2, t3, t4, t5 })
     }
 }
