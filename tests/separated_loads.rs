@@ -69,3 +69,30 @@ fn non_finite_time_factor_names_the_expression_and_time() {
     let e = loads.assemble_on_support(0.5, &mut l).unwrap_err().to_string();
     assert!(e.contains(text) && e.contains("t = 0.5"), "{e}");
 }
+
+/// Requirement: when the loads of the nodes span more than `MAX_RANK` patterns (mms_front's moving
+/// front does not separate), the refused superposition hands over the loads it assembled on the way,
+/// each equal to the load of its node, so the steps at those nodes reuse them instead of assembling
+/// them again (`solve::free::FreeResponse`).
+#[test]
+fn a_refused_superposition_keeps_the_loads_it_assembled() {
+    use tresca_cr::solve::superpose::{LoadBasis, MAX_RANK};
+    let mut s = scene("verification/cases/mms_front.toml");
+    s.set_refine(0).unwrap();
+    s.set_steps(16).unwrap();
+    let p = tresca_cr::Problem::new(s.clone()).unwrap();
+    let loads = Loads::new(&s, &p.mesh, &p.space).unwrap();
+    let mut kept = vec![(99, vec![1.0])];
+    let basis = LoadBasis::build(&loads, &s.times, p.free.factor(), &mut kept).unwrap();
+    assert!(basis.is_none(), "mms_front's loads were superposed");
+    assert!(!kept.is_empty() && kept.len() <= MAX_RANK + 1, "{} loads kept", kept.len());
+    let mut nodes: Vec<usize> = kept.iter().map(|(n, _)| *n).collect();
+    nodes.sort();
+    nodes.dedup();
+    assert_eq!(nodes.len(), kept.len(), "a node kept twice");
+    for (n, l) in &kept {
+        let mut a = Vec::new();
+        loads.assemble_on_support(s.times[*n], &mut a).unwrap();
+        assert_eq!(&a, l, "node {n}");
+    }
+}

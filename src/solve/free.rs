@@ -87,6 +87,9 @@ pub struct FreeResponse {
     factor: Arc<Factor>,
     loads: Loads,
     basis: Option<LoadBasis>,
+    /// Loads on the support that a refused superposition assembled, by node (`LoadBasis::build`): the
+    /// steps at those nodes use them (the same values) instead of assembling them again.
+    assembled: Vec<(usize, Vec<f64>)>,
     n_dofs: usize,
     /// Contact unknowns (empty without Γ_C).
     contact_dofs: Vec<usize>,
@@ -116,6 +119,7 @@ impl FreeResponse {
         factor: Arc<Factor>,
         loads: Loads,
         basis: Option<LoadBasis>,
+        assembled: Vec<(usize, Vec<f64>)>,
         condensation: Option<Condensation>,
         space: &CrSpace,
     ) -> (FreeResponse, Option<DMatrix<f64>>) {
@@ -129,12 +133,25 @@ impl FreeResponse {
             factor,
             loads,
             basis,
+            assembled,
             n_dofs: n,
             contact_dofs,
             w,
             friction_cache: RefCell::new((vec![], vec![])),
         };
         (free, c)
+    }
+
+    /// lⁿ (time t) on the loads' support: kept from the superposition's attempt, else assembled.
+    fn load_on_support(&self, n: usize, t: f64, out: &mut Vec<f64>) -> Result<()> {
+        match self.assembled.iter().find(|(m, _)| *m == n) {
+            Some((_, l)) => {
+                out.clear();
+                out.extend_from_slice(l);
+                Ok(())
+            }
+            None => self.loads.assemble_on_support(t, out),
+        }
     }
 
     /// The factor of K.
@@ -190,7 +207,7 @@ impl FreeResponse {
         let mut last = steps.first().map_or(0, |&n| n - 1);
         let mut failed = None;
         for n in steps {
-            if let Err(e) = self.loads.assemble_on_support(times[n], &mut on_support) {
+            if let Err(e) = self.load_on_support(n, times[n], &mut on_support) {
                 failed = Some(e);
                 break;
             }
@@ -330,7 +347,9 @@ impl FreeResponse {
                 }
             }
             None => {
-                self.loads.assemble(t, load)?;
+                let mut on_support = Vec::new();
+                self.load_on_support(n, t, &mut on_support)?;
+                self.loads.expand(&on_support, load);
                 if contact {
                     let mut y = load.clone();
                     self.factor.forward_solve(&mut y)?;

@@ -153,12 +153,13 @@ impl Problem0 {
         // by the condition estimate, whose solves run on their own thread from here on (conditioning).
         let factor = Arc::new(factor);
         let conditioning = Pending::start(&factor, stiffness.nrows(), top);
-        let basis = LoadBasis::build(&loads, &scene.times, &factor)?;
+        let mut assembled = Vec::new();
+        let basis = LoadBasis::build(&loads, &scene.times, &factor, &mut assembled)?;
         let t4 = Instant::now();
         let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
         let condensation = (!contact.is_empty()).then(|| condense(&contact, &factor)).transpose()?;
         let t5 = Instant::now();
-        let (free, c) = FreeResponse::new(factor, loads, basis, condensation, space);
+        let (free, c) = FreeResponse::new(factor, loads, basis, assembled, condensation, space);
         let friction = c.map(|c| Friction::new(space, c, scene.solver));
         Ok(SetUp { stiffness, free, friction, errors, conditioning, step0, t2, t3, t4, t5 })
     }
