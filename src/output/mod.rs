@@ -15,7 +15,7 @@
 //! 0: every step), at the last step, and by [`Writer::finish`] / drop. `tresca-cr run` hands the steps
 //! to a writer thread ([`Background`]) so that the solver goes on while they are written; there a step
 //! is committed as soon as the thread gets to it, together with the steps that queued up behind it
-//! (at most [`background::QUEUE`] steps or [`rows::BUDGET`] bytes; [`Writer::write_step_then`]), and [`Background::finish`] returns
+//! (at most [`background::QUEUE`] steps or `rows::BUDGET` bytes; [`Writer::write_step_then`]), and [`Background::finish`] returns
 //! only when every step handed over is committed and the file closed. A commit appends the
 //! batch to every time-dependent dataset (allocated for the whole run at creation, contiguous, written
 //! straight to the kernel: [`h5::Series`]), then sets `tresca/steps` attribute `completed` and

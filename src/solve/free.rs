@@ -28,6 +28,7 @@
 //! arithmetic whether a run starts at step 0 or resumes, and results do not depend on where a run
 //! started.
 
+pub use super::block::Block;
 use super::condense::Condensation;
 use super::factor::Factor;
 use super::superpose::LoadBasis;
@@ -44,43 +45,6 @@ const BLOCK_VALUES: usize = 1 << 24;
 /// Steps in a block at most (at 196,608 unknowns a solve pair costs 61 ms for one column, 13 ms a
 /// column for 8, 9 ms for 16 and 7.6 ms for 32).
 const MAX_BLOCK: usize = 16;
-
-/// The forward halves of a block of consecutive steps (see the module documentation).
-pub struct Block {
-    /// Step of column 0 (0: none computed yet).
-    first: usize,
-    /// Steps per block, B.
-    cols: usize,
-    /// Columns solved: B, fewer for the run's last block if it has fewer steps (module doc).
-    width: usize,
-    n: usize,
-    /// lⁿ, column by column, in the unknowns' order.
-    loads: Vec<f64>,
-    /// yⁿ = L⁻¹Pᵀlⁿ, then (after [`FreeResponse::finish_block`]) yⁿ − [0; Wμⁿ] solved backward;
-    /// with superposed loads [0; Wμⁿ] solved backward.
-    y: Vec<f64>,
-    /// Superposed loads: the last μ solved for in a block and its K⁻¹Eμ, reused while μ repeats
-    /// (bit-equal; the columns are computed independently of their position, so reuse changes no bit).
-    friction: (Vec<f64>, Vec<f64>),
-}
-
-impl Block {
-    /// True if step n has a column in the block.
-    fn holds(&self, n: usize) -> bool {
-        self.first > 0 && (self.first..self.first + self.cols).contains(&n)
-    }
-
-    /// Positions of step n's column.
-    fn col(&self, n: usize) -> std::ops::Range<usize> {
-        let j = n - self.first;
-        j * self.n..(j + 1) * self.n
-    }
-
-    /// lⁿ of a step in the block.
-    pub fn load(&self, n: usize) -> &[f64] {
-        &self.loads[self.col(n)]
-    }
-}
 
 /// u_f and s_f of one step at any time node.
 pub struct FreeResponse {
@@ -144,14 +108,11 @@ impl FreeResponse {
 
     /// lⁿ (time t) on the loads' support: kept from the superposition's attempt, else assembled.
     fn load_on_support(&self, n: usize, t: f64, out: &mut Vec<f64>) -> Result<()> {
-        match self.assembled.iter().find(|(m, _)| *m == n) {
-            Some((_, l)) => {
-                out.clear();
-                out.extend_from_slice(l);
-                Ok(())
-            }
-            None => self.loads.assemble_on_support(t, out),
-        }
+        let Some((_, l)) = self.assembled.iter().find(|(m, _)| *m == n) else {
+            return self.loads.assemble_on_support(t, out);
+        };
+        out.clone_from(l);
+        Ok(())
     }
 
     /// The factor of K.

@@ -2,6 +2,7 @@
 //! ([`factor`]) and its condition estimate ([`condition`]), the condensation onto the contact unknowns ([`condense`]), superposed load patterns
 //! ([`superpose`]) and the free response u_f = K⁻¹lⁿ of every step ([`free`]).
 
+mod block;
 pub mod condense;
 pub mod condition;
 pub mod factor;
