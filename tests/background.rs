@@ -9,9 +9,7 @@ use tresca_cr::output::{Background, Run, Writer};
 use tresca_cr::{Problem, Scene, StepResult};
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tresca-background-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
+    common::tmp_in("tresca-background", name)
 }
 
 fn example(steps: usize) -> Problem {

@@ -11,9 +11,7 @@ use tresca_cr::output::{sidecar, Run, Writer};
 use tresca_cr::{Problem, Scene, StepResult};
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tresca-output-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    let p = d.join(name);
+    let p = common::tmp_in("tresca-output", name);
     let _ = std::fs::remove_file(&p);
     p
 }

@@ -1,6 +1,8 @@
 //! Bad input never panics or lies: every invalid scene, mesh or expression gives an error naming the
 //! problem (and the key, line or location), checked here message by message.
 
+mod common;
+
 use tresca_cr::{Problem, Scene};
 
 const BASE: &str = r#"
@@ -130,7 +132,7 @@ fn mesh_geometry() {
 
 #[test]
 fn gmsh_files() {
-    let dir = std::env::temp_dir().join(format!("tresca-validation-{}", std::process::id()));
+    let dir = common::tmp_in("tresca-validation", "gmsh");
     std::fs::create_dir_all(&dir).unwrap();
     let good = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/verification/cases/lshape.msh")).unwrap();
     let scene = |msh: &str, name: &str| {

@@ -10,8 +10,10 @@ or with --regenerate): u = t·curl ψ, ψ = 100 (x(1−x)y(1−y))², div u = 0,
 (E = 2(1+ν)), so f = −μΔu does not depend on ν and the exact solution is the same for every ν.
 """
 import argparse
+import atexit
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -26,6 +28,7 @@ NEAR = os.path.join(ROOT, "verification", "cases", "near_incompressible.toml")
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 MMS_EL = os.path.join(ROOT, "verification", "cases", "mms_elastic.toml")
 TMP = tempfile.mkdtemp(prefix="tresca-stab-")
+atexit.register(shutil.rmtree, TMP, True)  # the runs' files are intermediate
 RESULTS = []  # (case, expected, measured, passed)
 H5_FILES = []
 

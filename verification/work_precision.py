@@ -13,9 +13,11 @@ and uzawa (max_iter raised to 200000 so Uzawa reaches loose and tight tolerances
 the joint path. The cheapest configuration reaching each target accuracy is read off all measured points.
 """
 import argparse
+import atexit
 import csv
 import os
 import re
+import shutil
 import statistics
 import subprocess
 import sys
@@ -91,6 +93,7 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
     tmp = tempfile.mkdtemp(prefix="tresca-wp-")
+    atexit.register(shutil.rmtree, tmp, True)  # the runs' files are intermediate
     rows = []
     for case, c in CASES.items():
         full, bare = prepare(case, tmp)
