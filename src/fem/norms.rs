@@ -5,19 +5,20 @@
 //! * broken H¹ seminorm |u − u_h|_{1,h} and L² norm ‖u − u_h‖,
 //!
 //! by the degree-4 triangle rule and the exact 2-point edge rule. The exact u and ∇u (six expressions,
-//! compiled together so shared subterms are computed once, bound to the quadrature points so their parts
-//! that do not depend on t are evaluated once) are evaluated chunk of elements by chunk of elements, each
+//! bound to the quadrature points: separated in time or compiled, see [`super::exact`]) are evaluated
+//! chunk of elements by chunk of elements, each
 //! chunk's values used at once while they are in the processor's cache (not written out for the whole
 //! mesh and read back). Chunks run in parallel; the per-element contributions are summed in element
 //! order, so the norms are bit-identical for any thread count.
 
 use super::elasticity::Elasticity;
+use super::exact::{ExactAt, VALUES};
 use super::quadrature::{tri_point, GAUSS2, TRI4};
 use super::space::{jump_terms, CrSpace, Element};
 use crate::error::Error;
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::scene::expr::{program::LANES, BoundSet, ExprSet};
+use crate::scene::expr::program::LANES;
 use crate::scene::Exact;
 use std::sync::Mutex;
 
@@ -46,7 +47,7 @@ pub struct ErrorEvaluator {
     /// The TRI4 points of every element, element by element.
     points: Vec<[f64; 2]>,
     /// The exact u and ∇u bound to `points` (see [`ErrorEvaluator::with_exact`]).
-    bound: Option<BoundSet>,
+    bound: Option<ExactAt>,
     /// Per stabilised edge and Gauss point: weight · 2ρμ and the jump terms.
     jumps: Vec<(f64, Vec<(usize, f64)>)>,
     law: Elasticity,
@@ -72,7 +73,7 @@ impl ErrorEvaluator {
     /// evaluated once for the run instead of at every time. [`ErrorEvaluator::errors`] must then be given
     /// the same `exact`.
     pub fn with_exact(mut self, exact: &Exact) -> Self {
-        self.bound = Some(exact_set(exact).bind(self.points.clone()));
+        self.bound = Some(ExactAt::new(exact, self.points.clone()));
         self
     }
 
@@ -100,28 +101,29 @@ impl ErrorEvaluator {
         let bound = match &self.bound {
             Some(b) => b,
             None => {
-                owned = exact_set(exact).bind(self.points.clone());
+                owned = ExactAt::new(exact, self.points.clone());
                 &owned
             }
         };
+        let nodes: Vec<_> = fields.iter().map(|&(_, t)| bound.node(t)).collect();
         let (per_element, nf) = (TRI4.len(), fields.len());
         // parts[k · nf + f]: the contributions of element k to field f
         let mut parts = vec![[0.0f64; 3]; self.elements.len() * nf];
         // the error of the first field (and within it the first chunk, in point order) that has a
         // non-finite exact value
         let failed: Mutex<Option<((usize, usize), Error)>> = Mutex::new(None);
-        crate::parallel::for_chunks(&mut parts, CHUNK_ELEMENTS * nf.max(1), per_element * 6, |c, chunk| {
+        crate::parallel::for_chunks(&mut parts, CHUNK_ELEMENTS * nf.max(1), per_element * VALUES, |c, chunk| {
             let (first, n) = (c * CHUNK_ELEMENTS, chunk.len() / nf.max(1));
-            let mut values = Vec::with_capacity(n * per_element * 6);
-            for (f, &(mid, t)) in fields.iter().enumerate() {
-                if let Err(e) = bound.eval_range(first * per_element, n * per_element, t, &mut values) {
+            let mut values = Vec::with_capacity(n * per_element * VALUES);
+            for (f, (&(mid, _), node)) in fields.iter().zip(&nodes).enumerate() {
+                if let Err(e) = bound.eval_range(node, first * per_element, n * per_element, &mut values) {
                     let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
                     if slot.as_ref().is_none_or(|(at, _)| (f, c) < *at) {
                         *slot = Some(((f, c), e));
                     }
                     return;
                 }
-                for (k, v) in values.chunks_exact(per_element * 6).enumerate() {
+                for (k, v) in values.chunks_exact(per_element * VALUES).enumerate() {
                     chunk[k * nf + f] = self.element_errors(mesh, v, mid, first + k);
                 }
             }
@@ -150,7 +152,7 @@ impl ErrorEvaluator {
         let (mut en, mut h1, mut l2) = (0.0f64, 0.0f64, 0.0f64);
         let ue = mesh.tri_edges[k].map(|e| mid[e]);
         let gh = el.gradient(ue);
-        for ((l, w), v) in TRI4.into_iter().zip(exact.chunks_exact(6)) {
+        for ((l, w), v) in TRI4.into_iter().zip(exact.chunks_exact(VALUES)) {
             let phi = Element::phi(l);
             let wt = w * el.area;
             let u = [v[0], v[1]];
@@ -182,11 +184,4 @@ impl ErrorEvaluator {
         }
         en
     }
-}
-
-/// u₀, u₁, ∂u₀/∂x, ∂u₀/∂y, ∂u₁/∂x, ∂u₁/∂y compiled together.
-fn exact_set(exact: &Exact) -> ExprSet {
-    let [u0, u1] = &exact.u.0;
-    let [[g00, g01], [g10, g11]] = &exact.grad;
-    ExprSet::new(&[u0, u1, g00, g01, g10, g11])
 }
