@@ -591,9 +591,13 @@ def mms_section(args, R, tmp, md, csvrows):
                           os.path.join(tmp, f"{name}_mms_stop_r4.h5"), "--refine", "4", "--steps", steps, "-q"]
                    for name in ["skfem", "dolfinx"]}
         # Interleaved rounds (Rust, skfem, dolfinx, Rust, ...): this VM's speed drifts by up to 1.7x within
-        # minutes, so solvers timed one after the other would be compared across different phases.
+        # minutes, so solvers timed one after the other would be compared across different phases. Three times
+        # the other sections' repeats: single Rust runs of this size scatter by +-20 % here (120-200 ms), and with
+        # 5 rounds the ratio of medians and the median of paired ratios differed by up to 14 % within one bench
+        # (dolfinx 17.2x against 19.6x at 03:45 on 2026-11-23); a round takes about 6 s.
+        rounds = 3 * R
         meas = {k: ([], [], [], []) for k in ["rust", "rust_solve", *py_cmds]}
-        for _ in range(R):
+        for _ in range(rounds):
             for k, cmd in [("rust", rust), ("rust_solve", rust_solve), *py_cmds.items()]:
                 meas[k][2].append(load1())
                 w, _, _ = timed(cmd)
@@ -607,7 +611,7 @@ def mms_section(args, R, tmp, md, csvrows):
                f"Rust written in full: {fmt_t(rw)} (CPU {fmt_t(rc)}); solve-only {fmt_t(rs)}. Same command shapes as "
                "section 2: the Rust file holds more than the scripts' (the VTKHDF and XDMF views of 17 frames, a "
                "commit per step), the scripts' \"own total\" leaves out their imports and writing. The solvers run in "
-               f"{R} interleaved rounds (Rust written, Rust solve-only, scikit-fem, dolfinx, Rust written, …); "
+               f"{rounds} interleaved rounds (Rust written, Rust solve-only, scikit-fem, dolfinx, Rust written, …); "
                "medians; \"paired\" is the median over the rounds of the ratio within a round.", "",
                "| solver | process (median) | CPU | own total | ratio process/Rust written | paired | ratio CPU/Rust | "
                "ratio own/Rust solve-only | max du vs Rust | load |",
