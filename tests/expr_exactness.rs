@@ -136,7 +136,8 @@ fn sets_as_runs_bind_them_match_single_expressions_bit_for_bit() {
 /// (the separated route reassociates the same terms' products and sums).
 #[test]
 fn exact_solutions_as_the_error_norms_evaluate_them_agree_with_the_interpreter() {
-    use tresca_cr::fem::exact::{ExactAt, VALUES};
+    use tresca_cr::fem::exact::ExactAt;
+    use tresca_cr::scene::expr::program::LANES;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/cases");
     let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
     files.sort();
@@ -148,18 +149,26 @@ fn exact_solutions_as_the_error_norms_evaluate_them_agree_with_the_interpreter()
         let mesh = Mesh::from_spec(&scene.mesh).unwrap();
         let pts: Vec<[f64; 2]> =
             mesh.tris.iter().flat_map(|t| TRI4.map(|(l, _)| tri_point(t.map(|v| mesh.points[v]), l))).collect();
-        let at = ExactAt::new(&ex, pts.clone());
+        let (pe, n_el) = (TRI4.len(), mesh.tris.len());
+        let at = ExactAt::new(&ex, pts.clone(), pe);
         separated += usize::from(at.is_separated());
         let exprs: Vec<&Expr> = ex.u.0.iter().chain(ex.grad.iter().flatten()).collect();
         let reference: Vec<_> = exprs.iter().map(|e| e.interpreted().unwrap()).collect();
-        let mut values = Vec::new();
+        let (mut batch, mut values) = (Vec::new(), vec![0.0; pts.len() * 6]);
         for &t in &scene.times {
-            at.eval_range(&at.node(t), 0, pts.len(), &mut values).unwrap();
+            // the batches of elements, back to point-major values
+            for b in 0..n_el.div_ceil(LANES) {
+                let n = LANES.min(n_el - b * LANES);
+                at.eval_batch(&at.node(t), b, n, &mut batch).unwrap();
+                for (e, q, k) in (0..n).flat_map(|e| (0..pe).flat_map(move |q| (0..6).map(move |k| (e, q, k)))) {
+                    values[((b * LANES + e) * pe + q) * 6 + k] = batch[(k * pe + q) * LANES + e];
+                }
+            }
             for (k, r) in reference.iter().enumerate() {
                 let exact: Vec<f64> = pts.iter().map(|p| r.eval(p[0], p[1], t)).collect();
                 let scale = exact.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 for (i, e) in exact.iter().enumerate() {
-                    let d = (values[i * VALUES + k] - e).abs() / scale.max(f64::MIN_POSITIVE);
+                    let d = (values[i * 6 + k] - e).abs() / scale.max(f64::MIN_POSITIVE);
                     if d > worst {
                         worst = d;
                         worst_at = format!("{} `{}` at {:?}, t={t}", file.display(), exprs[k].text(), pts[i]);

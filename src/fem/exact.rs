@@ -1,6 +1,8 @@
 //! The exact solution at fixed quadrature points, time node after time node: the six values
-//! u₀, u₁, ∂u₀/∂x, ∂u₀/∂y, ∂u₁/∂x, ∂u₁/∂y of every point, point-major, for the true error norms
-//! ([`super::norms`]).
+//! u₀, u₁, ∂u₀/∂x, ∂u₀/∂y, ∂u₁/∂x, ∂u₁/∂y at the points of every element, for the true error norms
+//! ([`super::norms`]). Elements go in batches of [`LANES`]; a batch's values are laid out value, point
+//! of the element, element (`out[(k · per_element + q) · LANES + e]`), so that the norms are loops
+//! over the elements of a batch, which the compiler vectorises.
 //!
 //! **Separated.** When every one of the six expressions is a sum of time factors times space parts
 //! (`Expr::separate`, as for the loads of [`super::loads`]),
@@ -33,13 +35,15 @@ pub const VALUES: usize = 6;
 /// memory a node reads per point outgrows the bound program's.
 pub const MAX_PARTS: usize = 48;
 
-/// Batches of [`LANES`] points per chunk of the space parts' evaluation.
-const CHUNK_BATCHES: usize = 16;
+/// Batches of elements per chunk of the space parts' evaluation.
+const CHUNK_BATCHES: usize = 4;
 
 /// The exact solution bound to its points (see the module doc).
 pub struct ExactAt {
     exprs: [Expr; VALUES],
+    /// The points, element by element (`per_element` each).
     points: Vec<[f64; 2]>,
+    per_element: usize,
     separated: Option<Separated>,
     /// The bound program: built at once when the solution does not separate, else on first need.
     bound: OnceLock<BoundSet>,
@@ -53,8 +57,7 @@ struct Separated {
     first: [usize; VALUES + 1],
     /// The time factor of each part.
     factor: Vec<usize>,
-    /// The space parts at the points in batches of [`LANES`] points: batch, part, lane (so a batch's
-    /// multiply-adds are loops over lanes, which the compiler vectorises).
+    /// The space parts at the points by batch of elements: batch, part, point of the element, element.
     space: Vec<f64>,
 }
 
@@ -65,13 +68,14 @@ pub struct Node {
 }
 
 impl ExactAt {
-    /// Bind `exact` to `points`: separated if it separates, else compiled and bound.
-    pub fn new(exact: &Exact, points: Vec<[f64; 2]>) -> ExactAt {
+    /// Bind `exact` to `points`, `per_element` points of each element in turn: separated if it
+    /// separates, else compiled and bound.
+    pub fn new(exact: &Exact, points: Vec<[f64; 2]>, per_element: usize) -> ExactAt {
         let [u0, u1] = &exact.u.0;
         let [[g00, g01], [g10, g11]] = &exact.grad;
         let exprs = [u0, u1, g00, g01, g10, g11].map(Expr::clone);
-        let separated = Separated::new(&exprs, &points);
-        let ex = ExactAt { exprs, points, separated, bound: OnceLock::new() };
+        let separated = Separated::new(&exprs, &points, per_element);
+        let ex = ExactAt { exprs, points, per_element, separated, bound: OnceLock::new() };
         if ex.separated.is_none() {
             ex.bound();
         }
@@ -100,23 +104,35 @@ impl ExactAt {
         Node { t, tau }
     }
 
-    /// The values at the points `start..start + n` at `node` into `out` (n · [`VALUES`], point-major);
-    /// `start` must be a multiple of `program::LANES`. An error names the first expression, point and
-    /// time with a value that is not finite.
-    pub fn eval_range(&self, node: &Node, start: usize, n: usize, out: &mut Vec<f64>) -> Result<()> {
+    /// The values at the points of the `n` ≤ [`LANES`] elements of batch `batch` (elements
+    /// batch · LANES, …) at `node` into `out`: [`VALUES`] · per_element · LANES values, laid out as
+    /// in the module doc (lanes past n hold zeros or the padding's values). An error names the first
+    /// expression, point and time with a value that is not finite.
+    pub fn eval_batch(&self, node: &Node, batch: usize, n: usize, out: &mut Vec<f64>) -> Result<()> {
+        let pe = self.per_element;
+        out.clear();
+        out.resize(VALUES * pe * LANES, 0.0);
         if let (Some(s), Some(tau)) = (&self.separated, &node.tau) {
-            if s.eval_range(tau, start, n, out) {
+            if s.eval_batch(tau, batch, pe, out) {
                 return Ok(());
             }
         }
-        self.bound().eval_range(start, n, node.t, out)
+        let mut values = Vec::with_capacity(n * pe * VALUES);
+        self.bound().eval_range(batch * LANES * pe, n * pe, node.t, &mut values)?;
+        out.fill(0.0);
+        for (p, v) in values.chunks_exact(VALUES).enumerate() {
+            for (k, &x) in v.iter().enumerate() {
+                out[(k * pe + p % pe) * LANES + p / pe] = x;
+            }
+        }
+        Ok(())
     }
 }
 
 impl Separated {
     /// The separated form of `exprs` at `points`, if all six separate within [`MAX_PARTS`] parts and
     /// every space part is finite at every point.
-    fn new(exprs: &[Expr; VALUES], points: &[[f64; 2]]) -> Option<Separated> {
+    fn new(exprs: &[Expr; VALUES], points: &[[f64; 2]], pe: usize) -> Option<Separated> {
         let mut keys: Vec<String> = Vec::new();
         let mut taus = Vec::new();
         let (mut first, mut factor, mut names, mut trees) = ([0; VALUES + 1], Vec::new(), Vec::new(), Vec::new());
@@ -139,11 +155,13 @@ impl Separated {
         }
         let set = ExprSet::derived(&names, &trees.iter().collect::<Vec<_>>());
         let np = factor.len();
-        let mut space = vec![0.0; points.len().div_ceil(LANES) * np * LANES];
+        // one batch of elements: LANES · pe points, np · pe · LANES values
+        let per_batch = np * pe * LANES;
+        let mut space = vec![0.0; points.len().div_ceil(pe * LANES) * per_batch];
         // evaluated and laid out chunk by chunk (no point-major copy of all the values)
         let finite = AtomicBool::new(true);
-        crate::parallel::for_chunks(&mut space, CHUNK_BATCHES * np * LANES, 1, |c, chunk| {
-            let first = c * CHUNK_BATCHES * LANES;
+        crate::parallel::for_chunks(&mut space, CHUNK_BATCHES * per_batch, 1, |c, chunk| {
+            let first = c * CHUNK_BATCHES * LANES * pe;
             let pts = &points[first..(first + chunk.len() / np).min(points.len())];
             let mut values = Vec::with_capacity(pts.len() * np);
             if set.eval(pts, 0.0, &mut values).is_err() {
@@ -151,8 +169,9 @@ impl Separated {
                 return;
             }
             for (p, v) in values.chunks_exact(np).enumerate() {
+                let (e, q) = (p / pe, p % pe);
                 for (i, &x) in v.iter().enumerate() {
-                    chunk[(p / LANES * np + i) * LANES + p % LANES] = x;
+                    chunk[e / LANES * per_batch + (i * pe + q) * LANES + e % LANES] = x;
                 }
             }
         });
@@ -162,47 +181,39 @@ impl Separated {
         Some(Separated { factors: Program::new(&taus.iter().collect::<Vec<_>>()), first, factor, space })
     }
 
-    /// The values at points `start..start + n` into `out`; false if one is not finite. `start` is a
-    /// multiple of [`LANES`].
-    fn eval_range(&self, tau: &[f64], start: usize, n: usize, out: &mut Vec<f64>) -> bool {
-        out.clear();
-        out.resize(n * VALUES, 0.0);
+    /// The values of batch `batch` (pe points per element) into `out` (zeroed, laid out as in the
+    /// module doc); false if one is not finite.
+    fn eval_batch(&self, tau: &[f64], batch: usize, pe: usize, out: &mut [f64]) -> bool {
         let coef: Vec<f64> = self.factor.iter().map(|&j| tau[j]).collect();
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the processor supports AVX2.
-            return unsafe { self.batches_avx2(&coef, start / LANES, out) };
+            return unsafe { self.combine_avx2(&coef, batch, pe, out) };
         }
-        self.batches(&coef, start / LANES, out)
+        self.combine(&coef, batch, pe, out)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn batches_avx2(&self, coef: &[f64], first: usize, out: &mut [f64]) -> bool {
-        self.batches(coef, first, out)
+    unsafe fn combine_avx2(&self, coef: &[f64], batch: usize, pe: usize, out: &mut [f64]) -> bool {
+        self.combine(coef, batch, pe, out)
     }
 
-    /// The batches from `first` on into `out` (point-major): per value a loop over lanes, as in
-    /// `scene::expr::eval` (the same operations with or without AVX2: no fused multiply-add).
+    /// v_k = Σ_i c_i s_i row by row: loops over the lanes, as in `scene::expr::eval` (the same
+    /// operations with or without AVX2: no fused multiply-add).
     #[inline(always)]
-    fn batches(&self, coef: &[f64], first: usize, out: &mut [f64]) -> bool {
+    fn combine(&self, coef: &[f64], batch: usize, pe: usize, out: &mut [f64]) -> bool {
         let np = self.factor.len();
+        let space = &self.space[batch * np * pe * LANES..][..np * pe * LANES];
         let mut finite = true;
-        let mut rows = [[0.0f64; LANES]; VALUES];
-        for (b, o) in out.chunks_mut(LANES * VALUES).enumerate() {
-            let batch = &self.space[(first + b) * np * LANES..][..np * LANES];
-            for (k, row) in rows.iter_mut().enumerate() {
-                *row = [0.0; LANES];
+        for k in 0..VALUES {
+            for q in 0..pe {
+                let row: &mut [f64] = &mut out[(k * pe + q) * LANES..][..LANES];
                 for i in self.first[k]..self.first[k + 1] {
-                    let (c, s) = (coef[i], &batch[i * LANES..(i + 1) * LANES]);
+                    let (c, s) = (coef[i], &space[(i * pe + q) * LANES..][..LANES]);
                     row.iter_mut().zip(s).for_each(|(r, s)| *r += c * s);
                 }
                 finite &= row.iter().all(|v| v.is_finite());
-            }
-            for (l, o) in o.chunks_exact_mut(VALUES).enumerate() {
-                for (k, o) in o.iter_mut().enumerate() {
-                    *o = rows[k][l];
-                }
             }
         }
         finite
@@ -227,8 +238,22 @@ mod tests {
         (0..n).map(|i| [(i as f64 * 0.37).sin() * 0.5 + 0.5, (i as f64 * 0.11).cos() * 0.5 + 0.5]).collect()
     }
 
+    /// The values of batch b (n elements of pe points) from the bound program, in the batch layout.
+    fn reference(set: &BoundSet, b: usize, n: usize, pe: usize, t: f64) -> Vec<f64> {
+        let mut v = Vec::new();
+        set.eval_range(b * LANES * pe, n * pe, t, &mut v).unwrap();
+        let mut out = vec![0.0; VALUES * pe * LANES];
+        for (p, x) in v.chunks_exact(VALUES).enumerate() {
+            for k in 0..VALUES {
+                out[(k * pe + p % pe) * LANES + p / pe] = x[k];
+            }
+        }
+        out
+    }
+
     /// Requirement: the separated route gives the bound program's values to within a few ulps of the
-    /// parts (1e-14 of their size: the same terms, products reassociated) at every point and time.
+    /// parts (1e-14 of their size: the same terms, products reassociated) at every point and time, in
+    /// full batches and in the last, shorter one.
     #[test]
     fn separated_values_agree_with_the_bound_program() {
         let ex = exact(
@@ -238,18 +263,24 @@ mod tests {
                 ["y*(1-y)*(t/2+1)/20", "(1-2*y)*(t/2+1)*(x+1)/20"],
             ],
         );
-        let pts = points(3 * 64);
-        let at = ExactAt::new(&ex, pts.clone());
+        let (pe, elements) = (6, 2 * LANES + 5);
+        let pts = points(pe * elements);
+        let at = ExactAt::new(&ex, pts.clone(), pe);
         assert!(at.is_separated());
         let e = &at.exprs;
-        let reference = ExprSet::new(&[&e[0], &e[1], &e[2], &e[3], &e[4], &e[5]]).bind(pts.clone());
-        let (mut a, mut b) = (Vec::new(), Vec::new());
+        let set = ExprSet::new(&[&e[0], &e[1], &e[2], &e[3], &e[4], &e[5]]).bind(pts.clone());
+        let mut a = Vec::new();
         for t in [0.0, 0.2, 1.0 / 3.0, 0.5, 1.0] {
-            at.eval_range(&at.node(t), 64, 128, &mut a).unwrap();
-            reference.eval_range(64, 128, t, &mut b).unwrap();
-            let scale = b.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-            let worst = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
-            assert!(worst <= 1e-14 * scale, "t = {t}: {worst:e} of {scale:e}");
+            for (b, n) in [(0, LANES), (2, 5)] {
+                at.eval_batch(&at.node(t), b, n, &mut a).unwrap();
+                let r = reference(&set, b, n, pe, t);
+                let scale = r.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+                let worst = (0..VALUES * pe)
+                    .flat_map(|row| (0..n).map(move |e| row * LANES + e))
+                    .map(|i| (a[i] - r[i]).abs())
+                    .fold(0.0, f64::max);
+                assert!(worst <= 1e-14 * scale, "t = {t}, batch {b}: {worst:e} of {scale:e}");
+            }
         }
     }
 
@@ -257,13 +288,18 @@ mod tests {
     /// exactly), and a value that is not finite is an error naming the expression.
     #[test]
     fn a_moving_front_is_bound_and_a_pole_is_reported() {
-        let front = exact(["max(x - t, 0)", "0"], [["0", "0"], ["0", "0"]]);
-        let pts = points(64);
-        let at = ExactAt::new(&front, pts.clone());
+        let front = exact(["max(x - t, 0)", "y*t"], [["0", "0"], ["0", "0"]]);
+        let (pe, pts) = (6, points(6 * LANES));
+        let at = ExactAt::new(&front, pts.clone(), pe);
         assert!(!at.is_separated());
+        let set = ExprSet::new(&[&at.exprs[0], &at.exprs[1], &at.exprs[2], &at.exprs[3], &at.exprs[4], &at.exprs[5]])
+            .bind(pts.clone());
+        let mut a = Vec::new();
+        at.eval_batch(&at.node(0.4), 0, LANES, &mut a).unwrap();
+        assert!(a.iter().zip(reference(&set, 0, LANES, pe, 0.4)).all(|(x, y)| x.to_bits() == y.to_bits()));
         let pole = exact(["t/(x - x)", "0"], [["0", "0"], ["0", "0"]]);
-        let at = ExactAt::new(&pole, pts);
-        let err = at.eval_range(&at.node(0.5), 0, 64, &mut Vec::new()).unwrap_err().to_string();
+        let at = ExactAt::new(&pole, pts, pe);
+        let err = at.eval_batch(&at.node(0.5), 0, LANES, &mut a).unwrap_err().to_string();
         assert!(err.contains("x - x"), "{err}");
     }
 }

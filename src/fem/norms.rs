@@ -6,9 +6,11 @@
 //!
 //! by the degree-4 triangle rule and the exact 2-point edge rule. The exact u and ∇u (six expressions,
 //! bound to the quadrature points: separated in time or compiled, see [`super::exact`]) are evaluated
-//! chunk of elements by chunk of elements, each
-//! chunk's values used at once while they are in the processor's cache (not written out for the whole
-//! mesh and read back). Chunks run in parallel; the per-element contributions are summed in element
+//! chunk of elements by chunk of elements, each chunk's values used at once while they are in the
+//! processor's cache (not written out for the whole mesh and read back). Within a chunk the elements go
+//! in batches of `LANES`, the element geometry stored by batch, so every sum is a loop over the
+//! elements of a batch (vectorised) while each element's sum over its points keeps the order of an
+//! element-by-element loop. Chunks run in parallel; the per-element contributions are summed in element
 //! order, so the norms are bit-identical for any thread count.
 
 use super::elasticity::Elasticity;
@@ -41,39 +43,82 @@ impl ErrorNorms {
     }
 }
 
+/// Rows of an element batch's geometry: the area, then ∇φ_i (i = 0, 1, 2; x then y).
+const GEOMETRY: usize = 7;
+
+/// The stabilisation's quadrature, flat: per stabilised edge and Gauss point q its weight · 2ρμ and
+/// the terms of the jump, [u_h](x_q) = Σ coef · u_edge over `first[q]..first[q + 1]`.
+struct Jumps {
+    weight: Vec<f64>,
+    first: Vec<usize>,
+    edge: Vec<usize>,
+    coef: Vec<f64>,
+}
+
+/// A batch of elements for [`ErrorEvaluator::batch_errors`]: batch b, its elements' edges, the exact
+/// (u₀, u₁, ∂u₀/∂x, …) at their quadrature points (laid out as in `fem::exact`), the CR field's
+/// midpoint values.
+#[derive(Clone, Copy)]
+struct Batch<'a> {
+    b: usize,
+    edges: &'a [[usize; 3]],
+    exact: &'a [f64],
+    mid: &'a [[f64; 2]],
+}
+
 /// Precomputed geometry for repeated error evaluation.
 pub struct ErrorEvaluator {
-    elements: Vec<Element>,
+    /// Triangles.
+    n_elements: usize,
+    /// By batch of [`LANES`] elements: [`GEOMETRY`] rows of LANES values (0 past the last element).
+    geometry: Vec<f64>,
     /// The TRI4 points of every element, element by element.
     points: Vec<[f64; 2]>,
     /// The exact u and ∇u bound to `points` (see [`ErrorEvaluator::with_exact`]).
     bound: Option<ExactAt>,
     /// Per stabilised edge and Gauss point: weight · 2ρμ and the jump terms.
-    jumps: Vec<(f64, Vec<(usize, f64)>)>,
+    jumps: Jumps,
     law: Elasticity,
 }
 
 impl ErrorEvaluator {
     pub fn new(mesh: &Mesh, space: &CrSpace, law: &Elasticity, rho: f64) -> Self {
-        let elements: Vec<Element> = (0..mesh.tris.len()).map(|t| Element::new(mesh, t)).collect();
-        let points = elements.iter().flat_map(|el| TRI4.map(|(l, _)| tri_point(el.pts, l))).collect();
-        let pen = 2.0 * rho * law.mu;
-        let mut jumps = Vec::new();
-        for e in 0..mesh.edges.len() {
-            if space.is_stabilised(mesh, e) {
-                for (s, w) in GAUSS2 {
-                    jumps.push((pen * w, jump_terms(mesh, e, s)));
+        let n_elements = mesh.tris.len();
+        let mut geometry = vec![0.0; n_elements.div_ceil(LANES) * GEOMETRY * LANES];
+        let mut points = Vec::with_capacity(n_elements * TRI4.len());
+        for t in 0..n_elements {
+            let el = Element::new(mesh, t);
+            points.extend(TRI4.map(|(l, _)| tri_point(el.pts, l)));
+            let rows = &mut geometry[t / LANES * GEOMETRY * LANES..][..GEOMETRY * LANES];
+            rows[t % LANES] = el.area;
+            for i in 0..3 {
+                for (d, g) in el.grad_phi(i).into_iter().enumerate() {
+                    rows[(1 + 2 * i + d) * LANES + t % LANES] = g;
                 }
             }
         }
-        ErrorEvaluator { elements, points, bound: None, jumps, law: *law }
+        let pen = 2.0 * rho * law.mu;
+        let mut jumps = Jumps { weight: Vec::new(), first: vec![0], edge: Vec::new(), coef: Vec::new() };
+        for e in 0..mesh.edges.len() {
+            if space.is_stabilised(mesh, e) {
+                for (s, w) in GAUSS2 {
+                    jumps.weight.push(pen * w);
+                    for (k, p) in jump_terms(mesh, e, s) {
+                        jumps.edge.push(k);
+                        jumps.coef.push(p);
+                    }
+                    jumps.first.push(jumps.edge.len());
+                }
+            }
+        }
+        ErrorEvaluator { n_elements, geometry, points, bound: None, jumps, law: *law }
     }
 
     /// Bind the exact solution to the quadrature points once: its parts that do not depend on t are then
     /// evaluated once for the run instead of at every time. [`ErrorEvaluator::errors`] must then be given
     /// the same `exact`.
     pub fn with_exact(mut self, exact: &Exact) -> Self {
-        self.bound = Some(ExactAt::new(exact, self.points.clone()));
+        self.bound = Some(ExactAt::new(exact, self.points.clone(), TRI4.len()));
         self
     }
 
@@ -101,30 +146,36 @@ impl ErrorEvaluator {
         let bound = match &self.bound {
             Some(b) => b,
             None => {
-                owned = ExactAt::new(exact, self.points.clone());
+                owned = ExactAt::new(exact, self.points.clone(), TRI4.len());
                 &owned
             }
         };
         let nodes: Vec<_> = fields.iter().map(|&(_, t)| bound.node(t)).collect();
-        let (per_element, nf) = (TRI4.len(), fields.len());
+        let nf = fields.len();
         // parts[k · nf + f]: the contributions of element k to field f
-        let mut parts = vec![[0.0f64; 3]; self.elements.len() * nf];
+        let mut parts = vec![[0.0f64; 3]; self.n_elements * nf];
         // the error of the first field (and within it the first chunk, in point order) that has a
         // non-finite exact value
         let failed: Mutex<Option<((usize, usize), Error)>> = Mutex::new(None);
-        crate::parallel::for_chunks(&mut parts, CHUNK_ELEMENTS * nf.max(1), per_element * VALUES, |c, chunk| {
-            let (first, n) = (c * CHUNK_ELEMENTS, chunk.len() / nf.max(1));
-            let mut values = Vec::with_capacity(n * per_element * VALUES);
+        crate::parallel::for_chunks(&mut parts, CHUNK_ELEMENTS * nf.max(1), TRI4.len() * VALUES, |c, chunk| {
+            let n = chunk.len() / nf.max(1);
+            let mut values = Vec::with_capacity(VALUES * TRI4.len() * LANES);
+            let mut batch = [[0.0f64; 3]; LANES];
             for (f, (&(mid, _), node)) in fields.iter().zip(&nodes).enumerate() {
-                if let Err(e) = bound.eval_range(node, first * per_element, n * per_element, &mut values) {
-                    let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
-                    if slot.as_ref().is_none_or(|(at, _)| (f, c) < *at) {
-                        *slot = Some(((f, c), e));
+                for (j, first) in (0..n).step_by(LANES).enumerate() {
+                    let (b, m) = (c * CHUNK_ELEMENTS / LANES + j, LANES.min(n - first));
+                    if let Err(e) = bound.eval_batch(node, b, m, &mut values) {
+                        let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
+                        if slot.as_ref().is_none_or(|(at, _)| (f, c) < *at) {
+                            *slot = Some(((f, c), e));
+                        }
+                        return;
                     }
-                    return;
-                }
-                for (k, v) in values.chunks_exact(per_element * VALUES).enumerate() {
-                    chunk[k * nf + f] = self.element_errors(mesh, v, mid, first + k);
+                    let edges = &mesh.tri_edges[b * LANES..b * LANES + m];
+                    self.batch_errors(Batch { b, edges, exact: &values, mid }, &mut batch);
+                    for (k, e) in batch[..m].iter().enumerate() {
+                        chunk[(first + k) * nf + f] = *e;
+                    }
                 }
             }
         });
@@ -145,39 +196,79 @@ impl ErrorEvaluator {
         (norms, failed.map(|(_, e)| e))
     }
 
-    /// (energy, H¹, L²) squared error contributions of element k, from the exact (u₀, u₁, ∂u/∂x...) at its
-    /// quadrature points (`exact`, point-major).
-    fn element_errors(&self, mesh: &Mesh, exact: &[f64], mid: &[[f64; 2]], k: usize) -> [f64; 3] {
-        let el = &self.elements[k];
-        let (mut en, mut h1, mut l2) = (0.0f64, 0.0f64, 0.0f64);
-        let ue = mesh.tri_edges[k].map(|e| mid[e]);
-        let gh = el.gradient(ue);
-        for ((l, w), v) in TRI4.into_iter().zip(exact.chunks_exact(VALUES)) {
-            let phi = Element::phi(l);
-            let wt = w * el.area;
-            let u = [v[0], v[1]];
-            for c in 0..2 {
-                let uh = phi[0] * ue[0][c] + phi[1] * ue[1][c] + phi[2] * ue[2][c];
-                l2 += wt * (u[c] - uh) * (u[c] - uh);
+    /// (energy, H¹, L²) squared error contributions of the elements of a batch into `out`: per element
+    /// the sums over its points in order, as element by element.
+    fn batch_errors(&self, batch: Batch, out: &mut [[f64; 3]; LANES]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor supports AVX2.
+            return unsafe { self.batch_errors_avx2(batch, out) };
+        }
+        self.batch_errors_lanes(batch, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn batch_errors_avx2(&self, batch: Batch, out: &mut [[f64; 3]; LANES]) {
+        self.batch_errors_lanes(batch, out)
+    }
+
+    /// [`ErrorEvaluator::batch_errors`] as loops over the lanes (elements), which the compiler vectorises
+    /// (the same operations with or without AVX2: no fused multiply-add).
+    #[inline(always)]
+    fn batch_errors_lanes(&self, Batch { b, edges, exact, mid }: Batch, out: &mut [[f64; 3]; LANES]) {
+        const L: usize = LANES;
+        let pe = TRI4.len();
+        let geo = &self.geometry[b * GEOMETRY * L..][..GEOMETRY * L];
+        let row = |k: usize, q: usize| -> &[f64] { &exact[(k * pe + q) * L..][..L] };
+        // the midpoint values u_i (component c) of the batch's elements
+        let mut ue = [[[0.0f64; L]; 2]; 3];
+        for (e, te) in edges.iter().enumerate() {
+            for i in 0..3 {
+                let m = mid[te[i]];
+                ue[i][0][e] = m[0];
+                ue[i][1][e] = m[1];
             }
-            let mut g = [[0.0; 2]; 2];
-            for c in 0..2 {
-                for d in 0..2 {
-                    g[c][d] = v[2 + 2 * c + d] - gh[c][d];
+        }
+        // ∇u_h = Σ_i u_i ⊗ ∇φ_i, in Element::gradient's order
+        let mut gh = [[[0.0f64; L]; 2]; 2];
+        for (i, u) in ue.iter().enumerate() {
+            for (c, uc) in u.iter().enumerate() {
+                for (d, g) in gh[c].iter_mut().enumerate() {
+                    let gp = &geo[(1 + 2 * i + d) * L..][..L];
+                    for l in 0..L {
+                        g[l] += uc[l] * gp[l];
+                    }
                 }
             }
-            en += wt * self.law.energy_density(g);
-            h1 += wt * (g[0][0] * g[0][0] + g[0][1] * g[0][1] + g[1][0] * g[1][0] + g[1][1] * g[1][1]);
         }
-        [en, h1, l2]
+        let (mut en, mut h1, mut l2) = ([0.0f64; L], [0.0f64; L], [0.0f64; L]);
+        for (q, (lq, w)) in TRI4.into_iter().enumerate() {
+            let phi = Element::phi(lq);
+            let (u0, u1) = (row(0, q), row(1, q));
+            let (v00, v01, v10, v11) = (row(2, q), row(3, q), row(4, q), row(5, q));
+            for l in 0..L {
+                let wt = w * geo[l];
+                for (c, u) in [u0[l], u1[l]].into_iter().enumerate() {
+                    let uh = phi[0] * ue[0][c][l] + phi[1] * ue[1][c][l] + phi[2] * ue[2][c][l];
+                    l2[l] += wt * (u - uh) * (u - uh);
+                }
+                let g = [[v00[l] - gh[0][0][l], v01[l] - gh[0][1][l]], [v10[l] - gh[1][0][l], v11[l] - gh[1][1][l]]];
+                en[l] += wt * self.law.energy_density(g);
+                h1[l] += wt * (g[0][0] * g[0][0] + g[0][1] * g[0][1] + g[1][0] * g[1][0] + g[1][1] * g[1][1]);
+            }
+        }
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = [en[l], h1[l], l2[l]];
+        }
     }
 
     /// The stabilisation part Σ_e (2ρμ/h_e) ∫_e |[u_h]|² of a CR field.
     pub fn jump_energy(&self, mid: &[[f64; 2]]) -> f64 {
-        let mut en = 0.0;
-        for (w, terms) in &self.jumps {
+        let (mut en, jp) = (0.0, &self.jumps);
+        for (w, at) in jp.weight.iter().zip(jp.first.windows(2)) {
             let mut j = [0.0; 2];
-            for &(e, p) in terms {
+            for (&e, &p) in jp.edge[at[0]..at[1]].iter().zip(&jp.coef[at[0]..at[1]]) {
                 j = [j[0] + p * mid[e][0], j[1] + p * mid[e][1]];
             }
             en += w * (j[0] * j[0] + j[1] * j[1]);
