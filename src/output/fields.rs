@@ -108,25 +108,26 @@ impl Fields {
     pub fn eval(&self, mid: &[[f64; 2]], r: &StepResult, prev_slip: Option<&[f64]>, out: &mut StepFields) {
         let nt = self.n_tris();
         let nc = self.n_contact();
-        out.displacement.clear();
-        out.strain.clear();
-        out.stress.clear();
-        out.von_mises.clear();
-        out.displacement.reserve(9 * nt);
-        out.strain.reserve(TENSOR * nt);
-        out.stress.reserve(TENSOR * nt);
-        out.von_mises.reserve(nt);
-        for (te, el) in self.tri_edges.iter().zip(&self.elements) {
+        // every entry is written below: the buffers are only sized (no pushes in the loop)
+        out.displacement.resize(9 * nt, 0.0);
+        out.strain.resize(TENSOR * nt, 0.0);
+        out.stress.resize(TENSOR * nt, 0.0);
+        out.von_mises.resize(nt, 0.0);
+        let cells =
+            out.strain.chunks_exact_mut(TENSOR).zip(out.stress.chunks_exact_mut(TENSOR)).zip(&mut out.von_mises);
+        let points = out.displacement.chunks_exact_mut(9);
+        for (((te, el), d), ((strain, stress), vm)) in self.tri_edges.iter().zip(&self.elements).zip(points).zip(cells)
+        {
             let u = te.map(|e| mid[e]);
             let s = [u[0][0] + u[1][0] + u[2][0], u[0][1] + u[1][1] + u[2][1]];
-            for uj in &u {
-                out.displacement.extend_from_slice(&[(s[0] - 2.0 * uj[0]) as f32, (s[1] - 2.0 * uj[1]) as f32, 0.0]);
+            for (d, uj) in d.chunks_exact_mut(3).zip(&u) {
+                d.copy_from_slice(&[(s[0] - 2.0 * uj[0]) as f32, (s[1] - 2.0 * uj[1]) as f32, 0.0]);
             }
             let ss = self.law.strain_stress(el.gradient(u));
             let ([exx, eyy, exy], [sxx, syy, szz, sxy]) = (ss.strain, ss.stress);
-            out.strain.extend_from_slice(&[exx as f32, eyy as f32, 0.0, exy as f32, 0.0, 0.0]);
-            out.stress.extend_from_slice(&[sxx as f32, syy as f32, szz as f32, sxy as f32, 0.0, 0.0]);
-            out.von_mises.push(von_mises(ss.stress) as f32);
+            strain.copy_from_slice(&[exx as f32, eyy as f32, 0.0, exy as f32, 0.0, 0.0]);
+            stress.copy_from_slice(&[sxx as f32, syy as f32, szz as f32, sxy as f32, 0.0, 0.0]);
+            *vm = von_mises(ss.stress) as f32;
         }
         out.contact_displacement.clear();
         for &q in &self.contact_points_of {

@@ -6,9 +6,9 @@ use super::*;
 
 /// An error naming the first non-finite value of `v`, if any.
 fn check_finite(path: &Path, n: usize, what: &str, v: &[f64]) -> Result<()> {
-    // x · 0 is 0 for every finite x and NaN otherwise: one vectorised pass finds whether any value is not
-    // finite, the position is looked for only then
-    if v.iter().fold(0.0, |a, x| a + x * 0.0) == 0.0 {
+    // one pass without early exit (vectorised) finds whether any value is not finite, the position is
+    // looked for only then
+    if v.iter().fold(true, |ok, x| ok & x.is_finite()) {
         return Ok(());
     }
     match v.iter().position(|x| !x.is_finite()) {
@@ -88,7 +88,7 @@ impl Writer {
                 ("slip_increment", &b.slip_increment),
             ] {
                 // as in check_finite: one vectorised pass, the position only when there is one
-                if v.iter().fold(0.0f32, |a, x| a + x * 0.0) == 0.0 {
+                if v.iter().fold(true, |ok, x| ok & x.is_finite()) {
                     continue;
                 }
                 if let Some(k) = v.iter().position(|x| !x.is_finite()) {
