@@ -12,7 +12,8 @@ For each manufactured case (exact solution known):
     value 10^(-j/4) that some grid configuration meets with a 10 % margin (MARGIN: so that the truth decides
     every target robustly; for the default grids 3.16e-1 .. 3.16e-3, or 1.78e-1 .. 1.78e-3 where refine 6
     reaches below 1.6e-3). For each,
-    `tresca-cr plan SCENE --target T --csv F` (its CPU time is the planner's own cost: all pilot runs);
+    `tresca-cr plan SCENE --target T --csv F` (its CPU time is the planner's own cost: all pilot runs;
+    median of 3 as above);
     the plan (refine, steps, ssn, tol) is then run like a grid point (true error with [exact], cost without).
  3. Requirements (per case):
     PL1 the plan meets the target in truth (true error <= target) for >= 90 % of the sweep;
@@ -142,9 +143,18 @@ def plan(scene, target, tmp, extra=()):
     if os.path.exists(out):
         os.remove(out)
     cmd = [BIN, "plan", scene, "--target", f"{target:.6g}", "--csv", out] + list(extra)
-    p, wall, cpu = timed(cmd)
-    if p.returncode not in (0, 3):
-        raise RuntimeError(f"{cmdline(cmd)} failed:\n{p.stderr}")
+    # measured as the configurations are: median of 3 runs, one when it takes over 2 s (the planner is
+    # deterministic: every run plans the same; a single run of ~0.25 s scattered by up to 35 % on this VM)
+    cpus, walls = [], []
+    while len(cpus) < 3:
+        p, wall, cpu = timed(cmd)
+        if p.returncode not in (0, 3):
+            raise RuntimeError(f"{cmdline(cmd)} failed:\n{p.stderr}")
+        cpus.append(cpu)
+        walls.append(wall)
+        if wall > 2.0:
+            break
+    cpu, wall = statistics.median(cpus), statistics.median(walls)
     rows = list(csv.DictReader(open(out))) if os.path.exists(out) else []
     best = next((r for r in rows if r["role"] == "plan"), None)
     return best, cpu, wall, p.stdout, cmd
@@ -261,7 +271,7 @@ def main(argv=None):
           "process; wall in the CSV). Binary: " + VERSION + ".", "",
           "Cost of a configuration = CPU time of `tresca-cr run SCENE --refine r --steps N [--solver ssn --tol TOL] -q` on the "
           "scene without `[exact]` (median of 3 under 2 s); true error = the same command on the scene with `[exact]` (CLI "
-          "\"max over time nodes: energy error\"). Planner cost = CPU time of `tresca-cr plan SCENE --target T` (all pilot runs). "
+          "\"max over time nodes: energy error\"). Planner cost = CPU time of `tresca-cr plan SCENE --target T` (all pilot runs; median of 3). "
           "Brute-force cheapest = the cheapest grid configuration whose true error meets the target.", ""]
     reqs, csv_rows = [], []
     for name in args.cases:
