@@ -32,6 +32,7 @@ Sections:
     mms_stop refine 5.
 """
 import argparse
+import atexit
 import csv
 import json
 import os
@@ -247,6 +248,8 @@ def main(argv=None):
     if not os.path.exists(BIN):
         sys.exit(f"{BIN} missing: cargo build --release")
     tmp = tempfile.mkdtemp(prefix="tresca-bench-")
+    # removed at exit on every path (--mms-only returns before the end of main, an error may stop it)
+    atexit.register(shutil.rmtree, tmp, ignore_errors=True)
     version = subprocess.run([BIN, "--version"], capture_output=True, text=True).stdout.strip()
     md = []
     csvrows = []
