@@ -21,7 +21,9 @@ Plain script (no pytest needed); prints one line per check and exits non-zero if
 The scenes of 4 and 8 are generated here with sympy (f = -div sigma(u), g = sigma(u) n).
 """
 import argparse
+import atexit
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -287,6 +289,9 @@ def main():
 
     gen = generated_scenes()
     tmp = tempfile.mkdtemp(prefix="tresca_py_")
+    # the generated scenes and the solvers' results files (about 8 MB) are removed at exit (kept when a
+    # check fails, see the end)
+    atexit.register(shutil.rmtree, tmp, ignore_errors=True)
     paths = {}
     for name, text in gen.items():
         paths[name] = os.path.join(tmp, f"{name}.toml")
@@ -400,8 +405,12 @@ def main():
     check("bad scenes give a one-line error", ok_all)
 
     nfail = sum(not ok for _, ok in RESULTS)
+    # a failed check's files are kept for its diagnosis (and with TRESCA_KEEP_TMP set, as for the Rust tests)
+    keep = nfail > 0 or bool(os.environ.get("TRESCA_KEEP_TMP"))
+    if keep:
+        atexit.unregister(shutil.rmtree)
     print(f"\n{len(RESULTS) - nfail}/{len(RESULTS)} checks passed in {time.perf_counter() - t_start:.0f} s "
-          f"(work files in {tmp})")
+          + (f"(work files kept in {tmp})" if keep else "(work files removed)"))
     return 1 if nfail else 0
 
 
