@@ -22,6 +22,7 @@
 //! naming the expression, the point and the time.
 
 use crate::error::Result;
+use crate::scene::expr::factor_slot;
 use crate::scene::expr::program::{Program, LANES};
 use crate::scene::expr::{BoundSet, Expr, ExprSet};
 use crate::scene::Exact;
@@ -89,6 +90,11 @@ impl ExactAt {
         })
     }
 
+    /// The points, given back.
+    pub fn into_points(self) -> Vec<[f64; 2]> {
+        self.points
+    }
+
     /// True if the separated route serves the nodes.
     pub fn is_separated(&self) -> bool {
         self.separated.is_some()
@@ -133,18 +139,11 @@ impl Separated {
     /// The separated form of `exprs` at `points`, if all six separate within [`MAX_PARTS`] parts and
     /// every space part is finite at every point.
     fn new(exprs: &[Expr; VALUES], points: &[[f64; 2]], pe: usize) -> Option<Separated> {
-        let mut keys: Vec<String> = Vec::new();
         let mut taus = Vec::new();
         let (mut first, mut factor, mut names, mut trees) = ([0; VALUES + 1], Vec::new(), Vec::new(), Vec::new());
         for (k, e) in exprs.iter().enumerate() {
             for (tau, space) in e.separate()? {
-                let key = format!("{tau:?}");
-                let j = keys.iter().position(|x| *x == key).unwrap_or_else(|| {
-                    keys.push(key);
-                    taus.push(tau);
-                    keys.len() - 1
-                });
-                factor.push(j);
+                factor.push(factor_slot(&mut taus, tau));
                 names.push(e);
                 trees.push(space);
             }
@@ -178,7 +177,12 @@ impl Separated {
         if !finite.into_inner() {
             return None;
         }
-        Some(Separated { factors: Program::new(&taus.iter().collect::<Vec<_>>()), first, factor, space })
+        Some(Separated {
+            factors: Program::new(&taus.iter().map(|(_, tau)| tau).collect::<Vec<_>>()),
+            first,
+            factor,
+            space,
+        })
     }
 
     /// The values of batch `batch` (pe points per element) into `out` (zeroed, laid out as in the

@@ -22,7 +22,7 @@ use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::scene::expr::program::Program;
 use crate::scene::expr::sym::Sym;
-use crate::scene::expr::{BoundSet, Expr, ExprSet, Vec2Expr};
+use crate::scene::expr::{factor_slot, BoundSet, Expr, ExprSet, Vec2Expr};
 use crate::scene::{PartKind, Scene};
 
 /// A quadrature point of a load term: position, and the (edge, weight · φ) pairs it feeds.
@@ -292,11 +292,7 @@ fn separated(e: &Vec2Expr, factors: &mut Vec<(String, Sym)>, separate: bool) -> 
     let mut out: Vec<(usize, [Sym; 2])> = Vec::new();
     for (c, parts) in comps.into_iter().enumerate() {
         for (tau, space) in parts {
-            let key = format!("{tau:?}");
-            let j = known.iter().position(|(k, _)| *k == key).unwrap_or_else(|| {
-                known.push((key, tau));
-                known.len() - 1
-            });
+            let j = factor_slot(&mut known, tau);
             let at = out.iter().position(|(i, _)| *i == j).unwrap_or_else(|| {
                 out.push((j, [Sym::Num(0.0), Sym::Num(0.0)]));
                 out.len() - 1

@@ -72,7 +72,7 @@ pub struct ErrorEvaluator {
     n_elements: usize,
     /// By batch of [`LANES`] elements: [`GEOMETRY`] rows of LANES values (0 past the last element).
     geometry: Vec<f64>,
-    /// The TRI4 points of every element, element by element.
+    /// The TRI4 points of every element, element by element (moved into `bound` once bound).
     points: Vec<[f64; 2]>,
     /// The exact u and ∇u bound to `points` (see [`ErrorEvaluator::with_exact`]).
     bound: Option<ExactAt>,
@@ -118,7 +118,11 @@ impl ErrorEvaluator {
     /// evaluated once for the run instead of at every time. [`ErrorEvaluator::errors`] must then be given
     /// the same `exact`.
     pub fn with_exact(mut self, exact: &Exact) -> Self {
-        self.bound = Some(ExactAt::new(exact, self.points.clone(), TRI4.len()));
+        let points = match self.bound.take() {
+            Some(b) => b.into_points(),
+            None => std::mem::take(&mut self.points),
+        };
+        self.bound = Some(ExactAt::new(exact, points, TRI4.len()));
         self
     }
 

@@ -16,6 +16,7 @@ mod lint;
 pub mod program;
 mod regroup;
 mod separate;
+pub use separate::factor_slot;
 pub mod sym;
 
 use crate::error::{Error, Result};

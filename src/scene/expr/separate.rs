@@ -45,6 +45,17 @@ pub fn separate(s: &Sym) -> Option<Vec<(Sym, Sym)>> {
     Some(merged)
 }
 
+/// The index of the time factor `tau` in `factors` (keyed by its tree), appended if new: how several
+/// separated expressions share their distinct time factors (the loads' patterns, the exact solution of
+/// the true errors).
+pub fn factor_slot(factors: &mut Vec<(String, Sym)>, tau: Sym) -> usize {
+    let key = format!("{tau:?}");
+    factors.iter().position(|(k, _)| *k == key).unwrap_or_else(|| {
+        factors.push((key, tau));
+        factors.len() - 1
+    })
+}
+
 /// True if the tree depends on x or y.
 fn has_xy(s: &Sym) -> bool {
     match s {
