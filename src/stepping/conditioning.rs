@@ -3,8 +3,9 @@
 //!
 //! The estimate's solves (λ_max(K⁻¹), a few passes over the factor) run on a thread of their own
 //! ([`Pending`]) while the set-up ends and the first steps are computed; no step result is handed out
-//! before the verdict (`Problem::conditioned`), and a run that fails before that reports a refused K
-//! rather than what followed from it.
+//! before the verdict (`Problem::conditioned`): the steps computed before it are held back (up to a
+//! budget, `stepping::run`), and a run that fails before it reports a refused K rather than what
+//! followed from it.
 
 use crate::error::{Error, Result};
 use crate::fem::space::CrSpace;
@@ -30,6 +31,12 @@ impl Pending {
         let f = Arc::clone(factor);
         let solves = std::thread::spawn(move || condition::largest_inverse_eigenvalue(&f, n, 12));
         Pending { top, solves: Mutex::new(Some(solves)), verdict: OnceLock::new() }
+    }
+
+    /// Whether the estimate is in (or its thread ended): [`Pending::verdict`] would not wait.
+    pub(super) fn ready(&self) -> bool {
+        self.verdict.get().is_some()
+            || self.solves.lock().unwrap_or_else(|e| e.into_inner()).as_ref().is_none_or(|h| h.is_finished())
     }
 
     /// Wait for the estimate (once) and refuse K if it is too large.

@@ -10,6 +10,44 @@ use super::*;
 /// block at once, mms_stop r4 written took 6 ms longer: the writing no longer overlapped the errors).
 const ERROR_BATCH: usize = 4;
 
+/// Bytes of step results held back while K's condition estimate is under way (see [`Held`]); beyond
+/// them the steps wait for the estimate. Steps without u (runs with neither a results file nor true
+/// errors) take a few hundred bytes each, so those runs never wait; a step with u takes 8 bytes per
+/// unknown (200 kB at 24,640 unknowns).
+const HOLD_BYTES: usize = 4 << 20;
+
+/// The results not handed out yet because K's condition estimate (`conditioning`) is still under way:
+/// step 0, then the steps in order. The steps go on meanwhile; the first step handed out after the
+/// verdict hands these out first. (Waiting for the verdict at the first step instead held Example 5.1
+/// n = 64 for 20 ms after its first block of steps: the estimate's 12 solves end 26 ms after the factor.)
+struct Held {
+    first: Option<StepResult>,
+    steps: Vec<StepResult>,
+    bytes: usize,
+}
+
+impl Held {
+    fn bytes_of(r: &StepResult) -> usize {
+        8 * (r.u.len() + r.mu.len() + r.slip.len()) + r.state.len() + std::mem::size_of::<StepResult>()
+    }
+
+    /// Hand out what is held, in order, then `r` (if any).
+    fn hand_out(
+        &mut self,
+        r: Option<&StepResult>,
+        on_step: &mut impl FnMut(&StepResult) -> Result<()>,
+    ) -> Result<()> {
+        if let Some(f) = self.first.take() {
+            on_step(&f)?;
+        }
+        self.bytes = 0;
+        for h in std::mem::take(&mut self.steps) {
+            on_step(&h)?;
+        }
+        r.map_or(Ok(()), on_step)
+    }
+}
+
 impl Problem {
     /// [`Problem::finish`] for the steps of a block: their true errors evaluated [`ERROR_BATCH`] steps
     /// at a time (`ErrorEvaluator::errors_at`, the same values). Each step is checked and handed to `hand`
@@ -138,23 +176,19 @@ impl Problem {
         want: impl Fn(usize) -> bool,
         mut on_step: impl FnMut(&StepResult) -> Result<()>,
     ) -> Result<()> {
-        let mut first = first;
+        let mut held = Held { first, steps: Vec::new(), bytes: 0 };
         let mut hand = |r: &StepResult| -> Result<()> {
-            self.conditioned()?;
-            if let Some(f) = first.take() {
-                on_step(&f)?;
+            if !self.conditioning.ready() && held.bytes + Held::bytes_of(r) <= HOLD_BYTES {
+                held.bytes += Held::bytes_of(r);
+                held.steps.push(r.clone());
+                return Ok(());
             }
-            on_step(r)
+            self.conditioned()?;
+            held.hand_out(Some(r), &mut on_step)
         };
         let result = if from.n >= self.n_steps() {
-            // nothing to step: `first` alone (handed out as the last result)
-            match first.take() {
-                Some(f) => {
-                    self.conditioned()?;
-                    on_step(&f)
-                }
-                None => Ok(()),
-            }
+            // nothing to step: `first` alone (handed out below)
+            Ok(())
         } else if let (Some(friction), true) = (&self.friction, self.free.block_size() > 0) {
             self.run_blocks(friction, from, want, &mut hand).map(|_| ())
         } else {
@@ -169,10 +203,12 @@ impl Problem {
                 Ok(())
             })()
         };
-        if let (Err(_), Some(f)) = (&result, first.take()) {
-            // a run that fails before handing out a step still hands out step 0, as step by step
-            if self.conditioned().is_ok() {
-                on_step(&f)?;
+        // What is still held (step 0 at least, if nothing was handed out) once K is accepted: a run that
+        // fails hands out the steps before the failure, as step by step.
+        if held.first.is_some() || !held.steps.is_empty() {
+            match self.conditioned() {
+                Ok(()) => held.hand_out(None, &mut on_step)?,
+                Err(c) => return Err(c),
             }
         }
         result.map_err(|e| self.prefer_conditioning(e))
