@@ -3,6 +3,7 @@
 //! results file there).
 
 use super::*;
+use faer::sparse::SymbolicSparseColMat;
 
 impl Problem {
     /// As [`Problem::new`], running `beside` on a thread of its own while the rest of the set-up
@@ -89,8 +90,9 @@ struct SetUp {
 
 impl Problem0 {
     /// Assembly, factorisation, superposition and condensation, in three phases:
-    /// 1. K's values and the loads; beside them the ordering and the symbolic factorisation (they need
-    ///    only K's pattern, which is the mesh's; with the loads on a third thread, the results file's
+    /// 1. K's pattern, values and the loads; beside them the ordering (from the graph of the edges, begun
+    ///    before K's pattern is made) and the symbolic factorisation (it needs only K's pattern, which is
+    ///    the mesh's; with the loads on a third thread, the results file's
     ///    creation, beside from the start, got less of the two cores: Example 5.1 n = 32 written
     ///    65.5 → 63.4 ms, mms_stop r4 written 136.7 → 134.4 ms, interleaved);
     /// 2. the numeric factorisation; beside it the factor's pages are mapped, then λ_max(K) of the
@@ -113,25 +115,35 @@ impl Problem0 {
     fn assemble(&self) -> Result<(SparseColMat<usize, f64>, Loads, Symbolic)> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         let pattern = EdgePattern::new(mesh);
-        let k_pattern = pattern.unknown_pattern(space);
         // contact unknowns last: the condensation then comes from the factor (solve::condense)
         let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
-        let (val, loads, symbolic) = std::thread::scope(|s| {
-            let symbolic = s.spawn(|| {
+        // The ordering needs only the graph of the edges, so the second thread starts on it before K's
+        // pattern (of the unknowns) is made, which it needs only for the symbolic factorisation: that
+        // thread ends phase 1 (at refine 5 of mms_stop its 52 ms of work against the main thread's 43).
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Arc<SymbolicSparseColMat<usize>>>(1);
+        let (val, loads, symbolic, k_pattern) = std::thread::scope(|s| {
+            let (pattern, contact) = (&pattern, &contact);
+            let symbolic = s.spawn(move || {
                 let (first, start, adj) = pattern.unknown_graph(space);
                 let graph = Graph::new(first, start, adj)
                     .ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
                 let order = fill_order(&graph, space.n_dofs >= ND_MIN_SIZE)?;
-                Symbolic::new(k_pattern.as_ref(), &contact, order)
+                let k_pattern = rx.recv().map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
+                Symbolic::new(k_pattern.as_ref().as_ref(), contact, order)
             });
-            let val = stiffness_values(&pattern, k_pattern.as_ref(), mesh, space, law, scene.rho);
+            let k_pattern = Arc::new(pattern.unknown_pattern(space));
+            // a thread that failed before taking it has dropped the receiver: its error is the one reported
+            let _ = tx.send(Arc::clone(&k_pattern));
+            let val = stiffness_values(pattern, k_pattern.as_ref().as_ref(), mesh, space, law, scene.rho);
             let loads = Loads::new(scene, mesh, space)?;
             let symbolic = symbolic
                 .join()
                 .map_err(|_| Error::Linear("the symbolic factorisation failed".into()))
                 .and_then(|r| r)?;
-            Ok((val, loads, symbolic))
+            Ok((val, loads, symbolic, k_pattern))
         })?;
+        // the second thread has ended, so this is the one reference left
+        let k_pattern = Arc::try_unwrap(k_pattern).unwrap_or_else(|k| (*k).clone());
         Ok((SparseColMat::new(k_pattern, val), loads, symbolic))
     }
 
