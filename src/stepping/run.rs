@@ -19,7 +19,7 @@ const HOLD_BYTES: usize = 4 << 20;
 /// The results not handed out yet because K's condition estimate (`conditioning`) is still under way:
 /// step 0, then the steps in order. The steps go on meanwhile; the first step handed out after the
 /// verdict hands these out first. (Waiting for the verdict at the first step instead held Example 5.1
-/// n = 64 for 20 ms after its first block of steps: the estimate's 12 solves end 26 ms after the factor.)
+/// n = 64 for 20 ms after its first block of steps: the estimate's solves end 26 ms after the factor.)
 struct Held {
     first: Option<StepResult>,
     steps: Vec<StepResult>,
@@ -27,16 +27,19 @@ struct Held {
 }
 
 impl Held {
-    fn bytes_of(r: &StepResult) -> usize {
-        8 * (r.u.len() + r.mu.len() + r.slip.len()) + r.state.len() + std::mem::size_of::<StepResult>()
+    /// Keep a copy of `r` if it fits within [`HOLD_BYTES`]; false (nothing kept) otherwise.
+    fn hold(&mut self, r: &StepResult) -> bool {
+        let b = 8 * (r.u.len() + r.mu.len() + r.slip.len()) + r.state.len() + std::mem::size_of::<StepResult>();
+        if self.bytes + b > HOLD_BYTES {
+            return false;
+        }
+        self.bytes += b;
+        self.steps.push(r.clone());
+        true
     }
 
     /// Hand out what is held, in order, then `r` (if any).
-    fn hand_out(
-        &mut self,
-        r: Option<&StepResult>,
-        on_step: &mut impl FnMut(&StepResult) -> Result<()>,
-    ) -> Result<()> {
+    fn hand_out(&mut self, r: Option<&StepResult>, on_step: &mut impl FnMut(&StepResult) -> Result<()>) -> Result<()> {
         if let Some(f) = self.first.take() {
             on_step(&f)?;
         }
@@ -178,9 +181,7 @@ impl Problem {
     ) -> Result<()> {
         let mut held = Held { first, steps: Vec::new(), bytes: 0 };
         let mut hand = |r: &StepResult| -> Result<()> {
-            if !self.conditioning.ready() && held.bytes + Held::bytes_of(r) <= HOLD_BYTES {
-                held.bytes += Held::bytes_of(r);
-                held.steps.push(r.clone());
+            if !self.conditioning.ready() && held.hold(r) {
                 return Ok(());
             }
             self.conditioned()?;
