@@ -192,6 +192,17 @@ fn tune_malloc() {
     }
 }
 
+/// Hand the heap's free pages back to the system now (`malloc_trim`), instead of at the process's exit,
+/// where freeing them is the last serial work of a run (about 57 MB, 5–8 ms at 24,640 unknowns). Called
+/// while another thread still works (the results writer), so the two overlap.
+pub(crate) fn hand_back_memory() {
+    // SAFETY: malloc_trim only returns free pages of glibc's arenas to the system; it is thread-safe.
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
+
 fn main() {
     tune_malloc();
     let cli = Cli::parse();
