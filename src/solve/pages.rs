@@ -10,14 +10,19 @@
 //! made by the populating thread). On kernels without it the call fails and the owner faults the
 //! pages itself, as before; the values are the same either way.
 //!
-//! Buffers of [`HUGE_MIN`] bytes or more are placed on 2 MiB boundaries and marked for transparent huge
-//! pages (`madvise(MADV_HUGEPAGE)`), where the kernel offers them (`enabled` = `always` or `madvise`): a
-//! 29 MB factor then takes 15 faults of 2 MiB instead of 7,300 of 4 KiB (mms_stop at refine 4: 23.3k →
-//! 14.6k page faults in all, 14 ms less CPU). The kernel still zero-fills each page, so the contents are
-//! the same; where it has no free huge page it falls back to 4 KiB pages. Only this one large buffer,
-//! filled once and read to the end of the run, is marked: huge pages for the whole heap (tried with
-//! glibc's `hugetlb` tunable and with mimalloc) made small runs slower at times, when the kernel
-//! compacted memory for the heap's many short-lived allocations.
+//! Buffers of [`HUGE_MIN`] to [`HUGE_MAX`] bytes are placed on 2 MiB boundaries and marked for
+//! transparent huge pages (`madvise(MADV_HUGEPAGE)`), where the kernel offers them (`enabled` = `always`
+//! or `madvise`): a 29 MB factor then takes 15 faults of 2 MiB instead of 7,300 of 4 KiB (mms_stop at
+//! refine 4: 23.3k → 16.1k page faults in all, 14 ms less CPU). The kernel still zero-fills each page, so
+//! the contents are the same; where it has no free huge page it falls back to 4 KiB pages. Measured on
+//! the project's 2-core VMs (interleaved, medians): mms_stop r4 written −5 ms, Example 5.1 n = 64 −13 ms,
+//! mms_stop r5/64 written (a 163 MB factor) −67 ms; but the 347 MB factor of the 196,608-unknown
+//! benchmark took 0.29 s longer (0.58 → 0.87 s, the system time doubled, nearly all of it zeroing the
+//! huge pages: these VMs hand freed memory back to the host, free page reporting, and large runs of huge
+//! pages then come from memory the host must provide anew), hence the upper bound. Only this one large
+//! buffer, filled once and read to the end of the run, is marked: huge pages for the whole heap (glibc's
+//! `hugetlb` tunable, mimalloc, jemalloc) made small runs slower at times and tripled the system time of
+//! the 196,608-unknown run.
 
 use std::ops::{Deref, DerefMut};
 
@@ -25,8 +30,11 @@ use std::ops::{Deref, DerefMut};
 const PIECE: usize = HUGE;
 /// A transparent huge page (x86-64).
 const HUGE: usize = 2 << 20;
-/// Buffers of at least this many bytes are backed by transparent huge pages (see the module doc).
+/// Buffers of at least this many bytes and at most [`HUGE_MAX`] are backed by transparent huge pages
+/// (see the module doc).
 pub const HUGE_MIN: usize = 4 << 20;
+/// Above this many bytes a buffer stays on 4 KiB pages (see the module doc: 163 MB gained, 347 MB lost).
+pub const HUGE_MAX: usize = 192 << 20;
 
 /// `len` zeroed `f64` on their own anonymous mapping.
 pub struct Pages {
@@ -47,13 +55,14 @@ pub struct Range {
 
 impl Pages {
     /// A zeroed buffer of `len` values; `None` if the mapping fails (out of memory). From [`HUGE_MIN`]
-    /// bytes on, on 2 MiB boundaries and marked for transparent huge pages (see the module doc).
+    /// to [`HUGE_MAX`] bytes, on 2 MiB boundaries and marked for transparent huge pages (see the module
+    /// doc).
     pub fn zeroed(len: usize) -> Option<Pages> {
         if len == 0 {
             return Some(Pages { ptr: std::ptr::NonNull::dangling().as_ptr(), len });
         }
         let bytes = len.checked_mul(8)?;
-        let huge = bytes >= HUGE_MIN;
+        let huge = (HUGE_MIN..=HUGE_MAX).contains(&bytes);
         // a huge-page buffer is cut out of a mapping one huge page longer, at its first 2 MiB boundary
         let total = if huge { bytes.checked_add(HUGE)? } else { bytes };
         let p = map(total)?;
@@ -157,7 +166,7 @@ mod tests {
 
     fn populated_beside_writes(len: usize) {
         let mut p = Pages::zeroed(len).unwrap();
-        if len * 8 >= HUGE_MIN {
+        if (HUGE_MIN..=HUGE_MAX).contains(&(len * 8)) {
             assert_eq!(p.as_ptr() as usize % HUGE, 0, "a huge-page buffer starts on a 2 MiB boundary");
         }
         assert!(p.iter().all(|&v| v == 0.0));
