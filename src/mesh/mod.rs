@@ -6,14 +6,15 @@
 //! overlapping triangles, non-manifold edges and tags on interior edges; [`Mesh::bind_parts`] checks
 //! that every boundary edge belongs to exactly one declared part.
 
+mod edge_index;
 mod gmsh;
 mod quality;
 mod refine;
 mod structured;
 
 use crate::error::{Error, Result};
+use edge_index::EdgeIndex;
 use serde::Deserialize;
-use std::collections::HashMap;
 use std::path::PathBuf;
 
 pub use gmsh::parse as parse_gmsh;
@@ -128,16 +129,18 @@ impl Mesh {
                 t.swap(1, 2);
             }
         }
-        let mut index: HashMap<[usize; 2], usize> = HashMap::new();
-        let mut edges = Vec::new();
-        let mut edge_tris: Vec<(usize, Option<usize>)> = Vec::new();
+        let sides = |t: &[usize; 3]| [[t[1], t[2]], [t[2], t[0]], [t[0], t[1]]];
+        let mut index = EdgeIndex::with_room(np, tris.iter().flat_map(sides));
+        // about 3/2 edges a triangle
+        let mut edges = Vec::with_capacity(tris.len() * 3 / 2 + 2);
+        let mut edge_tris: Vec<(usize, Option<usize>)> = Vec::with_capacity(edges.capacity());
         let mut tri_edges = Vec::with_capacity(tris.len());
         for (k, t) in tris.iter().enumerate() {
             let mut te = [0; 3];
             for i in 0..3 {
                 let (a, b) = (t[(i + 1) % 3], t[(i + 2) % 3]);
                 let key = [a.min(b), a.max(b)];
-                let e = *index.entry(key).or_insert_with(|| {
+                let e = index.get_or_insert_with(a, b, || {
                     edges.push(key);
                     edge_tris.push((k, None));
                     edges.len() - 1
@@ -184,7 +187,7 @@ impl Mesh {
         for &(pair, tag) in &raw.tagged {
             let key = [pair[0].min(pair[1]), pair[0].max(pair[1])];
             let p = raw.points.get(key[0]).copied().unwrap_or([f64::NAN; 2]);
-            let Some(&e) = index.get(&key) else {
+            let Some(e) = index.get(key[0], key[1]) else {
                 return Err(Error::mesh(
                     src,
                     format!(

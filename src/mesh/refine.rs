@@ -1,15 +1,16 @@
 //! Uniform red refinement: every triangle is split into four by its edge midpoints; a tagged boundary
 //! edge becomes two edges with the same tag.
 
+use super::edge_index::EdgeIndex;
 use super::RawMesh;
-use std::collections::HashMap;
 
 /// One red refinement of `raw`.
 pub fn red(raw: &RawMesh) -> RawMesh {
     let mut points = raw.points.clone();
-    let mut mid: HashMap<[usize; 2], usize> = HashMap::new();
+    let sides = raw.tris.iter().flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]]);
+    let mut mid = EdgeIndex::with_room(raw.points.len(), sides.chain(raw.tagged.iter().map(|t| t.0)));
     let mut midpoint = |a: usize, b: usize, points: &mut Vec<[f64; 2]>| -> usize {
-        *mid.entry([a.min(b), a.max(b)]).or_insert_with(|| {
+        mid.get_or_insert_with(a, b, || {
             let (p, q) = (points[a], points[b]);
             points.push([0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])]);
             points.len() - 1
