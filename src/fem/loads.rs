@@ -166,14 +166,21 @@ impl Loads {
                 loads.terms.push(LoadTerm { expr: ExprSet::new(&[&e.0[0], &e.0[1]]).bind(points), quad });
                 continue;
             };
-            for (j, [sx, sy]) in parts {
+            for &(j, _) in &parts {
                 if j == loads.patterns.vectors.len() {
                     loads.patterns.vectors.push(vec![0.0; loads.support.len()]);
                     loads.patterns.names.push(e.0[0].clone());
                 }
-                ExprSet::derived(&[&e.0[0], &e.0[1]], &[&sx, &sy]).eval(&points, 0.0, &mut values)?;
-                let mut p = std::mem::take(&mut loads.patterns.vectors[j]);
-                loads.scatter(&quad, &values, &mut p);
+            }
+            // all parts of the term in one program (their common subexpressions, such as cos(x), computed
+            // once a point) and one pass over the points
+            let names: Vec<&Expr> = parts.iter().flat_map(|_| [&e.0[0], &e.0[1]]).collect();
+            let trees: Vec<&Sym> = parts.iter().flat_map(|(_, [sx, sy])| [sx, sy]).collect();
+            ExprSet::derived(&names, &trees).eval(&points, 0.0, &mut values)?;
+            let mut outs: Vec<Vec<f64>> =
+                parts.iter().map(|&(j, _)| std::mem::take(&mut loads.patterns.vectors[j])).collect();
+            loads.scatter(&quad, &values, &mut outs.iter_mut().map(|p| &mut p[..]).collect::<Vec<_>>());
+            for (&(j, _), p) in parts.iter().zip(outs) {
                 loads.patterns.vectors[j] = p;
             }
         }
@@ -225,15 +232,16 @@ impl Loads {
             for term in &self.terms {
                 // the expression values in parallel batches, the sums sequentially: bit-identical results
                 term.expr.eval(t, values)?;
-                self.scatter(&term.quad, values, out);
+                self.scatter(&term.quad, values, &mut [&mut out[..]]);
             }
             Ok(())
         })
     }
 
-    /// out += the quadrature sums of `values` (two per point, point-major) over the points of `quad`.
-    fn scatter(&self, quad: &Quad, values: &[f64], out: &mut [f64]) {
-        let mut points = values.chunks_exact(2).zip(&quad.weights);
+    /// outs[j] += the quadrature sums of the j-th pair of `values` (2 · outs.len() per point,
+    /// point-major) over the points of `quad`; each sum in the order of a scatter of that pair alone.
+    fn scatter(&self, quad: &Quad, values: &[f64], outs: &mut [&mut [f64]]) {
+        let mut points = values.chunks_exact(2 * outs.len()).zip(&quad.weights);
         for &(edges, n) in &quad.groups {
             let terms = edges.map(|e| {
                 &self.edge_terms[self.edge_first[e as usize] as usize..self.edge_first[e as usize + 1] as usize]
@@ -241,7 +249,9 @@ impl Loads {
             for (v, w) in points.by_ref().take(n as usize) {
                 for (terms, w) in terms.iter().zip(w) {
                     for &(slot, c) in *terms {
-                        out[slot as usize] += w * (c[0] * v[0] + c[1] * v[1]);
+                        for (out, v) in outs.iter_mut().zip(v.chunks_exact(2)) {
+                            out[slot as usize] += w * (c[0] * v[0] + c[1] * v[1]);
+                        }
                     }
                 }
             }
