@@ -4,6 +4,11 @@
 //! inserted (each key counted at every occurrence). At 24,640 edges this replaced a `HashMap` whose
 //! hashing and growth were a third of building the mesh (1.9 ms), on the single thread that starts a run.
 
+/// The sides of triangle `t`, side i opposite its vertex i.
+pub fn sides(t: &[usize; 3]) -> [[usize; 2]; 3] {
+    [[t[1], t[2]], [t[2], t[0]], [t[0], t[1]]]
+}
+
 /// Values (edge numbers, midpoint vertices) of vertex pairs, bucketed by the smaller vertex.
 pub struct EdgeIndex {
     /// Bucket a is `pairs[start[a]..start[a] + len[a]]`, with room up to `start[a + 1]`.

@@ -13,7 +13,7 @@ mod refine;
 mod structured;
 
 use crate::error::{Error, Result};
-use edge_index::EdgeIndex;
+use edge_index::{sides, EdgeIndex};
 use serde::Deserialize;
 use std::path::PathBuf;
 
@@ -129,7 +129,6 @@ impl Mesh {
                 t.swap(1, 2);
             }
         }
-        let sides = |t: &[usize; 3]| [[t[1], t[2]], [t[2], t[0]], [t[0], t[1]]];
         let mut index = EdgeIndex::with_room(np, tris.iter().flat_map(sides));
         // about 3/2 edges a triangle
         let mut edges = Vec::with_capacity(tris.len() * 3 / 2 + 2);
@@ -137,8 +136,7 @@ impl Mesh {
         let mut tri_edges = Vec::with_capacity(tris.len());
         for (k, t) in tris.iter().enumerate() {
             let mut te = [0; 3];
-            for i in 0..3 {
-                let (a, b) = (t[(i + 1) % 3], t[(i + 2) % 3]);
+            for (i, [a, b]) in sides(t).into_iter().enumerate() {
                 let key = [a.min(b), a.max(b)];
                 let e = index.get_or_insert_with(a, b, || {
                     edges.push(key);

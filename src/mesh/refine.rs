@@ -1,14 +1,14 @@
 //! Uniform red refinement: every triangle is split into four by its edge midpoints; a tagged boundary
 //! edge becomes two edges with the same tag.
 
-use super::edge_index::EdgeIndex;
+use super::edge_index::{sides, EdgeIndex};
 use super::RawMesh;
 
 /// One red refinement of `raw`.
 pub fn red(raw: &RawMesh) -> RawMesh {
     let mut points = raw.points.clone();
-    let sides = raw.tris.iter().flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]]);
-    let mut mid = EdgeIndex::with_room(raw.points.len(), sides.chain(raw.tagged.iter().map(|t| t.0)));
+    let keys = raw.tris.iter().flat_map(sides).chain(raw.tagged.iter().map(|t| t.0));
+    let mut mid = EdgeIndex::with_room(raw.points.len(), keys);
     let mut midpoint = |a: usize, b: usize, points: &mut Vec<[f64; 2]>| -> usize {
         mid.get_or_insert_with(a, b, || {
             let (p, q) = (points[a], points[b]);
