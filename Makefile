@@ -44,11 +44,12 @@ paraview:
 build: deps
 	cargo build --release --locked
 
-$(VENV)/.stamp: requirements.txt
+$(VENV)/.stamp: requirements.txt python/pyproject.toml
 	@test -n "$(PY312)" || { echo "error: Python 3.12 not found (pyenv install 3.12.1)"; exit 1; }
 	$(PY312) -m venv $(VENV)
 	$(VENV)/bin/pip install -q --upgrade pip
 	$(VENV)/bin/pip install -q -r requirements.txt
+	$(VENV)/bin/pip install -q --no-deps --no-build-isolation -e python
 	touch $@
 
 venv: $(VENV)/.stamp
