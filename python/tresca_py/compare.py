@@ -13,44 +13,38 @@ files may number vertices and edges differently.  For every time node n it repor
     derr_* = relative difference of the true errors (energy, h1, l2), when both files have them
              (0 when both are below --err-floor, as in patch tests)
 
-and exits with status 1 if max(du, dE, dsig, derr) > tol or the meshes/times do not match.  Differing
+and exits with status 1 if max(du, dE, dsig, derr) > tol or is NaN; with status 2 and one ``error:`` line if
+a file is not a valid results file (``tresca_py.results``: NaN/Inf in a series is refused there) or the
+meshes/times do not match.  Differing
 stick/slip flags are reported but only fail the comparison with --strict-flags (a flag may flip at an
 edge where |mu_e| = w_e and the slip increment vanishes up to rounding).
 """
 import argparse
+import math
 import sys
 
-import h5py
 import numpy as np
 from scipy.spatial import cKDTree
 
+from . import results
+
 
 class CompareError(ValueError):
-    """The two files cannot be compared (unreadable, different meshes or time nodes)."""
+    """The two files cannot be compared (unreadable, invalid, different meshes or time nodes)."""
 
 
 def load(path):
+    """The arrays compared, from a validated results file (``tresca_py.results``: NaN/Inf are refused)."""
     try:
-        f = h5py.File(path, "r")
-    except OSError as err:
-        raise CompareError(f"cannot open {path}: {err}") from None
-    if "tresca" not in f:
-        raise CompareError(f"{path} has no 'tresca' group")
-    g = f["tresca"]
-    out = {k: g[k][()] for k in ("times", "u")}
-    out["mid"] = g["mesh/midpoints"][()]
-    for k in ("energy",):
-        if k in g:
-            out[k] = g[k][()]
-    if "contact" in g:
-        ce = g["contact/edges"][()]
-        out["cmid"] = out["mid"][ce] if len(ce) else np.zeros((0, 2))
-        for k in ("sigma_t", "state", "slip", "g"):
-            out[k] = g[f"contact/{k}"][()]
-    if "errors" in g:
-        out["errors"] = {k: g[f"errors/{k}"][()] for k in g["errors"]}
-    out["solver"] = str(g.attrs.get("solver", "?"))
-    f.close()
+        r = results.read(path)
+    except results.ResultsError as err:
+        raise CompareError(str(err)) from None
+    out = {"times": r.times, "u": r.u, "mid": r.mesh.midpoints, "energy": r.energy, "solver": str(r.attrs["solver"])}
+    if r.contact is not None:
+        c = r.contact
+        out.update(cmid=r.mesh.midpoints[c.edges], sigma_t=c.sigma_t, state=c.state, slip=c.slip, g=c.g)
+    if r.errors is not None:
+        out["errors"] = dict(r.errors)
     return out
 
 
@@ -107,10 +101,11 @@ def compare_files(path_a, path_b, err_floor=1e-12):
         fl = int(np.sum(A["state"][n] != stB[n])) if has_c else 0
         de = [abs(A["errors"][k][n] - B["errors"][k][n]) / max(abs(A["errors"][k][n]), abs(B["errors"][k][n]))
               if max(abs(A["errors"][k][n]), abs(B["errors"][k][n])) > err_floor else 0.0 for k in errs]
-        worst["du"] = max(worst["du"], du)
-        worst["dE"] = max(worst["dE"], dE)
-        worst["dsig"] = max(worst["dsig"], dsig)
-        worst["derr"] = max([worst["derr"]] + de)
+        # np.maximum propagates NaN (Python's max(0.0, nan) is 0.0, which would pass a NaN difference)
+        worst["du"] = float(np.maximum(worst["du"], du))
+        worst["dE"] = float(np.maximum(worst["dE"], dE))
+        worst["dsig"] = float(np.maximum(worst["dsig"], dsig))
+        worst["derr"] = float(np.max(np.array([worst["derr"]] + de)))
         nflags += fl
         rows.append((n, float(A["times"][n]), du, dE, dsig, fl, de))
     return dict(worst, flags=nflags, rows=rows, errors=errs, solver_a=A["solver"], solver_b=B["solver"],
@@ -127,10 +122,14 @@ def main(argv=None):
                     help="true errors below this (absolute) count as equal, e.g. in patch tests (1e-12)")
     ap.add_argument("--strict-flags", action="store_true", help="fail on any differing stick/slip flag")
     args = ap.parse_args(argv)
+    if not (math.isfinite(args.tol) and args.tol >= 0) or not (math.isfinite(args.err_floor) and args.err_floor >= 0):
+        print("error: --tol and --err-floor must be finite numbers >= 0", file=sys.stderr)
+        return 2
     try:
         r = compare_files(args.a, args.b, args.err_floor)
     except CompareError as err:
-        sys.exit(f"error: {err}")
+        print(f"error: {err}", file=sys.stderr)
+        return 2
     if not args.quiet:
         head = f"{'n':>5} {'t':>10} {'du':>10} {'dE':>10} {'dsig':>10} {'flags':>5}"
         head += "".join(f" {'derr_' + k:>11}" for k in r["errors"])
@@ -138,8 +137,8 @@ def main(argv=None):
         print(head)
         for n, t, du, dE, dsig, fl, de in r["rows"]:
             print(f"{n:5d} {t:10.6g} {du:10.3e} {dE:10.3e} {dsig:10.3e} {fl:5d}" + "".join(f" {x:11.3e}" for x in de))
-    m = max(r[k] for k in ("du", "dE", "dsig", "derr"))
-    ok = m <= args.tol and (r["flags"] == 0 or not args.strict_flags)
+    m = np.max([r[k] for k in ("du", "dE", "dsig", "derr")])
+    ok = bool(np.isfinite(m) and m <= args.tol) and (r["flags"] == 0 or not args.strict_flags)
     print(f"max du = {r['du']:.3e}, max dE = {r['dE']:.3e}, max dsig = {r['dsig']:.3e}, "
           f"max derr = {r['derr']:.3e}, differing stick/slip flags = {r['flags']} "
           f"-> {'PASS' if ok else 'FAIL'} (tol {args.tol:g})")

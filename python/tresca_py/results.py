@@ -302,20 +302,22 @@ def _read_group(f, where, verify):
         if k not in attrs and not (legacy and k in LEGACY_MISSING):
             raise ResultsError(f"{where}: attribute {k} of /tresca is missing")
     ds = {}
-    for name in ("mesh/points", "mesh/triangles", "mesh/edges", "times") + (("contact/edges",) if "contact" in g else ()):
+    # the Python writer before this module wrote an empty contact group for a run without Γ_C
+    has_contact = "contact" in g and not (legacy and _dataset(where, g, "contact/edges").shape[:1] == (0,))
+    for name in ("mesh/points", "mesh/triangles", "mesh/edges", "times") + (("contact/edges",) if has_contact else ()):
         ds[name] = _dataset(where, g, name)
         if ds[name].ndim != len(SPEC[name][1]):
             raise ResultsError(f"{where}: tresca/{name} has {ds[name].ndim} dimensions, the layout wants "
                                f"{len(SPEC[name][1])}")
     sizes = {"P": ds["mesh/points"].shape[0], "T": ds["mesh/triangles"].shape[0], "E": ds["mesh/edges"].shape[0],
-             "R": ds["times"].shape[0], "C": ds["contact/edges"].shape[0] if "contact" in g else 0}
-    if "contact" not in g and attrs.get("n_contact", 0) > 0:
+             "R": ds["times"].shape[0], "C": ds["contact/edges"].shape[0] if has_contact else 0}
+    if not has_contact and attrs.get("n_contact", 0) > 0:
         raise ResultsError(f"{where}: n_contact = {attrs['n_contact']} but there is no tresca/contact group: "
                            "the contact part of the run is missing")
     if "n_contact" in attrs and attrs["n_contact"] != sizes["C"]:
         raise ResultsError(f"{where}: n_contact = {attrs['n_contact']} but tresca/contact/edges lists {sizes['C']}")
-    wanted = [n for n, *_ in DATASETS if n.split("/")[0] not in ("contact", "errors")
-              or n.split("/")[0] in g]
+    parts = {"contact": has_contact, "errors": "errors" in g}
+    wanted = [n for n, *_ in DATASETS if parts.get(n.split("/")[0], True)]
     for name in wanted:
         optional = name == "steps/checksum" or (legacy and name in LEGACY_MISSING)
         if optional and name not in g:
@@ -341,7 +343,7 @@ def _read_group(f, where, verify):
 
     mesh = Mesh(*(load(f"mesh/{k}", False) for k in ("points", "triangles", "edges", "midpoints")))
     contact = None
-    if "contact" in g:
+    if has_contact:
         contact = Contact(*(load(f"contact/{k}", False) for k in CONTACT_STATIC),
                           *(load(f"contact/{k}") for k in CONTACT_SERIES))
     errors = {k: load(f"errors/{k}") for k in ERRORS} if "errors" in g else None
