@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Check a tresca-cr results file through three independent readers (VTK's vtkHDFReader, meshio and VTK's
 XDMF readers, h5py): ``.venv/bin/python scripts/check_results.py run.h5 [--xdmf run.xdmf]``.
 

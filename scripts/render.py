@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Pictures of a tresca-cr results file (matplotlib):
 ``.venv/bin/python scripts/render.py run.h5 [--times 0.25 0.5 1.0] [-o DIR] [--field vm|u] [--scale S]``.
 

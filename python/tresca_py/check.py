@@ -67,7 +67,8 @@ def blocks_of(o, vtk):
         return {o.GetMetaData(i).Get(vtk.vtkCompositeDataSet.NAME()): o.GetPartition(i, 0)
                 for i in range(o.GetNumberOfPartitionedDataSets())}
     if o.IsA("vtkMultiBlockDataSet"):
-        return {o.GetMetaData(i).Get(vtk.vtkCompositeDataSet.NAME()): o.GetBlock(i) for i in range(o.GetNumberOfBlocks())}
+        return {o.GetMetaData(i).Get(vtk.vtkCompositeDataSet.NAME()): o.GetBlock(i)
+                for i in range(o.GetNumberOfBlocks())}
     return {"body": o}
 
 
@@ -118,8 +119,9 @@ def check_vtkhdf(c, run, h5):
             c.check(b.GetNumberOfPoints() == npt and b.GetNumberOfCells() == ncl,
                     f"VTKHDF {name} frame {k}: {b.GetNumberOfPoints()} points, {b.GetNumberOfCells()} cells; "
                     f"expected {npt}, {ncl}")
-            c.check(array_names(b.GetCellData()) == sorted(cnames), f"VTKHDF {name} cell arrays {array_names(b.GetCellData())}")
-            c.check(array_names(b.GetPointData()) == pnames, f"VTKHDF {name} point arrays {array_names(b.GetPointData())}")
+            cells, pts = array_names(b.GetCellData()), array_names(b.GetPointData())
+            c.check(cells == sorted(cnames), f"VTKHDF {name} cell arrays {cells}")
+            c.check(pts == pnames, f"VTKHDF {name} point arrays {pts}")
         body, cont = blocks.get("body"), blocks.get("contact")
         if body is not None and body.GetPointData().GetArray("displacement") is not None:
             d = v2n(body.GetPointData().GetArray("displacement"))
@@ -127,12 +129,14 @@ def check_vtkhdf(c, run, h5):
             c.check(np.all(d[:, 2] == 0), "VTKHDF displacement z != 0")
             if body.GetCellData().GetArray("von_mises") is not None:
                 c.close(v2n(body.GetCellData().GetArray("von_mises")), run.vm[n], f"VTKHDF von_mises frame {k}", 2e-5)
-                c.close(v2n(body.GetCellData().GetArray("stress"))[:, 0], run.sxx[n], f"VTKHDF stress xx frame {k}", 2e-5)
+                c.close(v2n(body.GetCellData().GetArray("stress"))[:, 0], run.sxx[n], f"VTKHDF stress xx frame {k}",
+                        2e-5)
         if run.C and cont is not None and array_names(cont.GetCellData()) == sorted(CONTACT_CELLS):
             cd = cont.GetCellData()
             c.close(v2n(cd.GetArray("sigma_t")), res.contact.sigma_t[n], f"VTKHDF sigma_t frame {k}")
             c.close(v2n(cd.GetArray("slip")), res.contact.slip[n], f"VTKHDF slip frame {k}")
-            c.check(np.array_equal(v2n(cd.GetArray("stick_slip")), res.contact.state[n]), f"VTKHDF stick_slip frame {k}")
+            c.check(np.array_equal(v2n(cd.GetArray("stick_slip")), res.contact.state[n]),
+                    f"VTKHDF stick_slip frame {k}")
             c.close(v2n(cont.GetPointData().GetArray("displacement"))[:, :2], run.disp[n][run.contact_pts],
                     f"VTKHDF contact displacement frame {k}")
         tval = r.GetOutputInformation(0).Get(vtk.vtkStreamingDemandDrivenPipeline.TIME_STEPS())
@@ -146,7 +150,8 @@ def check_meshio(c, run, xdmf):
     with meshio.xdmf.TimeSeriesReader(xdmf) as rd:
         points, cells = rd.read_points_cells()
         c.check(len(points) == 3 * run.T, f"XDMF: {len(points)} points, expected {3 * run.T}")
-        c.check([b.type for b in cells] == ["triangle"] and len(cells[0].data) == run.T, f"XDMF (meshio): cells {cells}")
+        c.check([b.type for b in cells] == ["triangle"] and len(cells[0].data) == run.T,
+                f"XDMF (meshio): cells {cells}")
         c.check(rd.num_steps == len(frames), f"XDMF: {rd.num_steps} steps, expected {len(frames)}")
         for k in range(min(rd.num_steps, len(frames))):
             t, pd, cd = rd.read_data(k)

@@ -90,7 +90,7 @@ def deformed(d, n, field, scale, out):
         # deformed Γ_C from the trace of the triangle owning each edge
         segs = []
         tri = d["mesh/triangles"]
-        for e, (a, b) in zip(d["c_edges"], e2):
+        for e, (a, b) in zip(d["c_edges"], e2, strict=True):
             t = np.nonzero((te == e).any(axis=1))[0][0]
             ja, jb = list(tri[t]).index(a), list(tri[t]).index(b)
             segs.append([y[t, ja], y[t, jb]])
@@ -140,7 +140,8 @@ def contact(d, n, out):
     a2.set_ylabel(f"slip velocity Δs/Δt [{u_['V']}]")
     a2.set_xlabel(f"position along Γ_C, x·τ [{u_['L']}]")
     nslip = int(state.sum())
-    a1.set_title(title(d, f"Γ_C at t = {times[n]:.4g}{u_['T']} (step {n}); shaded: slip ({nslip} of {len(state)} edges)"),
+    a1.set_title(title(d, f"Γ_C at t = {times[n]:.4g}{u_['T']} (step {n}); "
+                          f"shaded: slip ({nslip} of {len(state)} edges)"),
                  fontsize=9)
     fig.savefig(out, dpi=120, bbox_inches="tight")
 
