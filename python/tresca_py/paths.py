@@ -58,8 +58,10 @@ def _superblock_eof(head):
         at = 12 + 2 * size  # signature, version, sizes, flags, base address, extension address
     else:
         return None
-    if size not in (2, 4, 8) or len(head) < at + size:
+    if size not in (2, 4, 8):
         return None
+    if len(head) < at + size:
+        return at + size  # the file ends inside its superblock
     return int.from_bytes(head[at:at + size], "little")
 
 
@@ -84,17 +86,17 @@ def hdf5_file(path, what="results file"):
                             f"not a {what}")
     eof = _superblock_eof(head)
     if eof is not None and at + eof > size:
-        raise PathError(f"{path}: is truncated: its HDF5 superblock records {at + eof} bytes, the file has {size} "
-                        f"(an interrupted copy?)")
+        raise PathError(f"{path}: is truncated: its HDF5 superblock records at least {at + eof} bytes, the file "
+                        f"has {size} (an interrupted copy?)")
     return path
 
 
 def _is_text(b):
     try:
-        b.decode("utf-8")
+        text = b.decode("utf-8")
     except UnicodeDecodeError:
         return False
-    return True
+    return all(c.isprintable() or c in "\t\r\n" for c in text)
 
 
 def output_dir(path, what="output directory"):
