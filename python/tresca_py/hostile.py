@@ -181,3 +181,29 @@ RESULTS = [
     ("a value changed after writing", lambda good, plain, d: _edit(good, d, "flip.h5", _flip_checksummed),
      "does not match its checksum", "data"),
 ]
+
+
+def rust_runs(directory):
+    """Good files for the corpus, written by the Rust binary: {"contact": mms_stop (Γ_C, exact errors),
+    "plain": elastic_rect (no Γ_C)}, each with its XDMF sidecar; None when the binary is not built."""
+    import subprocess
+
+    from .common import BIN, case
+    if not os.path.exists(BIN):
+        return None
+    out = {}
+    for key, scene in (("contact", "mms_stop"), ("plain", "elastic_rect")):
+        out[key] = os.path.join(directory, f"{key}.h5")
+        subprocess.run([BIN, "run", case(scene), "-q", "-o", out[key], "--force"], check=True,
+                       capture_output=True)
+    return out
+
+
+def unprivileged():
+    """A command prefix under which permission bits apply (root ignores them: its file-access capabilities
+    are dropped with util-linux ``setpriv``); [] for other users."""
+    if os.geteuid() != 0:
+        return []
+    if shutil.which("setpriv") is None:
+        return None
+    return ["setpriv", "--bounding-set=-dac_override,-dac_read_search,-fowner"]

@@ -77,7 +77,7 @@ class Mesh:
     edges: np.ndarray
     midpoints: np.ndarray
 
-    def triangle_edges(self):
+    def triangle_edges(self, where="results"):
         """(T, 3): the edge opposite local vertex i of each triangle."""
         P = len(self.points)
         key = np.sort(self.edges, axis=1) @ np.array([P, 1])
@@ -90,7 +90,7 @@ class Mesh:
         bad = np.argwhere(key[found] != want) if len(key) else np.argwhere(np.ones_like(want, bool))
         if len(bad):
             k, i = bad[0]
-            raise ResultsError(f"tresca/mesh/triangles: side {sides[k, i].tolist()} of triangle {k} is not an edge "
+            raise ResultsError(f"{where}: tresca/mesh/triangles: side {sides[k, i].tolist()} of triangle {k} is not an edge "
                                "of tresca/mesh/edges")
         return found
 
@@ -215,7 +215,7 @@ def validate(r, where="results"):
                                    "not a valid result")
     _check_indices(where, m.triangles, sizes["P"], "mesh/triangles")
     _check_indices(where, m.edges, sizes["P"], "mesh/edges")
-    m.triangle_edges()
+    m.triangle_edges(where)
     if sizes["R"] == 0:
         raise ResultsError(f"{where}: no committed step (tresca-cr never leaves such a file under its name)")
     if np.any(np.diff(r.times) <= 0):
