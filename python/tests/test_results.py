@@ -44,8 +44,9 @@ def synthetic(contact=True, errors=True, steps=3):
     c = None
     if contact:
         c = results.Contact(np.array([2]), np.array([[0.0, -1.0]]), np.array([[1.0, 0.0]]), np.array([0.5]),
-                            rng.normal(size=(R, 1)), rng.normal(size=(R, 1)), rng.integers(0, 2, (R, 1)).astype(np.uint8),
-                            rng.normal(size=(R, 1)), rng.normal(size=(R, 1)))
+                            rng.normal(size=(R, 1)), rng.normal(size=(R, 1)),
+                            rng.integers(0, 2, (R, 1)).astype(np.uint8), rng.normal(size=(R, 1)),
+                            rng.normal(size=(R, 1)))
     st = {k: rng.integers(0, 9, R) if k in ("iterations", "n_stick", "n_slip") else rng.random(R)
           for k in results.STEP_FIELDS}
     err = {k: rng.random(R) for k in results.ERRORS} if errors else None

@@ -90,8 +90,8 @@ class Mesh:
         bad = np.argwhere(key[found] != want) if len(key) else np.argwhere(np.ones_like(want, bool))
         if len(bad):
             k, i = bad[0]
-            raise ResultsError(f"{where}: tresca/mesh/triangles: side {sides[k, i].tolist()} of triangle {k} is not an edge "
-                               "of tresca/mesh/edges")
+            raise ResultsError(f"{where}: tresca/mesh/triangles: side {sides[k, i].tolist()} of triangle {k} is not "
+                               "an edge of tresca/mesh/edges")
         return found
 
 
