@@ -21,10 +21,7 @@ PVPYTHON = shutil.which("pvpython") and shutil.which("xvfb-run")
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    out = hostile.rust_runs(str(tmp_path_factory.mktemp("rust")))
-    if out is None:
-        pytest.skip("target/release/tresca-cr is not built (cargo build --release)")
-    return out
+    return hostile.rust_runs_or_skip(tmp_path_factory)
 
 
 def one_error_line(err, fragment=""):
@@ -232,3 +229,15 @@ class TestParaviewView:
         assert rc == 0, err
         assert os.path.getsize(tmp_path / "v.png") > 1000
 
+
+
+def test_reference_of_an_h5py_group(runs):
+    """The system shall give the same expected view arrays from an open h5py group (as
+    verification/paraview_check.py calls check_results.reference) as from the validated results."""
+    from tresca_py import results
+    r = results.read(runs["contact"])
+    with h5py.File(runs["contact"]) as f:
+        a = check.reference(f["tresca"], 3)
+    b = check.reference(r)
+    for x, y in zip(a, b, strict=True):
+        assert np.array_equal(x, y[:3])

@@ -12,10 +12,7 @@ from tresca_py.results import ResultsError
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    out = hostile.rust_runs(str(tmp_path_factory.mktemp("rust")))
-    if out is None:
-        pytest.skip("target/release/tresca-cr is not built (cargo build --release)")
-    return out
+    return hostile.rust_runs_or_skip(tmp_path_factory)
 
 
 def arrays(r):

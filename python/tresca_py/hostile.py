@@ -199,6 +199,15 @@ def rust_runs(directory):
     return out
 
 
+def rust_runs_or_skip(tmp_path_factory):
+    """``rust_runs`` in a pytest temporary directory; the test is skipped when the binary is not built."""
+    import pytest
+    out = rust_runs(str(tmp_path_factory.mktemp("rust")))
+    if out is None:
+        pytest.skip("target/release/tresca-cr is not built (cargo build --release)")
+    return out
+
+
 def unprivileged():
     """A command prefix under which permission bits apply (root ignores them: its file-access capabilities
     are dropped with util-linux ``setpriv``); [] for other users."""
