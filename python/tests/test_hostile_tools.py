@@ -69,6 +69,11 @@ class TestCheckResults:
         assert check.main([copied_pair(runs, str(tmp_path))]) == 2
         one_error_line(capsys.readouterr().err, "belongs to another results file")
 
+    @pytest.mark.parametrize("name,make,fragment", hostile.SIDECARS, ids=[h[0] for h in hostile.SIDECARS])
+    def test_hostile_sidecar(self, runs, tmp_path, capsys, name, make, fragment):
+        assert check.main([make(runs["contact"], str(tmp_path))]) == 2
+        one_error_line(capsys.readouterr().err, fragment)
+
     def test_damaged_view(self, runs, tmp_path, capsys):
         """A valid /tresca with a damaged VTKHDF view is a mismatch found, not a crash."""
         p = copied_pair(runs, str(tmp_path), "contact")  # the same name: the sidecar still fits
@@ -191,6 +196,26 @@ class TestParaviewView:
         rc, out, err = pvpython(foreign)
         assert rc == 2
         one_error_line(err, "sidecar")
+
+    @pytest.mark.parametrize("name,make,fragment", hostile.SIDECARS, ids=[h[0] for h in hostile.SIDECARS])
+    def test_hostile_sidecar(self, runs, tmp_path, name, make, fragment):
+        rc, out, err = pvpython(make(runs["contact"], str(tmp_path)), "-o", tmp_path / "v.png")
+        assert rc == 2
+        one_error_line(err, fragment)
+
+    def test_vtkhdf_on_5_11(self, runs, tmp_path):
+        """ParaView 5.11 cannot read temporal VTKHDF collections: said, exit 1, no picture."""
+        rc, out, err = pvpython(runs["contact"], "--vtkhdf", "-o", tmp_path / "v.png")
+        if rc == 0:
+            pytest.skip("this ParaView reads temporal VTKHDF (5.13 or newer)")
+        assert rc == 1
+        one_error_line(err, "cannot read temporal VTKHDF")
+
+    def test_without_pvpython(self, runs, tmp_path):
+        """Run by the venv's Python, which has no ParaView: one line saying what to run instead."""
+        rc, out, err = script("paraview_view.py", runs["contact"], "-o", tmp_path / "v.png")
+        assert rc == 2
+        one_error_line(err, "pvpython")
 
     @pytest.mark.parametrize("opened", ["copy.h5", "copy.xdmf"])
     def test_copied_pair(self, runs, tmp_path, opened):

@@ -216,3 +216,32 @@ def unprivileged():
     if shutil.which("setpriv") is None:
         return None
     return ["setpriv", "--bounding-set=-dac_override,-dac_read_search,-fowner"]
+
+
+def _pair(good, d, name, sidecar):
+    """A copy of ``good`` as ``d/name.h5`` with the sidecar made by sidecar(path of the .xdmf)."""
+    h5 = _copy(good, d, name + ".h5")
+    sidecar(os.path.join(d, name + ".xdmf"))
+    return h5
+
+
+def _text(data):
+    def make(p):
+        with open(p, "w") as f:
+            f.write(data)
+    return make
+
+
+# (name, make(good, d) -> results file whose sidecar is hostile, what the refusal says)
+SIDECARS = [
+    ("sidecar missing", lambda good, d: _pair(good, d, "s1", lambda p: None), "no such file"),
+    ("sidecar empty", lambda good, d: _pair(good, d, "s2", _text("")), "is empty"),
+    ("sidecar a directory", lambda good, d: _pair(good, d, "s3", os.makedirs), "is a directory"),
+    ("sidecar not XML", lambda good, d: _pair(good, d, "s4", _text("time,u\n")), "not an XDMF (XML) file"),
+    ("sidecar other XML", lambda good, d: _pair(good, d, "s5", _text("<html><body/></html>")), "is XML but not XDMF"),
+    ("sidecar without data", lambda good, d: _pair(good, d, "s6", _text('<Xdmf Version="3.0"><Domain/></Xdmf>')),
+     "references no HDF5 data"),
+    ("sidecar of a copied pair", lambda good, d: _pair(
+        good, d, "s7", lambda p: shutil.copy(os.path.splitext(good)[0] + ".xdmf", p)), "belongs to another"),
+    ("sidecar a FIFO", lambda good, d: _pair(good, d, "s8", os.mkfifo), "not a regular file"),
+]
