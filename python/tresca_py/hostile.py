@@ -177,7 +177,9 @@ RESULTS = [
     ("contact edge twice", lambda good, plain, d: _edit(
         good, d, "ce.h5", _replace("contact/edges", lambda a: np.r_[a[:1], a[:1], a[2:]])), "lists an edge twice",
      "data"),
-    ("E is NaN", lambda good, plain, d: _edit(good, d, "enan.h5", _attr("E", np.nan)), "attribute E", "data"),
+    ("E is NaN", lambda good, plain, d: _edit(good, d, "enan.h5", _attr("E", np.nan)), "E = nan", "data"),
+    ("nu = 0.5", lambda good, plain, d: _edit(good, d, "nu.h5", _attr("nu", 0.5)), "nu = 0.5", "data"),
+    ("E a string", lambda good, plain, d: _edit(good, d, "es.h5", _attr("E", "stiff")), "not of type float", "data"),
     ("a value changed after writing", lambda good, plain, d: _edit(good, d, "flip.h5", _flip_checksummed),
      "does not match its checksum", "data"),
 ]

@@ -174,28 +174,16 @@ class Results:
         return checksum.step_checksums([np.asarray(s[k], SPEC[k][0]) for k in checksum.SERIES if k in s])
 
 
-def _want(name, sizes):
-    return tuple(sizes[s] if isinstance(s, str) else s for s in SPEC[name][1])
-
-
 def _check_array(where, name, shape, dtype, sizes):
     """ResultsError unless a dataset of this shape and dtype fits the layout."""
-    want, sym = _want(name, sizes), SPEC[name][1]
+    sym = SPEC[name][1]
+    want = tuple(sizes[s] if isinstance(s, str) else s for s in sym)
     if tuple(shape) != want:
         raise ResultsError(f"{where}: tresca/{name} has shape {tuple(shape)}, the layout wants {want} "
                            f"({', '.join(map(str, sym))})")
-    kinds = {"f": "f", "i": "iu", "u": "iub" if name == "contact/state" else "iu"}[SPEC[name][0].kind]
-    if name == "steps/checksum":
-        kinds = "u"
+    kinds = {"contact/state": "iub", "steps/checksum": "u"}.get(name, "f" if SPEC[name][0].kind == "f" else "iu")
     if np.dtype(dtype).kind not in kinds:
         raise ResultsError(f"{where}: tresca/{name} holds {np.dtype(dtype)}, the layout wants {SPEC[name][0]}")
-
-
-def _first_bad(a):
-    """(count, index of the first) non-finite values of a float array."""
-    bad = ~np.isfinite(a)
-    n = int(bad.sum())
-    return n, (np.unravel_index(int(np.argmax(bad)), a.shape) if n else None)
 
 
 def validate(r, where="results"):
@@ -207,12 +195,12 @@ def validate(r, where="results"):
     for name, a in arrays.items():
         a = np.asarray(a)
         _check_array(where, name, a.shape, a.dtype, sizes)
-        if a.dtype.kind == "f":
-            n, at = _first_bad(a)
-            if n:
-                step = f" (first at step {at[0]})" if SPEC[name][1][0] == "R" else f" (first at {tuple(map(int, at))})"
-                raise ResultsError(f"{where}: tresca/{name} holds {n} NaN/Inf value{'s' * (n > 1)}{step}: "
-                                   "not a valid result")
+        bad = ~np.isfinite(a) if a.dtype.kind == "f" else None
+        if bad is not None and bad.any():
+            n, at = int(bad.sum()), np.unravel_index(int(np.argmax(bad)), a.shape)
+            step = f"step {at[0]}" if SPEC[name][1][0] == "R" else f"{tuple(map(int, at))}"
+            raise ResultsError(f"{where}: tresca/{name} holds {n} NaN/Inf value{'s' * (n > 1)} (first at {step}): "
+                               "not a valid result")
     _check_indices(where, m.triangles, sizes["P"], "mesh/triangles")
     _check_indices(where, m.edges, sizes["P"], "mesh/edges")
     m.triangle_edges(where)
@@ -230,9 +218,10 @@ def validate(r, where="results"):
             raise ResultsError(f"{where}: tresca/contact/edges lists an edge twice")
         if np.any((c.state != 0) & (c.state != 1)):
             raise ResultsError(f"{where}: tresca/contact/state holds values other than 0 (stick) and 1 (slip)")
-    for k in ("E", "nu"):
-        if k in r.attrs and not np.isfinite(r.attrs[k]):
-            raise ResultsError(f"{where}: attribute {k} = {r.attrs[k]} is not finite")
+    E, nu = r.attrs.get("E", 1.0), r.attrs.get("nu", 0.0)
+    if not (np.isfinite(E) and E > 0 and np.isfinite(nu) and -1 < nu < 0.5):  # as src/scene/mod.rs requires
+        raise ResultsError(f"{where}: attributes E = {E}, nu = {nu}: not a plane-strain material (E > 0, "
+                           "-1 < nu < 0.5)")
 
 
 def _check_indices(where, a, n, name):
