@@ -101,6 +101,9 @@ def render(p, args):
     # a run without Γ_C has one block: the reader's output is then the body itself, and no block is
     # extracted (ExtractBlock of a missing block crashes pvpython 5.11 in vtkExtractBlockUsingDataAssembly)
     has_contact = "contact" in p["blocks"]
+    if p["xdmf"] is None:  # /VTKHDF (ParaView >= 5.13, not available here to test): count the blocks read
+        reader.UpdatePipeline(times[-1])
+        has_contact = reader.GetDataInformation().DataInformation.GetNumberOfDataSets() >= 2
     body = ExtractBlock(Input=reader, Selectors=["/Root/body"]) if has_contact else reader
     body.UpdatePipeline(times[-1])
     bounds = body.GetDataInformation().GetBounds()
