@@ -115,7 +115,7 @@ def _side_not_edge(g):
     g["mesh/edges"][...] = e
 
 
-RESULTS = [
+RESULTS = (
     ("missing", lambda good, plain, d: os.path.join(d, "missing.h5"), "no such file", "file"),
     ("empty", lambda good, plain, d: _write(d, "empty.h5", b""), "is empty", "file"),
     ("directory", lambda good, plain, d: os.makedirs(os.path.join(d, "dir.h5")) or os.path.join(d, "dir.h5"),
@@ -182,7 +182,7 @@ RESULTS = [
     ("E a string", lambda good, plain, d: _edit(good, d, "es.h5", _attr("E", "stiff")), "not of type float", "data"),
     ("a value changed after writing", lambda good, plain, d: _edit(good, d, "flip.h5", _flip_checksummed),
      "does not match its checksum", "data"),
-]
+)
 
 
 def rust_runs(directory):
@@ -235,7 +235,7 @@ def _text(data):
 
 
 # (name, make(good, d) -> results file whose sidecar is hostile, what the refusal says)
-SIDECARS = [
+SIDECARS = (
     ("sidecar missing", lambda good, d: _pair(good, d, "s1", lambda p: None), "no such file"),
     ("sidecar empty", lambda good, d: _pair(good, d, "s2", _text("")), "is empty"),
     ("sidecar a directory", lambda good, d: _pair(good, d, "s3", os.makedirs), "is a directory"),
@@ -246,4 +246,4 @@ SIDECARS = [
     ("sidecar of a copied pair", lambda good, d: _pair(
         good, d, "s7", lambda p: shutil.copy(os.path.splitext(good)[0] + ".xdmf", p)), "belongs to another"),
     ("sidecar a FIFO", lambda good, d: _pair(good, d, "s8", os.mkfifo), "not a regular file"),
-]
+)

@@ -371,7 +371,11 @@ def write(path, r, extra_attrs=None):
     """Write ``r`` as a results file at ``path`` (atomically: built beside it, then renamed into place), with
     ``status`` (default "completed"), ``steps`` (default: the committed steps − 1), ``n_edges``,
     ``n_contact``, ``tresca/steps`` attribute ``completed`` and the step checksums. Refuses (ResultsError)
-    results that ``read`` would refuse, before anything is written."""
+    results that ``read`` would refuse, before anything is written. A serial Python solver writes its run as
+    ``write(out, Results(mesh=Mesh(points, triangles, edges, midpoints), times=..., u=..., energy=...,
+    steps={"iterations": ..., ...}, contact=Contact(edges, normal, tangent, g, slip, sigma_t, state, mu, dof)
+    or None, errors={"energy": ..., "h1": ..., "l2": ...} or None, attrs={"scene": text, "version": ...,
+    "solver": ..., "E": ..., "nu": ..., ...}))``."""
     import h5py
     validate(r, "results to write")
     try:
