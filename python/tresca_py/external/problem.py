@@ -204,6 +204,8 @@ def contact_probes(pts, segs, n_samples=513):
     length = float(np.hypot(*(b - a)))
     tau = (b - a) / length  # counter-clockwise boundary direction = (−n_y, n_x) for the outward normal n
     s = np.linspace(0.0, length, n_samples)
-    return {"start": a.tolist(), "tangent": tau.tolist(), "normal": [float(tau[1]), float(-tau[0])],
-            "length": length, "points": [(a + f * (b - a)).tolist() for f in (0.25, 0.5, 0.75)],
-            "samples": (a[None, :] + s[:, None] * tau[None, :]).tolist()}
+    normal = np.array([tau[1], -tau[0]])
+    inward = -1e-10 * length * normal  # keeps probes inside the mesh against rounding on a rotated side
+    return {"start": a.tolist(), "tangent": tau.tolist(), "normal": normal.tolist(),
+            "length": length, "points": [(a + f * (b - a) + inward).tolist() for f in (0.25, 0.5, 0.75)],
+            "samples": (a[None, :] + s[:, None] * tau[None, :] + inward[None, :]).tolist()}

@@ -57,7 +57,8 @@ class Solver:
     def __init__(self, prob):
         self.prob = prob
         self.lam, self.mu = prob["lam"], prob["mu"]
-        self.mesh = MeshTri(np.asarray(prob["points"]).T, np.asarray(prob["triangles"]).T)
+        self.mesh = MeshTri(np.ascontiguousarray(np.asarray(prob["points"]).T),
+                            np.ascontiguousarray(np.asarray(prob["triangles"]).T))
         self.basis = Basis(self.mesh, ElementVector(ElementTriP2()), intorder=6)
         pr = prob["probes"]
         self.n, self.tau = np.asarray(pr["normal"]), np.asarray(pr["tangent"])
@@ -122,7 +123,7 @@ class Solver:
     def traction(self, u, u_prev, t):
         """(q, P, g) at the contact quadrature points: q = σ_τ(u) − p(u_τ − u_τ_prev), P = proj(q)."""
         fu, fp = self.fb.interpolate(u), self.fb.interpolate(u_prev)
-        du = fu.value - fp.value
+        du = np.asarray(fu) - np.asarray(fp)
         q = _nsn(fu.grad, self.lam, self.mu, self.tau, self.n) - self.pen * (du[0] * self.tau[0] + du[1] * self.tau[1])
         x = self.fb.global_coordinates().value
         g = evaluate(self.contact["g_a"], x[0], x[1], t)
@@ -145,7 +146,7 @@ class Solver:
             pos[self.free] = np.arange(self.free.size)
             cdofs = self.basis.get_dofs(facets=self.parts[self.contact["name"]][1]).all()
             self.B = pos[np.setdiff1d(cdofs, self.D)]
-            self._lu = spla.splu(A[self.free][:, self.free].tocsc())
+            self._lu = spla.splu(A[self.free][:, self.free].tocsc(), permc_spec="MMD_AT_PLUS_A")  # symmetric A
             E = np.zeros((self.free.size, self.B.size))
             E[self.B, np.arange(self.B.size)] = 1.0
             self._Z = self._lu.solve(E)
@@ -163,12 +164,19 @@ class Solver:
         A = self.K + self.A_n
         lu, Z = self._factor()
         free, B = self.free, self.B
-        scale = max(np.linalg.norm(rhs), 1e-300)
         res, chi = self.residual(A, rhs, u, u_prev, t)
+        scale = max(np.linalg.norm(rhs), np.linalg.norm(res[free]), 1e-300)  # |l| or the first residual
+        alpha, chi_old, rnorm_old = 1.0, None, np.inf
         for it in range(1, max_iter + 1):
             rnorm = np.linalg.norm(res[free]) / scale
             if rnorm < tol:
                 return u, it - 1, rnorm
+            # rounding floor: a full step with an unchanged active set that no longer reduces |R| (seen at
+            # λ/μ = 10⁴, where cond(A)·ε ≈ 1e-10) ends the iteration if |R| is below √tol
+            if it > 1 and alpha == 1.0 and np.array_equal(chi, chi_old) and rnorm > 0.5 * rnorm_old \
+                    and rnorm < np.sqrt(tol):
+                return u, it - 1, rnorm
+            chi_old, rnorm_old = chi, rnorm
 
             def jac(du, v, w, chi=chi):
                 return -chi * (_nsn(du.grad, lam, mu, tau, n) - self.pen * (du[0] * tau[0] + du[1] * tau[1])) \
@@ -258,4 +266,9 @@ class Solver:
 
 def solve(prob):
     """Run one problem dict; returns the result dict."""
-    return Solver(prob).run()
+    t0 = time.perf_counter()
+    solver = Solver(prob)
+    setup = time.perf_counter() - t0
+    out = solver.run()
+    out["wall_s"] += setup  # set-up + time loop; the post-processing of the quantities is not counted
+    return out
