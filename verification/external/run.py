@@ -17,7 +17,7 @@ from pathlib import Path
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-from tresca_py.external import report, requirements, suite  # noqa: E402
+from tresca_py.external import report, requirements, suite
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -53,7 +53,7 @@ def main(argv=None):
         elapsed = time.perf_counter() - t0
         (out / "rows.json").write_text(json.dumps({"rows": rows, "notes": notes, "elapsed_s": elapsed}))
     reqs = requirements.evaluate(rows, scenes)
-    report.write_all(rows, scenes, notes, reqs, elapsed, Path(args.reference))
+    report.write_all(rows, scenes, notes, reqs, elapsed, Path(args.reference), out)
     for rid, text, ok, detail, _ in reqs:
         print(f"{'PASS' if ok else 'FAIL'}  {rid}: {text} — {detail}")
     print(f"{sum(r[2] for r in reqs)}/{len(reqs)} requirements pass; suite {elapsed:.0f} s")

@@ -10,9 +10,10 @@ Standalone: it imports only numpy, getfem and the standard library, because Debi
 GetFEM's machinery does the work:
 
 * ``add_isotropic_linearized_elasticity_brick`` (a(u, v)), ``add_source_term_brick`` (f and tractions),
-  ``add_Dirichlet_condition_with_simplification`` (u = u_D, nodal interpolant);
+  ``add_Dirichlet_condition_with_multipliers`` (u = u_D weakly on the trace space of mfu; the variant "with
+  simplification" clears matrix rows at every assembly and made the assembly grow ~30× per refinement);
 * ``add_normal_Dirichlet_condition_with_Nitsche_method`` (θ = 1) for the bilateral condition u·n = g_n with
-  Neumann term ``Model.Neumann_term`` (σ(u)n) and γ = γ₀ h_T, γ₀ = 1/(γ_N E);
+  Neumann term ``Model.Neumann_term`` (σ(u)n) and γ = γ₀ h_T, γ₀ = 1/(γ_N (λ + 2μ));
 * Tresca friction on the slip increment as a Nitsche term in GWFL with GetFEM's ``Ball_projection``
   (θ = 0):  −∫_{Γ_C} P·v,  P = Ball_projection((I − n⊗n)(σ(u)n − (u − uⁿ⁻¹)/γ), g_a),  γ = γ₀ element_size;
 * the model's own Newton (``Model.solve``, line search "basic": the "default" one stalls on Example 5.1
@@ -67,7 +68,7 @@ class Solver:
         md.add_fem_variable("u", self.mfu)
         md.add_initialized_data("lambda", prob["lam"])
         md.add_initialized_data("mu", prob["mu"])
-        md.add_initialized_data("gamma0", 1.0 / (prob["gamma_n"] * prob["E"]))
+        md.add_initialized_data("gamma0", 1.0 / (prob["gamma_n"] * (prob["lam"] + 2 * prob["mu"])))
         md.add_isotropic_linearized_elasticity_brick(self.mim, "u", "lambda", "mu")
         self.xd = self.mfd.basic_dof_nodes()
         self.xu = self.mfu.basic_dof_nodes()
@@ -86,7 +87,7 @@ class Solver:
             elif part["kind"] == "dirichlet":
                 md.add_initialized_fem_data(f"UD{i}", self.mfu, np.zeros(self.mfu.nbdof()))
                 self.data.append((f"UD{i}", "u", part["u"], None))
-                md.add_Dirichlet_condition_with_simplification("u", rg, f"UD{i}")
+                md.add_Dirichlet_condition_with_multipliers(self.mim, "u", self.mfu, rg, f"UD{i}")
             else:
                 self.contact = part
         self._scalar_data("GAP", self.contact["gap"])

@@ -172,13 +172,16 @@ def load(path):
 
 
 def at_level(scene, refine, steps=None, degree=2, gamma_n=10.0):
-    """The problem of a :func:`load`-ed scene on mesh level ``refine`` (cells × 2^refine) with ``steps`` uniform
+    """The problem of a :func:`load`-ed scene on mesh level ``refine`` (cells × 2^refine, refine may be negative
+    where the cells halve evenly) with ``steps`` uniform
     steps (default: the scene's), as a JSON-serialisable dict for the external solvers. γ_N: the Nitsche
-    parameter, p = γ_N E / h."""
+    parameter, p = γ_N (λ + 2μ)/h (λ + 2μ, not E: the trace inequality for σ(v)n carries λ, and with E the
+    symmetric Nitsche term lost coercivity on the λ/μ = 10⁴ case: a spurious level in both P2 codes)."""
     mesh = scene["mesh"]
-    n0, m0 = mesh["cells"]
-    pts, tri, sides = structured_mesh(mesh["corners"], n0 * 2 ** refine, m0 * 2 ** refine,
-                                      mesh.get("diagonal", "first"))
+    n, m = (c * 2.0 ** refine for c in mesh["cells"])  # refine < 0 coarsens cells that halve evenly
+    if n != int(n) or m != int(m) or n < 1 or m < 1:
+        raise ProblemError(f"{scene['scene']}: refine {refine} does not give whole cells from {mesh['cells']}")
+    pts, tri, sides = structured_mesh(mesh["corners"], int(n), int(m), mesh.get("diagonal", "first"))
     parts = [dict(p, segments=sides[p["name"]].tolist()) for p in scene["parts"]]
     contact = next(p for p in parts if p["kind"] == "contact")
     n_steps = int(steps or scene["steps"])

@@ -3,7 +3,7 @@
 Each backward-Euler step n solves, for u = uⁿ in P2 (nodal interpolant of u_D on Γ_D), for all v:
 
     a(u, v) + N(u, v) − ∫_{Γ_C} P(u) v_τ  = (lⁿ, v) + N(g_n n, v)            (Nitsche, θ = 1 normal, θ = 0 tangential)
-    N(u, v) = −∫ σ_n(u) v_n − ∫ σ_n(v) u_n + ∫ p u_n v_n,     p = γ_N E / h_F  (h_F the facet length)
+    N(u, v) = −∫ σ_n(u) v_n − ∫ σ_n(v) u_n + ∫ p u_n v_n,     p = γ_N (λ + 2μ) / h_F  (h_F the facet length)
     P(u)    = proj_[−g_a, g_a]( σ_τ(u) − p (u_τ − u_τⁿ⁻¹) )       (Tresca on the slip increment)
 
 with σ_n = n·σn, σ_τ = τ·σn, τ = (−n_y, n_x) written out as a constant vector of the straight contact side
@@ -74,7 +74,7 @@ class Solver:
         hf = self.mesh.facets  # facet length per contact quadrature point, shape (nel, nqp)
         fac = self.parts[self.contact["name"]][1]
         length = np.linalg.norm(self.mesh.p[:, hf[0, fac]] - self.mesh.p[:, hf[1, fac]], axis=0)
-        self.pen = prob["gamma_n"] * prob["E"] / length[:, None] * np.ones_like(self.fb.X[0][None, :])
+        self.pen = prob["gamma_n"] * (self.lam + 2 * self.mu) / length[:, None] * np.ones_like(self.fb.X[0][None, :])
         self.A_n = asm(BilinearForm(self._normal_form), self.fb)
 
     def _setup_dofs(self):

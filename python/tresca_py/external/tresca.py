@@ -63,7 +63,7 @@ def read_results(path, probes):
         points = np.asarray(points)
         s = (points - start) @ tau
         out = np.zeros(len(points))
-        for i, (x, si) in enumerate(zip(points, s)):
+        for i, (x, si) in enumerate(zip(points, s, strict=True)):
             hits = np.nonzero((s_end[:, 0] <= si + 1e-12) & (si <= s_end[:, 1] + 1e-12))[0]
             vals = []
             for c in hits:
