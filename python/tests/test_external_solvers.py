@@ -18,18 +18,7 @@ cells = [2, 2]
 [material]
 E = 1.0
 nu = 0.3
-[[boundary]]
-name = "right"
-kind = "dirichlet"
-u = ["t*(0.01*x+0.02*y)", "t*0.01*y"]
-[[boundary]]
-name = "top"
-kind = "dirichlet"
-u = ["t*(0.01*x+0.02*y)", "t*0.01*y"]
-[[boundary]]
-name = "left"
-kind = "dirichlet"
-u = ["t*(0.01*x+0.02*y)", "t*0.01*y"]
+{dirichlet}
 [[boundary]]
 name = "bottom"
 kind = "contact"
@@ -40,7 +29,9 @@ steps = 1
 [exact]
 u = ["t*(0.01*x+0.02*y)", "t*0.01*y"]
 grad = [["0.01*t", "0.02*t"], ["0", "0.01*t"]]
-"""
+""".replace("{dirichlet}", "\n".join(
+    f'[[boundary]]\nname = "{side}"\nkind = "dirichlet"\nu = ["t*(0.01*x+0.02*y)", "t*0.01*y"]'
+    for side in ("right", "top", "left")))
 G_A = 0.02 / 2.6
 
 

