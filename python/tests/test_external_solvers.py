@@ -73,6 +73,10 @@ def test_getfem_reports_bad_input(tmp_path):
     script = importlib.util.find_spec("tresca_py.external.getfem_solver").origin
     proc = subprocess.run([suite.GETFEM_PYTHON, script], capture_output=True, text=True)
     assert proc.returncode == 2 and "usage" in proc.stderr
+    missing = tmp_path / "missing.json"
+    proc = subprocess.run([suite.GETFEM_PYTHON, script, str(missing), str(tmp_path / "out.json")],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2 and "cannot read the problem file" in proc.stderr and "Traceback" not in proc.stderr
 
 
 def test_richardson_exact_on_a_power_law():

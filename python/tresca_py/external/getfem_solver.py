@@ -190,8 +190,12 @@ def main(argv):
     if len(argv) != 3:
         print("usage: getfem_solver.py problem.json result.json", file=sys.stderr)
         return 2
-    with open(argv[1]) as fh:
-        prob = json.load(fh)
+    try:
+        with open(argv[1]) as fh:
+            prob = json.load(fh)
+    except (OSError, ValueError) as err:
+        print(f"error: cannot read the problem file {argv[1]}: {err}", file=sys.stderr)
+        return 2
     try:
         t0 = time.perf_counter()
         solver = Solver(prob)
