@@ -63,7 +63,7 @@ $(VENV)/.stamp: requirements.txt python/pyproject.toml
 
 venv: $(VENV)/.stamp
 
-test: build venv
+test: build venv getfem
 	cargo test --release --locked
 	$(PY) verification/python_tests.py
 
