@@ -43,11 +43,14 @@ import subprocess
 import sys
 import tempfile
 import time
+from typing import NamedTuple, Optional
 
 import h5py
 import numpy as np
 
-from tresca_py.common import BIN, PY, REF, ROOT, child_cpu, load1  # noqa: E402
+from tresca_py.common import BIN, PY, REF, ROOT, child_cpu, load1
+from tresca_py.compare import CompareError, compare_files
+from tresca_py.verify import summary as cli_summary
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 ELASTIC = os.path.join(ROOT, "verification", "bench", "bench_elastic.toml")
 TIME = "/usr/bin/time"
@@ -60,41 +63,58 @@ def cpu_model():
     return "unknown"
 
 
-LAST_CPU = [0.0]
+class Timed(NamedTuple):
+    """One timed process: wall and CPU (user + sys) seconds, peak RSS in KB (with ``mem``), and the CLI's
+    --json summary (``summary``: for a tresca-cr command)."""
+    wall: float
+    cpu: float
+    rss: Optional[int]
+    summary: Optional[dict]
 
 
-def timed(cmd, env=None, mem=False):
-    """Run cmd; return (wall seconds, stdout, peak RSS in KB or None). Its CPU time (user + sys) is left
-    in LAST_CPU[0]."""
+def timed(cmd, env=None, mem=False, summary=False):
+    """Run cmd (with ``summary``: a tresca-cr command, given --json into a temporary file, read back)."""
+    js = None
+    if summary:
+        fd, js = tempfile.mkstemp(prefix="tresca-bench-", suffix=".json")
+        os.close(fd)
+        cmd = list(cmd) + ["--json", js]
     if mem:
-        cmd = [TIME, "-f", "MAXRSS %M"] + cmd
+        cmd = [TIME, "-f", "MAXRSS %M"] + cmd  # our own format for /usr/bin/time's report on stderr
     c0 = child_cpu()
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
     wall = time.perf_counter() - t0
-    LAST_CPU[0] = child_cpu() - c0
+    cpu = child_cpu() - c0
     if p.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stdout}\n{p.stderr}")
     rss = None
     if mem:
         m = re.search(r"MAXRSS (\d+)", p.stderr)
         rss = int(m.group(1)) if m else None
-    return wall, p.stdout, rss
+    s = None
+    if js:
+        s = cli_summary.load(js)
+        os.remove(js)
+    return Timed(wall, cpu, rss, s)
 
 
-def parse_rust(out):
-    r = {}
-    m = re.search(r"unknowns (\d+) \(paper DOF (\d+)\), contact edges (\d+), steps (\d+)", out)
-    r["unknowns"], r["paper_dofs"], r["contact"], r["steps"] = map(int, m.groups())
-    # printed: mesh, assembly, factorisation, condensation, load superposition; kept in the results file's
-    # order: mesh, assembly, factorisation, superposition, condensation
-    m = re.search(r"set-up: mesh ([\d.]+)s, assembly ([\d.]+)s, factorisation ([\d.]+)s, condensation ([\d.]+)s, "
-                  r"load superposition ([\d.]+)s", out)
-    mesh, asm, fact, cond, sup = (float(v) for v in m.groups())
-    r["setup"] = [mesh, asm, fact, sup, cond]
-    m = re.search(r"(\d+) iterations in all, max residual (\S+); wall time ([\d.]+)s", out)
-    r["iters"], r["residual"], r["cli_wall"] = int(m.group(1)), float(m.group(2)), float(m.group(3))
-    return r
+def run_info(s):
+    """What a run's --json summary says: sizes, the set-up split (results-file order), iterations, CLI wall."""
+    r = s["run"]
+    return dict(unknowns=r["unknowns"], paper_dofs=r["paper_dofs"], contact=r["contact_edges"], steps=r["steps"],
+                setup=cli_summary.setup_times(s), iters=r["iterations"], residual=r["max_residual"],
+                cli_wall=s["wall"])
+
+
+def max_du(a, b):
+    """The largest relative L2 difference of u over the time nodes of two results files
+    (tresca_py.compare, what scripts/compare.py reports); NaN when they cannot be compared."""
+    try:
+        return compare_files(a, b)["du"]
+    except (CompareError, OSError, KeyError) as e:
+        print(f"warning: {a} vs {b}: {e}")
+        return float("nan")
 
 
 def med(xs):
@@ -111,21 +131,19 @@ class Rec:
         self.info = None
         for _ in range(repeats):
             la = load1()
-            w, out, rss = timed(cmd, env=env, mem=mem)
-            r = parse_rust(out)
+            t = timed(cmd, env=env, mem=mem, summary=True)
+            r = run_info(t.summary)
             self.info = r
-            self.walls.append(w)
-            self.cpus.append(LAST_CPU[0])
+            self.walls.append(t.wall)
+            self.cpus.append(t.cpu)
             self.cli.append(r["cli_wall"])
             self.setups.append(r["setup"])
             self.loads.append(la)
-            if rss is not None:
-                self.rss.append(rss)
+            if t.rss is not None:
+                self.rss.append(t.rss)
             if h5:
                 with h5py.File(h5, "r") as f:
                     self.step_walls.extend(f["tresca/steps/wall_time"][1:].tolist())
-                    # full-precision set-up split (the CLI prints milliseconds)
-                    self.setups[-1] = [float(v) for v in f["tresca"].attrs["setup_times"]]
 
     @property
     def wall(self):
@@ -349,14 +367,10 @@ def main(argv=None):
                 walls, owns, loads = [], [], []
                 for _ in range(R):
                     loads.append(load1())
-                    w, _, _ = timed(cmd)
-                    walls.append(w)
+                    walls.append(timed(cmd).wall)
                     with h5py.File(out, "r") as f:
                         owns.append(float(f["tresca"].attrs["total_time"]))
-                cmp = subprocess.run([PY, os.path.join(ROOT, "scripts", "compare.py"), rust_h5, out, "--quiet"],
-                                     capture_output=True, text=True)
-                m = re.search(r"max du = (\S+),", cmp.stdout)
-                du = float(m.group(1)) if m else float("nan")
+                du = max_du(rust_h5, out)
                 w, o = med(walls), med(owns)
                 rw, rs = ex[(k, "ssn", "write")].wall, ex[(k, "ssn", "solve")].wall
                 py[(k, name)] = (w, o, w / rw, o / rs, du)
@@ -544,7 +558,7 @@ def mms_section(args, R, tmp, md, csvrows):
     md += ["## 6. Manufactured-solution runs and the condensation (issue 13)", "",
            "`tresca-cr run SCENE ARGS -q` (solve-only, true errors at every time node when the scene has `[exact]`). "
            "CPU = user + sys time of the process (both cores count), next to the wall time: on this shared "
-           "machine the wall time also contains waiting for a core. Set-up split from the CLI (ms resolution). "
+           "machine the wall time also contains waiting for a core. Set-up split from the CLI's --json summary. "
            "Before issue 13 (2-core machine, from the issue): mms_stop r5 87 s (condensation 21 s), the "
            "196,608-unknown polynomial case 54 s (condensation 12.6 s), mms_front r2 7–16 s, Example 5.1 n = 64 0.36 s. "
            "Steps with contact run in blocks of up to 16 that share one forward and one backward triangular solve "
@@ -602,9 +616,9 @@ def mms_section(args, R, tmp, md, csvrows):
         for _ in range(rounds):
             for k, cmd in [("rust", rust), ("rust_solve", rust_solve), *py_cmds.items()]:
                 meas[k][2].append(load1())
-                w, _, _ = timed(cmd)
-                meas[k][0].append(w)
-                meas[k][1].append(LAST_CPU[0])
+                t = timed(cmd)
+                meas[k][0].append(t.wall)
+                meas[k][1].append(t.cpu)
                 if k in py_cmds:
                     with h5py.File(cmd[4], "r") as f:
                         meas[k][3].append(float(f["tresca"].attrs["total_time"]))
@@ -620,10 +634,7 @@ def mms_section(args, R, tmp, md, csvrows):
                "|---|---|---|---|---|---|---|---|---|---|"]
         for name, cmd in py_cmds.items():
             walls, cpus, loads, owns = meas[name]
-            cmp = subprocess.run([PY, os.path.join(ROOT, "scripts", "compare.py"), rust_h5, cmd[4], "--quiet"],
-                                 capture_output=True, text=True)
-            m = re.search(r"max du = (\S+),", cmp.stdout)
-            du = float(m.group(1)) if m else float("nan")
+            du = max_du(rust_h5, cmd[4])
             w, c = med(walls), med(cpus)
             paired = med([a / b for a, b in zip(walls, meas["rust"][0])])
             md.append(f"| {name} | {fmt_t(w)} | {fmt_t(c)} | {fmt_t(med(owns))} | {w / rw:.1f}× | {paired:.1f}× | "

@@ -358,6 +358,8 @@ def main(argv=None):
                     help="the Rust binary (default target/release/tresca-cr)")
     ap.add_argument("--json", default=os.path.join(ROOT, "out", "distributed.json"), help="requirement list")
     ap.add_argument("--md", default=os.path.join(ROOT, "reference", "distributed.md"), help="Markdown report")
+    ap.add_argument("--memory-json", help="with --memory: where the measurement goes (default "
+                    "reference/distributed_memory.json; make verify stages it under out/verify/reference/)")
     ap.add_argument("--work", default=os.path.join(ROOT, "out", "distributed"), help="directory for results files")
     ap.add_argument("--solver-compare", action="store_true",
                     help="only measure MUMPS against CG + GAMG (reference/distributed_solvers.json, ~3 min) and exit")
@@ -407,7 +409,7 @@ def main(argv=None):
         ok_runs = all(str(n) in meas["runs"] and "error" not in meas["runs"][str(n)] for n in (1, 2))
         if ok_runs:
             meas["model"] = scaling_model(meas)
-        with open(MEM_JSON, "w") as f:
+        with open(args.memory_json or MEM_JSON, "w") as f:
             json.dump(meas, f, indent=1)
     elif os.path.exists(MEM_JSON):
         with open(MEM_JSON) as f:

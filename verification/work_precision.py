@@ -29,7 +29,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from tresca_py.common import BIN, REF, ROOT, strip_exact, child_cpu, load1  # noqa: E402
+from tresca_py.common import BIN, REF, ROOT, child_cpu, load1, strip_exact  # noqa: E402
+from tresca_py.verify import summary as cli_summary  # noqa: E402
 CASES = {
     "mms_front": dict(path="verification/cases/mms_front.toml", h_N=32, h_r=3, k_r=2, k_N=[8, 16, 32, 64, 128, 256],
                       joint=[(0, 8), (1, 16), (2, 32), (3, 64)], tol_level=(2, 32)),
@@ -51,9 +52,13 @@ def prepare(case, tmp):
     return full, bare
 
 
+def command(scene, r, N, solver, tol):
+    return [BIN, "run", scene, "--refine", str(r), "--steps", str(N), "--solver", solver, "--tol", f"{tol:g}", "-q"]
+
+
 def run(scene, r, N, solver, tol):
     """(wall, CPU = user + sys of the process, completed process, command)."""
-    cmd = [BIN, "run", scene, "--refine", str(r), "--steps", str(N), "--solver", solver, "--tol", f"{tol:g}", "-q"]
+    cmd = command(scene, r, N, solver, tol)
     c0 = child_cpu()
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True)
@@ -61,15 +66,14 @@ def run(scene, r, N, solver, tol):
 
 
 def measure(case, full, bare, r, N, solver, tol, repeats, family):
-    _, _, p, cmd = run(full, r, N, solver, tol)
-    if p.returncode != 0:
+    cmd = command(full, r, N, solver, tol)
+    s, p = cli_summary.run(cmd, check=False)
+    if p.returncode != 0 or s is None:
         return dict(case=case, family=family, refine=r, steps=N, solver=solver, tol=tol, error=float("nan"),
                     wall=float("nan"), cpu=float("nan"), iters_per_step=float("nan"), dofs=0, load=load1(),
-                    note=p.stderr.strip().splitlines()[-1][:160])
-    m = re.search(r"energy error (\S+), H1 error (\S+), L2 error (\S+)", p.stdout)
-    err, l2 = float(m.group(1)), float(m.group(3))
-    it = int(re.search(r"(\d+) iterations in all", p.stdout).group(1))
-    dofs = int(re.search(r"paper DOF (\d+)", p.stdout).group(1))
+                    note=(p.stderr.strip().splitlines() or ["no summary"])[-1][:160])
+    err, _, l2 = cli_summary.max_errors(s)
+    it, dofs = s["run"]["iterations"], s["run"]["paper_dofs"]
     walls, cpus, loads = [], [], []
     for i in range(repeats):
         loads.append(load1())
