@@ -43,17 +43,16 @@ import subprocess
 import sys
 import tempfile
 import time
-from typing import NamedTuple, Optional
 
 import h5py
 import numpy as np
 
-from tresca_py.common import BIN, PY, REF, ROOT, child_cpu, load1
+from tresca_py.common import BIN, PY, REF, ROOT, load1
 from tresca_py.compare import CompareError, compare_files
 from tresca_py.verify import summary as cli_summary
+from tresca_py.verify.timing import timed
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 ELASTIC = os.path.join(ROOT, "verification", "bench", "bench_elastic.toml")
-TIME = "/usr/bin/time"
 
 
 def cpu_model():
@@ -61,42 +60,6 @@ def cpu_model():
         if line.startswith("model name"):
             return line.split(":", 1)[1].strip()
     return "unknown"
-
-
-class Timed(NamedTuple):
-    """One timed process: wall and CPU (user + sys) seconds, peak RSS in KB (with ``mem``), and the CLI's
-    --json summary (``summary``: for a tresca-cr command)."""
-    wall: float
-    cpu: float
-    rss: Optional[int]
-    summary: Optional[dict]
-
-
-def timed(cmd, env=None, mem=False, summary=False):
-    """Run cmd (with ``summary``: a tresca-cr command, given --json into a temporary file, read back)."""
-    js = None
-    if summary:
-        fd, js = tempfile.mkstemp(prefix="tresca-bench-", suffix=".json")
-        os.close(fd)
-        cmd = list(cmd) + ["--json", js]
-    if mem:
-        cmd = [TIME, "-f", "MAXRSS %M"] + cmd  # our own format for /usr/bin/time's report on stderr
-    c0 = child_cpu()
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
-    wall = time.perf_counter() - t0
-    cpu = child_cpu() - c0
-    if p.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stdout}\n{p.stderr}")
-    rss = None
-    if mem:
-        m = re.search(r"MAXRSS (\d+)", p.stderr)
-        rss = int(m.group(1)) if m else None
-    s = None
-    if js:
-        s = cli_summary.load(js)
-        os.remove(js)
-    return Timed(wall, cpu, rss, s)
 
 
 def run_info(s):
@@ -401,7 +364,7 @@ def main(argv=None):
         rw = Rec([BIN, "run", fscene, "--refine", str(k), "--steps", str(N), "-q", "-o", h5, "--force"], R, h5=h5)
         e_s, e_w = ex[(k, "ssn", "solve")], ex[(k, "ssn", "write")]
         fl = med(rw.step_walls)
-        md.append(f"| {2 * 2 ** k} | {N} | {rs.info["unknowns"]} | {fmt_t(rs.per_step)} | {fmt_t(fl)} | "
+        md.append(f"| {2 * 2 ** k} | {N} | {rs.info['unknowns']} | {fmt_t(rs.per_step)} | {fmt_t(fl)} | "
                   f"{fmt_t(e_s.per_step)} | {fmt_t(med(e_w.step_walls))} | {med(e_w.step_walls) / fl:.2f} | "
                   f"{fmt_t(rs.setup[2])} | {rs.load} |")
         csvrows.append(dict(section="floor", refine=k, steps=N, dofs=rs.info["unknowns"], mode="solve",

@@ -26,7 +26,7 @@ import sys
 import h5py
 import numpy as np
 
-from tresca_py.common import ROOT  # noqa: E402
+from tresca_py.common import ROOT, rel_to
 # not numbers of the method: they change from run to run or build to build
 # steps/checksum hashes each step's rows including steps/wall_time, so it changes from run to run too (its
 # agreement with the rows is what --resume and scripts/check_results.py verify)
@@ -82,17 +82,19 @@ def items(f):
     return out
 
 
-def rel_diff(a, b):
-    """max |a - b| / max |a| for floating-point values of equal shape, else None."""
+def dataset_diff(a, b):
+    """max |a - b| / max |a| (tresca_py.common.rel_to) over the finite entries of two floating-point datasets
+    of equal shape and dtype; inf when their non-finite entries differ or a vanishes and b does not; None
+    when they cannot be compared so."""
     a, b = np.asarray(a), np.asarray(b)
     if a.shape != b.shape or a.dtype != b.dtype or a.dtype.kind != "f" or a.size == 0:
         return None
     if not (np.array_equal(np.isfinite(a), np.isfinite(b))):
         return np.inf
     fa, fb = a[np.isfinite(a)], b[np.isfinite(b)]
-    scale = np.max(np.abs(fa)) if fa.size else 0.0
-    d = np.max(np.abs(fa - fb)) if fa.size else 0.0
-    return 0.0 if d == 0 else (d / scale if scale > 0 else np.inf)
+    if fa.size == 0 or np.array_equal(fa, fb):
+        return 0.0
+    return rel_to(fb, fa) if np.max(np.abs(fa)) > 0 else np.inf
 
 
 # --rel: the solvers' natural residuals are round-off quantities (~1e-15 of the force scale, far below any
@@ -106,7 +108,7 @@ def same(a, b, rel=None, key=""):
         if key.endswith("residual"):
             a, b = np.asarray(a), np.asarray(b)
             return a.shape == b.shape and bool(np.all(np.abs(a - b) <= RESIDUAL_ABS))
-        r = rel_diff(a, b)
+        r = dataset_diff(a, b)
         if r is not None:
             return r <= (max(rel, FLOAT32_REL) if np.asarray(a).dtype == np.float32 else rel)
     if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
@@ -135,7 +137,7 @@ def cmd_compare(args):
         worst = ""
         if args.rel is not None:
             for kind, sel in (("float64", np.float64), ("float32", np.float32)):
-                r = [rel_diff(ia[k], ib[k]) for k in keys if k in ia and k in ib and not k.endswith("residual")
+                r = [dataset_diff(ia[k], ib[k]) for k in keys if k in ia and k in ib and not k.endswith("residual")
                      and np.asarray(ia[k]).dtype == sel]
                 worst += f"  max rel {kind} {max([x for x in r if x is not None] + [0.0]):.1e}"
         ok = "identical" if args.rel is None else f"within {args.rel:g}"

@@ -33,8 +33,9 @@ import time
 import h5py
 import numpy as np
 
-from tresca_py.common import MPIRUN, PY, ROOT, SCRIPTS, case  # noqa: E402
+from tresca_py.common import MPIRUN, PY, ROOT, case  # noqa: E402
 from tresca_py.common import cmdline  # noqa: E402
+from tresca_py.common import run as common_run  # noqa: E402
 from tresca_py.common import short_path as rel  # noqa: E402
 
 from tresca_py import compare  # noqa: E402
@@ -78,15 +79,13 @@ steps = 8
 
 
 def run(cmd, timeout=600):
-    """Run a command; a hang (e.g. one rank waiting for a dead one) becomes a failure after `timeout` s."""
-    t0 = time.perf_counter()
+    """tresca_py.common.run without raising: a hang (e.g. one rank waiting for a dead one) becomes a failed
+    process after `timeout` s."""
     try:
-        p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=timeout)
+        return common_run(cmd, check=False, timeout=timeout)
     except subprocess.TimeoutExpired as e:
-        p = subprocess.CompletedProcess(cmd, -9, e.stdout or "", f"timed out after {timeout} s")
-        if isinstance(p.stdout, bytes):
-            p.stdout = p.stdout.decode(errors="replace")
-    return p, time.perf_counter() - t0
+        out = e.stdout.decode(errors="replace") if isinstance(e.stdout, bytes) else (e.stdout or "")
+        return subprocess.CompletedProcess(cmd, -9, out, f"timed out after {timeout} s"), float(timeout)
 
 
 def dist_cmd(scene, out, refine, steps, ranks, timed=False, extra=()):

@@ -19,18 +19,16 @@ import os
 import re
 import shutil
 import statistics
-import subprocess
-import sys
 import tempfile
-import time
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from tresca_py.common import BIN, REF, ROOT, child_cpu, load1, strip_exact  # noqa: E402
+from tresca_py.common import BIN, REF, ROOT, load1, strip_exact  # noqa: E402
 from tresca_py.verify import summary as cli_summary  # noqa: E402
+from tresca_py.verify.timing import timed  # noqa: E402
 CASES = {
     "mms_front": dict(path="verification/cases/mms_front.toml", h_N=32, h_r=3, k_r=2, k_N=[8, 16, 32, 64, 128, 256],
                       joint=[(0, 8), (1, 16), (2, 32), (3, 64)], tol_level=(2, 32)),
@@ -56,15 +54,6 @@ def command(scene, r, N, solver, tol):
     return [BIN, "run", scene, "--refine", str(r), "--steps", str(N), "--solver", solver, "--tol", f"{tol:g}", "-q"]
 
 
-def run(scene, r, N, solver, tol):
-    """(wall, CPU = user + sys of the process, completed process, command)."""
-    cmd = command(scene, r, N, solver, tol)
-    c0 = child_cpu()
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    return time.perf_counter() - t0, child_cpu() - c0, p, cmd
-
-
 def measure(case, full, bare, r, N, solver, tol, repeats, family):
     cmd = command(full, r, N, solver, tol)
     s, p = cli_summary.run(cmd, check=False)
@@ -77,11 +66,10 @@ def measure(case, full, bare, r, N, solver, tol, repeats, family):
     walls, cpus, loads = [], [], []
     for i in range(repeats):
         loads.append(load1())
-        w, c, q, _ = run(bare, r, N, solver, tol)
-        assert q.returncode == 0, q.stderr
-        walls.append(w)
-        cpus.append(c)
-        if w > 2.0:  # long runs: one timing (the table says how many)
+        t = timed(command(bare, r, N, solver, tol))  # raises with the command and its stderr on failure
+        walls.append(t.wall)
+        cpus.append(t.cpu)
+        if t.wall > 2.0:  # long runs: one timing (the table says how many)
             break
     return dict(case=case, family=family, refine=r, steps=N, solver=solver, tol=tol, error=err, l2=l2,
                 wall=statistics.median(walls), cpu=statistics.median(cpus), n_timed=len(walls), iters_per_step=it / N, dofs=dofs,

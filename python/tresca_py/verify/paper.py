@@ -103,7 +103,6 @@ def paper_tables(hs, quick):
             ok_rec, ", ".join(f"{v:.4f}" for v in o1[1:]), "verification/run_all.py (paper_tables)", "reference/paper_tables.md")
     h = [r["h"] for r in rows1]
     e = [r["reference_T"] for r in rows1]
-    x = [r["h"] for r in rows1[1:]]
     c = [r["consecutive_T"] for r in rows1[1:]]
     plot(hs, "paper_table_5_1", "Example 5.1 (N = 20n): error at T", h, [("true (vs reference)", e)], "h", [1])
     req(hs, "P2-paper-runs", "Example 5.1 shall run on the paper's meshes and steps with every step converged, "

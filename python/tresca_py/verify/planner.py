@@ -42,13 +42,13 @@ import math
 import os
 import shutil
 import statistics
-import subprocess
 import tempfile
 import time
 
-from tresca_py.common import BIN, REF, ROOT, case, child_cpu, cmdline, load1, strip_exact
+from tresca_py.common import BIN, REF, ROOT, case, cmdline, load1, run, strip_exact
 from tresca_py.verify import summary as cli_summary
 from tresca_py.verify.harness import Harness, out_dir
+from tresca_py.verify.timing import timed
 
 # grid per case: steps N_s·2^j for j < len; refinements 0..R
 CASES = {
@@ -73,24 +73,15 @@ def targets(grid, count):
 EX51 = case("paper_example_5_1")
 
 
-def timed(cmd):
-    """(completed process, wall seconds, CPU seconds of the child) — for the --costs rows only."""
-    c0, t0 = child_cpu(), time.perf_counter()
-    p = subprocess.run([str(c) for c in cmd], cwd=ROOT, capture_output=True, text=True)
-    return p, time.perf_counter() - t0, child_cpu() - c0
-
-
 def median_cost(cmd):
     """Median CPU and wall seconds of up to 3 runs (one when it takes over 2 s), the max 1-minute load."""
     cpus, walls, loads = [], [], []
     for _ in range(3):
         loads.append(load1())
-        p, w, c = timed(cmd)
-        if p.returncode not in (0, 3):
-            raise RuntimeError(f"{cmdline(cmd)} failed:\n{p.stderr}")
-        cpus.append(c)
-        walls.append(w)
-        if w > 2.0:
+        t = timed(cmd)
+        cpus.append(t.cpu)
+        walls.append(t.wall)
+        if t.wall > 2.0:
             break
     return statistics.median(cpus), statistics.median(walls), max(loads)
 
@@ -102,7 +93,7 @@ def scene_steps(path):
 
 
 def binary_version():
-    return subprocess.run([BIN, "--version"], capture_output=True, text=True).stdout.strip()
+    return run([BIN, "--version"])[0].stdout.strip()
 
 
 class Cache:
@@ -164,20 +155,20 @@ def plan(scene, target, extra=(), costs=False):
 
 
 def sweep_case(name, spec, tmp, quick, cache, costs):
-    run = Runner(name, tmp, cache, costs)
-    ns = scene_steps(run.full)
+    runner = Runner(name, tmp, cache, costs)
+    ns = scene_steps(runner.full)
     rmax = 4 if quick else spec["R"]
     steps = [ns * 2 ** j for j in range(min(spec["doublings"], 3) if quick else spec["doublings"])]
     grid = []
     for r in range(rmax + 1):
         for n in steps:
-            row = run.config(r, n)
+            row = runner.config(r, n)
             grid.append(row)
             print(f"  grid {name} r={r} N={n}: error {row['error']:.4e}" +
                   (f", CPU {row['cpu']:.3f} s" if costs else ""), flush=True)
     sweep = []
     for t in targets(grid, 5 if quick else 9):
-        p, pcpu, pwall, cmd, _ = plan(run.full, t, costs=costs)
+        p, pcpu, pwall, cmd, _ = plan(runner.full, t, costs=costs)
         meets = [g for g in grid if g["error"] <= t]
         cheapest = min(meets, key=lambda g: g["cpu"], default=None) if costs else None
         row = dict(case=name, target=t, planner_cpu=pcpu, planner_wall=pwall, plan_cmd=cmdline(cmd), cheapest=cheapest)
@@ -186,7 +177,7 @@ def sweep_case(name, spec, tmp, quick, cache, costs):
             row.update(refused=True)
         else:
             r, n, tol = best["refine"], best["steps"], p["tol"]
-            got = run.config(r, n, tol)
+            got = runner.config(r, n, tol)
             row.update(refused=False, refine=r, steps=n, tol=tol, pred_error=best["error"], pred_wall=best["wall"],
                        pilot_wall=p["pilot_wall"], error=got["error"], cpu=got.get("cpu"), wall=got.get("wall"),
                        run_cmd=got["cmd"])
@@ -254,7 +245,7 @@ def example51(tmp, quick, costs):
     for steps in [640, 40]:
         for written in [False, True]:
             c = [BIN, "run", EX51, "--refine", 4, "--steps", steps, "-q"] + (["-o", h5, "--force"] if written else [])
-            cpus = sorted(timed(c)[2] for _ in range(3))
+            cpus = sorted(timed(c).cpu for _ in range(3))
             rows.append(f"| {steps} | {'written (-o, per-step commits)' if written else 'solve-only'} | {cpus[1]:.3f} s | "
                         f"`{cmdline(c).replace(h5, 'out.h5')}` |")
     lines.append("### The paper's finest level (refine 4, n = 32)\n\nThe paper pairs N = 20 n steps with each mesh; the "
