@@ -107,7 +107,7 @@ class Harness:
     def dump(self, path):
         """The results as a JSON list (what :meth:`record_list` reads)."""
         with open(path, "w", encoding="utf-8") as f:
-            json.dump([asdict(r) for r in self.results], f, indent=1)
+            json.dump([asdict(r) for r in self.results], f, indent=1, ensure_ascii=False)
 
     def table(self):
         lines = ["| requirement | statement | result | measured | command | reference |", "|---|---|---|---|---|---|"]

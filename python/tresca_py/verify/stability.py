@@ -281,11 +281,11 @@ def case_ga(st):
             ok = False
             continue
         slip = h5(r["h5"], "tresca/contact/slip")
-        st = h5(r["h5"], "tresca/contact/state")
+        state = h5(r["h5"], "tresca/contact/state")
         umax = np.max(np.abs(h5(r["h5"], "tresca/u")))
-        out.append(f"g_a={g:g}: max|slip|/max|u| = {np.max(np.abs(slip)) / umax:.1e}, slipping edge-steps {int(st.sum())}, "
-                   f"iterations {r['iters']}")
-        ok &= np.max(np.abs(slip)) <= 1e-12 * umax and st.sum() == 0
+        out.append(f"g_a={g:g}: max|slip|/max|u| = {np.max(np.abs(slip)) / umax:.1e}, slipping edge-steps "
+                   f"{int(state.sum())}, iterations {r['iters']}")
+        ok &= np.max(np.abs(slip)) <= 1e-12 * umax and state.sum() == 0
     st.check("g_a → ∞: clamped (stick) limit",
           "g_a ≥ 1 (load ~ 0.1): every contact edge sticks at every step, slip = 0 to rounding, no overflow "
           "at g_a = 1e12", "; ".join(out), ok)
