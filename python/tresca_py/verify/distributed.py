@@ -40,7 +40,7 @@ from tresca_py.common import short_path as rel  # noqa: E402
 
 from tresca_py import compare  # noqa: E402
 from tresca_py.verify.harness import Harness, out_dir  # noqa: E402
-import cross_check  # noqa: E402  (scenes, quick levels)
+from tresca_py.verify import cross_check  # noqa: E402  (scenes, quick levels)
 
 SCRIPT = os.path.join(ROOT, "scripts", "dolfinx_distributed.py")
 MEM_JSON = os.path.join(ROOT, "reference", "distributed_memory.json")

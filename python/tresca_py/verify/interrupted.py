@@ -68,15 +68,8 @@ def wait_for(path, p, limit=120.0):
     return time.perf_counter() - t
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--json", help="write the requirement list (O2-interrupted) here")
-    args = ap.parse_args(argv)
-    check = Checks()
-    out = os.path.join(ROOT, "out", "interrupted")
-    os.makedirs(out, exist_ok=True)
-    run = [BIN, "run", EX51, "--refine", "3", "--steps", "2000", "-q"]
-
+def killed_and_resumed(check, out, run):
+    """A run killed in the step phase, then resumed; returns its file."""
     # 1. killed in the step phase, then resumed
     h5 = os.path.join(out, "killed.h5")
     clear(h5)
@@ -106,7 +99,11 @@ def main(argv=None):
     done, status, n = state(h5)
     check(r.returncode == 0 and done == n + 1 and status == "completed", f"resumed run: {done} steps, status {status!r}")
     clients(check, h5, "resumed run")
+    return h5
 
+
+def killed_while_creating(check, h5, run):
+    """Killed while creating a new file over the complete one ``h5``: the old pair stays as it was."""
     # 1b. killed while creating a new file over the complete one: the old pair stays as it was.
     # --frame-every 1 makes creation long (8 virtual datasets per frame, 2001 frames).
     with open(h5, "rb") as f:
@@ -129,6 +126,9 @@ def main(argv=None):
           f"old run.xdmf unchanged {same_x}")
     clients(check, h5, "old file after a kill during creation")
 
+
+def killed_often(check, out, run):
+    """Killed at 30 moments of the step phase: the sidecar never shows a frame the file has not committed."""
     # 1c. killed at 30 moments of the step phase with a frame every 5 steps: the sidecar's two collections
     # always hold the same frames, and none the HDF5 file has not committed. (The grids of a frame were
     # once written block by block, and a kill between the writes left a contact frame without its body
@@ -155,6 +155,9 @@ def main(argv=None):
             bad.append(f"contact {c}, body {b} frames, {nsteps} committed")
     check(seen >= 20 and not bad, f"killed at 30 moments: {seen} sidecars read, inconsistent: {bad or 'none'}")
 
+
+def stopped(check, out):
+    """A run stopped by a solver failure at step 1."""
     # 2. stopped on a solver failure at step 1
     scene = os.path.join(out, "fail.toml")
     with open(EX51) as f:
@@ -167,6 +170,20 @@ def main(argv=None):
     done, status, n = state(h5)
     check(r.returncode == 1 and done == 1 and status.startswith("stopped:"), f"stopped run: {done} step, status {status!r}")
     clients(check, h5, "stopped run")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--json", help="write the requirement list (O2-interrupted) here")
+    args = ap.parse_args(argv)
+    check = Checks()
+    out = os.path.join(ROOT, "out", "interrupted")
+    os.makedirs(out, exist_ok=True)
+    run = [BIN, "run", EX51, "--refine", "3", "--steps", "2000", "-q"]
+    h5 = killed_and_resumed(check, out, run)
+    killed_while_creating(check, h5, run)
+    killed_often(check, out, run)
+    stopped(check, out)
 
     hs = Harness(out=os.path.join(out_dir(), "interrupted_runs"), echo=False)
     hs.require("O2-interrupted", not check.failed,

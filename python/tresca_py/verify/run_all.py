@@ -4,7 +4,8 @@ Runs the release binary's `study` subcommand on the manufactured cases and on th
 independent Python solvers and the comparisons, and records every requirement of
 :mod:`tresca_py.verify.requirements` in one :class:`~tresca_py.verify.harness.Harness`. Everything is written
 under out/verify/ (tables and plots for reference/ staged in out/verify/reference/; `make reference`
-publishes them); the summary is out/verify/summary.md. Exit status 1 if any requirement fails.
+publishes them; a --quick run writes under out/verify/quick/, never published); the summary is
+out/verify/summary.md. Exit status 1 if any requirement fails.
 
     .venv/bin/python verification/run_all.py [--quick] [--only NAME ...]
 """
@@ -15,7 +16,7 @@ import time
 
 from tresca_py.common import BIN, PY
 from tresca_py.verify import checks, estimates, paper, studies
-from tresca_py.verify.harness import Harness
+from tresca_py.verify.harness import Harness, out_dir
 
 
 def study_table(quick):
@@ -69,7 +70,8 @@ def main(argv=None):
     unknown = sorted(set(args.only or []) - set(table))
     if unknown:
         ap.error(f"unknown studies {', '.join(unknown)}; known: {', '.join(table)}")
-    hs = Harness()
+    # a --quick run's tables are not the reference's: they go to out/verify/quick/, which `make reference` ignores
+    hs = Harness(out=os.path.join(out_dir(), "quick") if args.quick else None)
     t0 = time.time()
     for name, fn in table.items():
         if args.only and name not in args.only:
