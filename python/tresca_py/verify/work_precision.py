@@ -26,7 +26,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from tresca_py.common import BIN, REF, ROOT, load1, strip_exact  # noqa: E402
+from tresca_py.common import BIN, REF, ROOT, load1, short_path, strip_exact  # noqa: E402
 from tresca_py.verify import summary as cli_summary  # noqa: E402
 from tresca_py.verify.timing import timed  # noqa: E402
 CASES = {
@@ -82,6 +82,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--out", default=REF, help="where the CSV, plot and Markdown go (default reference/)")
     args = ap.parse_args(argv)
     tmp = tempfile.mkdtemp(prefix="tresca-wp-")
     atexit.register(shutil.rmtree, tmp, True)  # the runs' files are intermediate
@@ -108,10 +109,10 @@ def main(argv=None):
             print(f"{case:9} {fam:5} r={r} N={N:5} {s:5} tol={tol:.0e}: error {row['error']:.4e} "
                   f"wall {row['wall']:.4f}s it/step {row['iters_per_step']:.2f} {row['note']}", flush=True)
 
-    os.makedirs(REF, exist_ok=True)
+    os.makedirs(args.out, exist_ok=True)
     keys = ["case", "family", "refine", "steps", "dofs", "solver", "tol", "error", "l2", "wall", "cpu", "n_timed", "iters_per_step",
             "load", "note", "cmd"]
-    with open(os.path.join(REF, "work_precision.csv"), "w", newline="") as f:
+    with open(os.path.join(args.out, "work_precision.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
@@ -132,7 +133,7 @@ def main(argv=None):
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(os.path.join(REF, "work_precision.png"), dpi=120)
+    fig.savefig(os.path.join(args.out, "work_precision.png"), dpi=120)
 
     # markdown
     md = ["# Work–precision on the manufactured cases (issues 7 and 13)", "",
@@ -169,9 +170,9 @@ def main(argv=None):
                       f"{b['error']:.3e} | {b['cpu'] * 1e3:.1f} ms | {b['wall'] * 1e3:.1f} ms | `{b.get('cmd', '')}` |")
         md.append("")
     md += conclusions(rows)
-    with open(os.path.join(REF, "work_precision.md"), "w") as f:
+    with open(os.path.join(args.out, "work_precision.md"), "w") as f:
         f.write("\n".join(md) + "\n")
-    print("wrote reference/work_precision.{md,csv,png}")
+    print(f"wrote {short_path(args.out)}/work_precision.{{md,csv,png}}")
 
 
 def conclusions(rows):
