@@ -235,6 +235,129 @@ def versions():
     return v
 
 
+class Context:
+    """What the checks of one cross-check share: the harness, the work directory, the scenes, and the rows,
+    timings and commands the report lists."""
+
+    def __init__(self, hs, work, scenes, self_cmd, md_path):
+        self.hs, self.work, self.scenes, self.self_cmd, self.md_path = hs, work, scenes, self_cmd, md_path
+        self.rows, self.timing, self.commands = [], [], []
+
+
+def check_case(cx, name, k, steps):
+    """Rust, scikit-fem and dolfinx on one case at refine k: the three pairs compared, one requirement."""
+    tag = f"{name}_r{k}" + (f"_n{steps}" if steps else "")
+    files, walls, inner, errs = {}, {}, {}, []
+    for code in ("rust", "skfem", "dolfinx"):
+        out = os.path.join(cx.work, f"{tag}_{code}.h5")
+        ok, wall, cmd, msg = run_code(code, cx.scenes[name], out, k, steps)
+        cx.commands.append(cmd)
+        walls[code] = wall
+        if ok:
+            files[code] = out
+            inner[code] = inner_time(out, code)
+        else:
+            errs.append(f"{code} failed: {msg}")
+            print(f"  {code} FAILED on {tag}: {msg}", flush=True)
+    n_edges = n_contact = n_steps = None
+    if files:
+        n_edges, n_contact, n_steps = sizes(next(iter(files.values())))
+    results = {}
+    for a, b in PAIRS:
+        if a in files and b in files:
+            r, err = compare_pair(files[a], files[b])
+            results[(a, b)] = r
+            if err:
+                errs.append(f"{a} vs {b}: {err}")
+            cx.rows.append(dict(case=name, refine=k, steps=n_steps, pair=f"{a}–{b}", r=r))
+            cx.commands.append(f".venv/bin/python scripts/compare.py {rel(files[a])} {rel(files[b])} --strict-flags")
+    passed = not errs and len(results) == 3 and all(pair_ok(r) for r in results.values())
+    measured = "; ".join(f"{a}–{b}: {fmt_pair(results.get((a, b)))}" for a, b in PAIRS if (a, b) in results)
+    if errs:
+        measured = "; ".join(errs) + ("; " + measured if measured else "")
+    cx.timing.append(dict(case=name, refine=k, steps=n_steps, edges=n_edges, contact=n_contact,
+                          wall=walls, inner=inner))
+    cx.hs.require(f"X-{name}-r{k}", passed, measured,
+                  statement=(f"Rust, scikit-fem and dolfinx shall agree on {name} at refine {k}"
+                             f"{f' ({steps} steps)' if steps else ''}: DOF vectors, energies, σ_τ"
+                             f"{', true errors' if any(r and r['has_errors'] for r in results.values()) else ''}"
+                             f" within {TOL:g} (relative) at every time node, identical stick/slip sets"),
+                  command=f"{cx.self_cmd} --only {name}", reference=rel(cx.md_path))
+
+
+def check_mpi(cx, name, k, plan):
+    """dolfinx under mpirun -n 2 against serial dolfinx on one case at refine k; returns its table row."""
+    steps = plan.get(name, ((), None))[1]
+    tag = f"{name}_r{k}" + (f"_n{steps}" if steps else "")
+    serial = os.path.join(cx.work, f"{tag}_dolfinx.h5")
+    errs = []
+    if not os.path.exists(serial) or k not in plan.get(name, ((),))[0]:
+        ok, wall, cmd, msg = run_code("dolfinx", cx.scenes[name], serial, k, steps)
+        cx.commands.append(cmd)
+        if not ok:
+            errs.append(f"serial dolfinx failed: {msg}")
+    par = os.path.join(cx.work, f"{tag}_dolfinx_np2.h5")
+    ok, wall, cmd, msg = run_code("dolfinx", cx.scenes[name], par, k, steps, mpi=2)
+    cx.commands.append(cmd)
+    r = None
+    if not ok:
+        errs.append(f"mpirun -n 2 dolfinx failed: {msg}")
+    elif not errs:
+        r, err = compare_pair(serial, par)
+        if err:
+            errs.append(err)
+        cx.commands.append(f".venv/bin/python scripts/compare.py {rel(serial)} {rel(par)} --strict-flags")
+    passed = not errs and pair_ok(r)
+    measured = "; ".join(errs) if errs else fmt_pair(r)
+    for t in cx.timing:
+        if t["case"] == name and t["refine"] == k:
+            t["wall"]["dolfinx -n 2"] = wall
+            t["inner"]["dolfinx -n 2"] = inner_time(par, "dolfinx") if ok else None
+    cx.hs.require(f"X-mpi-{name}-r{k}", passed, measured,
+                  statement=(f"dolfinx under mpirun -n 2 shall agree with serial dolfinx on {name} at refine {k} "
+                             f"within {TOL:g} (DOFs, energies, σ_τ, true errors) with identical stick/slip sets"),
+                  command=f"{cx.self_cmd} --only {name}", reference=rel(cx.md_path))
+    return dict(case=name, refine=k, steps=steps, r=r, wall=wall, passed=passed, measured=measured)
+
+
+def tables(cx, mpi_rows):
+    """The agreement and wall-time tables (Markdown)."""
+    codes = ["rust", "skfem", "dolfinx"] + (["dolfinx -n 2"] if mpi_rows else [])
+    lines = ["Agreement (max over the time nodes; du, dE, derr relative; dsig relative to max ḡ; flags = differing "
+             "stick/slip states summed over the nodes):", "",
+             "| case | refine | N | pair | du | dE | dsig | derr | flags | ok |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for row in cx.rows:
+        r = row["r"]
+        if r is None:
+            lines.append(f"| {row['case']} | {row['refine']} | {row['steps']} | {row['pair']} | – | – | – | – | – | FAIL |")
+            continue
+        derr = f"{r['derr']:.1e}" if r["has_errors"] else "–"
+        lines.append(f"| {row['case']} | {row['refine']} | {row['steps']} | {row['pair']} | {r['du']:.1e} | {r['dE']:.1e} | "
+                     f"{r['dsig']:.1e} | {derr} | {r['flags']} | {'PASS' if pair_ok(r) else 'FAIL'} |")
+    for m in mpi_rows:
+        r = m["r"]
+        if r is None:
+            lines.append(f"| {m['case']} | {m['refine']} | – | dolfinx–dolfinx -n 2 | – | – | – | – | – | FAIL |")
+            continue
+        derr = f"{r['derr']:.1e}" if r["has_errors"] else "–"
+        lines.append(f"| {m['case']} | {m['refine']} | {r['n_times'] - 1} | dolfinx–dolfinx -n 2 | {r['du']:.1e} | "
+                     f"{r['dE']:.1e} | {r['dsig']:.1e} | {derr} | {r['flags']} | {'PASS' if m['passed'] else 'FAIL'} |")
+    lines += ["", "Wall time in seconds: whole process (start-up, scene, assembly, every step, true errors, output), "
+              "in brackets the solver's own record (Rust: set-up + steps, without true errors and output; Python: "
+              "assembly + steps + true errors, after imports and scene loading).", "",
+              "| case | refine | N | edges | Γ_C edges | " + " | ".join(codes) + " |", "|---|---|---|---|---|" + "---|" * len(codes)]
+    for t in cx.timing:
+        cells = []
+        for c in codes:
+            if c in t["wall"]:
+                inn = t["inner"].get(c)
+                cells.append(f"{t['wall'][c]:.2f}" + (f" ({inn:.3f})" if inn is not None else ""))
+            else:
+                cells.append("–")
+        lines.append(f"| {t['case']} | {t['refine']} | {t['steps']} | {t['edges']} | {t['contact']} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="one mesh level per case, fewer steps (make test)")
@@ -268,118 +391,14 @@ def main(argv=None):
         sys.exit(f"error: {rel(BIN)} missing (cargo build --release)")
 
     hs = Harness(out=os.path.join(out_dir(), "cross_check_harness"))
-    rows, timing, commands = [], [], []
     self_cmd = f".venv/bin/python verification/cross_check.py{' --quick' if args.quick else ''}"
+    cx = Context(hs, work, scenes, self_cmd, md_path)
     for name, (levels, steps) in plan.items():
         for k in levels:
-            tag = f"{name}_r{k}" + (f"_n{steps}" if steps else "")
-            files, walls, inner, errs = {}, {}, {}, []
-            for code in ("rust", "skfem", "dolfinx"):
-                out = os.path.join(work, f"{tag}_{code}.h5")
-                ok, wall, cmd, msg = run_code(code, scenes[name], out, k, steps)
-                commands.append(cmd)
-                walls[code] = wall
-                if ok:
-                    files[code] = out
-                    inner[code] = inner_time(out, code)
-                else:
-                    errs.append(f"{code} failed: {msg}")
-                    print(f"  {code} FAILED on {tag}: {msg}", flush=True)
-            n_edges = n_contact = n_steps = None
-            if files:
-                n_edges, n_contact, n_steps = sizes(next(iter(files.values())))
-            results = {}
-            for a, b in PAIRS:
-                if a in files and b in files:
-                    r, err = compare_pair(files[a], files[b])
-                    results[(a, b)] = r
-                    if err:
-                        errs.append(f"{a} vs {b}: {err}")
-                    rows.append(dict(case=name, refine=k, steps=n_steps, pair=f"{a}–{b}", r=r))
-                    commands.append(f".venv/bin/python scripts/compare.py {rel(files[a])} {rel(files[b])} --strict-flags")
-            passed = not errs and len(results) == 3 and all(pair_ok(r) for r in results.values())
-            measured = "; ".join(f"{a}–{b}: {fmt_pair(results.get((a, b)))}" for a, b in PAIRS if (a, b) in results)
-            if errs:
-                measured = "; ".join(errs) + ("; " + measured if measured else "")
-            timing.append(dict(case=name, refine=k, steps=n_steps, edges=n_edges, contact=n_contact,
-                               wall=walls, inner=inner))
-            hs.require(f"X-{name}-r{k}", passed, measured,
-                       statement=(f"Rust, scikit-fem and dolfinx shall agree on {name} at refine {k}"
-                                  f"{f' ({steps} steps)' if steps else ''}: DOF vectors, energies, σ_τ"
-                                  f"{', true errors' if any(r and r['has_errors'] for r in results.values()) else ''}"
-                                  f" within {TOL:g} (relative) at every time node, identical stick/slip sets"),
-                       command=f"{self_cmd} --only {name}", reference=rel(md_path))
-
-    mpi_rows = []
-    for name, k in mpi_plan:
-        steps = plan.get(name, ((), None))[1]
-        tag = f"{name}_r{k}" + (f"_n{steps}" if steps else "")
-        serial = os.path.join(work, f"{tag}_dolfinx.h5")
-        errs = []
-        if not os.path.exists(serial) or k not in plan.get(name, ((),))[0]:
-            ok, wall, cmd, msg = run_code("dolfinx", scenes[name], serial, k, steps)
-            commands.append(cmd)
-            if not ok:
-                errs.append(f"serial dolfinx failed: {msg}")
-        par = os.path.join(work, f"{tag}_dolfinx_np2.h5")
-        ok, wall, cmd, msg = run_code("dolfinx", scenes[name], par, k, steps, mpi=2)
-        commands.append(cmd)
-        r = None
-        if not ok:
-            errs.append(f"mpirun -n 2 dolfinx failed: {msg}")
-        elif not errs:
-            r, err = compare_pair(serial, par)
-            if err:
-                errs.append(err)
-            commands.append(f".venv/bin/python scripts/compare.py {rel(serial)} {rel(par)} --strict-flags")
-        passed = not errs and pair_ok(r)
-        measured = "; ".join(errs) if errs else fmt_pair(r)
-        for t in timing:
-            if t["case"] == name and t["refine"] == k:
-                t["wall"]["dolfinx -n 2"] = wall
-                t["inner"]["dolfinx -n 2"] = inner_time(par, "dolfinx") if ok else None
-        mpi_rows.append(dict(case=name, refine=k, steps=steps, r=r, wall=wall, passed=passed, measured=measured))
-        hs.require(f"X-mpi-{name}-r{k}", passed, measured,
-                   statement=(f"dolfinx under mpirun -n 2 shall agree with serial dolfinx on {name} at refine {k} "
-                              f"within {TOL:g} (DOFs, energies, σ_τ, true errors) with identical stick/slip sets"),
-                   command=f"{self_cmd} --only {name}", reference=rel(md_path))
-
-    # ------------------------------------------------------------------ report
+            check_case(cx, name, k, steps)
+    mpi_rows = [check_mpi(cx, name, k, plan) for name, k in mpi_plan]
     total = time.perf_counter() - t_start
-    codes = ["rust", "skfem", "dolfinx"] + (["dolfinx -n 2"] if mpi_rows else [])
-    lines = ["Agreement (max over the time nodes; du, dE, derr relative; dsig relative to max ḡ; flags = differing "
-             "stick/slip states summed over the nodes):", "",
-             "| case | refine | N | pair | du | dE | dsig | derr | flags | ok |", "|---|---|---|---|---|---|---|---|---|---|"]
-    for row in rows:
-        r = row["r"]
-        if r is None:
-            lines.append(f"| {row['case']} | {row['refine']} | {row['steps']} | {row['pair']} | – | – | – | – | – | FAIL |")
-            continue
-        derr = f"{r['derr']:.1e}" if r["has_errors"] else "–"
-        lines.append(f"| {row['case']} | {row['refine']} | {row['steps']} | {row['pair']} | {r['du']:.1e} | {r['dE']:.1e} | "
-                     f"{r['dsig']:.1e} | {derr} | {r['flags']} | {'PASS' if pair_ok(r) else 'FAIL'} |")
-    for m in mpi_rows:
-        r = m["r"]
-        if r is None:
-            lines.append(f"| {m['case']} | {m['refine']} | – | dolfinx–dolfinx -n 2 | – | – | – | – | – | FAIL |")
-            continue
-        derr = f"{r['derr']:.1e}" if r["has_errors"] else "–"
-        lines.append(f"| {m['case']} | {m['refine']} | {r['n_times'] - 1} | dolfinx–dolfinx -n 2 | {r['du']:.1e} | "
-                     f"{r['dE']:.1e} | {r['dsig']:.1e} | {derr} | {r['flags']} | {'PASS' if m['passed'] else 'FAIL'} |")
-    lines += ["", "Wall time in seconds: whole process (start-up, scene, assembly, every step, true errors, output), "
-              "in brackets the solver's own record (Rust: set-up + steps, without true errors and output; Python: "
-              "assembly + steps + true errors, after imports and scene loading).", "",
-              "| case | refine | N | edges | Γ_C edges | " + " | ".join(codes) + " |", "|---|---|---|---|---|" + "---|" * len(codes)]
-    for t in timing:
-        cells = []
-        for c in codes:
-            if c in t["wall"]:
-                inn = t["inner"].get(c)
-                cells.append(f"{t['wall'][c]:.2f}" + (f" ({inn:.3f})" if inn is not None else ""))
-            else:
-                cells.append("–")
-        lines.append(f"| {t['case']} | {t['refine']} | {t['steps']} | {t['edges']} | {t['contact']} | " + " | ".join(cells) + " |")
-    table = "\n".join(lines)
+    table = tables(cx, mpi_rows)
     print("\n" + table)
     reqs, nfail = hs.results, len(hs.failed)
     print(f"\n{len(reqs) - nfail}/{len(reqs)} cross-check requirements passed in {total:.0f} s")
@@ -395,7 +414,7 @@ def main(argv=None):
           "## Requirements", "", "| id | passed | measured |", "|---|---|---|"]
     md += [f"| {r.id} | {'PASS' if r.passed else 'FAIL'} | {r.measured} |" for r in reqs]
     md += ["", "## Tables", "", table, "", "## Commands", "", "Run from the repository root, one after the other:", "", "```"]
-    md += commands
+    md += cx.commands
     md += ["```", "", NOTES, "## Versions", ""] + [f"- {k}: {v}" for k, v in ver.items()] + [""]
     os.makedirs(os.path.dirname(md_path), exist_ok=True)
     with open(md_path, "w") as fh:
