@@ -10,7 +10,7 @@ BIN   := target/release/tresca-cr
 PY312 := $(shell for p in $$(pyenv root 2>/dev/null)/versions/3.12*/bin/python3.12 /usr/local/bin/python3.12 /usr/bin/python3.12; do \
            [ -x "$$p" ] && "$$p" -c 'import sys' 2>/dev/null && echo "$$p" && break; done)
 
-.PHONY: all deps paraview getfem build venv test verify bench clean-out
+.PHONY: all deps paraview getfem build venv test verify reference bench clean-out
 
 all: build
 
@@ -67,8 +67,15 @@ test: build venv getfem
 	cargo test --release --locked
 	$(PY) verification/python_tests.py
 
+# make verify writes under out/verify/ only (a clean clone stays clean); make reference publishes what it
+# staged in out/verify/reference/ into the tracked reference/ and regenerates verification/README.md's table.
 verify: build venv paraview getfem
 	$(PY) verification/run_all.py
 
+reference: venv
+	$(PY) -m tresca_py.verify.harness publish
+
+# Timings live here only (no pass/fail of make verify or make test depends on a time).
 bench: build venv
 	$(PY) verification/bench.py
+	$(PY) verification/planner.py --costs

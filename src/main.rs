@@ -28,6 +28,8 @@ enum Cmd {
         steps: Option<usize>,
         #[command(flatten)]
         limits: Limits,
+        #[command(flatten)]
+        json: cli::summary::JsonArg,
     },
     /// Run a scene.
     Run {
@@ -54,6 +56,8 @@ enum Cmd {
         quiet: bool,
         #[command(flatten)]
         limits: Limits,
+        #[command(flatten)]
+        json: cli::summary::JsonArg,
     },
     /// Convergence study: run the scene at several levels and print/write errors and observed orders.
     Study {
@@ -76,6 +80,8 @@ enum Cmd {
         /// Write per level the elementwise energy density of u_l − P u_{l−1} (XDMF, ParaView) into DIR.
         #[arg(long, value_name = "DIR")]
         differences: Option<PathBuf>,
+        #[command(flatten)]
+        json: cli::summary::JsonArg,
     },
     /// Plan the cheapest run that meets a target accuracy: pilot runs, error and cost models, the
     /// cheapest (refine, steps, solver, tolerance) and two runners-up, or a refusal (exit code 3).
@@ -103,6 +109,8 @@ enum Cmd {
         /// Refuse configurations whose estimated peak memory exceeds this (default: available memory).
         #[arg(long, value_parser = parse_size)]
         max_memory: Option<u64>,
+        #[command(flatten)]
+        json: cli::summary::JsonArg,
     },
 }
 
@@ -207,28 +215,34 @@ fn main() {
     tune_malloc();
     let cli = Cli::parse();
     let result = match cli.cmd {
-        Cmd::Check { scene, refine, steps, limits } => {
+        Cmd::Check { scene, refine, steps, limits, json } => {
             // the estimate of the results file is for the scene's [output] path, else the current directory
             let out = |s: &Scene| Some(s.output.clone().unwrap_or_else(|| PathBuf::from("run.h5")));
-            load(&scene, refine, steps, limits, out).and_then(|(s, e)| cli::check::check(s, e))
+            cli::summary::check_path(json.json.as_deref())
+                .and_then(|()| load(&scene, refine, steps, limits, out))
+                .and_then(|(s, e)| cli::check::check(s, e, json.json))
         }
-        Cmd::Run { scene, refine, steps, solver, tol, out, verbose, quiet, limits } => {
+        Cmd::Run { scene, refine, steps, solver, tol, out, verbose, quiet, limits, json } => {
             // a resumed run's file already holds its disk space: only memory is checked then
             let (given, resume) = (out.output.clone(), out.resume);
             let new_file = move |s: &Scene| given.or_else(|| s.output.clone()).filter(|_| !resume);
-            load(&scene, refine, steps, limits, new_file).and_then(|(mut s, _)| {
-                solver_overrides(&mut s, solver, tol)?;
-                cli::run::run(s, out, verbose, quiet)
-            })
+            cli::summary::check_path(json.json.as_deref())
+                .and_then(|()| load(&scene, refine, steps, limits, new_file))
+                .and_then(|(mut s, _)| {
+                    solver_overrides(&mut s, solver, tol)?;
+                    cli::run::run(s, out, verbose, quiet, json.json)
+                })
         }
-        Cmd::Study { scene, levels, reference, solver, tol, csv, differences } => {
+        Cmd::Study { scene, levels, reference, solver, tol, csv, differences, json } => {
             let no_limits = Limits { max_memory: None, max_disk: None };
-            load(&scene, None, None, no_limits, |_| None).and_then(|(mut s, _)| {
-                solver_overrides(&mut s, solver, tol)?;
-                cli::study::study(s, &levels, reference, csv, differences)
-            })
+            cli::summary::check_path(json.json.as_deref())
+                .and_then(|()| load(&scene, None, None, no_limits, |_| None))
+                .and_then(|(mut s, _)| {
+                    solver_overrides(&mut s, solver, tol)?;
+                    cli::study::study(s, &levels, reference, csv, differences, json.json)
+                })
         }
-        Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory } => {
+        Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory, json } => {
             let no_limits = Limits { max_memory: None, max_disk: None };
             let options = tresca_cr::plan::Options {
                 target,
@@ -237,13 +251,15 @@ fn main() {
                 pilot_budget: pilot_budget.unwrap_or(budget / 10.0),
                 max_memory,
             };
-            load(&scene, None, None, no_limits, |_| None).and_then(|(s, _)| {
-                let code = cli::plan::run(s, options, csv, run)?;
-                if code != 0 {
-                    std::process::exit(code);
-                }
-                Ok(())
-            })
+            cli::summary::check_path(json.json.as_deref())
+                .and_then(|()| load(&scene, None, None, no_limits, |_| None))
+                .and_then(|(s, _)| {
+                    let code = cli::plan::run(s, options, csv, run, json.json)?;
+                    if code != 0 {
+                        std::process::exit(code);
+                    }
+                    Ok(())
+                })
         }
     };
     if let Err(e) = result {

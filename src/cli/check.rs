@@ -15,7 +15,8 @@ fn short(text: &str) -> String {
     }
 }
 
-pub fn check(scene: Scene, estimate: Estimate) -> Result<()> {
+pub fn check(scene: Scene, estimate: Estimate, json: Option<std::path::PathBuf>) -> Result<()> {
+    let start = std::time::Instant::now();
     let problem = Problem::new(scene)?;
     // what `run` evaluates before its first step: u⁰ = I_CR u₀ and, with [exact], the errors at t₀
     problem.initial()?;
@@ -77,6 +78,27 @@ pub fn check(scene: Scene, estimate: Estimate) -> Result<()> {
     say!("solver     {} (tol {:.1e}, max_iter {})", s.solver.method.name(), s.solver.tol, s.solver.max_iter());
     say!("exact      {}", if s.exact.is_some() { "given: true errors computed" } else { "none" });
     say!("estimate   {}", estimate.describe());
+    if let Some(j) = &json {
+        let mut summary = super::summary::Summary::new("check", &s.file, start.elapsed().as_secs_f64());
+        summary.check = Some(super::summary::CheckSummary {
+            vertices: m.points.len(),
+            triangles: m.tris.len(),
+            edges: m.edges.len(),
+            h: m.h_max(),
+            unknowns: sp.n_dofs,
+            paper_dofs: sp.paper_dofs(),
+            contact_unknowns: sp.contact.len(),
+            steps: problem.n_steps(),
+            solver: s.solver.method.name().into(),
+            tol: s.solver.tol,
+            max_iter: s.solver.max_iter(),
+            exact: s.exact.is_some(),
+            setup: problem.setup.into(),
+            memory: estimate.memory,
+            disk: estimate.disk,
+        });
+        super::summary::write(j, &summary)?;
+    }
     match super::out::stdout_error() {
         Some(e) => anyhow::bail!("cannot write to standard output: {e}"),
         None => Ok(()),

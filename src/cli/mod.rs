@@ -5,3 +5,4 @@ pub mod out;
 pub mod plan;
 pub mod run;
 pub mod study;
+pub mod summary;

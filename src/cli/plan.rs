@@ -15,7 +15,17 @@ use tresca_cr::Scene;
 /// Exit code of a refusal (no plan; errors exit with 1, command-line usage errors with 2 as clap does).
 pub const REFUSED: i32 = 3;
 
-pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool) -> Result<i32> {
+pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool, json: Option<PathBuf>) -> Result<i32> {
+    let start = std::time::Instant::now();
+    let summarise = |p: &Plan, achieved| -> Result<()> {
+        let Some(j) = &json else { return Ok(()) };
+        let mut s = super::summary::Summary::new("plan", &scene.file, start.elapsed().as_secs_f64());
+        s.plan = Some(super::summary::PlanSummary::of(p, &p.options.quantity.describe(), achieved));
+        if let Some(why) = &p.refused {
+            s.status = format!("refused: {why}");
+        }
+        super::summary::write(j, &s)
+    };
     say!("Planning {} for the {} ≤ {:e}", scene.file, options.quantity.describe(), options.target);
     let p = plan(&scene, &options)?;
     print_evidence(&p);
@@ -27,6 +37,7 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool) 
     }
     if let Some(why) = &p.refused {
         say!("\nNo plan: {why}");
+        summarise(&p, None)?;
         return Ok(REFUSED);
     }
     say!(
@@ -68,9 +79,8 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool) 
         p.solver,
         p.tol
     );
-    if execute {
-        execute_plan(&scene, &p, b)?;
-    }
+    let achieved = if execute { Some(execute_plan(&scene, &p, b)?) } else { None };
+    summarise(&p, achieved)?;
     Ok(0)
 }
 
@@ -194,7 +204,7 @@ fn csv_text(p: &Plan) -> String {
 /// Run the plan as the finest level of a short study at its steps (refine r−3 … r, as far as the
 /// scene's mesh allows: about 1.3 times the run; four levels for the asymptotic check), whose Richardson estimate of the finest level, combined
 /// with the time model at its steps, is the achieved estimate; the true error too when the scene has one.
-fn execute_plan(scene: &Scene, p: &Plan, b: &Candidate) -> Result<()> {
+fn execute_plan(scene: &Scene, p: &Plan, b: &Candidate) -> Result<super::summary::Achieved> {
     let mut s = scene.clone();
     s.solver.method = tresca_cr::scene::Method::Ssn;
     s.solver.tol = p.tol;
@@ -229,7 +239,14 @@ fn execute_plan(scene: &Scene, p: &Plan, b: &Candidate) -> Result<()> {
         );
     }
     say!("wall of the planned level {:.3} s (predicted {:.3} s)", finest.wall, b.wall);
-    Ok(())
+    Ok(super::summary::Achieved {
+        estimate: achieved,
+        space,
+        time,
+        true_error: finest.max_err.filter(|_| matches!(p.options.quantity, Quantity::Energy)).map(|e| e.energy),
+        met: achieved <= p.options.target,
+        levels: study.levels.iter().map(|r| super::summary::Level::of(r, None)).collect(),
+    })
 }
 
 /// A duration such as 90, 90s, 250ms, 10m or 2h, in seconds.

@@ -49,7 +49,7 @@ pub struct OutputArgs {
     pub commit_interval: f64,
 }
 
-pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<()> {
+pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool, json: Option<PathBuf>) -> Result<()> {
     use tresca_cr::output::{Background, Options, Run, Writer};
     let start = std::time::Instant::now();
     let path = out.output.clone().or_else(|| scene.output.clone());
@@ -110,7 +110,9 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     let (mut iters, mut max_res) = (0usize, 0.0f64);
     // stick and slip edges of the last step (for the summary; not the whole step, whose u is large)
     let mut last = None;
+    let mut step_stats = Vec::new();
     let on_step = |r: &tresca_cr::StepResult| -> tresca_cr::Result<()> {
+        step_stats.push(super::summary::Step::of(r));
         if let Some(w) = writer.as_mut() {
             w.write_step(r)?;
         }
@@ -153,6 +155,23 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     let sp = &problem.space;
     let (dofs, paper_dofs, contact) = (sp.n_dofs, sp.paper_dofs(), sp.contact.len());
     let (st, method, exact) = (problem.setup, problem.scene.solver.method.name(), problem.scene.exact.is_some());
+    let mut summary = super::summary::Summary::new("run", &problem.scene.file, 0.0);
+    summary.status = status.clone();
+    summary.run = Some(super::summary::RunSummary {
+        refine: problem.scene.mesh_level(),
+        unknowns: dofs,
+        paper_dofs,
+        contact_edges: contact,
+        steps: n,
+        solver: method.into(),
+        tol: problem.scene.solver.tol,
+        setup: st.into(),
+        step_stats,
+        iterations: iters,
+        max_residual: max_res,
+        max_errors: exact.then_some(max_err.into()),
+        output: path.as_ref().map(|p| p.display().to_string()),
+    });
     if writer.is_some() {
         // The writer still commits the last frames and closes the file: meanwhile this thread hands the
         // problem's memory (the factor, K, the load basis: about 60 MB at 24,640 unknowns) back to the
@@ -169,6 +188,10 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
             }
             _ => note!("every completed step is in {p}; its `tresca` group records why the run stopped"),
         }
+    }
+    if let Some(j) = &json {
+        summary.wall = start.elapsed().as_secs_f64();
+        super::summary::write(j, &summary)?;
     }
     result.with_context(|| "run stopped")?;
     bar.finish_and_clear();

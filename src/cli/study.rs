@@ -12,7 +12,9 @@ pub fn study(
     reference: Option<Level>,
     csv: Option<PathBuf>,
     differences: Option<PathBuf>,
+    json: Option<PathBuf>,
 ) -> Result<()> {
+    let start = std::time::Instant::now();
     use tresca_cr::study::orders::observed_order;
     use tresca_cr::study::run_study;
     println!(
@@ -61,6 +63,11 @@ pub fn study(
     if let Some(path) = csv {
         std::fs::write(&path, tresca_cr::study::csv::text(&study))
             .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(j) = &json {
+        let mut summary = super::summary::Summary::new("study", &scene.file, start.elapsed().as_secs_f64());
+        summary.study = Some(super::summary::StudySummary::of(&study, reference));
+        super::summary::write(j, &summary)?;
     }
     Ok(())
 }

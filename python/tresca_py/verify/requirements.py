@@ -1,0 +1,187 @@
+"""The requirements of `make verify`, declared once: id, statement, command and reference file.
+
+``verification/README.md``'s table is generated from this list (:mod:`tresca_py.verify.readme`, run by
+``make reference``; a pytest test checks the README is current), and the harness
+(:mod:`tresca_py.verify.harness`) takes every recorded result's default statement, command and reference
+from here and refuses an id that is not declared.
+
+A requirement is one row: ``id``; ``statement``, completing "The solver shall …"; ``command``, the command
+that checks it (a shell line, or prose such as "as P2"); ``reference``, the file it writes (``None`` when
+its evidence is the command's output). Most requirements record results under their own id or ``id-…``
+(``E1-rect-energy``); a family (one row for the cross-check's ``X-<case>-r<k>``) gives a ``pattern``, a
+regular expression a recorded id must match in full.
+"""
+import re
+from dataclasses import dataclass
+from typing import Optional
+
+
+@dataclass(frozen=True)
+class Requirement:
+    id: str
+    statement: str
+    command: str
+    reference: Optional[str]
+    pattern: Optional[str] = None
+
+    @property
+    def sentence(self):
+        """The statement as a sentence: "The solver shall …"."""
+        return f"The solver shall {self.statement}"
+
+    def matches(self, rid):
+        """True when a recorded result id ``rid`` belongs to this requirement."""
+        pattern = self.pattern or re.escape(self.id) + r"(-.+)?"
+        return re.fullmatch(pattern, rid) is not None
+
+
+REQUIREMENTS = (
+    Requirement(
+        'E1-rect',
+        'converge with order 1 ± 0.1 (energy) and 2 ± 0.15 (L²) on a smooth manufactured elasticity problem on a rectangle, 5 levels',
+        'tresca-cr study verification/cases/elastic_rect.toml --levels 2:1,3:1,4:1,5:1,6:1',
+        'reference/h_elastic_rect.md',
+    ),
+    Requirement(
+        'E2-rotated',
+        '… the same on a rotated square',
+        'tresca-cr study verification/cases/elastic_rotated.toml --levels 2:1,…,6:1',
+        'reference/h_elastic_rotated.md',
+    ),
+    Requirement(
+        'C1-front',
+        'converge with order 1 ± 0.1 in the energy norm on a Tresca problem whose stick–slip front moves in time (`mms_front`, 5 levels, N = 64)',
+        'tresca-cr study verification/cases/mms_front.toml --levels 0:64,…,4:64',
+        'reference/h_mms_front.md',
+    ),
+    Requirement(
+        'C2-rotated',
+        '… on a contact edge that is not axis-aligned (`mms_rotated`)',
+        'tresca-cr study verification/cases/mms_rotated.toml --levels 0:16,…,4:16',
+        'reference/h_mms_rotated.md',
+    ),
+    Requirement(
+        'K1-mms_stop',
+        'converge with order 1 ± 0.1 in k when slip stops abruptly inside a step (`mms_stop`, t* = 1/3, N = 4^j; time error against the N = 4096 solution on the same mesh)',
+        'tresca-cr study verification/cases/mms_stop.toml --levels 3:4,3:16,3:64,3:256 --reference 3:4096',
+        'reference/k_study_mms_stop.md',
+    ),
+    Requirement(
+        'K2-stick-to-slip',
+        'give errors independent of k (relative spread ≤ 1e-8) while points only pass from stick to slip: backward Euler is exact at the nodes (a finding, `mms_stick_to_slip`)',
+        'tresca-cr study verification/cases/mms_stick_to_slip.toml --levels 3:2,3:8,3:32,3:128',
+        'reference/be_exact_stick_to_slip.md',
+    ),
+    Requirement(
+        'J1-joint',
+        'converge with order 1 ± 0.1 in h under joint refinement h → h/2, k → k/4 (`mms_stop`)',
+        'tresca-cr study verification/cases/mms_stop.toml --levels 0:1,1:4,2:16,3:64,4:256',
+        'reference/joint_mms_stop.md',
+    ),
+    Requirement(
+        'P1-paper-orders',
+        "rest on the paper's Table 5.1 as printed (a data check): its orders recomputed from its errors are 0.8577, "
+        "0.9671, 0.9015, 0.866",
+        'verification/run_all.py --only paper',
+        'reference/paper_tables.md',
+    ),
+    Requirement(
+        'P2-paper-runs',
+        "run Example 5.1 on the paper's meshes and steps (Tables 5.1, 5.2) with every step converged, consecutive and true errors decreasing",
+        'tresca-cr study verification/cases/paper_example_5_1.toml --levels 0:40,…,4:640 --reference 7:5120',
+        'reference/paper_tables.md',
+    ),
+    Requirement(
+        'R1-estimate-effectivity',
+        'estimate the energy error without an exact solution (Richardson model, `study`) within [0.8, 1.25] of the true error at the finest two levels wherever its verdict says "in the asymptotic range", on every manufactured case (h: `mms_front`, `mms_rotated`, `mms_elastic`, `mms_stick_to_slip`, `mms_stop`; k: `mms_stop` N = 4^j against N = 4096 on the same mesh, corrected by 1/(1 − N/4096); joint: `mms_stop`), each kind in range at least once. Band from the issue; the verdict\'s tolerances (order within [p_th/2, p_th + 0.15], GCI ratio within 10 % of rᵖ) are derived in `src/study/richardson.rs`',
+        'verification/run_all.py --only estimates',
+        'reference/estimates.md',
+    ),
+    Requirement(
+        'R2-estimate-refuses',
+        'say "not yet: refine further" on the coarsest level of `mms_front` (order 0.80 between refine 0 and 1) and on every level of `mms_stop` with N = 2^j (θ = frac(N/3) alternates)',
+        'tresca-cr study verification/cases/mms_stop.toml --levels 3:4,3:8,3:16,3:32 --reference 3:4096',
+        'reference/estimates.md',
+    ),
+    Requirement(
+        'R3-differences',
+        "write with `--differences DIR` one XDMF file per level with the elementwise energy density of u_l − P u_{l−1} as a cell field that meshio and VTK's vtkXdmfReader (ParaView's XDMF Reader) open",
+        'tresca-cr study verification/cases/paper_example_5_1.toml --levels 0:40,1:80,2:160 --differences out/verify/differences',
+        None,
+    ),
+    Requirement(
+        'P3-paper-estimate',
+        "estimate the error of Example 5.1's n = 32 level from the five levels of Table 5.1 alone within 20 % of its error against the n = 256 reference run",
+        'as P2',
+        'reference/paper_tables.md',
+    ),
+    Requirement(
+        'O1-clients',
+        "write results that VTK's `vtkHDFReader`, meshio (XDMF) and h5py open, with the solver's values",
+        'scripts/check_results.py out/verify_ex51.h5',
+        None,
+    ),
+    Requirement(
+        'O2-interrupted',
+        'write files that open in the same three clients for a killed (SIGKILL mid-run), a stopped (solver failure) and a resumed run, each showing exactly its committed steps',
+        'verification/interrupted_runs.py',
+        None,
+    ),
+    Requirement(
+        'V1-paraview',
+        "be seen in ParaView as users meet it: Debian 12's ParaView 5.11 (`make paraview`; pvpython on a virtual X server) opens the files of a finished, a killed (SIGKILL) and a resumed run with `XDMFReader`, `Xdmf3ReaderS` and `Xdmf3ReaderT` as a body block and a contact-line block showing exactly the committed frames, with von Mises, displacement, slip and stick/slip equal to `/tresca` at two times (≤ 2e-5 relative, f32), and `scripts/paraview_view.py` renders a PNG whose pixels show a coloured body and the red/blue contact line (also in `make test`, skipped with a message where pvpython is absent)",
+        'verification/paraview_check.py',
+        'out/paraview/*.png',
+    ),
+    Requirement(
+        'X…',
+        'agree with the independent scikit-fem and dolfinx solutions of the same discrete problem to ≤ 1e-8 on every case at two levels (DOF vectors, energies, stick/slip sets, true errors), and dolfinx under `mpirun -n 2` with serial',
+        'verification/cross_check.py',
+        'reference/cross_check.md',
+        pattern='X-.+',
+    ),
+    Requirement(
+        'D1-distributed-agree',
+        'run distributed (scripts/dolfinx_distributed.py: mesh, a_h, factor and solves spread over the ranks, only the contact unknowns gathered) and agree with the Rust solver under `mpirun -n 1`, `-n 2` and `-n 3` on every cross-check scene at its quick level to ≤ 1e-8 (DOF vectors, energies, σ_τ, true errors), identical stick/slip sets (about 3 min)',
+        'verification/distributed.py',
+        'reference/distributed.md',
+    ),
+    Requirement(
+        'D2-distributed-memory',
+        'spread its memory: on Example 5.1 at refine 8 (1,574,912 unknowns) the peak RSS of the largest rank at `-n 2` is ≤ 0.6 × the `-n 1` peak (per rank, `/usr/bin/time -f "RSS %M"`), the two runs agreeing to 1e-8; ~5 min, in the full `make verify` only (`--quick` reports the last measurement, `reference/distributed_memory.json`)',
+        'verification/distributed.py --memory',
+        'reference/distributed.md',
+    ),
+    Requirement(
+        "PL1, PL2-<case>",
+        "plan the cheapest run for a target accuracy (`tresca-cr plan`) on mms_front, mms_rotated and mms_stop: over "
+        "nine targets a quarter decade apart spanning two decades, the plan meets the target in truth (true error ≤ "
+        "target) for ≥ 90 % (PL1) and never misses by more than 25 % (PL2). The plan's cost against the cheapest "
+        "configuration of a brute-force grid and the planner's own share of it are CPU times: `make bench` reports "
+        "them (`verification/planner.py --costs`), no pass/fail",
+        "verification/planner.py",
+        "reference/planner.md",
+        pattern=r"PL[12]-.+",
+    ),
+    Requirement(
+        'S1…S13',
+        'behave as stated at the extremes: locking-free for ν → ½ (conforming P1 locks), exact 1/E scaling, g_a → 0 / ∞ limits, k from 1e-6 to 1, ρ from 1e-4 to 1e4 (ρ → 0 refused), thin and stretched meshes, singular set-ups refused, no NaN/Inf in any results file',
+        'verification/stability.py',
+        'reference/stability.md',
+        pattern='S\\d+-.+',
+    ),
+    Requirement(
+        'F1-fuzz',
+        'not panic on 20 000 fuzzed inputs each for the scene parser (+ set-up and run), expressions and the Gmsh reader',
+        'TRESCA_FUZZ_CASES=20000 cargo test --release --test fuzz -- --nocapture',
+        'reference/fuzz.md',
+    ),
+)
+
+
+def find(rid):
+    """The requirement a recorded result id belongs to; KeyError when none declares it."""
+    found = [r for r in REQUIREMENTS if r.matches(rid)]
+    if len(found) != 1:
+        raise KeyError(f"result id {rid!r} matches {len(found)} declared requirements (tresca_py/verify/requirements.py)")
+    return found[0]

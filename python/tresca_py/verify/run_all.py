@@ -1,0 +1,85 @@
+"""make verify: every verification study of tresca-cr, its requirements checked pass/fail.
+
+Runs the release binary's `study` subcommand on the manufactured cases and on the paper's Example 5.1, the
+independent Python solvers and the comparisons, and records every requirement of
+:mod:`tresca_py.verify.requirements` in one :class:`~tresca_py.verify.harness.Harness`. Everything is written
+under out/verify/ (tables and plots for reference/ staged in out/verify/reference/; `make reference`
+publishes them; a --quick run writes under out/verify/quick/, never published); the summary is
+out/verify/summary.md. Exit status 1 if any requirement fails.
+
+    .venv/bin/python verification/run_all.py [--quick] [--only NAME ...]
+"""
+import argparse
+import os
+import subprocess
+import time
+
+from tresca_py.common import BIN, PY
+from tresca_py.verify import checks, estimates, paper, studies
+from tresca_py.verify.harness import Harness, out_dir
+
+
+def study_table(quick):
+    """The studies by name, each a function of the harness (run in this order)."""
+    n = 4 if quick else 5
+    return {
+        "elastic": lambda hs: (
+            studies.h_study(hs, "E1-rect", "verification/cases/elastic_rect.toml", "h_elastic_rect",
+                            [(k, 1) for k in range(2, 7)], 1, 2,
+                            "the CR solver shall converge on a smooth elasticity problem (rectangle)"),
+            studies.h_study(hs, "E2-rotated", "verification/cases/elastic_rotated.toml", "h_elastic_rotated",
+                            [(k, 1) for k in range(2, 7)], 1, 2,
+                            "the CR solver shall converge on a smooth elasticity problem (rotated square)")),
+        "front": lambda hs: studies.h_study(hs, "C1-front", "verification/cases/mms_front.toml", "h_mms_front",
+                                            [(k, 64) for k in range(n)], 1, 2,
+                                            "with a moving stick–slip front the solver shall converge in h",
+                                            l2_required=False),
+        "rotated": lambda hs: studies.h_study(hs, "C2-rotated", "verification/cases/mms_rotated.toml", "h_mms_rotated",
+                                              [(k, 16) for k in range(n)], 1, 2,
+                                              "with contact on a non-axis-aligned edge the solver shall converge in h",
+                                              l2_required=False),
+        "k": lambda hs: studies.k_study(hs, quick),
+        "be_exact": studies.be_exact_study,
+        "joint": lambda hs: studies.joint_study(hs, quick),
+        "paper": lambda hs: paper.paper_tables(hs, quick),
+        "estimates": lambda hs: estimates.run(hs, quick),
+        "planner": lambda hs: checks.planner(hs, quick),
+        "clients": checks.results_clients,
+        "paraview": checks.paraview,
+        "stability": checks.stability,
+        "cross": lambda hs: checks.cross_check(hs, quick),
+        "distributed": lambda hs: checks.distributed(hs, quick),
+        "fuzz": lambda hs: checks.fuzz(hs, quick),
+    }
+
+
+def versions():
+    version = subprocess.run([BIN, "--version"], capture_output=True, text=True).stdout.strip()
+    pyv = subprocess.run([PY, "-c", "import skfem, dolfinx_solver, dolfinx, numpy, scipy, sympy; print('scikit-fem', "
+                          "skfem.__version__, 'dolfinx', dolfinx.__version__, 'numpy', numpy.__version__, 'scipy', "
+                          "scipy.__version__, 'sympy', sympy.__version__)"], capture_output=True, text=True).stdout.strip()
+    return f"{version}; {pyv}"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="smaller levels (for make test)")
+    ap.add_argument("--only", nargs="*", help="run only these studies")
+    args = ap.parse_args(argv)
+    table = study_table(args.quick)
+    unknown = sorted(set(args.only or []) - set(table))
+    if unknown:
+        ap.error(f"unknown studies {', '.join(unknown)}; known: {', '.join(table)}")
+    # a --quick run's tables are not the reference's: they go to out/verify/quick/, which `make reference` ignores
+    hs = Harness(out=os.path.join(out_dir(), "quick") if args.quick else None)
+    t0 = time.time()
+    for name, fn in table.items():
+        if args.only and name not in args.only:
+            continue
+        try:
+            fn(hs)
+        except Exception as e:  # a study that cannot run is a failed requirement, not a crash
+            hs.not_run(name, str(e).splitlines()[0][:300] if str(e) else repr(e))
+    header = (f"Machine: {os.uname().nodename}, {os.cpu_count()} cores; total {time.time() - t0:.0f} s. "
+              f"Versions: {versions()}.")
+    return hs.report(header, partial=bool(args.only))

@@ -1,0 +1,375 @@
+//! `--json FILE`: the machine-readable summary of `check`, `run`, `study` and `plan`, written (atomically:
+//! a temporary file renamed) when the subcommand ends, also when a run stops on a solver failure. The
+//! verification scripts read it instead of the human messages, which may be reworded at any time. Its
+//! structs mirror library types (`LevelResult`, `plan::Candidate`, …) on purpose: the schema is a contract
+//! with the scripts and stays put when the library renames or regroups its fields.
+//!
+//! Schema (version [`SCHEMA`]; times in seconds, sizes in unknowns or bytes; a non-finite number is
+//! written as `null`):
+//!
+//! | field | meaning |
+//! |---|---|
+//! | `schema` | the schema version, [`SCHEMA`] |
+//! | `command` | `check`, `run`, `study` or `plan` |
+//! | `version`, `commit` | the crate version and the git commit of the build (`-dirty` when it had changes) |
+//! | `scene` | the scene file as given |
+//! | `status` | `completed`, `stopped: <why>` (a run's solver failure) or `refused: <why>` (a plan's refusal) |
+//! | `wall` | wall time of the whole subcommand |
+//! | `check`, `run`, `study`, `plan` | the part of the subcommand that ran (the others `null`) |
+//!
+//! `check` ([`CheckSummary`]): `vertices`, `triangles`, `edges`, `h` (largest edge) of the mesh; `unknowns`,
+//! `paper_dofs` (the paper's count 2(edges − Dirichlet edges)), `contact_unknowns`; `steps`; `solver`, `tol`,
+//! `max_iter`; `exact` (true errors computed); `setup` ([`Phases`]); `memory`, `disk`: the pre-run estimate
+//! of the peak memory and of the results file (bytes).
+//!
+//! `run` ([`RunSummary`]): `refine` (the mesh level), `unknowns`, `paper_dofs`, `contact_edges`, `steps` (time
+//! steps of the run); `solver`, `tol`; `setup` ([`Phases`]); `step_stats`: one [`Step`] per step solved (step
+//! 0 included: `n`, `t`, `iterations`, `residual` (the solver's final KKT residual), `stick`, `slip` (contact
+//! edges), `errors` (true errors at tⁿ with `[exact]`, else `null`)); `iterations` (sum over the steps),
+//! `max_residual`; `max_errors`: the true errors, max over the time nodes (`null` without `[exact]`);
+//! `output`: the results file (`null` when none was written).
+//!
+//! [`Phases`]: the set-up's wall times `space` (mesh binding and numbering of V_h), `assembly` (K and the
+//! loads, with the fill-reducing ordering beside them), `factorisation` (Cholesky of K), `superposition`
+//! (the load responses K⁻¹b_j) and `condensation` (C = EᵀK⁻¹E and W = L_cc⁻¹).
+//!
+//! [`Errors`]: `energy` (the a_h norm with the jump term), `h1` (broken H¹ seminorm) and `l2`.
+//!
+//! `study` ([`StudySummary`]): `levels`, one [`Level`] per level, coarse to fine: `refine`, `steps`, `h`, `k`,
+//! `dofs`, `paper_dofs`, `wall`, `setup` (its set-up wall time), `iterations`; the true errors `max_err` (max
+//! over its own nodes), `common_err` (max over the nodes common to all levels), `final_err` (at T); `norm_max`
+//! (max over the common nodes of |||u|||); `consecutive` and `reference`: [max over common nodes, at T] of
+//! |||u_l − P u_{l−1}||| and of the error against the `--reference` run; `estimate`: [`LevelEstimate`]
+//! (`error_max`, `error_t`, `gci`, `verdict`) or `null`; `outputs`: the scalar outputs at T, in the order of
+//! `output_names`. `reference`: the reference level (`refine`, `steps`) or `null`. `estimates`
+//! ([`Estimates`]): `size` (`h` or `k`), `p`, `beta` (the model of the three finest levels, `null` when
+//! refused), `refused` (why no estimate). `outputs`: per scalar output `name`, `p`, `limit` (the extrapolated
+//! value, `null` without a model) and per level `estimate`, `gci`, `verdict`. `difference_files`: the files
+//! `--differences` wrote.
+//!
+//! `plan` ([`PlanSummary`]): `target`, `quantity`, `budget`, `pilot_budget`; `pilot_wall` (the pilots' wall
+//! time); `space_pilot`, `time_pilot` ([`Pilot`]: `size`, `levels` ([`Level`] without true errors: the
+//! pilots run the scene without `[exact]`), `x`, `errors`, `verdicts`, `p`, `beta`, `refused`); `time_ratio`,
+//! `scene_steps`; `error_model` (`space_c`, `space_p`; `time_c`, `time_p` for a power law or `time_bound`;
+//! `combine`: `quadrature` or `sum`); `cost_model` (`setup_c`, `setup_p`, `step`: wall = setup_c n^setup_p
+//! + N · step · n ln n); `plan` and `runners_up` ([`Candidate`]: `refine`, `steps`, `unknowns`, `h`, `k`,
+//! `error`, `space_error`, `time_error`, `wall`, `memory`), `over_budget`; `solver`, `tol`; `notes`;
+//! `refused`; `achieved` (with `--run`, [`Achieved`]: `estimate`, `space`, `time`, `true_error`, `met`,
+//! `levels`).
+
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use tresca_cr::fem::norms::ErrorNorms;
+use tresca_cr::stepping::SetupTimes;
+use tresca_cr::study::LevelResult;
+
+/// The schema version written in `schema`; raised when a field changes meaning or goes away.
+pub const SCHEMA: u32 = 1;
+
+/// `--json FILE`, shared by the subcommands.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct JsonArg {
+    /// Write a machine-readable summary (JSON; fields in src/cli/summary.rs) to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+}
+
+/// The summary of one subcommand (see the module doc).
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct Summary {
+    pub schema: u32,
+    pub command: String,
+    pub version: String,
+    pub commit: String,
+    pub scene: String,
+    pub status: String,
+    pub wall: f64,
+    pub check: Option<CheckSummary>,
+    pub run: Option<RunSummary>,
+    pub study: Option<StudySummary>,
+    pub plan: Option<PlanSummary>,
+}
+
+impl Summary {
+    /// An empty summary of `command` on `scene`, completed.
+    pub fn new(command: &str, scene: &str, wall: f64) -> Summary {
+        Summary {
+            schema: SCHEMA,
+            command: command.into(),
+            version: env!("CARGO_PKG_VERSION").into(),
+            commit: env!("TRESCA_BUILD_COMMIT").into(),
+            scene: scene.into(),
+            status: "completed".into(),
+            wall,
+            check: None,
+            run: None,
+            study: None,
+            plan: None,
+        }
+    }
+}
+
+/// Refuse a `--json` path whose directory does not exist before any work is done (a long run would
+/// otherwise fail at its end).
+pub fn check_path(path: Option<&Path>) -> Result<()> {
+    if let Some(p) = path {
+        let dir = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        anyhow::ensure!(dir.is_dir(), "--json {}: the directory {} does not exist", p.display(), dir.display());
+        anyhow::ensure!(!p.is_dir(), "--json {}: is a directory", p.display());
+    }
+    Ok(())
+}
+
+/// Write `s` to `path` (a temporary file beside it, then renamed: never half written).
+pub fn write(path: &Path, s: &Summary) -> Result<()> {
+    let text = serde_json::to_string_pretty(s).context("cannot serialise the summary")?;
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    std::fs::write(&tmp, text + "\n").with_context(|| format!("cannot write {}", tmp.display()))?;
+    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// The set-up's wall times.
+#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq, Default)]
+pub struct Phases {
+    pub space: f64,
+    pub assembly: f64,
+    pub factorisation: f64,
+    pub superposition: f64,
+    pub condensation: f64,
+}
+
+impl From<SetupTimes> for Phases {
+    fn from(s: SetupTimes) -> Phases {
+        let SetupTimes { space, assembly, factorisation, superposition, condensation } = s;
+        Phases { space, assembly, factorisation, superposition, condensation }
+    }
+}
+
+/// True errors at one time (or their max).
+#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq, Default)]
+pub struct Errors {
+    pub energy: f64,
+    pub h1: f64,
+    pub l2: f64,
+}
+
+impl From<ErrorNorms> for Errors {
+    fn from(e: ErrorNorms) -> Errors {
+        Errors { energy: e.energy, h1: e.h1, l2: e.l2 }
+    }
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct CheckSummary {
+    pub vertices: usize,
+    pub triangles: usize,
+    pub edges: usize,
+    pub h: f64,
+    pub unknowns: usize,
+    pub paper_dofs: usize,
+    pub contact_unknowns: usize,
+    pub steps: usize,
+    pub solver: String,
+    pub tol: f64,
+    pub max_iter: usize,
+    pub exact: bool,
+    pub setup: Phases,
+    pub memory: u64,
+    pub disk: u64,
+}
+
+/// One time step's statistics.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct Step {
+    pub n: usize,
+    pub t: f64,
+    pub iterations: usize,
+    pub residual: f64,
+    pub stick: usize,
+    pub slip: usize,
+    pub errors: Option<Errors>,
+}
+
+impl Step {
+    pub fn of(r: &tresca_cr::StepResult) -> Step {
+        Step {
+            n: r.n,
+            t: r.t,
+            iterations: r.iterations,
+            residual: r.residual,
+            stick: r.n_stick(),
+            slip: r.n_slip(),
+            errors: r.errors.map(Errors::from),
+        }
+    }
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct RunSummary {
+    pub refine: u32,
+    pub unknowns: usize,
+    pub paper_dofs: usize,
+    pub contact_edges: usize,
+    pub steps: usize,
+    pub solver: String,
+    pub tol: f64,
+    pub setup: Phases,
+    pub step_stats: Vec<Step>,
+    pub iterations: usize,
+    pub max_residual: f64,
+    pub max_errors: Option<Errors>,
+    pub output: Option<String>,
+}
+
+/// A level's estimate.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct LevelEstimate {
+    pub error_max: f64,
+    pub error_t: f64,
+    pub gci: f64,
+    pub verdict: String,
+}
+
+/// One level of a study or of a planner's pilot.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct Level {
+    pub refine: u32,
+    pub steps: usize,
+    pub h: f64,
+    pub k: f64,
+    pub dofs: usize,
+    pub paper_dofs: usize,
+    pub wall: f64,
+    pub setup: f64,
+    pub iterations: usize,
+    pub max_err: Option<Errors>,
+    pub common_err: Option<Errors>,
+    pub final_err: Option<Errors>,
+    pub norm_max: f64,
+    pub consecutive: Option<[f64; 2]>,
+    pub reference: Option<[f64; 2]>,
+    pub estimate: Option<LevelEstimate>,
+    pub outputs: Vec<f64>,
+}
+
+impl Level {
+    pub fn of(r: &LevelResult, estimate: Option<LevelEstimate>) -> Level {
+        Level {
+            refine: r.refine,
+            steps: r.steps,
+            h: r.h,
+            k: r.k,
+            dofs: r.dofs,
+            paper_dofs: r.paper_dofs,
+            wall: r.wall,
+            setup: r.setup,
+            iterations: r.iterations,
+            max_err: r.max_err.map(Errors::from),
+            common_err: r.common_err.map(Errors::from),
+            final_err: r.final_err.map(Errors::from),
+            norm_max: r.norm_max,
+            consecutive: r.consecutive,
+            reference: r.reference,
+            estimate,
+            outputs: r.outputs.clone(),
+        }
+    }
+}
+
+/// The energy-norm model of a study.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct Estimates {
+    pub size: String,
+    pub p: Option<f64>,
+    pub beta: Option<f64>,
+    pub refused: Option<String>,
+}
+
+/// A scalar output's estimate at one level.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct OutputLevel {
+    pub estimate: f64,
+    pub gci: f64,
+    pub verdict: String,
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct OutputEstimate {
+    pub name: String,
+    pub p: Option<f64>,
+    pub limit: Option<f64>,
+    pub levels: Vec<OutputLevel>,
+}
+
+/// The level spelled refine:steps.
+#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq)]
+pub struct LevelSpec {
+    pub refine: u32,
+    pub steps: usize,
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct StudySummary {
+    pub levels: Vec<Level>,
+    pub reference: Option<LevelSpec>,
+    pub estimates: Estimates,
+    pub output_names: Vec<String>,
+    pub outputs: Vec<OutputEstimate>,
+    pub difference_files: Vec<String>,
+}
+
+impl StudySummary {
+    pub fn of(s: &tresca_cr::study::Study, reference: Option<tresca_cr::study::Level>) -> StudySummary {
+        let e = &s.estimates;
+        let levels = s
+            .levels
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let est = e.levels.get(i).map(|l| LevelEstimate {
+                    error_max: l.error[0],
+                    error_t: l.error[1],
+                    gci: l.gci,
+                    verdict: l.verdict.text(),
+                });
+                Level::of(r, est)
+            })
+            .collect();
+        let outputs = s
+            .outputs
+            .iter()
+            .map(|o| OutputEstimate {
+                name: o.name.clone(),
+                p: o.model.map(|m| m.p),
+                limit: o.model.map(|m| m.limit),
+                levels: o
+                    .levels
+                    .iter()
+                    .map(|(est, gci, v)| OutputLevel { estimate: *est, gci: *gci, verdict: v.text() })
+                    .collect(),
+            })
+            .collect();
+        StudySummary {
+            levels,
+            reference: reference.map(|l| LevelSpec { refine: l.refine, steps: l.steps }),
+            estimates: Estimates {
+                size: e.size.into(),
+                p: e.model.map(|m| m.p),
+                beta: e.model.map(|m| m.beta),
+                refused: e.refused.clone(),
+            },
+            output_names: s.output_names.clone(),
+            outputs,
+            difference_files: s.difference_files.iter().map(|f| f.display().to_string()).collect(),
+        }
+    }
+}
+
+mod plan;
+pub use plan::{Achieved, PlanSummary};
+
+#[cfg(test)]
+mod tests;
