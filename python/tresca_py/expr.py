@@ -161,7 +161,7 @@ def _names():
         return S.Piecewise((-((-a) ** S.Rational(1, 3)), a < 0), (a ** S.Rational(1, 3), True))
 
     return {
-        "x": x, "y": y, "t": t, "PI": S.pi, "π": S.pi, "E": S.E, "e": S.E, "TAU": 2 * S.pi, "τ": 2 * S.pi,
+        "x": x, "y": y, "t": t, "PI": S.pi, "pi": S.pi, "π": S.pi, "E": S.E, "e": S.E, "TAU": 2 * S.pi, "τ": 2 * S.pi,
         "abs": S.Abs, "signum": signum, "sin": S.sin, "cos": S.cos, "tan": S.tan, "asin": S.asin,
         "acos": S.acos, "atan": S.atan, "sinh": S.sinh, "cosh": S.cosh, "tanh": S.tanh, "asinh": S.asinh,
         "acosh": S.acosh, "atanh": S.atanh, "floor": S.floor, "round": rnd, "ceil": S.ceiling,
