@@ -56,7 +56,7 @@ venv: $(VENV)/.stamp
 
 test: build venv
 	cargo test --release --locked
-	$(PY) verification/python_tests.py
+	$(PY) -m pytest python/tests -q
 
 verify: build venv paraview
 	$(PY) verification/run_all.py

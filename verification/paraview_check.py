@@ -23,7 +23,8 @@ import signal
 import subprocess
 import sys
 
-from tresca_py.common import BIN, ROOT  # noqa: E402
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))   # no tresca_py: pvpython runs this file too
+BIN = os.path.join(ROOT, "target", "release", "tresca-cr")
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 OUT = os.path.join(ROOT, "out", "paraview")
 READERS = ("XDMFReader", "Xdmf3ReaderS", "Xdmf3ReaderT")

@@ -170,9 +170,8 @@ def p1_h1_error(nu, n):
 
 def cond_K(scene_path, refine):
     """Condition number of the reduced stabilised CR stiffness (scikit-fem assembly of the same a_h)."""
-    sys.path.insert(0, os.path.join(ROOT, "scripts"))
-    from tresca_py import tresca_scene as ts
-    from skfem_solve import SkfemProblem
+    from tresca_py import cli as ts
+    from tresca_py.skfem_cr.assemble import SkfemProblem
     args = ts.cli("cond", [scene_path, "-o", os.path.join(TMP, "c.h5"), "--refine", str(refine), "-q"])
     scene, disc, _ = ts.open_scene(args)
     K = SkfemProblem(disc).K
