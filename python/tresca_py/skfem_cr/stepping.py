@@ -85,7 +85,8 @@ def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True):
 # ----------------------------------------------------------------------------------------------
 # output
 # ----------------------------------------------------------------------------------------------
-def _git_commit():
+def git_commit():
+    """The repository's commit (for the results file's attributes), "unknown" outside a clone."""
     try:
         return subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
                               cwd=os.path.dirname(os.path.abspath(__file__)), timeout=5).stdout.strip() or "unknown"
@@ -124,7 +125,7 @@ def write_results(path, disc: Discretisation, res, solver_name, extra_attrs=None
             for k, v in res["errors"].items():
                 g.create_dataset(f"errors/{k}", data=v)
         attrs = {"scene": scene.text, "scene_path": os.path.abspath(scene.path), "version": "python-1",
-                 "git_commit": _git_commit(), "solver": solver_name,
+                 "git_commit": git_commit(), "solver": solver_name,
                  "method": "primal active set on the condensed dual (exact)",
                  "tol": float(scene.solver.get("tol", 1e-12)), "rho": scene.rho, "E": scene.E, "nu": scene.nu,
                  "refine": int(scene.mesh["refine"]), "steps": len(scene.times) - 1,
