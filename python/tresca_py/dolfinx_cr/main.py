@@ -8,6 +8,7 @@ from mpi4py import MPI
 
 from tresca_py.cli import cli, open_scene
 from tresca_py.dolfinx_cr.assemble import DolfinxProblem
+from tresca_py.dolfinx_cr.friction import TaoStepSolver
 from tresca_py.errors import InputError
 from tresca_py.skfem_cr.stepping import run, write_results
 
@@ -23,10 +24,12 @@ def main(argv=None):
         sys.exit(f"error: {err}")
     t_asm = time.perf_counter() - t0
     errors = prob.errors if scene.exact_u is not None else None
-    res = run(disc, prob.K, prob.J, prob.load, errors, comm=comm, log=not args.quiet and comm.rank == 0)
+    res = run(disc, prob.K, prob.J, prob.load, errors, comm=comm, log=not args.quiet and comm.rank == 0,
+              step_solver=TaoStepSolver)
     wall = time.perf_counter() - t0
     if comm.rank == 0:
         write_results(out, disc, res, "dolfinx", {"assembly_time": t_asm, "total_time": wall,
+                                                     "method": TaoStepSolver.method,
                                                      "mpi_size": comm.size})
         print(f"dolfinx ({comm.size} rank{'s' if comm.size > 1 else ''}): {len(disc.edges)} edges, "
               f"{len(disc.contact)} contact edges, {len(scene.times) - 1} steps; "

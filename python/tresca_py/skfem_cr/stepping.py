@@ -10,8 +10,9 @@ from tresca_py.skfem_cr.cr import Discretisation
 from tresca_py.skfem_cr.friction import StepSolver, classify
 
 
-def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True):
-    """Backward Euler over ``scene.times``.
+def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True, step_solver=StepSolver):
+    """Backward Euler over ``scene.times``; ``step_solver(disc, K)`` solves the steps (its ``step(l, u_prev)``
+    as ``friction.StepSolver``'s; the dolfinx re-implementation passes its own).
 
     ``K``: canonical sparse a_h (only needed on rank 0); ``J`` (its jump part) is unused here.
     ``load(t)``: collective; canonical load vector on rank 0 (anything elsewhere).
@@ -28,7 +29,7 @@ def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True):
     root = rank == 0
     if root:
         t0 = time.perf_counter()
-        stepper = StepSolver(disc, K)
+        stepper = step_solver(disc, K)
         t_fact = time.perf_counter() - t0
         E2 = disc.n_dofs
         res = dict(u=np.zeros((N + 1, E2 // 2, 2)), slip=np.zeros((N + 1, C)), mu=np.zeros((N + 1, C)),
