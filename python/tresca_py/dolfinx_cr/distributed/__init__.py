@@ -29,7 +29,7 @@ Wadhawan), but nothing of size O(mesh) is held by one rank:
   ``--rhs-block`` columns at a time; at 1.57M unknowns on 1 rank, blocks of 32: 76 s and +0.95 GB for C,
   against 10 s and no extra memory for the selected entries.)
   Per step: u_f = K_r^{-1} l^n (distributed), d = E^T u_f - s^{n-1} gathered to rank 0 (n_c numbers),
-  the friction problem solved there by the project's exact box-QP step (``tresca_py.skfem_cr.friction.box_qp``),
+  the friction problem solved there by PETSc TAO TRON (``tresca_py.dolfinx_cr.friction.TaoBoxQP``),
   mu broadcast, u^n = u_f - K_r^{-1} E mu (distributed).
 * True errors are assembled distributed (the UFL forms of ``tresca_py.dolfinx_cr.forms``).
 * Output, without gathering the field: each rank writes its owned edges (points, triangles, edges,

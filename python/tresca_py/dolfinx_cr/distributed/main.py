@@ -17,7 +17,8 @@ from tresca_py.dolfinx_cr.distributed.output import PartWriter, write_main
 from tresca_py.dolfinx_cr.distributed.problem import Problem, peak_mb
 from tresca_py.errors import InputError
 from tresca_py.scene import load_scene
-from tresca_py.skfem_cr.friction import box_qp, classify, kkt_residual
+from tresca_py.dolfinx_cr.friction import TaoBoxQP, natural_residual
+from tresca_py.skfem_cr.friction import classify
 
 DESCRIPTION = ("Quasi-static Tresca friction with stabilised CR elements -- distributed DOLFINx 0.11 + PETSc/MUMPS "
                "solver.")
@@ -90,21 +91,24 @@ def new_results(scene, nc):
 
 
 class Friction:
-    """The friction problem of each step on rank 0 (exact box QP on the condensed contact unknowns)."""
+    """The friction problem of each step on rank 0: the dual box QP on the condensed contact unknowns by
+    PETSc TAO TRON (``tresca_py.dolfinx_cr.friction``)."""
 
     def __init__(self, prob):
         self.prob = prob
         self.s_prev = prob.gather_contact(prob.ur)
-        self.mu_prev = np.zeros(prob.n_c) if prob.comm.rank == 0 else None
+        root = prob.comm.rank == 0
+        self.mu_prev = np.zeros(prob.n_c) if root else None
+        self.qp = TaoBoxQP(prob.C, prob.C_w) if root and prob.n_c else None
 
     def step(self, n, sf, res):
         """Rank 0: mu of step n from the frictionless contact unknowns sf; the statistics into res."""
         prob = self.prob
         d = sf - self.s_prev
-        mu, its = box_qp(prob.C, d, prob.C_w, self.mu_prev)
+        mu, its = self.qp.solve(d, self.mu_prev)
         ds = d - prob.C @ mu
         res["iterations"][n] = its
-        res["residual"][n] = kkt_residual(prob.C, d, prob.C_w, mu)
+        res["residual"][n] = natural_residual(prob.C, d, prob.C_w, mu)
         res["state"][n] = classify(mu, ds, d, prob.C_w)
         res["sigma_t"][n] = -mu / prob.C_len
         res["mu"][n] = mu

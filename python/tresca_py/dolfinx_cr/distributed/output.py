@@ -86,7 +86,7 @@ def write_main(out, prob, res, writer_dirname, sizes, attrs):
                 g.create_dataset(f"errors/{k}", data=v)
         a = {"scene": scene.text, "scene_path": os.path.abspath(scene.path), "version": "python-distributed-1",
              "git_commit": git_commit(), "solver": "dolfinx-distributed",
-             "method": "primal active set on the condensed dual (exact), rank 0",
+             "method": "TAO TRON on the condensed dual (PETSc), rank 0",
              "tol": float(scene.solver.get("tol", 1e-12)), "rho": scene.rho, "E": scene.E, "nu": scene.nu,
              "refine": int(scene.mesh["refine"]), "steps": N1 - 1, "n_edges": prob.nb_glob,
              "n_contact": prob.n_c, "n_dofs": 2 * prob.nb_glob, "parts": rel}
