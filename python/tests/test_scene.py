@@ -52,8 +52,10 @@ def scene(tmp_path, **kw):
     return str(path)
 
 
-def test_the_system_shall_read_a_valid_scene_as_the_rust_solver_does(tmp_path, rust_bin):
-    p = scene(tmp_path)
+@pytest.mark.parametrize("extra", ["", "[outputs]\nmax_slip = true\ntraction_at = [[0.5, 0.0]]\n",
+                                   "[units]\nlength = 'm'\n"])
+def test_the_system_shall_read_a_valid_scene_as_the_rust_solver_does(extra, tmp_path, rust_bin):
+    p = scene(tmp_path, extra=extra)
     assert run([rust_bin, "check", p]).returncode == 0
     assert len(load_scene(p).times) == 3
 

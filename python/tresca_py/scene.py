@@ -34,6 +34,7 @@ _SCHEMA = {
     "exact": {"u", "grad"},
     "output": {"path"},
     "units": {"length", "force", "time"},  # labels for pictures only (scripts/render.py)
+    "outputs": {"max_slip", "stick_length", "energy", "traction_at"},  # what `tresca-cr study` estimates
 }
 
 
