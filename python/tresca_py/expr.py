@@ -38,10 +38,8 @@ class ExprError(InputError):
 _BINARY = ("min", "max", "atan2")
 
 
-def lint(text: str) -> str:
-    """src/scene/expr/lint.rs: refuse the readings exmex makes unlike mathematics; return the text as
-    handed to exmex (``pi`` written ``PI``; scientific literals are left as they are, Python reads them).
-    Raises ``ExprError`` with the Rust message."""
+def _tokens(text):
+    """lint.rs's tokens (atom ident binary open close comma op:<c>) and the text as handed to exmex."""
     toks = []                                   # kinds: atom ident binary open close comma op:<c>
     i, n = 0, len(text)
     out = []
@@ -82,6 +80,14 @@ def lint(text: str) -> str:
             out.append(c)
             toks.append({"(": "open", ")": "close", ",": "comma"}.get(c, "op:" + c))
             i += 1
+    return toks, "".join(out)
+
+
+def lint(text: str) -> str:
+    """src/scene/expr/lint.rs: refuse the readings exmex makes unlike mathematics; return the text as
+    handed to exmex (``pi`` written ``PI``; scientific literals are left as they are, Python reads them).
+    Raises ``ExprError`` with the Rust message."""
+    toks, normalised = _tokens(text)
 
     def skip_operand(i):
         j = i
@@ -125,7 +131,7 @@ def lint(text: str) -> str:
                 j += 1
             if at(skip_operand(j)) == "op:^":
                 raise ExprError("chained powers: exmex reads a^b^c as (a^b)^c; parenthesise, e.g. a^(b^c)")
-    return "".join(out)
+    return normalised
 
 
 # characters exmex's float operators are written with (plus Python's float literal syntax)

@@ -88,8 +88,9 @@ def _num(tab, key, where, default=None, positive=False, integer=False):
     return v
 
 
-def load_scene(path, refine=None, steps=None):
-    """Read and validate a scene TOML file. ``refine``/``steps`` override [mesh] refine / [time] steps."""
+
+def _read_doc(path):
+    """The TOML text and document; unknown tables and keys are errors naming them."""
     try:
         with open(path, "rb") as fh:
             raw = fh.read()
@@ -115,8 +116,10 @@ def load_scene(path, refine=None, steps=None):
             for k in tab:
                 if k not in allowed:
                     raise SceneError(f"{path}: unknown key '{k}' in [{key}] (allowed: {sorted(allowed)})")
+    return text, doc
 
-    # mesh
+
+def _read_mesh(path, doc, refine):
     mesh = dict(doc.get("mesh", {}))
     if not mesh:
         raise SceneError(f"{path}: missing [mesh]")
@@ -146,7 +149,10 @@ def load_scene(path, refine=None, steps=None):
         mesh["refine"] = int(refine)
     if mesh["refine"] < 0:
         raise SceneError(f"{path}: [mesh] refine must be >= 0")
+    return mesh
 
+
+def _read_material(path, doc):
     mat = doc.get("material")
     if not isinstance(mat, dict):
         raise SceneError(f"{path}: missing [material]")
@@ -154,7 +160,10 @@ def load_scene(path, refine=None, steps=None):
     nu = _num(mat, "nu", "material")
     if not (-1.0 < nu < 0.5):
         raise SceneError(f"[material] nu = {nu} must lie in (-1, 0.5)")
+    return E, nu
 
+
+def _read_boundaries(doc):
     bnds = []
     seen = set()
     for i, b in enumerate(doc.get("boundary", [])):
@@ -181,11 +190,10 @@ def load_scene(path, refine=None, steps=None):
             if bd.g_a.depends_on_t:
                 raise SceneError(f"boundary '{name}' g_a must not depend on t")
         bnds.append(bd)
+    return bnds
 
-    loads = doc.get("loads", {})
-    f = VecExpr(loads.get("f", ["0", "0"]), "[loads] f")
-    u0 = VecExpr(doc.get("initial", {}).get("u0", ["0", "0"]), "[initial] u0")
 
+def _read_times(path, doc, steps):
     tm = doc.get("time")
     if not isinstance(tm, dict):
         raise SceneError(f"{path}: missing [time]")
@@ -205,13 +213,11 @@ def load_scene(path, refine=None, steps=None):
         if N < 1:
             raise SceneError("[time] steps must be >= 1")
         times = T * np.arange(N + 1) / N
+    return times
 
-    rho = _num(doc.get("discretisation", {}), "rho", "discretisation", default=10.0)
-    if rho <= 0:
-        raise SceneError("[discretisation] rho must be positive (without the jump term CR elasticity is singular)")
-    solver = {"method": "ssn", "tol": 1e-12, "max_iter": 500, "uzawa_step": 0.0}
-    solver.update(doc.get("solver", {}))
 
+def _read_exact(doc):
+    """([exact] u, [exact] grad) as expressions, or (None, None)."""
     exact_u = exact_grad = None
     if "exact" in doc:
         ex = doc["exact"]
@@ -222,9 +228,26 @@ def load_scene(path, refine=None, steps=None):
         if not isinstance(g, list) or len(g) != 2 or any(not isinstance(r, list) or len(r) != 2 for r in g):
             raise SceneError("[exact] grad must be [[du1/dx, du1/dy], [du2/dx, du2/dy]]")
         exact_grad = [[Expr(g[i][j], f"[exact] grad[{i}][{j}]") for j in range(2)] for i in range(2)]
+    return exact_u, exact_grad
+
+
+def load_scene(path, refine=None, steps=None):
+    """Read and validate a scene TOML file. ``refine``/``steps`` override [mesh] refine / [time] steps."""
+    text, doc = _read_doc(path)
+    mesh = _read_mesh(path, doc, refine)
+    E, nu = _read_material(path, doc)
+    bnds = _read_boundaries(doc)
+    loads = doc.get("loads", {})
+    f = VecExpr(loads.get("f", ["0", "0"]), "[loads] f")
+    u0 = VecExpr(doc.get("initial", {}).get("u0", ["0", "0"]), "[initial] u0")
+    times = _read_times(path, doc, steps)
+    rho = _num(doc.get("discretisation", {}), "rho", "discretisation", default=10.0)
+    if rho <= 0:
+        raise SceneError("[discretisation] rho must be positive (without the jump term CR elasticity is singular)")
+    solver = {"method": "ssn", "tol": 1e-12, "max_iter": 500, "uzawa_step": 0.0}
+    solver.update(doc.get("solver", {}))
+    exact_u, exact_grad = _read_exact(doc)
     out = doc.get("output", {}).get("path")
     return Scene(path=str(path), text=text, title=str(doc.get("title", "")), mesh=mesh, E=float(E),
                  nu=float(nu), boundaries=bnds, f=f, u0=u0, times=times, rho=float(rho), solver=solver,
                  exact_u=exact_u, exact_grad=exact_grad, output=out)
-
-

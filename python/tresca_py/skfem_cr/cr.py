@@ -27,6 +27,12 @@ class Discretisation:
         self.scene = scene
         mesh = build_mesh(scene) if mesh is None else mesh
         self.points, self.triangles = mesh.points, mesh.triangles
+        self._edges()
+        self._parts(mesh)
+        self._contact_data()
+
+    def _edges(self):
+        """Edges (boundary ones counter-clockwise), their triangles, midpoints and lengths."""
         p, tri = self.points, self.triangles
         d1, d2 = p[tri[:, 1]] - p[tri[:, 0]], p[tri[:, 2]] - p[tri[:, 0]]
         area2 = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
@@ -57,7 +63,9 @@ class Discretisation:
         self.lengths = np.hypot(dvec[:, 0], dvec[:, 1])
         self.is_boundary = bnd
 
-        # boundary parts
+    def _parts(self, mesh):
+        """The boundary part of every edge, and the edge lists per kind."""
+        scene, bnd, E = self.scene, self.is_boundary, len(self.edges)
         self.part_of_edge = -np.ones(E, dtype=np.int64)
         lookup = {(int(a), int(b)): k for k, (a, b) in enumerate(np.sort(self.edges, axis=1))}
         parts = {b.name: b for b in scene.boundaries}
@@ -93,6 +101,10 @@ class Discretisation:
             # with the jump term a_h is still definite only if rigid motions are excluded
             print("warning: no Dirichlet edges; a_h may be singular", file=sys.stderr)
 
+    def _contact_data(self):
+        """Normals, tangents and the edge means gbar of g_a (3-point Gauss) on the contact edges."""
+        scene, p = self.scene, self.points
+        dvec = p[self.edges[:, 1]] - p[self.edges[:, 0]]
         c = self.contact
         dv = dvec[c] / self.lengths[c, None]
         self.tangent = dv                                       # counter-clockwise direction
