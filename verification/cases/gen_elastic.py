@@ -2,7 +2,8 @@
 
 Exact solutions vanish on the clamped side; f = -div sigma(u) and the tractions sigma(u) n on the other
 sides are derived with sympy (tresca_py.mms) and printed in the solver's expression syntax (exmex: ^ for
-powers, no unary minus before a power). Run from the repository root:  .venv/bin/python verification/cases/gen_elastic.py
+powers, no unary minus before a power). Run from the repository root:
+    .venv/bin/python verification/cases/gen_elastic.py
 """
 import sympy as sp
 

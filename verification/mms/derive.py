@@ -73,7 +73,8 @@ def main():
         for make in CASES:
             case = make()
             print("== %s: %s" % (case["name"], case["title"]))
-            log = lambda msg: print("   " + msg)
+            def log(msg):
+                print("   " + msg)
             d = run_checks(case, args.exmex, log)
             log("longest printed expression: %d characters" % max(len(v) for v in d["str"].values()))
             derived.append(d)
