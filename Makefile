@@ -65,7 +65,7 @@ venv: $(VENV)/.stamp
 
 test: build venv getfem
 	cargo test --release --locked
-	$(PY) verification/python_tests.py
+	$(PY) -m pytest python/tests -q
 
 # make verify writes under out/verify/ only (a clean clone stays clean); make reference publishes what it
 # staged in out/verify/reference/ into the tracked reference/ and regenerates verification/README.md's table.

@@ -77,12 +77,12 @@ NOTES = """## Notes
 1. `signum(0)`: exmex evaluates Rust's `f64::signum`, +1 at 0; the Python reader mapped `signum` to
    `sympy.sign`, 0 at 0. On `expr_signum` (g_a, traction and f containing `signum(0*x)`) the old Python
    solvers differed from Rust by du = 0.57, dE = 0.75, dsig = 0.40 (relative). Fixed in
-   scripts/tresca_scene.py (`_signum`, a Piecewise with value +1 at 0) and scripts/dolfinx_solve.py
+   tresca_py/expr.py (`signum`, a Piecewise with value +1 at 0) and scripts/dolfinx_solve.py
    (Piecewise -> `ufl.conditional`). Both codes now agree with Rust to 1e-14.
 2. Stick/slip flag: the Python solvers flagged slip when |s_e - s_e^(n-1)| > 1e-12 max(|u^n|, |u^(n-1)|);
    Rust (`contact::classify`) when |Δs_e| > 1e-9 max(|Δs|, |d|). No case here produced a differing flag with
    the old rule, but the rules differ for increments between the two thresholds; the Python codes now use
-   Rust's rule (`tresca_scene.classify`), so identical sets can be required.
+   Rust's rule (`tresca_py.skfem_cr.friction.classify`), so identical sets can be required.
 3. Lower-case `pi`: the README lists the constants `pi` and `e`; the Python reader accepts `pi`, the Rust
    reader rejects it ("unknown variable `pi`"; exmex knows only `PI`, `π`, `E`, `e`, `TAU`). A reading
    difference, not a numerical one; the scenes here use `PI`.

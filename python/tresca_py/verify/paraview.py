@@ -9,7 +9,6 @@ import os
 import shutil
 import signal
 import subprocess
-import sys
 
 from tresca_py.common import BIN, ROOT
 from tresca_py.verify.harness import Harness, out_dir
@@ -103,8 +102,7 @@ def runs(ss):
 def compare(ss, label, h5, reader, data):
     import h5py
     import numpy as np
-    sys.path.insert(0, os.path.join(ROOT, "scripts"))
-    from check_results import reference
+    from tresca_py.check import reference
     with h5py.File(h5, "r") as f:
         g = f["tresca"]
         S = int(g["steps"].attrs["completed"])

@@ -17,7 +17,6 @@ import atexit
 import os
 import re
 import shutil
-import sys
 import tempfile
 
 import h5py
@@ -183,9 +182,8 @@ def p1_h1_error(nu, n):
 
 def cond_K(st, scene_path, refine):
     """Condition number of the reduced stabilised CR stiffness (scikit-fem assembly of the same a_h)."""
-    sys.path.insert(0, os.path.join(ROOT, "scripts"))
-    from tresca_py import tresca_scene as ts
-    from skfem_solve import SkfemProblem
+    from tresca_py import cli as ts
+    from tresca_py.skfem_cr.assemble import SkfemProblem
     args = ts.cli("cond", [scene_path, "-o", os.path.join(st.tmp, "c.h5"), "--refine", str(refine), "-q"])
     scene, disc, _ = ts.open_scene(args)
     K = SkfemProblem(disc).K

@@ -1,0 +1,121 @@
+"""Distributed assembly of a_h, its jump part, loads and true errors with DOLFINx, gathered to rank 0 in
+the canonical edge ordering of ``tresca_py.skfem_cr.cr.Discretisation`` (edges matched by midpoints)."""
+import dolfinx_solver  # noqa: F401  (loads libmpi for the wheel; must precede dolfinx)
+import basix.ufl
+import numpy as np
+import scipy.sparse as sp
+import ufl
+from dolfinx import fem
+from dolfinx import mesh as dmesh
+from mpi4py import MPI
+
+from tresca_py.dolfinx_cr.forms import error_forms, load_form
+from tresca_py.mesh import match_points
+from tresca_py.skfem_cr.cr import Discretisation
+
+
+class DolfinxProblem:
+    """Distributed assembly of a_h, its jump part, loads and true errors (canonical ordering on rank 0)."""
+
+    def __init__(self, disc: Discretisation, comm):
+        self.disc, self.comm = disc, comm
+        scene = disc.scene
+        rank = comm.rank
+        coord = basix.ufl.element("Lagrange", "triangle", 1, shape=(2,))
+        cells = disc.triangles if rank == 0 else np.zeros((0, 3), dtype=np.int64)
+        pts = disc.points if rank == 0 else np.zeros((0, 2))
+        part = dmesh.create_cell_partitioner(dmesh.GhostMode.shared_facet, 2) if comm.size > 1 else None
+        self.msh = msh = dmesh.create_mesh(comm, cells, ufl.Mesh(coord), pts, partitioner=part)
+        tdim = 2
+        msh.topology.create_connectivity(tdim - 1, tdim)
+        self.V = V = fem.functionspace(msh, ("CR", 1, (2,)))
+        # canonical index of every local (owned + ghost) scalar dof
+        imap = V.dofmap.index_map
+        nloc = imap.size_local + imap.num_ghosts
+        xy = V.tabulate_dof_coordinates()[:nloc, :2]
+        edge = match_points(disc.midpoints, xy, what="dolfinx CR dof coordinates")
+        self.canon = np.empty(2 * nloc, dtype=np.int64)
+        self.canon[0::2], self.canon[1::2] = 2 * edge, 2 * edge + 1
+        # global dof block -> canonical edge, known on every rank
+        lo = imap.local_range[0]
+        owned = comm.allgather((np.arange(lo, lo + imap.size_local), edge[:imap.size_local]))
+        self.edge_of_global = np.empty(imap.size_global, dtype=np.int64)
+        for g, e in owned:
+            self.edge_of_global[g] = e
+
+        # boundary facet tags: part index + 1 (matched by midpoint to the canonical boundary edges)
+        bfacets = dmesh.exterior_facet_indices(msh.topology)
+        bmid = dmesh.compute_midpoints(msh, tdim - 1, bfacets)[:, :2]
+        bedges = np.flatnonzero(disc.is_boundary)
+        k = match_points(disc.midpoints[bedges], bmid, what="dolfinx boundary facets")
+        tags = disc.part_of_edge[bedges[k]] + 1
+        order = np.argsort(bfacets)
+        self.ft = dmesh.meshtags(msh, tdim - 1, bfacets[order], tags[order].astype(np.int32))
+        ids = {kind: tuple(i + 1 for i, b in enumerate(scene.boundaries) if b.kind == kind)
+               for kind in ("dirichlet", "neumann", "contact")}
+
+        lam, mu, rho = scene.lam, scene.mu, scene.rho
+        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+        eps = lambda w: ufl.sym(ufl.grad(w))  # noqa: E731
+        sigma = lambda w: lam * ufl.tr(eps(w)) * ufl.Identity(2) + 2 * mu * eps(w)  # noqa: E731
+        dx0 = ufl.Measure("dx", domain=msh, metadata={"quadrature_degree": 0})   # integrand is constant
+        dS2 = ufl.Measure("dS", domain=msh, metadata={"quadrature_degree": 3})   # 2-point Gauss
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=self.ft)
+        h = ufl.FacetArea(msh)
+        pen = 2.0 * rho * mu / h
+        a_el = ufl.inner(sigma(u), eps(v)) * dx0
+        a_j = 2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(u), ufl.jump(v)) * dS2
+        if ids["dirichlet"]:
+            a_j = a_j + pen * ufl.inner(u, v) * ds(ids["dirichlet"], metadata={"quadrature_degree": 3})
+        self.J = self._gather_matrix(fem.form(a_j))
+        Kel = self._gather_matrix(fem.form(a_el))
+        self.K = None if rank else (Kel + self.J).tocsr()
+
+        # loads: UFL expressions in x and the time constant t
+        self.t = fem.Constant(msh, 0.0)
+        self.L = load_form(scene, msh, v, ds, self.t)
+
+        # true errors
+        self.err_forms = None
+        if scene.exact_u is not None:
+            self.uh = fem.Function(V)
+            self.err_forms = error_forms(scene, self.uh, self.t, (lam, mu, rho, pen), h, dS2, ds, ids["dirichlet"])
+
+    def _gather_matrix(self, form):
+        A = fem.assemble_matrix(form)             # not finalised: ghost rows hold partial sums
+        S = A.to_scipy(ghosted=True).tocoo()      # local (owned + ghost) rows, local columns
+        b0, b1 = A.block_size
+        # the matrix has its own row/column index maps (the column map carries extra ghosts):
+        # local block -> global block -> canonical edge
+        rows = A.index_map(0).local_to_global((S.row // b0).astype(np.int32))
+        cols = A.index_map(1).local_to_global((S.col // b1).astype(np.int32))
+        trip = (2 * self.edge_of_global[rows] + S.row % b0, 2 * self.edge_of_global[cols] + S.col % b1, S.data)
+        allt = self.comm.gather(trip, root=0)
+        if self.comm.rank:
+            return None
+        n = self.disc.n_dofs
+        r, c, d = (np.concatenate([a[i] for a in allt]) for i in range(3))
+        return sp.csr_matrix((d, (r, c)), shape=(n, n))
+
+    def load(self, t):
+        self.t.value = t
+        if self.L is None:
+            vals = np.zeros(0)
+            idx = np.zeros(0, dtype=np.int64)
+        else:
+            b = fem.assemble_vector(self.L)       # owned + ghost entries, ghosts not accumulated
+            vals, idx = b.array.copy(), self.canon
+        allv = self.comm.gather((idx, vals), root=0)
+        if self.comm.rank:
+            return None
+        out = np.zeros(self.disc.n_dofs)
+        for i, v in allv:
+            np.add.at(out, i, v)
+        return out
+
+    def errors(self, t, u_canon):
+        self.t.value = t
+        self.uh.x.array[:] = u_canon[self.canon]
+        loc = np.array([fem.assemble_scalar(f) for f in self.err_forms])
+        tot = self.comm.allreduce(loc, op=MPI.SUM)
+        return tuple(float(v) for v in tot)

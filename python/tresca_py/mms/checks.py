@@ -1,0 +1,218 @@
+"""Checks of a derived manufactured case: the printed strings read back (by ``tresca_py.expr``, the reading
+the solvers share) equal the sympy originals; grad, f, u0 and the tractions agree with independent finite
+differences; the Tresca conditions hold pointwise on Gamma_C on a fine space-time grid."""
+import subprocess
+
+import numpy as np
+import sympy as sp
+
+from tresca_py.expr import parse, symbols
+from tresca_py.mms.blocks import lam
+from tresca_py.mms.derive import derive, require
+from tresca_py.mms.elasticity import body_force, side_geometry, stress
+
+x, y, t = symbols()
+
+def sample_points(d, rng, n=400):
+    """Random points of the (possibly rotated) quadrilateral and random times in [0, T]."""
+    c = np.array([[float(v) for v in p] for p in d["corners"]])
+    a, b = rng.random(n), rng.random(n)
+    P = ((1 - a) * (1 - b))[:, None] * c[0] + (a * (1 - b))[:, None] * c[1] + \
+        (a * b)[:, None] * c[2] + ((1 - a) * b)[:, None] * c[3]
+    T = rng.random(n) * float(d["T"])
+    return P[:, 0], P[:, 1], T
+
+
+def check_roundtrip(d, rng, log):
+    """Printed string == sympy original at random points (strings re-parsed into sympy Max/Min)."""
+    X, Y, T = sample_points(d, rng, 600)
+    d["parsed"] = {}
+    for k, s in d["str"].items():
+        p = parse(s, k)
+        d["parsed"][k] = p
+        a, b = lam(d["sym"][k])(X, Y, T), lam(p)(X, Y, T)
+        scale = max(1.0, np.max(np.abs(a)))
+        err = np.max(np.abs(a - b)) / scale
+        require(err < 1e-13, "%s: round trip of %s differs by %.3e" % (d["name"], k, err))
+    log("round trip of %d printed expressions (max/min re-parsed)      ok" % len(d["str"]))
+
+
+def check_exmex_binary(d, rng, binary, log):
+    """Evaluate every printed string with a real exmex binary (reads 'expr\\tt\\tx\\ty' lines)."""
+    X, Y, T = sample_points(d, rng, 40)
+    lines, refs = [], []
+    for k, s in d["str"].items():
+        ref = lam(d["sym"][k])(X, Y, T)
+        for i in range(len(X)):
+            lines.append("%s\t%r\t%r\t%r" % (s, float(T[i]), float(X[i]), float(Y[i])))
+            refs.append((k, ref[i]))
+    out = subprocess.run([binary], input="\n".join(lines) + "\n", capture_output=True, text=True,
+                         check=True).stdout.split("\n")
+    worst = 0.0
+    for (k, ref), o in zip(refs, out, strict=False):
+        require(not o.startswith("ERR"), "%s: exmex rejects %s: %s" % (d["name"], k, o))
+        worst = max(worst, abs(float(o) - ref) / max(1.0, abs(ref)))
+    require(worst < 1e-12, "%s: exmex evaluation differs by %.3e" % (d["name"], worst))
+    log("exmex binary evaluates all %d strings (max rel diff %.1e)        ok" % (len(d["str"]), worst))
+
+
+def np_grad(d, which="parsed"):
+    src = d[which]
+    return [[lam(src["grad11"]), lam(src["grad12"])], [lam(src["grad21"]), lam(src["grad22"])]]
+
+
+def stress_np(Gf, lam_, mu, X, Y, T):
+    g = [[Gf[i][j](X, Y, T) for j in range(2)] for i in range(2)]
+    tr = g[0][0] + g[1][1]
+    s11 = lam_ * tr + 2 * mu * g[0][0]
+    s22 = lam_ * tr + 2 * mu * g[1][1]
+    s12 = mu * (g[0][1] + g[1][0])
+    return s11, s12, s22
+
+
+def check_derivatives(d, rng, log):
+    """Independent finite-difference checks of the printed data: grad vs FD of u, f vs -div sigma(FD),
+    u0 = u(.,0), Neumann traction = sigma(grad) n, all using the re-parsed strings."""
+    P = d["parsed"]
+    lam_, mu = float(d["lam"]), float(d["mu"])
+    X, Y, T = sample_points(d, rng, 400)
+    u = [lam(P["u1"]), lam(P["u2"])]
+    Gf = np_grad(d)
+    h = 1e-6
+    worst = 0.0
+    for i in range(2):
+        for j, (dx, dy) in enumerate([(h, 0), (0, h)]):
+            fd = (u[i](X + dx, Y + dy, T) - u[i](X - dx, Y - dy, T)) / (2 * h)
+            g = Gf[i][j](X, Y, T)
+            worst = max(worst, np.max(np.abs(fd - g)) / max(1e-2, np.max(np.abs(g))))
+    require(worst < 1e-6, "%s: grad != FD of u (%.2e)" % (d["name"], worst))
+    # f = -div sigma with sigma from the printed grad, by central differences
+    h = 1e-5
+    def sig(Xp, Yp):
+        return stress_np(Gf, lam_, mu, Xp, Yp, T)
+    sxp, sxm, syp, sym_ = sig(X + h, Y), sig(X - h, Y), sig(X, Y + h), sig(X, Y - h)
+    div1 = (sxp[0] - sxm[0]) / (2 * h) + (syp[1] - sym_[1]) / (2 * h)
+    div2 = (sxp[1] - sxm[1]) / (2 * h) + (syp[2] - sym_[2]) / (2 * h)
+    f1, f2 = lam(P["f1"])(X, Y, T), lam(P["f2"])(X, Y, T)
+    scale = max(1e-2, np.max(np.abs(f1)), np.max(np.abs(f2)))
+    err = max(np.max(np.abs(f1 + div1)), np.max(np.abs(f2 + div2))) / scale
+    require(err < 1e-5, "%s: equilibrium f + div sigma = %.2e (FD)" % (d["name"], err))
+    # exact (symbolic) equilibrium with the parsed expressions
+    lam_s, mu_s = d["lam"], d["mu"]
+    Gp = sp.Matrix([[P["grad11"], P["grad12"]], [P["grad21"], P["grad22"]]])
+    Sp = stress(Gp, lam_s, mu_s)
+    fr = body_force(Sp)
+    res = max(np.max(np.abs(lam(fr[0] - P["f1"])(X, Y, T))), np.max(np.abs(lam(fr[1] - P["f2"])(X, Y, T))))
+    require(res < 1e-11 * scale, "%s: symbolic equilibrium residual %.2e" % (d["name"], res))
+    # u0
+    Z = np.zeros_like(X)
+    e0 = max(np.max(np.abs(lam(P["u0_1"])(X, Y, Z) - u[0](X, Y, Z))),
+             np.max(np.abs(lam(P["u0_2"])(X, Y, Z) - u[1](X, Y, Z))))
+    require(e0 < 1e-14, "%s: u0 != u(.,0)" % d["name"])
+    # Neumann tractions
+    s = np.linspace(0, 1, 201)
+    tt = np.linspace(0, float(d["T"]), 21)
+    S_, TT = np.meshgrid(s, tt, indexing="ij")
+    for side, kind in d["kinds"].items():
+        a, b, n, tau = side_geometry(d["corners"], side)
+        PX, PY = a[0] + S_ * (b[0] - a[0]), a[1] + S_ * (b[1] - a[1])
+        if kind == "neumann":
+            s11, s12, s22 = stress_np(Gf, lam_, mu, PX, PY, TT)
+            g1 = lam(P["g_%s_1" % side])(PX, PY, TT)
+            g2 = lam(P["g_%s_2" % side])(PX, PY, TT)
+            err = max(np.max(np.abs(s11 * n[0] + s12 * n[1] - g1)), np.max(np.abs(s12 * n[0] + s22 * n[1] - g2)))
+            require(err < 1e-12 * max(1, np.max(np.abs(g1)), np.max(np.abs(g2))),
+                    "%s: traction on %s != sigma n (%.2e)" % (d["name"], side, err))
+        if kind == "dirichlet":
+            err = max(np.max(np.abs(u[0](PX, PY, TT))), np.max(np.abs(u[1](PX, PY, TT))))
+            require(err < 1e-13, "%s: u != 0 on Dirichlet side %s (%.2e)" % (d["name"], side, err))
+    log("grad = FD(u), f = -div sigma (FD and symbolic), u0, g = sigma n, u = 0 on Gamma_D   ok")
+
+
+def check_contact(d, log):
+    """Pointwise Tresca conditions on Gamma_C on a fine space-time grid (parsed expressions;
+    velocities by sympy differentiation of the parsed u, independent of the PosPow/SStep rules)."""
+    sides = [s for s, k in d["kinds"].items() if k == "contact"]
+    if not sides:
+        return
+    P = d["parsed"]
+    lam_, mu = float(d["lam"]), float(d["mu"])
+    Gf = np_grad(d)
+    u = [lam(P["u1"]), lam(P["u2"])]
+    ud = [lam(sp.diff(P["u1"], t)), lam(sp.diff(P["u2"], t))]
+    ud_custom = [lam(sp.diff(d["sym"]["u1"], t)), lam(sp.diff(d["sym"]["u2"], t))]
+    ga_f = lam(P["g_a"])
+    Tn = float(d["T"])
+    times = set(np.linspace(0, Tn, 601).tolist())
+    for ts in d.get("t_special", []):
+        times |= {float(ts) - 1e-9, float(ts), float(ts) + 1e-9}
+    times = np.array(sorted(times))
+    for side in sides:
+        a, b, n, tau = side_geometry(d["corners"], side)
+        s = np.linspace(0, 1, 2001)
+        S_, TT = np.meshgrid(s, times, indexing="ij")           # (space, time)
+        PX, PY = a[0] + S_ * (b[0] - a[0]), a[1] + S_ * (b[1] - a[1])
+        un = u[0](PX, PY, TT) * n[0] + u[1](PX, PY, TT) * n[1]
+        require(np.max(np.abs(un)) < 1e-13, "%s: u.n != 0 on Gamma_C (%.2e)" % (d["name"], np.max(np.abs(un))))
+        s11, s12, s22 = stress_np(Gf, lam_, mu, PX, PY, TT)
+        sn1, sn2 = s11 * n[0] + s12 * n[1], s12 * n[0] + s22 * n[1]
+        snn = sn1 * n[0] + sn2 * n[1]
+        st1, st2 = sn1 - snn * n[0], sn2 - snn * n[1]             # sigma_t (vector)
+        st_abs = np.hypot(st1, st2)
+        ga = ga_f(PX, PY, TT)
+        require(np.min(ga) > 0, "%s: g_a must be positive" % d["name"])
+        require(np.all(ga == ga[:, :1]), "%s: g_a depends on t" % d["name"])
+        v1, v2 = ud[0](PX, PY, TT), ud[1](PX, PY, TT)
+        w1, w2 = ud_custom[0](PX, PY, TT), ud_custom[1](PX, PY, TT)
+        vnd = max(np.max(np.abs(v1 - w1)), np.max(np.abs(v2 - w2)))
+        require(vnd < 1e-12, "%s: time derivative (Max/Heaviside) != custom rule (%.2e)" % (d["name"], vnd))
+        vn = v1 * n[0] + v2 * n[1]
+        vt1, vt2 = v1 - vn * n[0], v2 - vn * n[1]
+        vt_abs = np.hypot(vt1, vt2)
+        ttol = 1e-11 * np.max(ga)
+        vtol = 1e-11 * max(1e-3, np.max(vt_abs))
+        # |sigma_t| <= g_a
+        viol = np.max(st_abs - ga)
+        require(viol <= ttol, "%s: |sigma_t| exceeds g_a by %.2e" % (d["name"], viol))
+        # stick: |sigma_t| < g_a strictly  =>  u_t' = 0
+        stick = st_abs < ga - ttol
+        bad = np.max(vt_abs[stick]) if stick.any() else 0.0
+        require(bad <= vtol, "%s: stick point with slip velocity %.2e" % (d["name"], bad))
+        # slip: u_t' != 0  =>  |sigma_t| = g_a and u_t' = -theta sigma_t, theta >= 0
+        slip = vt_abs > vtol
+        if slip.any():
+            gap = np.max(np.abs(st_abs[slip] - ga[slip]))
+            require(gap <= ttol, "%s: slipping point with |sigma_t| != g_a (%.2e)" % (d["name"], gap))
+            theta = -(vt1 * st1 + vt2 * st2)[slip] / st_abs[slip] ** 2
+            require(np.min(theta) >= 0, "%s: slip velocity not opposite to sigma_t" % d["name"])
+            res = np.max(np.hypot(vt1[slip] + theta * st1[slip], vt2[slip] + theta * st2[slip]))
+            require(res <= vtol, "%s: u_t' not parallel to sigma_t (%.2e)" % (d["name"], res))
+        # compatibility of u0: |sigma_t(u0)| <= g_a (t = 0 column)
+        require(times[0] == 0 and np.max(st_abs[:, 0] - ga[:, 0]) <= ttol, "%s: u0 incompatible" % d["name"])
+        # non-vacuity and expected kinds of transitions
+        require(stick.mean() > 0.05 or d["name"] == "mms_stop", "%s: (almost) no stick samples" % d["name"])
+        require(slip.mean() > 0.05, "%s: (almost) no slip samples" % d["name"])
+        dsl = np.diff(slip.astype(int), axis=1)
+        n_ss = int(np.sum(np.any(dsl == 1, axis=1)))            # points that go stick -> slip
+        n_sk = int(np.sum(np.any(dsl == -1, axis=1)))           # points that go slip -> stick
+        exp = d["expect"]
+        require((n_ss > 0) == exp["stick_to_slip"], "%s: stick->slip transitions: %d" % (d["name"], n_ss))
+        require((n_sk > 0) == exp["slip_to_stick"], "%s: slip->stick transitions: %d" % (d["name"], n_sk))
+        st_tau = st1 * tau[0] + st2 * tau[1]
+        log("Tresca on %s (%d x %d samples): u.n=0, |sig_t|<=g_a, stick, slip dir, u0   ok"
+            % (side, len(s), len(times)))
+        log("   stick %.0f%%, slipping %.0f%% of samples; %d points stick->slip, %d slip->stick; "
+            "sigma_t.tau in [%.3g, %.3g], g_a in [%.3g, %.3g], max|slip rate| %.3g"
+            % (100 * stick.mean(), 100 * slip.mean(), n_ss, n_sk, st_tau.min(), st_tau.max(),
+               ga.min(), ga.max(), vt_abs.max()))
+
+
+def run_checks(case, exmex_bin=None, log=print):
+    rng = np.random.default_rng(20240611)          # fixed seed: deterministic
+    d = derive(case)
+    check_roundtrip(d, rng, log)
+    if exmex_bin:
+        check_exmex_binary(d, rng, exmex_bin, log)
+    check_derivatives(d, rng, log)
+    check_contact(d, log)
+    return d

@@ -1,0 +1,253 @@
+"""Scene files (README "Scenes"): TOML reading and validation, as src/scene does it.
+
+Unknown tables and keys are errors naming them; fixed-length arrays (corners, cells, every vector of
+expressions, grad) must have exactly their length, like the Rust reader's serde arrays
+(``cells = [2, 2, 2]`` is refused). Expressions are read by ``tresca_py.expr``.
+"""
+from __future__ import annotations
+
+import math
+import os
+import tomllib
+from dataclasses import dataclass
+
+import numpy as np
+
+from tresca_py.errors import InputError
+from tresca_py.expr import Expr, VecExpr
+
+
+class SceneError(InputError):
+    """Invalid scene input; the message names the offending key or file."""
+
+
+_SCHEMA = {
+    "title": None,
+    "mesh": {"corners", "cells", "diagonal", "refine", "file"},
+    "material": {"E", "nu"},
+    "boundary": {"name", "kind", "traction", "g_a"},
+    "loads": {"f"},
+    "initial": {"u0"},
+    "time": {"T", "steps", "times"},
+    "discretisation": {"rho"},
+    "solver": {"method", "tol", "max_iter", "uzawa_step"},
+    "exact": {"u", "grad"},
+    "output": {"path"},
+    "units": {"length", "force", "time"},  # labels for pictures only (scripts/render.py)
+    "outputs": {"max_slip", "stick_length", "energy", "traction_at"},  # what `tresca-cr study` estimates
+}
+
+
+@dataclass
+class Boundary:
+    name: str
+    kind: str                    # "dirichlet" | "neumann" | "contact"
+    traction: VecExpr | None = None
+    g_a: Expr | None = None
+
+
+@dataclass
+class Scene:
+    path: str
+    text: str
+    title: str
+    mesh: dict
+    E: float
+    nu: float
+    boundaries: list
+    f: VecExpr
+    u0: VecExpr
+    times: np.ndarray
+    rho: float
+    solver: dict
+    exact_u: VecExpr | None = None
+    exact_grad: list | None = None       # [[Expr, Expr], [Expr, Expr]]
+    output: str | None = None
+
+    @property
+    def lam(self):
+        return self.E * self.nu / ((1 + self.nu) * (1 - 2 * self.nu))
+
+    @property
+    def mu(self):
+        return self.E / (2 * (1 + self.nu))
+
+
+def _num(tab, key, where, default=None, positive=False, integer=False):
+    if key not in tab:
+        if default is None:
+            raise SceneError(f"[{where}] is missing the key '{key}'")
+        return default
+    v = tab[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or (integer and not isinstance(v, int)):
+        raise SceneError(f"[{where}] {key} = {v!r}: expected {'an integer' if integer else 'a number'}")
+    if not math.isfinite(v):
+        raise SceneError(f"[{where}] {key} must be finite")
+    if positive and v <= 0:
+        raise SceneError(f"[{where}] {key} = {v!r} must be positive")
+    return v
+
+
+
+def _read_doc(path):
+    """The TOML text and document; unknown tables and keys are errors naming them."""
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as err:
+        raise SceneError(f"cannot read scene file {path!r}: {err.strerror}") from None
+    text = raw.decode("utf-8")
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError(f"{path}: invalid TOML: {err}") from None
+    for key, val in doc.items():
+        if key not in _SCHEMA:
+            raise SceneError(f"{path}: unknown top-level key '{key}' (allowed: {sorted(_SCHEMA)})")
+        allowed = _SCHEMA[key]
+        tabs = val if key == "boundary" else [val]
+        if allowed is None:
+            continue
+        if key == "boundary" and not isinstance(val, list):
+            raise SceneError(f"{path}: 'boundary' must be an array of tables ([[boundary]])")
+        for tab in tabs:
+            if not isinstance(tab, dict):
+                raise SceneError(f"{path}: [{key}] must be a table")
+            for k in tab:
+                if k not in allowed:
+                    raise SceneError(f"{path}: unknown key '{k}' in [{key}] (allowed: {sorted(allowed)})")
+    return text, doc
+
+
+def _read_mesh(path, doc, refine):
+    mesh = dict(doc.get("mesh", {}))
+    if not mesh:
+        raise SceneError(f"{path}: missing [mesh]")
+    if "file" in mesh:
+        if "corners" in mesh or "cells" in mesh or "diagonal" in mesh:
+            raise SceneError(f"{path}: [mesh] takes either 'file' or 'corners'/'cells'/'diagonal', not both")
+        fpath = mesh["file"]
+        if not os.path.isabs(fpath):
+            fpath = os.path.join(os.path.dirname(os.path.abspath(path)), fpath)
+        mesh["file"] = fpath
+    else:
+        c = mesh.get("corners")
+        if (not isinstance(c, list) or len(c) != 4 or
+                any(not isinstance(p, list) or len(p) != 2 or
+                    any(isinstance(q, bool) or not isinstance(q, (int, float)) for q in p) for p in c)):
+            raise SceneError(f"{path}: [mesh] corners must be four [x, y] pairs, got {c!r}")
+        cells = mesh.get("cells")
+        if (not isinstance(cells, list) or len(cells) != 2 or
+                any(isinstance(q, bool) or not isinstance(q, int) or q < 1 for q in cells)):
+            raise SceneError(f"{path}: [mesh] cells must be two positive integers, got {cells!r}")
+        diag = mesh.get("diagonal", "first")
+        if diag not in ("first", "second"):
+            raise SceneError(f"{path}: [mesh] diagonal must be \"first\" or \"second\", got {diag!r}")
+        mesh["diagonal"] = diag
+    mesh["refine"] = _num(mesh, "refine", "mesh", default=0, integer=True)
+    if refine is not None:
+        mesh["refine"] = int(refine)
+    if mesh["refine"] < 0:
+        raise SceneError(f"{path}: [mesh] refine must be >= 0")
+    return mesh
+
+
+def _read_material(path, doc):
+    mat = doc.get("material")
+    if not isinstance(mat, dict):
+        raise SceneError(f"{path}: missing [material]")
+    E = _num(mat, "E", "material", positive=True)
+    nu = _num(mat, "nu", "material")
+    if not (-1.0 < nu < 0.5):
+        raise SceneError(f"[material] nu = {nu} must lie in (-1, 0.5)")
+    return E, nu
+
+
+def _read_boundaries(doc):
+    bnds = []
+    seen = set()
+    for i, b in enumerate(doc.get("boundary", [])):
+        where = f"boundary #{i + 1}"
+        name, kind = b.get("name"), b.get("kind")
+        if not isinstance(name, str):
+            raise SceneError(f"[{where}] needs a string 'name'")
+        if name in seen:
+            raise SceneError(f"[{where}] boundary part '{name}' is declared twice")
+        seen.add(name)
+        if kind not in ("dirichlet", "neumann", "contact"):
+            raise SceneError(f"[{where}] ('{name}') kind must be dirichlet, neumann or contact, got {kind!r}")
+        if "traction" in b and kind != "neumann":
+            raise SceneError(f"[{where}] ('{name}') 'traction' is only allowed for kind = \"neumann\"")
+        if "g_a" in b and kind != "contact":
+            raise SceneError(f"[{where}] ('{name}') 'g_a' is only allowed for kind = \"contact\"")
+        bd = Boundary(name, kind)
+        if kind == "neumann":
+            bd.traction = VecExpr(b.get("traction", ["0", "0"]), f"boundary '{name}' traction")
+        if kind == "contact":
+            if "g_a" not in b:
+                raise SceneError(f"[{where}] ('{name}') contact needs 'g_a' (the friction bound)")
+            bd.g_a = Expr(b["g_a"], f"boundary '{name}' g_a")
+            if bd.g_a.depends_on_t:
+                raise SceneError(f"boundary '{name}' g_a must not depend on t")
+        bnds.append(bd)
+    return bnds
+
+
+def _read_times(path, doc, steps):
+    tm = doc.get("time")
+    if not isinstance(tm, dict):
+        raise SceneError(f"{path}: missing [time]")
+    if "times" in tm:
+        if "steps" in tm or "T" in tm:
+            raise SceneError("[time] takes either 'times' or 'T' + 'steps', not both")
+        times = np.asarray(tm["times"], dtype=float)
+        if times.ndim != 1 or len(times) < 2 or np.any(np.diff(times) <= 0):
+            raise SceneError("[time] times must be an increasing list of at least two numbers")
+        if steps is not None:
+            times = np.linspace(times[0], times[-1], int(steps) + 1)
+    else:
+        T = _num(tm, "T", "time", positive=True)
+        N = _num(tm, "steps", "time", integer=True)
+        if steps is not None:
+            N = int(steps)
+        if N < 1:
+            raise SceneError("[time] steps must be >= 1")
+        times = T * np.arange(N + 1) / N
+    return times
+
+
+def _read_exact(doc):
+    """([exact] u, [exact] grad) as expressions, or (None, None)."""
+    exact_u = exact_grad = None
+    if "exact" in doc:
+        ex = doc["exact"]
+        if "u" not in ex or "grad" not in ex:
+            raise SceneError("[exact] needs both 'u' and 'grad'")
+        exact_u = VecExpr(ex["u"], "[exact] u")
+        g = ex["grad"]
+        if not isinstance(g, list) or len(g) != 2 or any(not isinstance(r, list) or len(r) != 2 for r in g):
+            raise SceneError("[exact] grad must be [[du1/dx, du1/dy], [du2/dx, du2/dy]]")
+        exact_grad = [[Expr(g[i][j], f"[exact] grad[{i}][{j}]") for j in range(2)] for i in range(2)]
+    return exact_u, exact_grad
+
+
+def load_scene(path, refine=None, steps=None):
+    """Read and validate a scene TOML file. ``refine``/``steps`` override [mesh] refine / [time] steps."""
+    text, doc = _read_doc(path)
+    mesh = _read_mesh(path, doc, refine)
+    E, nu = _read_material(path, doc)
+    bnds = _read_boundaries(doc)
+    loads = doc.get("loads", {})
+    f = VecExpr(loads.get("f", ["0", "0"]), "[loads] f")
+    u0 = VecExpr(doc.get("initial", {}).get("u0", ["0", "0"]), "[initial] u0")
+    times = _read_times(path, doc, steps)
+    rho = _num(doc.get("discretisation", {}), "rho", "discretisation", default=10.0)
+    if rho <= 0:
+        raise SceneError("[discretisation] rho must be positive (without the jump term CR elasticity is singular)")
+    solver = {"method": "ssn", "tol": 1e-12, "max_iter": 500, "uzawa_step": 0.0}
+    solver.update(doc.get("solver", {}))
+    exact_u, exact_grad = _read_exact(doc)
+    out = doc.get("output", {}).get("path")
+    return Scene(path=str(path), text=text, title=str(doc.get("title", "")), mesh=mesh, E=float(E),
+                 nu=float(nu), boundaries=bnds, f=f, u0=u0, times=times, rho=float(rho), solver=solver,
+                 exact_u=exact_u, exact_grad=exact_grad, output=out)

@@ -1,0 +1,139 @@
+"""Backward Euler over a scene's time nodes with the exact friction step, and the results file."""
+import math
+import os
+import subprocess
+import time
+
+import numpy as np
+
+from tresca_py.skfem_cr.cr import Discretisation
+from tresca_py.skfem_cr.friction import StepSolver, classify
+
+
+def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True, step_solver=StepSolver):
+    """Backward Euler over ``scene.times``; ``step_solver(disc, K)`` solves the steps (its ``step(l, u_prev)``
+    as ``friction.StepSolver``'s; the dolfinx re-implementation passes its own).
+
+    ``K``: canonical sparse a_h (only needed on rank 0); ``J`` (its jump part) is unused here.
+    ``load(t)``: collective; canonical load vector on rank 0 (anything elsewhere).
+    ``errors(t, u)``: collective, ``u`` canonical on every rank; returns (energy error^2, h1^2, l2^2)
+    on rank 0, the energy error including the jump terms (2 rho mu/h_e) int_e |[u_h]|^2 computed by the
+    framework as an integral of squares (u^T J u would lose sqrt(eps) accuracy when the jumps vanish).
+    Returns the results dict on rank 0, None elsewhere.
+    """
+    rank = 0 if comm is None else comm.rank
+    scene = disc.scene
+    times = scene.times
+    N = len(times) - 1
+    C = len(disc.contact)
+    root = rank == 0
+    if root:
+        t0 = time.perf_counter()
+        stepper = step_solver(disc, K)
+        t_fact = time.perf_counter() - t0
+        E2 = disc.n_dofs
+        res = dict(u=np.zeros((N + 1, E2 // 2, 2)), slip=np.zeros((N + 1, C)), mu=np.zeros((N + 1, C)),
+                   dof=np.zeros((N + 1, C)),
+                   sigma_t=np.zeros((N + 1, C)), state=np.zeros((N + 1, C), dtype=np.int8),
+                   iterations=np.zeros(N + 1, dtype=np.int64), residual=np.zeros(N + 1),
+                   n_stick=np.zeros(N + 1, dtype=np.int64), n_slip=np.zeros(N + 1, dtype=np.int64),
+                   wall_time=np.zeros(N + 1), energy=np.zeros(N + 1), factor_time=t_fact)
+        if scene.exact_u is not None:
+            res["errors"] = {k: np.zeros(N + 1) for k in ("energy", "h1", "l2")}
+        u = disc.interpolate(scene.u0, times[0])
+    else:
+        u = None
+    for n, t in enumerate(times):
+        tic = time.perf_counter()
+        if n > 0:
+            load_t = load(t)
+            if root:
+                u_prev = u
+                u, info = stepper.step(load_t, u_prev)
+                mu = info["mu"]
+                slip = classify(mu, info["ds"], info["d"], disc.weight)
+                res["sigma_t"][n] = -mu / disc.lengths[disc.contact]
+                res["mu"][n] = mu
+                res["dof"][n] = info["dof"]
+                res["state"][n] = slip
+                res["iterations"][n] = info["iterations"]
+                res["residual"][n] = info["residual"]
+        if root:
+            res["u"][n] = u.reshape(-1, 2)
+            res["slip"][n] = np.sum(u.reshape(-1, 2)[disc.contact] * disc.tangent, axis=1)
+            if n == 0:
+                res["dof"][n] = res["slip"][n]          # u^0 = I_CR u0 holds s_e tau_e on contact edges
+            res["n_slip"][n] = int(res["state"][n].sum())
+            res["n_stick"][n] = C - res["n_slip"][n]
+            res["energy"][n] = float(u @ (K @ u))
+        if scene.exact_u is not None and errors is not None:
+            ub = u if comm is None else comm.bcast(u, root=0)
+            e = errors(t, ub)
+            if root:
+                el, h1, l2 = e
+                res["errors"]["energy"][n] = math.sqrt(max(el, 0.0))
+                res["errors"]["h1"][n] = math.sqrt(max(h1, 0.0))
+                res["errors"]["l2"][n] = math.sqrt(max(l2, 0.0))
+        if root:
+            res["wall_time"][n] = time.perf_counter() - tic
+            if log and (n == N or (N >= 10 and n % max(1, N // 10) == 0)):
+                extra = f" err_E={res['errors']['energy'][n]:.4e}" if "errors" in res else ""
+                print(f"step {n:5d}/{N} t={t:.6g} iters={res['iterations'][n]} "
+                      f"slip={res['n_slip'][n]}/{C} a_h(u,u)={res['energy'][n]:.6e}{extra}", flush=True)
+    return res if root else None
+
+
+# ----------------------------------------------------------------------------------------------
+# output
+# ----------------------------------------------------------------------------------------------
+def git_commit():
+    """The repository's commit (for the results file's attributes), "unknown" outside a clone."""
+    try:
+        return subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
+                              cwd=os.path.dirname(os.path.abspath(__file__)), timeout=5).stdout.strip() or "unknown"
+    except Exception:
+        return "unknown"
+
+
+def write_results(path, disc: Discretisation, res, solver_name, extra_attrs=None):
+    """Write the README ``tresca`` group (plus ``tresca/energy`` = a_h(u^n, u^n), ``contact/mu`` = the
+    friction force mu_e and ``contact/dof`` = the contact unknown s_e of the reduced vector r).
+    The one place the Python re-implementations write results (to become ``tresca_py.results.write``)."""
+    import h5py
+    scene = disc.scene
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with h5py.File(path, "w") as h5:
+        g = h5.create_group("tresca")
+        g.create_dataset("mesh/points", data=disc.points)
+        g.create_dataset("mesh/triangles", data=disc.triangles)
+        g.create_dataset("mesh/edges", data=disc.edges)
+        g.create_dataset("mesh/midpoints", data=disc.midpoints)
+        g.create_dataset("times", data=scene.times)
+        g.create_dataset("u", data=res["u"])
+        g.create_dataset("energy", data=res["energy"])
+        g.create_dataset("contact/edges", data=disc.contact)
+        g.create_dataset("contact/normal", data=disc.normal)
+        g.create_dataset("contact/tangent", data=disc.tangent)
+        g.create_dataset("contact/slip", data=res["slip"])
+        g.create_dataset("contact/sigma_t", data=res["sigma_t"])
+        g.create_dataset("contact/g", data=disc.gbar)
+        g.create_dataset("contact/state", data=res["state"])
+        g.create_dataset("contact/mu", data=res["mu"])
+        g.create_dataset("contact/dof", data=res["dof"])
+        for k in ("iterations", "residual", "n_stick", "n_slip", "wall_time"):
+            g.create_dataset(f"steps/{k}", data=res[k])
+        if "errors" in res:
+            for k, v in res["errors"].items():
+                g.create_dataset(f"errors/{k}", data=v)
+        attrs = {"scene": scene.text, "scene_path": os.path.abspath(scene.path), "version": "python-1",
+                 "git_commit": git_commit(), "solver": solver_name,
+                 "method": "primal active set on the condensed dual (exact)",
+                 "tol": float(scene.solver.get("tol", 1e-12)), "rho": scene.rho, "E": scene.E, "nu": scene.nu,
+                 "refine": int(scene.mesh["refine"]), "steps": len(scene.times) - 1,
+                 "n_edges": len(disc.edges), "n_contact": len(disc.contact),
+                 "factor_time": float(res.get("factor_time", 0.0))}
+        attrs.update(extra_attrs or {})
+        for k, v in attrs.items():
+            g.attrs[k] = v
+
+
