@@ -10,7 +10,7 @@ BIN   := target/release/tresca-cr
 PY312 := $(shell for p in $$(pyenv root 2>/dev/null)/versions/3.12*/bin/python3.12 /usr/local/bin/python3.12 /usr/bin/python3.12; do \
            [ -x "$$p" ] && "$$p" -c 'import sys' 2>/dev/null && echo "$$p" && break; done)
 
-.PHONY: all deps paraview build venv test verify bench clean-out
+.PHONY: all deps paraview build venv lint test verify bench clean-out
 
 all: build
 
@@ -54,7 +54,16 @@ $(VENV)/.stamp: requirements.txt python/pyproject.toml
 
 venv: $(VENV)/.stamp
 
+# The lint half of `make test` (CI): formatting, clippy with warnings as errors, ruff on the Python
+# (config python/pyproject.toml [tool.ruff]) and every path the documentation names exists.
+lint: venv
+	cargo fmt --check
+	cargo clippy --all-targets --locked -- -D warnings
+	$(VENV)/bin/ruff check --config python/pyproject.toml python scripts verification
+	$(PY) verification/check_doc_paths.py
+
 test: build venv
+	$(MAKE) --no-print-directory lint
 	cargo test --release --locked
 	$(PY) verification/python_tests.py
 

@@ -25,7 +25,7 @@ fn example(refine: u32, steps: usize) -> Scene {
 
 /// Run `p`, writing every step; returns the results.
 fn run_written(p: &Problem, path: &Path) -> Vec<StepResult> {
-    let mut w = Writer::create(path, &Run::of(&p), true).unwrap();
+    let mut w = Writer::create(path, &Run::of(p), true).unwrap();
     let mut out = Vec::new();
     p.run(|r| {
         out.push(r.clone());
@@ -162,10 +162,10 @@ fn check_file(p: &Problem, rs: &[StepResult], path: &Path) {
             let vals: Vec<[f64; 2]> =
                 (0..3).map(|j| [want[want.len() - 9 + 3 * j], want[want.len() - 8 + 3 * j]]).collect();
             let mut gu = [[0.0; 2]; 2];
-            for j in 0..3 {
-                for a in 0..2 {
-                    for b in 0..2 {
-                        gu[a][b] += vals[j][a] * el.grad_lambda[j][b];
+            for (v, g) in vals.iter().zip(&el.grad_lambda) {
+                for (row, va) in gu.iter_mut().zip(v) {
+                    for (gab, gb) in row.iter_mut().zip(g) {
+                        *gab += va * gb;
                     }
                 }
             }
@@ -397,7 +397,7 @@ fn sigkill_at_random_moments_leaves_complete_steps_and_resume_is_bit_identical()
         let done = attr_i64(&f, "tresca/steps", "completed") as usize;
         let every = attr_i64(&f, "tresca", "frame_every") as usize;
         let last = p.n_steps();
-        let frames = done.div_ceil(every) + usize::from(done > last && last % every != 0);
+        let frames = done.div_ceil(every) + usize::from(done > last && !last.is_multiple_of(every));
         assert_eq!(attr_i64(&f, "VTKHDF/body/Steps", "NSteps") as usize, frames);
         assert!(shape(&f, "tresca/u")[0] >= done);
         // every completed step equals the uninterrupted run

@@ -25,7 +25,7 @@ use std::sync::Mutex;
 /// K's graph, so AMD runs about 3× faster (22 → 7 ms at 24,640 unknowns) for the same fill within a few
 /// percent (AMD merges indistinguishable vertices itself, but only after reading the whole graph).
 pub(super) fn amd_order(q: &Graph, control: amd::Control) -> Result<Vec<usize>> {
-    let ng = q.len();
+    let ng = q.n_vertices();
     let (mut fwd, mut inv) = (vec![0usize; ng], vec![0usize; ng]);
     let graph = SymbolicSparseColMatRef::new_checked(ng, ng, &q.start, None, &q.adj);
     let mut buf = MemBuffer::try_new(amd::order_scratch::<usize>(ng, q.adj.len()))
@@ -132,18 +132,18 @@ impl Graph {
     }
 
     /// Number of vertices.
-    pub fn len(&self) -> usize {
+    pub fn n_vertices(&self) -> usize {
         self.first.len() - 1
     }
 
-    /// The unknowns of the vertices in the order `order` (position → vertex).
     /// Unknowns in all.
     pub fn unknowns(&self) -> usize {
-        self.first[self.len()]
+        self.first[self.n_vertices()]
     }
 
+    /// The unknowns of the vertices in the order `order` (position → vertex).
     fn expand(&self, order: impl Iterator<Item = usize>) -> Vec<usize> {
-        let mut fwd = Vec::with_capacity(self.first[self.len()]);
+        let mut fwd = Vec::with_capacity(self.first[self.n_vertices()]);
         for g in order {
             fwd.extend(self.first[g]..self.first[g + 1]);
         }
@@ -155,7 +155,7 @@ impl Graph {
 /// METIS cannot be used: the caller then falls back to AMD.
 pub(super) fn nested_dissection(q: &Graph) -> Option<(Vec<usize>, Vec<usize>)> {
     let n = q.unknowns();
-    let ng = q.len();
+    let ng = q.n_vertices();
     let mut xadj: Vec<i32> = q.start.iter().map(|&v| i32::try_from(v).ok()).collect::<Option<_>>()?;
     let mut adjncy: Vec<i32> = q.adj.iter().map(|&v| i32::try_from(v).ok()).collect::<Option<_>>()?;
     if adjncy.is_empty() {

@@ -5,6 +5,9 @@
 use super::*;
 use faer::sparse::SymbolicSparseColMat;
 
+/// The problem, or the set-up's error, each with the result of the work run beside the set-up.
+type WithBeside<R> = std::result::Result<(Problem, Option<R>), (Error, Option<R>)>;
+
 impl Problem {
     /// As [`Problem::new`], running `beside` on a thread of its own while the rest of the set-up
     /// (assembly, factorisation, condensation) runs: the results file is created there. `beside` sees
@@ -24,12 +27,11 @@ impl Problem {
     }
 
     /// [`Problem::with_mesh`] with [`Problem::new_beside`]'s second thread.
-    #[allow(clippy::type_complexity)]
     pub(super) fn with_mesh_beside<R: Send>(
         scene: Scene,
         mesh: Mesh,
         beside: Option<impl FnOnce(&Problem0) -> R + Send>,
-    ) -> std::result::Result<(Problem, Option<R>), (Error, Option<R>)> {
+    ) -> WithBeside<R> {
         let t0 = Instant::now();
         let space = CrSpace::new(&mesh, &scene.parts).map_err(|e| (e, None))?;
         let t1 = Instant::now();
