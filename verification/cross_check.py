@@ -82,7 +82,7 @@ NOTES = """## Notes
    scripts/tresca_scene.py (`_signum`, a Piecewise with value +1 at 0) and scripts/dolfinx_solve.py
    (Piecewise -> `ufl.conditional`). Both codes now agree with Rust to 1e-14.
 2. Stick/slip flag: the Python solvers flagged slip when |s_e - s_e^(n-1)| > 1e-12 max(|u^n|, |u^(n-1)|);
-   Rust (`contact::classify`) when |Δs_e| > 1e-9 max(|Δs|, |d|). No case here produced a differing flag with
+   Rust (`friction::classify`) when |Δs_e| > 1e-9 max(|Δs|, |d|). No case here produced a differing flag with
    the old rule, but the rules differ for increments between the two thresholds; the Python codes now use
    Rust's rule (`tresca_scene.classify`), so identical sets can be required.
 3. Lower-case `pi`: the README lists the constants `pi` and `e`; the Python reader accepts `pi`, the Rust
@@ -101,7 +101,7 @@ or below refine 2. Beyond that a bound on |e_A - e_B| / |||u||| is the meaningfu
 1e-7 (refine 2), skfem from dolfinx by 2e-9 and 2e-8. Against a skfem solve with 5 steps of iterative
 refinement the errors at refine 2 are: Rust 1.1e-7, dolfinx 1.8e-8, skfem (1 refinement step, as shipped)
 1.6e-9, skfem without refinement 1.8e-8. The Python solvers do one step of iterative refinement after
-SuperLU; the Rust solver (src/factor.rs, `Factor::solve_in_place` / `solve_many`) does none. A 1e-8
+SuperLU; the Rust solver (src/solve/factor.rs, `Factor::solve_in_place` / `solve_many`) does none. A 1e-8
 agreement is not a meaningful requirement there (assembly rounding alone moves dolfinx 1.8e-8 from skfem).
 
 **Wall times.** The Python processes spend 1.5–3 s in start-up (imports; dolfinx form compilation on
@@ -398,7 +398,7 @@ def main(argv=None):
           "# Cross-check: Rust, scikit-fem and dolfinx (issue 6)", "",
           f"`{self_cmd}{' --no-mpi' if args.no_mpi else ''}` — {len(reqs) - nfail}/{len(reqs)} requirements passed, "
           f"{total:.0f} s in all. Tolerance {TOL:g}; stick/slip sets must be identical.", "",
-          "Stick/slip convention of all three codes (Rust `contact::classify`): an edge slips at step n when "
+          "Stick/slip convention of all three codes (Rust `friction::classify`): an edge slips at step n when "
           "|μ_e| ≥ w_e(1 − 1e-9) and |Δs_e| > 1e-9·max(‖Δs‖∞, ‖d‖∞), Δs = d − Cμ the slip increment, d the "
           "increment without friction; state 0 and μ = 0 at step 0; σ_τ = −μ/|e|; exmex's signum(0) = 1.", "",
           "## Requirements", "", "| id | passed | measured |", "|---|---|---|"]

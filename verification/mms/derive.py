@@ -156,7 +156,7 @@ def minmax(name, args):
     """name(a1, a2, ...) for name in (min, max) WITHOUT nesting two-argument functions.
 
     exmex 0.21 rejects a two-argument function inside the second argument of another one
-    ("min(1,max(0,t))": 'parentheses mismatch'), and the solver's scene lint (src/expr.rs) rejects
+    ("min(1,max(0,t))": 'parentheses mismatch'), and the solver's scene lint (src/scene/expr/lint.rs) rejects
     any nesting of min/max/atan2. So name(a, b) is only written when neither argument contains
     one; otherwise max(a, b) = (a + b + abs(a - b))/2 and min(a, b) = (a + b - abs(a - b))/2."""
     s = args[0]
