@@ -24,6 +24,7 @@ pub mod error;
 pub mod fem;
 pub mod friction;
 pub mod mesh;
+pub mod names;
 pub mod output;
 pub mod parallel;
 pub mod plan;

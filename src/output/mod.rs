@@ -61,7 +61,7 @@ use crate::fem::elasticity::Elasticity;
 use crate::fem::space::CrSpace;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
-use crate::stepping::{Problem, Problem0, SetupTimes, StepResult};
+use crate::stepping::{Discretised, Problem, SetupTimes, StepResult};
 use fields::{Fields, StepFields};
 use h5::{io, Raw};
 use rows::Rows;
@@ -128,7 +128,7 @@ impl<'a> Run<'a> {
 
     /// The run of a problem whose set-up is still under way ([`Problem::new_beside`]): its set-up times
     /// are zeros until [`Writer::set_setup_times`].
-    pub fn before_setup(p: &'a Problem0) -> Run<'a> {
+    pub fn before_setup(p: &'a Discretised) -> Run<'a> {
         Run::new(&p.scene, &p.mesh, &p.space, p.law, SetupTimes::default())
     }
 

@@ -27,7 +27,7 @@ mod search;
 
 use crate::error::{Error, Result};
 use crate::scene::budget::Estimate;
-use crate::scene::Scene;
+use crate::scene::{Method, Scene};
 use crate::study::{Level, LevelResult, Study};
 use model::{CostModel, CostSample, ErrorModel, TimeError};
 use pilot::{fit, pilot_scene, time_pilot, Fit, Quantity, Runner};
@@ -104,7 +104,7 @@ pub struct Plan {
     pub best: Vec<Candidate>,
     /// The cheapest configuration meeting the target beyond the budget, when none fits it.
     pub over_budget: Option<Candidate>,
-    pub solver: &'static str,
+    pub solver: Method,
     pub tol: f64,
     pub notes: Vec<String>,
     pub refused: Option<String>,

@@ -9,7 +9,7 @@ use super::{
 };
 use crate::error::Result;
 use crate::scene::budget::{available_memory, Estimate};
-use crate::scene::Scene;
+use crate::scene::{Method, Scene};
 use crate::study::Study;
 
 /// Fit the models to the pilots and search (module doc).
@@ -40,7 +40,7 @@ pub(super) fn decide(
         pilot_wall,
         best: vec![],
         over_budget: None,
-        solver: "ssn",
+        solver: Method::Ssn,
         tol: 1e-12,
         notes: vec![],
         refused: None,

@@ -17,7 +17,6 @@ pub use values::MAX_EXPR_CHARS;
 use values::{line_of, positive_finite, sized, uniform_times};
 
 use raw::*;
-use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 pub use crate::mesh::{Diagonal, MeshSpec};
@@ -29,26 +28,15 @@ pub struct Material {
     pub nu: f64,
 }
 
-/// Per-step friction solver.
-#[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
-#[serde(rename_all = "lowercase")]
-pub enum Method {
-    /// Semismooth Newton (projected Newton with Armijo search on the condensed dual).
-    Ssn,
-    /// The paper's Uzawa iteration.
-    Uzawa,
-    /// Plain primal–dual active set (no globalisation; may cycle; diagnostics only).
-    Pdas,
-}
-
-impl Method {
-    /// Name used in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Ssn => "ssn",
-            Method::Uzawa => "uzawa",
-            Method::Pdas => "pdas",
-        }
+crate::named_enum! {
+    /// Per-step friction solver (`[solver] method`, `--solver`).
+    pub enum Method {
+        /// Semismooth Newton (projected Newton with Armijo search on the condensed dual).
+        Ssn = "ssn",
+        /// The paper's Uzawa iteration.
+        Uzawa = "uzawa",
+        /// Plain primal–dual active set (no globalisation; may cycle; diagnostics only).
+        Pdas = "pdas",
     }
 }
 
@@ -80,22 +68,18 @@ pub struct Exact {
     pub grad: [[Expr; 2]; 2],
 }
 
-/// Scalar outputs a study estimates (`[outputs]`), all at the final time T. Without the table a study
-/// reports `max_slip`, `stick_length` (scenes with contact) and `energy`.
-#[derive(Clone, Debug, PartialEq, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
+/// Scalar quantities at the final time T that `study` estimates and `plan` may target (`[quantities]`;
+/// `[output]` is where the results file goes). Without the table a study reports `max_slip`,
+/// `stick_length` (scenes with contact) and `elastic_energy`.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Outputs {
     /// max over Γ_C edges of |u_τ(m_e)|.
-    #[serde(default)]
     pub max_slip: bool,
     /// Total length of the Γ_C edges that stick in the last step.
-    #[serde(default)]
     pub stick_length: bool,
-    /// Elastic energy ½ a_h(u, u).
-    #[serde(default)]
-    pub energy: bool,
+    /// Elastic energy ½ a_h(u, u) (key `elastic_energy`; the old key `energy` is read with a deprecation).
+    pub elastic_energy: bool,
     /// σ_τ·τ on the Γ_C edge nearest to each point.
-    #[serde(default)]
     pub traction_at: Vec<[f64; 2]>,
 }
 
@@ -122,9 +106,64 @@ pub struct Scene {
     pub solver: SolverSettings,
     pub exact: Option<Exact>,
     pub output: Option<PathBuf>,
-    /// `[outputs]`: the scalar outputs a study estimates.
+    /// `[quantities]`: the scalar outputs a study estimates.
     pub outputs: Option<Outputs>,
+    /// Deprecated spellings the scene used, one message each (the command line prints them).
+    pub deprecations: Vec<String>,
 }
+
+/// `[quantities]`, or the deprecated `[outputs]` (a message in `deprecations`), with `energy` read as
+/// `elastic_energy` (likewise).
+fn quantities(
+    file: &str,
+    new: Option<RawQuantities>,
+    old: Option<RawQuantities>,
+    deprecations: &mut Vec<String>,
+) -> Result<Option<Outputs>> {
+    let raw = match (new, old) {
+        (Some(_), Some(_)) => {
+            return Err(Error::scene(file, "outputs", "give [quantities] only (`[outputs]` is its deprecated name)"))
+        }
+        (None, Some(o)) => {
+            deprecations.push(format!("{file}: the table [outputs] is deprecated: write [quantities]"));
+            o
+        }
+        (Some(q), None) => q,
+        (None, None) => return Ok(None),
+    };
+    let elastic_energy = match (raw.elastic_energy, raw.energy) {
+        (Some(_), Some(_)) => {
+            return Err(Error::scene(
+                file,
+                "quantities.energy",
+                "give elastic_energy only (`energy` is its deprecated name)",
+            ))
+        }
+        (None, Some(e)) => {
+            deprecations
+                .push(format!("{file}: [quantities] energy is deprecated: write elastic_energy (½ a_h(u, u) at T)"));
+            e
+        }
+        (e, None) => e.unwrap_or(false),
+    };
+    Ok(Some(Outputs {
+        max_slip: raw.max_slip,
+        stick_length: raw.stick_length,
+        elastic_energy,
+        traction_at: raw.traction_at,
+    }))
+}
+
+/// Uniform refinements beyond [`MAX_REFINE`] are refused (4¹² times the triangles is beyond any machine).
+fn check_refine(file: &str, key: &str, k: u32) -> Result<()> {
+    if k > MAX_REFINE {
+        return Err(Error::scene(file, key, format!("{k} refinements is beyond any machine")));
+    }
+    Ok(())
+}
+
+/// The most uniform refinements a scene or `--refine` may ask for.
+pub const MAX_REFINE: u32 = 12;
 
 fn nonzero(v: Option<Vec2Expr>) -> Option<Vec2Expr> {
     v.filter(|e| !e.is_zero())
@@ -178,13 +217,9 @@ impl Scene {
                 ))
             }
         };
-        if raw.mesh.refine > 12 {
-            return Err(Error::scene(
-                file,
-                "mesh.refine",
-                format!("{} refinements is beyond any machine", raw.mesh.refine),
-            ));
-        }
+        let mut deprecations = Vec::new();
+        let outputs = quantities(file, raw.quantities, raw.outputs, &mut deprecations)?;
+        check_refine(file, "mesh.refine", raw.mesh.refine)?;
         let e = positive_finite(file, "material.E", raw.material.E)?;
         let nu = raw.material.nu;
         if !(nu.is_finite() && nu > -1.0 && nu < 0.5) {
@@ -313,15 +348,14 @@ impl Scene {
             solver,
             exact,
             output: raw.output.and_then(|o| o.path),
-            outputs: raw.outputs,
+            outputs,
+            deprecations,
         })
     }
 
     /// Override the number of uniform refinements (`--refine`).
     pub fn set_refine(&mut self, k: u32) -> Result<()> {
-        if k > 12 {
-            return Err(Error::scene(&self.file, "--refine", format!("{k} refinements is beyond any machine")));
-        }
+        check_refine(&self.file, "--refine", k)?;
         match &mut self.mesh {
             MeshSpec::Structured { refine, .. } | MeshSpec::Gmsh { refine, .. } => *refine = k,
         }

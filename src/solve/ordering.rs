@@ -1,10 +1,8 @@
 //! Fill-reducing ordering P: nested dissection (METIS_NodeND) for K of [`ND_MIN_SIZE`] unknowns or
 //! more, AMD (faer's) below. Why: the factorisation is flop-bound, and on a 2D mesh nested dissection
 //! gives the asymptotically optimal fill, O(n log n) entries and O(n^1.5) flops, with a smaller constant
-//! than AMD: on the 1.57M-unknown benchmark nnz(L) drops from 613M to 462M and the flops from 1.14e12 to
-//! about 5e11, so the numeric phase halves (≈ 60 s → 29 s). But METIS itself takes ≈ 11 s there and
-//! ≈ 2.5 s at 394k unknowns, where it loses overall to AMD (the set-up was 40 % slower), hence the size
-//! threshold. Both order the graph of K with the unknowns of one edge (its two displacement components,
+//! than AMD, so the numeric phase of the largest benchmarks halves; but METIS itself is costly and loses
+//! overall to AMD on mid-sized meshes, hence the size threshold (figures in CHANGELOG.md). Both order the graph of K with the unknowns of one edge (its two displacement components,
 //! numbered consecutively by the space) merged into one (weighted) vertex: this halves the graph and
 //! quarters its edges, so METIS and AMD run 2–3× faster, with the same fill as ordering the full graph
 //! (both components of an edge have the same neighbours). The groups are given by the caller; the
@@ -22,7 +20,7 @@ use std::sync::Mutex;
 
 /// faer's approximate minimum degree ordering of K (position → unknown), computed on the graph with the
 /// groups merged ([`Graph`]; with the two components of an edge as a group): half the vertices and a quarter of the edges of
-/// K's graph, so AMD runs about 3× faster (22 → 7 ms at 24,640 unknowns) for the same fill within a few
+/// K's graph, so AMD runs about 3× faster for the same fill within a few
 /// percent (AMD merges indistinguishable vertices itself, but only after reading the whole graph).
 pub(super) fn amd_order(q: &Graph, control: amd::Control) -> Result<Vec<usize>> {
     let ng = q.n_vertices();

@@ -32,7 +32,7 @@ mod run;
 mod setup;
 
 pub use conditioning::MAX_CONDITION;
-pub use setup::Problem0;
+pub use setup::Discretised;
 
 /// Everything assembled once per run.
 pub struct Problem {
@@ -117,7 +117,7 @@ impl Problem {
 
     /// As [`Problem::new`] on a given mesh (the scene's `[mesh]` table is ignored).
     pub fn with_mesh(scene: Scene, mesh: Mesh) -> Result<Problem> {
-        Problem::with_mesh_beside(scene, mesh, None::<fn(&Problem0)>).map(|(p, _)| p).map_err(|(e, _)| e)
+        Problem::with_mesh_beside(scene, mesh, None::<fn(&Discretised)>).map(|(p, _)| p).map_err(|(e, _)| e)
     }
 
     /// Number of time steps N.

@@ -6,8 +6,8 @@ use super::*;
 
 /// Steps whose true errors are evaluated together (`Problem::finish_block`): the exact solution's
 /// spatial values bound to a chunk of elements are then read from memory once for this many time nodes.
-/// Few enough that the writer thread gets the first steps of a block early (with all 16 steps of a
-/// block at once, mms_stop r4 written took 6 ms longer: the writing no longer overlapped the errors).
+/// Few enough that the writer thread gets the first steps of a block early (with all the steps of a
+/// block at once the writing no longer overlapped the errors).
 const ERROR_BATCH: usize = 4;
 
 /// Bytes of step results held back while K's condition estimate is under way (see [`Held`]); beyond
@@ -18,8 +18,8 @@ const HOLD_BYTES: usize = 4 << 20;
 
 /// The results not handed out yet because K's condition estimate (`conditioning`) is still under way:
 /// step 0, then the steps in order. The steps go on meanwhile; the first step handed out after the
-/// verdict hands these out first. (Waiting for the verdict at the first step instead held Example 5.1
-/// n = 64 for 20 ms after its first block of steps: the estimate's solves end 26 ms after the factor.)
+/// verdict hands these out first. (Waiting for the verdict at the first step instead held the steps
+/// back: the estimate's solves end well after the factor.)
 struct Held {
     first: Option<StepResult>,
     steps: Vec<StepResult>,

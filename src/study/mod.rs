@@ -26,6 +26,16 @@ use measure::{max_last, Kept};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+crate::named_enum! {
+    /// The axis a sequence of levels refines: the mesh size h, or the time step k on one mesh.
+    pub enum Axis {
+        /// The mesh size (the levels' meshes differ).
+        H = "h",
+        /// The time step (all levels on one mesh).
+        K = "k",
+    }
+}
+
 /// A level: uniform refinements and number of uniform time steps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Level {
