@@ -85,7 +85,7 @@ NOTES = """## Notes
    Rust (`friction::classify`) when |Δs_e| > 1e-9 max(|Δs|, |d|). No case here produced a differing flag with
    the old rule, but the rules differ for increments between the two thresholds; the Python codes now use
    Rust's rule (`tresca_scene.classify`), so identical sets can be required.
-3. Lower-case `pi`: the README lists the constants `pi` and `e`; the Python reader accepts `pi`, the Rust
+3. Lower-case `pi`: docs/scene.md lists the constants `pi` and `e`; the Python reader accepts `pi`, the Rust
    reader rejects it ("unknown variable `pi`"; exmex knows only `PI`, `π`, `E`, `e`, `TAU`). A reading
    difference, not a numerical one; the scenes here use `PI`.
 

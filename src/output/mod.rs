@@ -2,7 +2,7 @@
 //!
 //! | group | for | content |
 //! |---|---|---|
-//! | `/tresca` | the project's tools (`scripts/`) | the README table, f64, one row per completed step ([`tresca`]) |
+//! | `/tresca` | the project's tools (`scripts/`) | the table of docs/results.md, f64, one row per completed step ([`tresca`]) |
 //! | `/VTKHDF` | ParaView ≥ 5.13, VTK ≥ 9.4 `vtkHDFReader` | temporal PartitionedDataSetCollection: block `body` (broken mesh, 3 points per triangle) and block `contact` (Γ_C line cells), each with only its own f32 fields ([`vtkhdf`], [`fields`]) |
 //! | `/xdmf` | `run.xdmf` (ParaView 5.11's XDMF readers, meshio's `TimeSeriesReader`) | static topologies and per-frame virtual datasets onto `/VTKHDF` arrays, one temporal collection per block ([`xdmf`]) |
 //!

@@ -44,7 +44,7 @@ crate::named_enum! {
 #[derive(Clone, Copy, Debug)]
 pub struct SolverSettings {
     pub method: Method,
-    /// Stopping tolerance (see README).
+    /// Stopping tolerance (see docs/model.md).
     pub tol: f64,
     /// Iteration limit per step; `None` = the method's default ([`SolverSettings::max_iter`]).
     pub max_iter_given: Option<usize>,

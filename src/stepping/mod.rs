@@ -1,7 +1,7 @@
 //! Backward Euler in time: set-up once (mesh, space, K assembled and factored once, loads, the
 //! condensed friction operator), then for n = 1..N
 //!   uⁿ = argmin ½a_h(v,v) − (lⁿ,v) + j_h(v − uⁿ⁻¹),   u⁰ = I_CR u₀,
-//! in two calls, as the README describes a step: the free response u_f = K⁻¹lⁿ with its contact trace
+//! in two calls, as docs/model.md describes a step: the free response u_f = K⁻¹lⁿ with its contact trace
 //! s_f (`solve::free`), then the friction problem on Γ_C for d = s_f − sⁿ⁻¹ (`friction`), and
 //! uⁿ = u_f − K⁻¹Eμ. Without Γ_C a step is the free response alone. Each completed step is handed to a
 //! callback (the writer), so nothing is lost if a later step fails.

@@ -24,7 +24,7 @@ Gamma_C, |sigma_t| <= g_a, stick where |sigma_t| < g_a, u_t' = -theta sigma_t wi
 where slipping, compatibility of u0). Any failed check aborts with a non-zero exit status and no
 file is written.
 
-Conventions (those of README.md of the repository): n outward unit normal, tau = (-n_y, n_x),
+Conventions (those of docs/model.md of the repository): n outward unit normal, tau = (-n_y, n_x),
 sigma_t = sigma(u) n - (sigma(u) n . n) n; the solver reports sigma_t . tau and the slip u . tau.
 
 Piecewise building blocks (all C^2 in their argument, so u(., t) is in H^2 and even W^{3,inf}):
