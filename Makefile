@@ -10,7 +10,7 @@ BIN   := target/release/tresca-cr
 PY312 := $(shell for p in $$(pyenv root 2>/dev/null)/versions/3.12*/bin/python3.12 /usr/local/bin/python3.12 /usr/bin/python3.12; do \
            [ -x "$$p" ] && "$$p" -c 'import sys' 2>/dev/null && echo "$$p" && break; done)
 
-.PHONY: all deps paraview build venv lint test verify bench clean-out
+.PHONY: all deps paraview getfem build venv lint test verify bench clean-out
 
 all: build
 
@@ -41,6 +41,15 @@ paraview:
 	  (sudo apt-get update -qq && sudo apt-get install -y -qq --no-install-recommends paraview python3-paraview xvfb xauth) >/dev/null; \
 	fi
 
+# Debian's GetFEM 5.4 (python3-getfem) for verification/external/run.py (make verify). It imports under the
+# system interpreter /usr/bin/python3 only (the python3 on PATH may be pyenv's).
+getfem:
+	@if ! /usr/bin/python3 -c 'import getfem' >/dev/null 2>&1; then \
+	  echo "installing python3-getfem"; \
+	  (apt-get update -qq && apt-get install -y -qq --no-install-recommends python3-getfem) >/dev/null || \
+	  (sudo apt-get update -qq && sudo apt-get install -y -qq --no-install-recommends python3-getfem) >/dev/null; \
+	fi
+
 build: deps
 	cargo build --release --locked
 
@@ -62,12 +71,12 @@ lint: venv
 	$(VENV)/bin/ruff check --config python/pyproject.toml python scripts verification
 	$(PY) verification/check_doc_paths.py
 
-test: build venv
+test: build venv getfem
 	$(MAKE) --no-print-directory lint
 	cargo test --release --locked
 	$(PY) verification/python_tests.py
 
-verify: build venv paraview
+verify: build venv paraview getfem
 	$(PY) verification/run_all.py
 
 bench: build venv

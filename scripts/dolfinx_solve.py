@@ -26,8 +26,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import tresca_scene as ts  # noqa: E402
+from tresca_py import tresca_scene as ts  # noqa: E402
 
 import dolfinx_solver  # noqa: E402,F401  (loads libmpi for the wheel; must precede dolfinx)
 from mpi4py import MPI  # noqa: E402

@@ -24,8 +24,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import tresca_scene as ts  # noqa: E402
+from tresca_py import tresca_scene as ts  # noqa: E402
 
 from skfem import (Basis, BilinearForm, ElementTriCR, ElementVector, FacetBasis,  # noqa: E402
                    InteriorFacetBasis, LinearForm, MeshTri, asm)

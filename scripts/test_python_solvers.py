@@ -33,9 +33,9 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "verification"))
-import tresca_scene as ts  # noqa: E402
-from common import CASES, MPIRUN, PY  # noqa: E402
-from common import run as run_cmd  # noqa: E402
+from tresca_py import tresca_scene as ts  # noqa: E402
+from tresca_py.common import CASES, MPIRUN, PY  # noqa: E402
+from tresca_py.common import run as run_cmd  # noqa: E402
 
 RESULTS = []
 

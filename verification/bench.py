@@ -47,8 +47,7 @@ import time
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, PY, REF, ROOT, child_cpu, load1  # noqa: E402
+from tresca_py.common import BIN, PY, REF, ROOT, child_cpu, load1  # noqa: E402
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 ELASTIC = os.path.join(ROOT, "verification", "bench", "bench_elastic.toml")
 TIME = "/usr/bin/time"

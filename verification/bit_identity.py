@@ -26,8 +26,7 @@ import sys
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import ROOT  # noqa: E402
+from tresca_py.common import ROOT  # noqa: E402
 # not numbers of the method: they change from run to run or build to build
 # steps/checksum hashes each step's rows including steps/wall_time, so it changes from run to run too (its
 # agreement with the rows is what --resume and scripts/check_results.py verify)

@@ -32,14 +32,12 @@ import time
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, MPIRUN, PY, ROOT, SCRIPTS  # noqa: E402
-from common import CASES as CASES_DIR  # noqa: E402
-from common import cmdline  # noqa: E402
-from common import short_path as rel  # noqa: E402
+from tresca_py.common import BIN, MPIRUN, PY, ROOT, SCRIPTS  # noqa: E402
+from tresca_py.common import CASES as CASES_DIR  # noqa: E402
+from tresca_py.common import cmdline  # noqa: E402
+from tresca_py.common import short_path as rel  # noqa: E402
 
-sys.path.insert(0, SCRIPTS)
-import compare  # noqa: E402
+from tresca_py import compare  # noqa: E402
 
 TOL = 1e-8
 

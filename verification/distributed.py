@@ -33,13 +33,11 @@ import time
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import MPIRUN, PY, ROOT, SCRIPTS, case  # noqa: E402
-from common import cmdline  # noqa: E402
-from common import short_path as rel  # noqa: E402
+from tresca_py.common import MPIRUN, PY, ROOT, SCRIPTS, case  # noqa: E402
+from tresca_py.common import cmdline  # noqa: E402
+from tresca_py.common import short_path as rel  # noqa: E402
 
-sys.path.insert(0, SCRIPTS)
-import compare  # noqa: E402
+from tresca_py import compare  # noqa: E402
 import cross_check  # noqa: E402  (scenes, quick levels)
 
 SCRIPT = os.path.join(ROOT, "scripts", "dolfinx_distributed.py")

@@ -27,8 +27,7 @@ import math
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import ROOT  # noqa: E402
+from tresca_py.common import ROOT  # noqa: E402
 K_REF = 4096  # same-mesh reference of the k sequences (time error 1/16 of the finest level's, corrected exactly)
 
 # (name, kind, scene, levels, reference). Levels chosen before looking at any estimate: the h studies of

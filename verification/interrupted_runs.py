@@ -25,8 +25,7 @@ import time
 
 import h5py
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, PY, ROOT, case  # noqa: E402
+from tresca_py.common import BIN, PY, ROOT, case  # noqa: E402
 
 EX51 = case("paper_example_5_1")
 FAILED = []

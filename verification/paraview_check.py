@@ -23,8 +23,7 @@ import signal
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, ROOT  # noqa: E402
+from tresca_py.common import BIN, ROOT  # noqa: E402
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 OUT = os.path.join(ROOT, "out", "paraview")
 READERS = ("XDMFReader", "Xdmf3ReaderS", "Xdmf3ReaderT")

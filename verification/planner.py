@@ -38,8 +38,7 @@ import sys
 import tempfile
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, REF, ROOT, case, cmdline, strip_exact, child_cpu, load1  # noqa: E402
+from tresca_py.common import BIN, REF, ROOT, case, cmdline, strip_exact, child_cpu, load1  # noqa: E402
 
 # grid per case: steps N_s·2^j for j < len; refinements 0..R
 CASES = {

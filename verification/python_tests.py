@@ -22,8 +22,7 @@ import subprocess
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import PY, ROOT  # noqa: E402
+from tresca_py.common import PY, ROOT  # noqa: E402
 BUDGET = 240.0
 
 

@@ -27,8 +27,7 @@ import estimates  # verification/estimates.py: Richardson/GCI estimates proved o
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, PY, REF, ROOT, orders  # noqa: E402
+from tresca_py.common import BIN, PY, REF, ROOT, orders  # noqa: E402
 RESULTS = []  # (requirement id, statement, passed, measured, command, reference file)
 
 

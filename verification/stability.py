@@ -21,9 +21,8 @@ import tempfile
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, REF, ROOT  # noqa: E402
-from common import rel_to as rel  # noqa: E402
+from tresca_py.common import BIN, REF, ROOT  # noqa: E402
+from tresca_py.common import rel_to as rel  # noqa: E402
 NEAR = os.path.join(ROOT, "verification", "cases", "near_incompressible.toml")
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 MMS_EL = os.path.join(ROOT, "verification", "cases", "mms_elastic.toml")
@@ -172,7 +171,7 @@ def p1_h1_error(nu, n):
 def cond_K(scene_path, refine):
     """Condition number of the reduced stabilised CR stiffness (scikit-fem assembly of the same a_h)."""
     sys.path.insert(0, os.path.join(ROOT, "scripts"))
-    import tresca_scene as ts
+    from tresca_py import tresca_scene as ts
     from skfem_solve import SkfemProblem
     args = ts.cli("cond", [scene_path, "-o", os.path.join(TMP, "c.h5"), "--refine", str(refine), "-q"])
     scene, disc, _ = ts.open_scene(args)

@@ -29,8 +29,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import BIN, REF, ROOT, strip_exact, child_cpu, load1  # noqa: E402
+from tresca_py.common import BIN, REF, ROOT, strip_exact, child_cpu, load1  # noqa: E402
 CASES = {
     "mms_front": dict(path="verification/cases/mms_front.toml", h_N=32, h_r=3, k_r=2, k_N=[8, 16, 32, 64, 128, 256],
                       joint=[(0, 8), (1, 16), (2, 32), (3, 64)], tol_level=(2, 32)),

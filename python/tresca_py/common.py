@@ -1,6 +1,6 @@
 """Shared helpers of the verification scripts: paths, running the binary, observed orders, relative
-differences. Each script imports what it needs from here (``from common import ...`` with this folder on
-``sys.path``); none defines its own copy.
+differences. Each script imports what it needs from here (``from tresca_py.common import ...``); none defines its
+own copy.
 
 Observed orders: for errors e_i at sizes x_i (mesh size h or time step k) the successive order is
     p_i = log(e_{i-1}/e_i) / log(x_{i-1}/x_i),
@@ -20,7 +20,8 @@ import time
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# python/tresca_py/common.py -> the repository root (the package is installed editable from python/)
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BIN = os.path.join(ROOT, "target", "release", "tresca-cr")
 PY = sys.executable
 MPIRUN = os.path.join(os.path.dirname(PY), "mpirun")

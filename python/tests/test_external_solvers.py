@@ -1,0 +1,109 @@
+"""Smoke tests of the external codes (issue 30 §3) on tiny meshes: a patch test through the friction law."""
+import json
+import math
+import subprocess
+
+import pytest
+
+from tresca_py.external import problem, quantities, richardson, skfem_nitsche, suite
+
+# An affine field u = (0.01x + 0.02y, 0.01y) on the unit square: f = 0, u·n = 0 on y = 0, and on y = 0
+# σ_τ = −σ₁₂ = −0.02μ while u_τ = 0.01x > 0: with g_a = 0.02μ the bottom slips everywhere under the exact
+# Tresca traction. Dirichlet data t·u on the other sides, one step from u0 = 0: the step's solution is u.
+PATCH = """
+title = "affine patch through the friction law"
+[mesh]
+corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+cells = [2, 2]
+[material]
+E = 1.0
+nu = 0.3
+{dirichlet}
+[[boundary]]
+name = "bottom"
+kind = "contact"
+g_a = "0.02/2.6"
+[time]
+T = 1.0
+steps = 1
+[exact]
+u = ["t*(0.01*x+0.02*y)", "t*0.01*y"]
+grad = [["0.01*t", "0.02*t"], ["0", "0.01*t"]]
+""".replace("{dirichlet}", "\n".join(
+    f'[[boundary]]\nname = "{side}"\nkind = "dirichlet"\nu = ["t*(0.01*x+0.02*y)", "t*0.01*y"]'
+    for side in ("right", "top", "left")))
+G_A = 0.02 / 2.6
+
+
+@pytest.fixture
+def patch(tmp_path):
+    p = tmp_path / "patch.toml"
+    p.write_text(PATCH)
+    return p
+
+
+def _check_patch(raw):
+    # Both discretisations contain the affine field and the Nitsche terms are consistent: the errors are
+    # rounding (1e-9 relative to |u|_H1 ≈ 0.025 leaves room for the Newton tolerance 1e-10).
+    assert raw["err_h1_semi"] < 1e-10 and raw["err_l2"] < 1e-10, raw
+    # ∫ σ_τ over Γ_C = −g_a·|Γ_C|: the friction force opposes the slip (a tangent τ = n would give 0 here)
+    assert raw["sigma_t_integral"] == pytest.approx(-G_A, rel=1e-8)
+    assert raw["u_tau_points"] == pytest.approx([0.0025, 0.005, 0.0075], rel=1e-8)
+    assert sum(raw["quad_stick"]) == 0  # slips everywhere
+
+
+def test_skfem_nitsche_patch(patch):
+    """The system shall reproduce an affine field that slips under the exact Tresca traction (scikit-fem P2)."""
+    _check_patch(skfem_nitsche.solve(problem.build(patch, 0, degree=2)))
+
+
+@pytest.mark.skipif(not suite.getfem_available(), reason="GetFEM not installed under /usr/bin/python3 (make getfem)")
+@pytest.mark.parametrize("degree", [1, 2])
+def test_getfem_patch(patch, tmp_path, degree):
+    """The system shall reproduce the affine slipping field with GetFEM P1 and P2."""
+    raw = suite.run_getfem(problem.build(patch, 0, degree=degree), tmp_path)
+    _check_patch(raw)
+
+
+def test_getfem_reports_bad_input(tmp_path):
+    """The GetFEM entry point shall refuse a wrong command line with a message and a non-zero exit."""
+    if not suite.getfem_available():
+        pytest.skip("GetFEM not installed")
+    import importlib.util
+    script = importlib.util.find_spec("tresca_py.external.getfem_solver").origin
+    proc = subprocess.run([suite.GETFEM_PYTHON, script], capture_output=True, text=True)
+    assert proc.returncode == 2 and "usage" in proc.stderr
+    missing = tmp_path / "missing.json"
+    proc = subprocess.run([suite.GETFEM_PYTHON, script, str(missing), str(tmp_path / "out.json")],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2 and "cannot read the problem file" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_richardson_exact_on_a_power_law():
+    """The system shall extrapolate Q(h) = 1 + h² exactly, with its band bounding the finest value's error."""
+    h = [0.4, 0.2, 0.1]
+    lim = richardson.limit(h, [1 + x * x for x in h], p_th=2)
+    assert lim.extrapolated and lim.p == pytest.approx(2.0) and lim.value == pytest.approx(1.0, abs=1e-14)
+    assert lim.gci >= 0.01 * 1.0 - 1e-15  # 1.25·|d₂|/3 = 0.0125 ≥ the finest error 0.01
+    osc = richardson.limit(h, [1.0, 1.1, 1.05], p_th=1)
+    assert not osc.extrapolated and osc.value == 1.05 and osc.gci == pytest.approx(3 * 0.05)
+
+
+def test_stick_ends():
+    """The system shall place the stick–slip transitions halfway between differing flags."""
+    a, b = quantities.stick_ends([0.0, 0.1, 0.2, 0.3, 0.4], [0, 1, 1, 1, 0], 0.4)
+    assert (a, b) == pytest.approx((0.05, 0.35))
+    assert all(math.isnan(v) for v in quantities.stick_ends([0.0, 0.1], [1, 1], 0.1))
+
+
+def test_problem_rejects_unknown_names(tmp_path):
+    """The scene reader shall name the key of an expression with unknown names."""
+    p = tmp_path / "bad.toml"
+    p.write_text(PATCH.replace('g_a = "0.02/2.6"', 'g_a = "0.02*z"'))
+    with pytest.raises(problem.ProblemError, match="g_a"):
+        problem.build(p, 0)
+
+
+def test_problem_is_json(patch):
+    """The problem description shall be JSON-serialisable (it is the GetFEM subprocess's input)."""
+    json.dumps(problem.build(patch, 1, degree=1))

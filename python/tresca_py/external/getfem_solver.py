@@ -1,0 +1,214 @@
+#!/usr/bin/python3
+"""GetFEM 5.4 (Debian python3-getfem) solver for bilateral contact with Tresca friction, P1 or P2 Lagrange.
+
+Standalone: it imports only numpy, getfem and the standard library, because Debian's GetFEM lives under
+/usr/bin/python3 (3.11), outside the project's venv. Usage:
+
+    /usr/bin/python3 getfem_solver.py problem.json result.json
+
+``problem.json`` is ``tresca_py.external.problem.build(...)`` (expressions as numpy code in x, y, t).
+GetFEM's machinery does the work:
+
+* ``add_isotropic_linearized_elasticity_brick`` (a(u, v)), ``add_source_term_brick`` (f and tractions),
+  ``add_Dirichlet_condition_with_multipliers`` (u = u_D weakly on the trace space of mfu; the variant "with
+  simplification" clears matrix rows at every assembly and made the assembly grow ~30× per refinement);
+* ``add_normal_Dirichlet_condition_with_Nitsche_method`` (θ = 1) for the bilateral condition u·n = g_n with
+  Neumann term ``Model.Neumann_term`` (σ(u)n) and γ = γ₀ h_T, γ₀ = 1/(γ_N (λ + 2μ));
+* Tresca friction on the slip increment as a Nitsche term in GWFL with GetFEM's ``Ball_projection``
+  (θ = 0):  −∫_{Γ_C} P·v,  P = Ball_projection((I − n⊗n)(σ(u)n − (u − uⁿ⁻¹)/γ), g_a),  γ = γ₀ element_size;
+* the model's own Newton (``Model.solve``, line search "basic": the "default" one stalls on Example 5.1
+  at refine 4 with P2 — residual stuck at half its initial value for 100 iterations) per backward-Euler step.
+"""
+import json
+import sys
+import time
+
+import numpy as np
+import getfem as gf
+
+gf.util_trace_level(0)
+gf.util_warning_level(0)
+
+SIGMA = "(lambda*Trace(Grad_u)*Id(2) + mu*(Grad_u + Grad_u'))"
+PROJ = ("Ball_projection((Id(2) - Normal@Normal)*(" + SIGMA + "*Normal - (u - UP)/(gamma0*element_size)), GA)")
+QTAU = "Norm((Id(2) - Normal@Normal)*(" + SIGMA + "*Normal - (u - UP)/(gamma0*element_size)))"
+FLOOR = 1e-8  # accepted relative residual of a stalled Newton iteration (rounding; see Solver.run)
+CONTACT = 10  # region numbers: CONTACT for Γ_C, 11, 12, ... for the other parts
+
+
+def evaluate(src, x, y, t):
+    """A numpy code string of (x, y, t) at points (the problem format; see problem.evaluate)."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    with np.errstate(all="ignore"):
+        val = eval(src, {"numpy": np, "x": x, "y": y, "t": float(t), "__builtins__": {}})  # noqa: S307
+    return np.broadcast_to(np.asarray(val, dtype=float), x.shape).copy()
+
+
+def region_faces(m, outer, pts):
+    """Outer faces of mesh m whose vertices all lie in the vertex set ``pts`` (coordinates)."""
+    pids = m.pid_from_coords(np.asarray(pts).T, 1e-10)
+    faces = m.faces_from_pid(np.asarray(pids, dtype=np.int32))
+    keep = {(int(c), int(f)) for c, f in outer.T}
+    sel = [k for k in range(faces.shape[1]) if (int(faces[0, k]), int(faces[1, k])) in keep]
+    return faces[:, sel]
+
+
+class Solver:
+    def __init__(self, prob):
+        self.prob = prob
+        k = int(prob["degree"])
+        P, T = np.asarray(prob["points"]).T, np.asarray(prob["triangles"]).T
+        self.m = gf.Mesh("pt2D", P, T)
+        outer = self.m.outer_faces()
+        self.mfu = gf.MeshFem(self.m, 2)
+        self.mfu.set_classical_fem(k)
+        self.mfd = gf.MeshFem(self.m, 1)
+        self.mfd.set_classical_fem(k + 1)
+        self.mim = gf.MeshIm(self.m, gf.Integ("IM_TRIANGLE(6)"))
+        md = self.md = gf.Model("real")
+        md.add_fem_variable("u", self.mfu)
+        md.add_initialized_data("lambda", prob["lam"])
+        md.add_initialized_data("mu", prob["mu"])
+        md.add_initialized_data("gamma0", 1.0 / (prob["gamma_n"] * (prob["lam"] + 2 * prob["mu"])))
+        md.add_isotropic_linearized_elasticity_brick(self.mim, "u", "lambda", "mu")
+        self.xd = self.mfd.basic_dof_nodes()
+        self.xu = self.mfu.basic_dof_nodes()
+        self.data = []  # (name, mf, codes-or-code, component or None)
+        if prob["f"] is not None:
+            self._fem_data("F", prob["f"])
+            md.add_source_term_brick(self.mim, "u", "[F1;F2]")
+        pts = np.asarray(prob["points"])
+        for i, part in enumerate(prob["parts"]):
+            verts = pts[np.unique(np.asarray(part["segments"]).ravel())]
+            rg = CONTACT if part["kind"] == "contact" else 11 + i
+            self.m.set_region(rg, region_faces(self.m, outer, verts))
+            if part["kind"] == "neumann":
+                self._fem_data(f"T{i}_", part["traction"])
+                md.add_source_term_brick(self.mim, "u", f"[T{i}_1;T{i}_2]", rg)
+            elif part["kind"] == "dirichlet":
+                md.add_initialized_fem_data(f"UD{i}", self.mfu, np.zeros(self.mfu.nbdof()))
+                self.data.append((f"UD{i}", "u", part["u"], None))
+                md.add_Dirichlet_condition_with_multipliers(self.mim, "u", self.mfu, rg, f"UD{i}")
+            else:
+                self.contact = part
+        self._scalar_data("GAP", self.contact["gap"])
+        self._scalar_data("GA", self.contact["g_a"])
+        md.add_initialized_fem_data("UP", self.mfu, np.zeros(self.mfu.nbdof()))
+        md.add_normal_Dirichlet_condition_with_Nitsche_method(self.mim, "u", md.Neumann_term("u", CONTACT),
+                                                              "gamma0", CONTACT, 1.0, "GAP")
+        md.add_nonlinear_term(self.mim, "-" + PROJ + ".Test_u", CONTACT)
+
+    def _scalar_data(self, name, src):
+        self.md.add_initialized_fem_data(name, self.mfd, np.zeros(self.mfd.nbdof()))
+        self.data.append((name, "d", src, None))
+
+    def _fem_data(self, prefix, codes):
+        for c in range(2):
+            self._scalar_data(f"{prefix}{c + 1}", codes[c])
+
+    def vector_values(self, codes, t):
+        """Nodal interpolant on mfu (dofs interleaved x, y per node) of a 2-vector of codes."""
+        out = np.zeros(self.mfu.nbdof())
+        for c in range(2):
+            out[c::2] = evaluate(codes[c], self.xu[0, c::2], self.xu[1, c::2], t)
+        return out
+
+    def set_time(self, t):
+        for name, where, src, _ in self.data:
+            if where == "u":
+                self.md.set_variable(name, self.vector_values(src, t))
+            else:
+                self.md.set_variable(name, evaluate(src, self.xd[0], self.xd[1], t))
+
+    def run(self, tol=1e-10, max_iter=40):
+        prob, md = self.prob, self.md
+        t0 = time.perf_counter()
+        times = prob["times"]
+        u = self.vector_values(prob["u0"], times[0]) if prob["u0"] is not None else np.zeros(self.mfu.nbdof())
+        md.set_variable("u", u)
+        iters = []
+        for n, t in enumerate(times[1:], start=1):
+            md.set_variable("UP", md.variable("u"))
+            self.set_time(t)
+            md.assembly("build_rhs")
+            r0 = max(float(np.linalg.norm(md.rhs())), 1e-300)
+            target = tol * r0  # relative to the step's first residual
+            nit, converged = md.solve("max_res", target, "max_iter", max_iter, "lsearch", "basic")
+            md.assembly("build_rhs")
+            rnorm = float(np.linalg.norm(md.rhs()))
+            # rounding floor: at λ/μ = 10⁴ (cep, P1, 64×64 cells) Newton stalls at ~1e-9·r0 ≈ ε·cond(A); a
+            # stalled iteration below FLOOR·r0 is accepted, anything else is a failure
+            if not np.isfinite(rnorm) or rnorm > (10 * target if converged else FLOOR * r0):
+                raise RuntimeError(f"getfem: step {n} (t={t:g}) did not converge: {nit} Newton iterations, "
+                                   f"residual {rnorm:.3e} (target {target:.3e})")
+            iters.append(int(nit))
+        wall = time.perf_counter() - t0
+        out = self.quantities(times[-1])
+        out.update({"code": f"getfem-P{prob['degree']}", "dofs": int(self.mfu.nbdof()), "wall_s": wall,
+                    "newton_iterations": iters})
+        return out
+
+    def quantities(self, t):
+        md, mim, mfu, pr = self.md, self.mim, self.mfu, self.prob["probes"]
+        U = md.variable("u")
+        tau = np.asarray(pr["tangent"])
+        l2, semi = gf.compute_L2_norm(mfu, U, mim), gf.compute_H1_semi_norm(mfu, U, mim)
+        energy = gf.asm("generic", mim, 0, "0.5*(" + SIGMA + "):Sym(Grad_u)", -1, md)
+        sig = gf.asm("generic", mim, 0, "[-Normal(2);Normal(1)]." + PROJ, CONTACT, md)
+        mimd2, mimd1 = gf.MeshImData(mim, CONTACT, [2]), gf.MeshImData(mim, CONTACT)
+        xq = np.asarray(md.interpolation("X", mimd2, CONTACT)).reshape(-1, 2).T
+        stick = np.asarray(md.interpolation("GA - " + QTAU, mimd1, CONTACT)) > 0
+        start = np.asarray(pr["start"])
+        s_q = (xq[0] - start[0]) * tau[0] + (xq[1] - start[1]) * tau[1]
+
+        def probe(points):
+            v = np.asarray(md.interpolation("u", np.asarray(points).T, self.m)).reshape(-1, 2).T
+            return v[0] * tau[0] + v[1] * tau[1]
+        out = {"h1_norm": float(np.hypot(l2, semi)), "energy": float(energy), "sigma_t_integral": float(sig),
+               "u_tau_points": probe(pr["points"]).tolist(), "u_tau_samples": probe(pr["samples"]).tolist(),
+               "quad_s": s_q.tolist(), "quad_stick": stick.astype(int).tolist()}
+        if self.prob["exact"] is not None:
+            out.update(self.errors(U, t))
+        return out
+
+    def errors(self, U, t):
+        """True errors at t: u_h and the exact u on P_{k+2} (the exact u enters by its nodal interpolant of
+        degree k+2, whose error is O(h^{k+1}) in H1 for smooth u, one order above the P_k error)."""
+        k = int(self.prob["degree"])
+        mfh = gf.MeshFem(self.m, 2)
+        mfh.set_classical_fem(k + 2)
+        xh = mfh.basic_dof_nodes()
+        ex = np.zeros(mfh.nbdof())
+        for c in range(2):
+            ex[c::2] = evaluate(self.prob["exact"]["u"][c], xh[0, c::2], xh[1, c::2], t)
+        diff = ex - gf.compute_interpolate_on(self.mfu, U, mfh)
+        return {"err_h1_semi": float(gf.compute_H1_semi_norm(mfh, diff, self.mim)),
+                "err_l2": float(gf.compute_L2_norm(mfh, diff, self.mim))}
+
+
+def main(argv):
+    if len(argv) != 3:
+        print("usage: getfem_solver.py problem.json result.json", file=sys.stderr)
+        return 2
+    try:
+        with open(argv[1]) as fh:
+            prob = json.load(fh)
+    except (OSError, ValueError) as err:
+        print(f"error: cannot read the problem file {argv[1]}: {err}", file=sys.stderr)
+        return 2
+    try:
+        t0 = time.perf_counter()
+        solver = Solver(prob)
+        setup = time.perf_counter() - t0
+        out = solver.run()
+        out["wall_s"] += setup  # set-up + time loop (not the interpreter start, not the post-processing)
+    except RuntimeError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 1
+    with open(argv[2], "w") as fh:
+        json.dump(out, fh)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,127 @@
+"""The external suite: every scene at every level with every code; rows of compared quantities.
+
+Codes: GetFEM P1 and P2 (a subprocess under /usr/bin/python3, JSON in and out), the scikit-fem P2 Nitsche
+solver (in process) and tresca-cr (``tresca-cr run``; its column is empty for scenes it cannot read yet).
+All codes of a scene use the same time steps (the backward-Euler problem at that k is the common limit).
+"""
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import shutil
+import subprocess
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import problem, quantities, skfem_nitsche, tresca
+
+GETFEM_PYTHON = "/usr/bin/python3"
+CODES = ("getfem-P1", "getfem-P2", "skfem-P2-nitsche", "tresca-cr")
+#: theoretical H1 order of each code (CR and P1: 1, P2: 2 where the regularity allows)
+ORDER = {"getfem-P1": 1, "getfem-P2": 2, "skfem-P2-nitsche": 2, "tresca-cr": 1}
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A scene with its levels (refine values) for the CR and P1 codes; the P2 codes run one level lower
+    (``P2_SHIFT``), so that every code's finest level has about the same number of unknowns."""
+    name: str
+    path: str
+    levels: tuple
+    steps: int
+    note: str = ""
+    #: the highest code order whose true errors at these steps are spatial: at N = 4, mms_front's exact
+    #: solution misses the backward-Euler inclusion on the strip the trailing front crosses in a step, a
+    #: time error (≈ 4e-4 in H1) that the P2 codes' spatial error reaches at 32 cells (their order 1.36 there
+    #: becomes 1.88 with N = 16: reference/external.md)
+    xo_max_order: int = 2
+
+    def levels_of(self, code):
+        return tuple(r + P2_SHIFT for r in self.levels) if ORDER[code] == 2 else self.levels
+
+
+P2_SHIFT = -1
+SCENES = (
+    Scene("ex51", "verification/cases/paper_example_5_1.toml", (1, 2, 3, 4, 5), 4,
+          "Example 5.1 (proportional load: N = 4 steps instead of the paper's 40)"),
+    Scene("mms_front", "verification/cases/mms_front.toml", (0, 1, 2, 3, 4), 4,
+          "manufactured, moving stick-slip fronts (its energy error does not depend on N, scene note)",
+          xo_max_order=1),
+    Scene("cep", "verification/external/scenes/cep_tresca.toml", (1, 2, 3, 4, 5), 1,
+          "Chouly-Ern-Pignet Tresca, lambda/mu = 1e4, nonzero Dirichlet data"),
+    Scene("imposed", "verification/external/scenes/imposed_normal.toml", (1, 2, 3, 4, 5), 1,
+          "static, imposed normal displacement -0.1 on Gamma_C"),
+    Scene("mms_rotated", "verification/cases/mms_rotated.toml", (0, 1, 2, 3, 4), 4,
+          "manufactured, rotated square (contact side not axis-aligned)"),
+)
+
+
+def getfem_available():
+    return Path(GETFEM_PYTHON).exists() and subprocess.run(
+        [GETFEM_PYTHON, "-c", "import getfem"], capture_output=True).returncode == 0
+
+
+def run_getfem(prob, work):
+    """Solve one problem with GetFEM in a subprocess; the raw result dict."""
+    work.mkdir(parents=True, exist_ok=True)
+    tag = f"getfem_P{prob['degree']}_r{prob['refine']}"
+    pin, pout = work / f"{tag}_problem.json", work / f"{tag}_result.json"
+    pin.write_text(json.dumps(prob))
+    script = importlib.util.find_spec("tresca_py.external.getfem_solver").origin
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")  # as the venv side (run.py)
+    proc = subprocess.run([GETFEM_PYTHON, script, str(pin), str(pout)], capture_output=True, text=True, env=env)
+    if proc.returncode != 0:
+        raise RuntimeError(f"GetFEM P{prob['degree']} on {prob['scene']} refine {prob['refine']}: "
+                           f"{proc.stderr.strip()[-600:]}")
+    return json.loads(pout.read_text())
+
+
+def tresca_reads(binary, path):
+    """Whether this tresca-cr binary accepts the scene (``tresca-cr check``), with its message if not."""
+    proc = subprocess.run([str(binary), "check", str(path)], capture_output=True, text=True)
+    return proc.returncode == 0, (proc.stderr or proc.stdout).strip().splitlines()[-1:] or [""]
+
+
+def run_scene(sc: Scene, codes, out_dir, binary, log=print):
+    """Rows (dicts) for one scene: code, level, h, dofs, wall, quantities, errors; and notes on skipped codes."""
+    scene = problem.load(sc.path)
+    work = Path(out_dir) / sc.name
+    if work.exists():
+        shutil.rmtree(work)
+    work.mkdir(parents=True)
+    rows, notes = [], []
+    use_tresca = "tresca-cr" in codes
+    if use_tresca:
+        ok, msg = tresca_reads(binary, sc.path)
+        if not ok:
+            use_tresca = False
+            notes.append(f"tresca-cr: this binary cannot read the scene yet ({msg[0]}); its column stays empty")
+    use_getfem = any(c.startswith("getfem") for c in codes)
+    if use_getfem and not getfem_available():
+        raise RuntimeError(f"{GETFEM_PYTHON} cannot import getfem: run `make getfem`")
+    for code in codes:
+        if code == "tresca-cr" and not use_tresca:
+            continue
+        for r in sc.levels_of(code):
+            k = 1 if code == "getfem-P1" else 2
+            prob = problem.at_level(scene, r, sc.steps, degree=k)
+            t0 = time.perf_counter()
+            if code.startswith("getfem"):
+                raw = run_getfem(prob, work)
+            elif code == "skfem-P2-nitsche":
+                raw = skfem_nitsche.solve(prob)
+            else:
+                raw = tresca.run_level(binary, sc.path, r, sc.steps, work, prob["probes"])
+            raw["h"] = prob["h"]
+            row = quantities.summarise(raw, prob["probes"]["length"])
+            row.update({"scene": sc.name, "code": code, "refine": r, "steps": sc.steps,
+                        "process_s": time.perf_counter() - t0})
+            rows.append(row)
+            log(f"  {sc.name:12s} {code:17s} refine {r:2d}  dofs {row['dofs']:7d}  wall {row['wall_s']:7.3f} s  "
+                f"H1 {row['h1_norm']:.6e}" + (f"  err_H1 {row['err_h1_semi']:.3e}" if "err_h1_semi" in row else ""),
+                flush=True)
+    if use_tresca:
+        tresca.study_csv(binary, sc.path, sc.levels, sc.steps, work / "tresca_study.csv")
+    return rows, notes

@@ -1,0 +1,191 @@
+"""Pictures of a tresca-cr results file (reads only the ``tresca`` group, matplotlib Agg).
+
+    .venv/bin/python scripts/render.py run.h5 [--times 0.25 0.5 1.0] [-o DIR] [--field vm|u] [--scale S]
+
+For each chosen time (nearest stored step; default: quarter, half and final time) writes
+* ``DIR/deformed_<n>.png``: the deformed body (CR field as discontinuous P1 on each triangle, displacement
+  magnified by S, stated in the title; default: 10 % of the body's size over max |u|), coloured by von Mises
+  stress or |u|, with Γ_C drawn in black;
+* ``DIR/contact_<n>.png`` (when Γ_C exists): σ_τ/ḡ along Γ_C and the slip velocity Δs/Δt, with slip
+  edges shaded.
+Only committed steps are drawn: a killed or stopped run is said so on stdout and in every title. Axis and
+colour-bar units come from the scene's optional ``[units]`` table (``length``, ``force``, ``time``; stress is
+force/length²), read from the scene text stored in the file; without it the labels say "length",
+"force/length²", "time". Bad input (an unreadable or invalid results file, a non-finite or negative
+``--scale`` or ``--times``, an output directory that cannot be written) gives one ``error:`` line and exit 2,
+before anything is drawn.
+"""
+import argparse
+import math
+import os
+import sys
+import textwrap
+import tomllib
+
+import numpy as np
+from matplotlib.collections import LineCollection, PolyCollection
+from matplotlib.figure import Figure
+
+from . import fields, paths, results
+
+
+def units(scene_text):
+    """Unit labels from the scene's optional [units] table."""
+    try:
+        u = tomllib.loads(scene_text).get("units", {})
+    except (tomllib.TOMLDecodeError, TypeError):
+        u = {}
+    L, F, T = u.get("length", "length"), u.get("force", "force"), u.get("time", "time")
+    return {"L": L, "S": f"{F}/{L}²", "T": f" {u['time']}" if "time" in u else "", "V": f"{L}/{T}"}
+
+
+def load(path):
+    """The committed steps of a results file (validated, ``tresca_py.results``) as the dict the pictures use."""
+    r = results.read(path)
+    d = {"mesh/points": r.mesh.points, "mesh/triangles": r.mesh.triangles, "mesh/edges": r.mesh.edges,
+         "te": r.mesh.triangle_edges(), "times": r.times, "u": r.u, "E": float(r.attrs["E"]),
+         "nu": float(r.attrs["nu"]), "title": str(r.attrs.get("title", "")) or os.path.basename(path),
+         "units": units(str(r.attrs.get("scene", ""))), "note": r.note}
+    if r.contact is not None:
+        for k in ("edges", "tangent", "g", "slip", "sigma_t", "state"):
+            d["c_" + k] = getattr(r.contact, k)
+    return d
+
+
+def title(d, text):
+    """Figure title: the run, what is shown, and the kill/stop note; wrapped, never clipped (bbox tight)."""
+    head = d["title"] + (f"  [{d['note']}]" if d["note"] else "")
+    return "\n".join(textwrap.wrap(head, 80) + textwrap.wrap(text, 80))
+
+
+def step_fields(d, n):
+    """(triangle vertices (T, 3, 2), vertex displacements (T, 3, 2), von Mises (T,)) at step n."""
+    disp = fields.vertex_values(d["u"][n:n + 1], d["te"])
+    gl = fields.basis_gradients(d["mesh/points"], d["mesh/triangles"])
+    vm = fields.stress(disp, gl, d["E"], d["nu"])[4]
+    return d["mesh/points"][d["mesh/triangles"]], disp[0], vm[0]
+
+
+def deformed(d, n, field, scale, out):
+    te = d["te"]
+    x, disp, vm = step_fields(d, n)
+    size = float(np.ptp(d["mesh/points"], axis=0).max())
+    umax = float(np.abs(d["u"]).max()) or 1.0
+    s = scale if scale else 0.1 * size / umax
+    y = x + s * disp
+    u_ = d["units"]
+    if field == "vm":
+        val, label = vm, f"von Mises stress (plane strain) [{u_['S']}]"
+    else:
+        val, label = np.linalg.norm(disp, axis=2).mean(axis=1), f"|u| (triangle mean) [{u_['L']}]"
+    fig = Figure(figsize=(7.0, 6.0))
+    ax = fig.subplots()
+    ax.add_collection(PolyCollection(x, facecolors="none", edgecolors="0.8", linewidths=0.4))
+    pc = PolyCollection(y, array=val, cmap="viridis", edgecolors="face", linewidths=0.2)
+    ax.add_collection(pc)
+    fig.colorbar(pc, ax=ax, label=label, shrink=0.85)
+    if "c_edges" in d:
+        pts = d["mesh/points"]
+        e2 = d["mesh/edges"][d["c_edges"]]
+        # deformed Γ_C from the trace of the triangle owning each edge
+        segs = []
+        tri = d["mesh/triangles"]
+        for e, (a, b) in zip(d["c_edges"], e2, strict=True):
+            t = np.nonzero((te == e).any(axis=1))[0][0]
+            ja, jb = list(tri[t]).index(a), list(tri[t]).index(b)
+            segs.append([y[t, ja], y[t, jb]])
+        ax.add_collection(LineCollection(segs, colors="k", linewidths=2.0, label="Γ_C (deformed)"))
+        ax.add_collection(LineCollection(pts[e2], colors="r", linewidths=1.0, linestyles=":", label="Γ_C (reference)"))
+        # below the axes, never over the body
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8, frameon=False)
+    ax.autoscale()
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"x [{u_['L']}]")
+    ax.set_ylabel(f"y [{u_['L']}]")
+    ax.set_title(title(d, f"t = {d['times'][n]:.4g}{u_['T']}, step {n}: deformed ×{s:.3g} (grey: reference). "
+                    "Gaps between triangles: the CR field is continuous only at edge midpoints"), fontsize=9)
+    fig.savefig(out, dpi=120, bbox_inches="tight")
+
+
+def contact(d, n, out):
+    pts, e2 = d["mesh/points"], d["mesh/edges"][d["c_edges"]]
+    mid = pts[e2].mean(axis=1)
+    tau = d["c_tangent"][0]
+    s = mid @ tau  # arclength-like coordinate along Γ_C (straight contact boundary)
+    order = np.argsort(s)
+    half = 0.5 * np.abs((pts[e2[:, 1]] - pts[e2[:, 0]]) @ tau)
+    g = d["c_g"]
+    sig = d["c_sigma_t"][n] / np.where(g > 0, g, 1.0)
+    times = d["times"]
+    if n > 0:
+        vel = (d["c_slip"][n] - d["c_slip"][n - 1]) / (times[n] - times[n - 1])
+    else:
+        vel = np.zeros_like(sig)
+    state = d["c_state"][n]
+    fig = Figure(figsize=(7, 5.6))
+    a1, a2 = fig.subplots(2, 1, sharex=True)
+    for ax in (a1, a2):
+        for k in np.nonzero(state == 1)[0]:
+            ax.axvspan(s[k] - half[k], s[k] + half[k], color="tab:orange", alpha=0.25, lw=0)
+        ax.grid(alpha=0.3)
+    a1.step(s[order], sig[order], where="mid", color="tab:blue")
+    a1.plot(s[order], sig[order], ".", color="tab:blue")
+    a1.axhline(1, color="k", lw=0.8, ls="--")
+    a1.axhline(-1, color="k", lw=0.8, ls="--")
+    u_ = d["units"]
+    a1.set_ylabel("σ_τ / ḡ  [–]")
+    a1.set_ylim(-1.15, 1.15)
+    a2.step(s[order], vel[order], where="mid", color="tab:red")
+    a2.plot(s[order], vel[order], ".", color="tab:red")
+    a2.set_ylabel(f"slip velocity Δs/Δt [{u_['V']}]")
+    a2.set_xlabel(f"position along Γ_C, x·τ [{u_['L']}]")
+    nslip = int(state.sum())
+    a1.set_title(title(d, f"Γ_C at t = {times[n]:.4g}{u_['T']} (step {n}); "
+                          f"shaded: slip ({nslip} of {len(state)} edges)"),
+                 fontsize=9)
+    fig.savefig(out, dpi=120, bbox_inches="tight")
+
+
+def positive_or_auto(text):
+    """--scale: a finite number ≥ 0 (0: automatic)."""
+    v = float(text)
+    if not math.isfinite(v) or v < 0:
+        raise argparse.ArgumentTypeError(f"must be a finite number >= 0 (0: automatic), not {text}")
+    return v
+
+
+def finite(text):
+    v = float(text)
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"must be a finite number, not {text}")
+    return v
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description="render a tresca-cr results file")
+    ap.add_argument("h5")
+    ap.add_argument("--times", type=finite, nargs="*", help="times to draw (nearest stored step)")
+    ap.add_argument("-o", "--out", default=".", help="output directory")
+    ap.add_argument("--field", choices=["vm", "u"], default="vm", help="colour: von Mises or |u|")
+    ap.add_argument("--scale", type=positive_or_auto, default=0.0,
+                    help="displacement magnification (default 0: automatic)")
+    args = ap.parse_args(argv)
+    try:
+        d = load(args.h5)
+        out = paths.output_dir(args.out)
+    except (results.ResultsError, paths.PathError) as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    t = d["times"]
+    if d["note"]:
+        print(f"note: {args.h5}: {d['note']}; drawing committed steps only (t ≤ {t[-1]:.4g})")
+    want = args.times if args.times else [t[0] + q * (t[-1] - t[0]) for q in (0.25, 0.5, 1.0)]
+    for n in dict.fromkeys(int(np.argmin(np.abs(t - w))) for w in want):
+        p = os.path.join(out, f"deformed_{n:06d}.png")
+        deformed(d, n, args.field, args.scale, p)
+        print(p)
+        if "c_edges" in d:
+            p = os.path.join(out, f"contact_{n:06d}.png")
+            contact(d, n, p)
+            print(p)
+    return 0

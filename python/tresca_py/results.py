@@ -1,0 +1,401 @@
+"""The one ``/tresca`` layout of a results file, for writing and reading (the README's layout table; written
+by ``src/output/tresca.rs`` and by ``write`` here for the serial Python solvers).
+
+``read(path)`` returns a validated ``Results`` of the committed steps, or raises ``ResultsError`` naming the
+file and the problem: not a readable regular file, not HDF5, truncated, no ``/tresca`` group, a dataset
+missing or of the wrong shape or type, attributes missing or inconsistent (``status``, the ``completed``
+steps, ``steps``, ``n_contact``), NaN or Inf in any float series, indices out of range, a triangle side that
+is not an edge, time nodes not increasing, a step that does not match its checksum.
+
+Sizes: P points, T triangles, E edges, C contact edges (Γ_C; the ``contact`` group exists only when C > 0),
+R rows of every series (N + 1 time nodes; a killed run, status "running", has room for all N + 1 but data
+in its first ``completed`` rows only; a finished or stopped run has exactly ``completed`` rows).
+"""
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import checksum, paths
+
+F8, I8, U1, U8 = np.dtype("<f8"), np.dtype("<i8"), np.dtype("u1"), np.dtype("<u8")
+
+# (dataset under /tresca, dtype written, shape in the size symbols, meaning)
+DATASETS = (
+    ("mesh/points", F8, ("P", 2), "vertices"),
+    ("mesh/triangles", I8, ("T", 3), "counter-clockwise vertex indices"),
+    ("mesh/edges", I8, ("E", 2), "edge vertex indices"),
+    ("mesh/midpoints", F8, ("E", 2), "edge midpoints (the CR nodes; tools match edges by these)"),
+    ("times", F8, ("R",), "time nodes"),
+    ("u", F8, ("R", "E", 2), "displacement at every edge midpoint"),
+    ("energy", F8, ("R",), "a_h(u^n, u^n)"),
+    ("steps/iterations", I8, ("R",), "solver iterations"),
+    ("steps/residual", F8, ("R",), "final residual"),
+    ("steps/n_stick", I8, ("R",), "contact edges sticking"),
+    ("steps/n_slip", I8, ("R",), "contact edges slipping"),
+    ("steps/wall_time", F8, ("R",), "seconds"),
+    ("steps/checksum", U8, ("R",), "XXH64 of the step's rows (tresca_py.checksum)"),
+    ("contact/edges", I8, ("C",), "indices of the Γ_C edges"),
+    ("contact/normal", F8, ("C", 2), "outward normal n_e"),
+    ("contact/tangent", F8, ("C", 2), "tangent τ_e = (−n_y, n_x)"),
+    ("contact/g", F8, ("C",), "friction bound ḡ_e"),
+    ("contact/slip", F8, ("R", "C"), "u_τ(m_e)"),
+    ("contact/sigma_t", F8, ("R", "C"), "σ_τ = −μ_e/|e|"),
+    ("contact/state", U1, ("R", "C"), "0 stick, 1 slip"),
+    ("contact/mu", F8, ("R", "C"), "friction force μ_e, exact"),
+    ("contact/dof", F8, ("R", "C"), "the contact unknown"),
+    ("errors/energy", F8, ("R",), "true energy error"),
+    ("errors/h1", F8, ("R",), "true broken H1 error"),
+    ("errors/l2", F8, ("R",), "true L2 error"),
+)
+SPEC = {name: (dtype, shape) for name, dtype, shape, _ in DATASETS}
+STEP_FIELDS = ("iterations", "residual", "n_stick", "n_slip", "wall_time")
+CONTACT_STATIC = ("edges", "normal", "tangent", "g")
+CONTACT_SERIES = ("slip", "sigma_t", "state", "mu", "dof")
+ERRORS = ("energy", "h1", "l2")
+
+# /tresca attributes as the Rust binary writes them: name -> type ("floats": a 1-D float array)
+ATTRIBUTES = {
+    "scene": str, "scene_path": str, "title": str, "version": str, "git_commit": str, "solver": str,
+    "tol": float, "max_iter": int, "uzawa_step": float, "rho": float, "E": float, "nu": float, "steps": int,
+    "n_edges": int, "n_contact": int, "n_dofs": int, "paper_dofs": int, "h": float, "setup_times": "floats",
+    "setup_times_meaning": str, "status": str, "frame_every": int,
+}
+REQUIRED = ("scene", "version", "solver", "E", "nu", "steps", "status")
+# Written by the Python solvers before this module: no status, completed, checksum, contact/mu, contact/dof.
+LEGACY_MISSING = ("status", "steps/checksum", "contact/mu", "contact/dof")
+
+
+class ResultsError(ValueError):
+    """A results file (or results to be written) that breaks the layout; the message names what."""
+
+
+@dataclass(eq=False)
+class Mesh:
+    points: np.ndarray
+    triangles: np.ndarray
+    edges: np.ndarray
+    midpoints: np.ndarray
+
+    def triangle_edges(self, where="results"):
+        """(T, 3): the edge opposite local vertex i of each triangle."""
+        P = len(self.points)
+        key = np.sort(self.edges, axis=1) @ np.array([P, 1])
+        order = np.argsort(key)
+        t = self.triangles
+        sides = np.stack([t[:, [1, 2]], t[:, [2, 0]], t[:, [0, 1]]], axis=1)
+        want = np.sort(sides, axis=2) @ np.array([P, 1])
+        pos = np.clip(np.searchsorted(key, want, sorter=order), 0, max(len(key) - 1, 0))
+        found = order[pos] if len(key) else np.zeros_like(want)
+        bad = np.argwhere(key[found] != want) if len(key) else np.argwhere(np.ones_like(want, bool))
+        if len(bad):
+            k, i = bad[0]
+            raise ResultsError(f"{where}: tresca/mesh/triangles: side {sides[k, i].tolist()} of triangle {k} is not "
+                               "an edge of tresca/mesh/edges")
+        return found
+
+
+@dataclass(eq=False)
+class Contact:
+    edges: np.ndarray
+    normal: np.ndarray
+    tangent: np.ndarray
+    g: np.ndarray
+    slip: np.ndarray
+    sigma_t: np.ndarray
+    state: np.ndarray
+    mu: np.ndarray | None
+    dof: np.ndarray | None
+
+
+@dataclass(eq=False)
+class Results:
+    """The committed steps of a run (series: first axis = step) and the ``/tresca`` attributes."""
+    mesh: Mesh
+    times: np.ndarray
+    u: np.ndarray
+    energy: np.ndarray
+    steps: dict
+    contact: Contact | None = None
+    errors: dict | None = None
+    attrs: dict = field(default_factory=dict)
+    path: str | None = None
+    rows: int | None = None  # rows in the file (> completed for a killed run)
+
+    @property
+    def completed(self):
+        return len(self.times)
+
+    @property
+    def status(self):
+        return self.attrs.get("status", "completed")
+
+    @property
+    def n_steps(self):
+        """N, the run's number of time steps (N + 1 time nodes when it completes)."""
+        return int(self.attrs.get("steps", self.completed - 1))
+
+    @property
+    def note(self):
+        """'' for a completed run, else what happened to it."""
+        if self.status.startswith("running"):
+            return f"killed run: {self.completed} of {self.n_steps + 1} steps committed"
+        if self.status.startswith("stopped"):
+            return f"stopped run: {self.completed} of {self.n_steps + 1} steps ({self.status})"
+        return ""
+
+    def require_contact(self, why):
+        """The contact part, or ResultsError saying that ``why`` needs one."""
+        if self.contact is None:
+            raise ResultsError(f"{self.path or 'results'}: the run has no contact part (no Γ_C in the scene); {why}")
+        return self.contact
+
+    def series(self):
+        """{dataset name: array of the committed steps} of every series present, in checksum order."""
+        out = {"times": self.times, "u": self.u, "energy": self.energy}
+        out.update({f"steps/{k}": self.steps[k] for k in STEP_FIELDS})
+        if self.contact is not None:
+            out.update({f"contact/{k}": getattr(self.contact, k) for k in CONTACT_SERIES
+                        if getattr(self.contact, k) is not None})
+        if self.errors is not None:
+            out.update({f"errors/{k}": self.errors[k] for k in ERRORS})
+        return out
+
+    def static(self):
+        """{dataset name: array} of the mesh and the contact geometry."""
+        out = {f"mesh/{k}": getattr(self.mesh, k) for k in ("points", "triangles", "edges", "midpoints")}
+        if self.contact is not None:
+            out.update({f"contact/{k}": getattr(self.contact, k) for k in CONTACT_STATIC})
+        return out
+
+    def checksums(self):
+        """The checksum of every step (``tresca_py.checksum``), the series in their stored dtypes."""
+        s = self.series()
+        return checksum.step_checksums([np.asarray(s[k], SPEC[k][0]) for k in checksum.SERIES if k in s])
+
+
+def _check_array(where, name, shape, dtype, sizes):
+    """ResultsError unless a dataset of this shape and dtype fits the layout."""
+    sym = SPEC[name][1]
+    want = tuple(sizes[s] if isinstance(s, str) else s for s in sym)
+    if tuple(shape) != want:
+        raise ResultsError(f"{where}: tresca/{name} has shape {tuple(shape)}, the layout wants {want} "
+                           f"({', '.join(map(str, sym))})")
+    kinds = {"contact/state": "iub", "steps/checksum": "u"}.get(name, "f" if SPEC[name][0].kind == "f" else "iu")
+    if np.dtype(dtype).kind not in kinds:
+        raise ResultsError(f"{where}: tresca/{name} holds {np.dtype(dtype)}, the layout wants {SPEC[name][0]}")
+
+
+def validate(r, where="results"):
+    """ResultsError unless the in-memory results fit the layout and hold valid values."""
+    m = r.mesh
+    sizes = {"P": len(m.points), "T": len(m.triangles), "E": len(m.edges), "R": len(r.times),
+             "C": len(r.contact.edges) if r.contact is not None else 0}
+    arrays = {**r.static(), **r.series()}
+    for name, a in arrays.items():
+        a = np.asarray(a)
+        _check_array(where, name, a.shape, a.dtype, sizes)
+        bad = ~np.isfinite(a) if a.dtype.kind == "f" else None
+        if bad is not None and bad.any():
+            n, at = int(bad.sum()), np.unravel_index(int(np.argmax(bad)), a.shape)
+            step = f"step {at[0]}" if SPEC[name][1][0] == "R" else f"{tuple(map(int, at))}"
+            raise ResultsError(f"{where}: tresca/{name} holds {n} NaN/Inf value{'s' * (n > 1)} (first at {step}): "
+                               "not a valid result")
+    _check_indices(where, m.triangles, sizes["P"], "mesh/triangles")
+    _check_indices(where, m.edges, sizes["P"], "mesh/edges")
+    m.triangle_edges(where)
+    if sizes["R"] == 0:
+        raise ResultsError(f"{where}: no committed step (tresca-cr never leaves such a file under its name)")
+    if np.any(np.diff(r.times) <= 0):
+        k = int(np.argmax(np.diff(r.times) <= 0)) + 1
+        raise ResultsError(f"{where}: tresca/times is not increasing at step {k} ({r.times[k - 1]!r}, {r.times[k]!r})")
+    if r.contact is not None:
+        c = r.contact
+        if sizes["C"] == 0:
+            raise ResultsError(f"{where}: a tresca/contact group without contact edges")
+        _check_indices(where, c.edges, sizes["E"], "contact/edges")
+        if len(np.unique(c.edges)) != len(c.edges):
+            raise ResultsError(f"{where}: tresca/contact/edges lists an edge twice")
+        if np.any((c.state != 0) & (c.state != 1)):
+            raise ResultsError(f"{where}: tresca/contact/state holds values other than 0 (stick) and 1 (slip)")
+    E, nu = r.attrs.get("E", 1.0), r.attrs.get("nu", 0.0)
+    if not (np.isfinite(E) and E > 0 and np.isfinite(nu) and -1 < nu < 0.5):  # as src/scene/mod.rs requires
+        raise ResultsError(f"{where}: attributes E = {E}, nu = {nu}: not a plane-strain material (E > 0, "
+                           "-1 < nu < 0.5)")
+
+
+def _check_indices(where, a, n, name):
+    if a.size and (a.min() < 0 or a.max() >= n):
+        raise ResultsError(f"{where}: tresca/{name} holds indices outside 0..{n - 1} ({int(a.min())}..{int(a.max())})")
+
+
+def _attrs(where, g):
+    """The /tresca attributes as Python values, type-checked against ATTRIBUTES."""
+    out = {}
+    for k, v in g.attrs.items():
+        if isinstance(v, bytes):
+            v = v.decode("utf-8", "replace")
+        elif isinstance(v, np.ndarray) and v.ndim == 0:
+            v = v[()]
+        if isinstance(v, np.generic):
+            v = v.item()
+        want = ATTRIBUTES.get(k)
+        ok = (want is None or (want is str and isinstance(v, str))
+              or (want is int and isinstance(v, int) and not isinstance(v, bool))
+              or (want is float and isinstance(v, (int, float)) and not isinstance(v, bool))
+              or (want == "floats" and isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind == "f"))
+        if not ok:
+            raise ResultsError(f"{where}: attribute {k} of /tresca is {v!r}, not of type "
+                               f"{getattr(want, '__name__', want)}")
+        out[k] = v
+    return out
+
+
+def _status_rows(where, status, completed, rows, n_steps):
+    """ResultsError unless the status, the completed steps and the rows agree."""
+    if not (status == "completed" or status.startswith("running") or status.startswith("stopped")):
+        raise ResultsError(f"{where}: unknown status {status!r} (completed, running or stopped: ...)")
+    if completed < 1:
+        raise ResultsError(f"{where}: no committed step (completed = {completed}); tresca-cr never leaves such "
+                           "a file under its name")
+    if completed > rows:
+        raise ResultsError(f"{where}: {completed} steps marked complete but the series hold {rows} rows: damaged")
+    if status == "completed" and not completed == rows == n_steps + 1:
+        raise ResultsError(f"{where}: status 'completed' but {completed} committed steps and {rows} rows for "
+                           f"{n_steps} steps (N + 1 = {n_steps + 1} expected)")
+    if status.startswith("running") and rows != n_steps + 1:
+        raise ResultsError(f"{where}: a killed run (status {status!r}) must have room for all {n_steps + 1} "
+                           f"steps; the series hold {rows} rows")
+    if status.startswith("stopped") and rows != completed:
+        raise ResultsError(f"{where}: a stopped run must be cut to its {completed} completed steps; the series "
+                           f"hold {rows} rows")
+
+
+def _dataset(where, g, name):
+    import h5py
+    obj = g.get(name)
+    if not isinstance(obj, h5py.Dataset):
+        raise ResultsError(f"{where}: tresca/{name} is missing")
+    return obj
+
+
+def _read_group(f, where, verify):
+    import h5py
+    g = f.get("tresca")
+    if not isinstance(g, h5py.Group):
+        top = ", ".join(sorted(f.keys())[:8]) or "nothing"
+        raise ResultsError(f"{where}: has no /tresca group (it holds {top}): not a tresca-cr results file")
+    attrs = _attrs(where, g)
+    legacy = "status" not in attrs and str(attrs.get("version", "")).startswith("python")
+    for k in REQUIRED:
+        if k not in attrs and not (legacy and k in LEGACY_MISSING):
+            raise ResultsError(f"{where}: attribute {k} of /tresca is missing")
+    ds = {}
+    # the Python writer before this module wrote an empty contact group for a run without Γ_C
+    has_contact = "contact" in g and not (legacy and _dataset(where, g, "contact/edges").shape[:1] == (0,))
+    for name in ("mesh/points", "mesh/triangles", "mesh/edges", "times") + (("contact/edges",) if has_contact else ()):
+        ds[name] = _dataset(where, g, name)
+        if ds[name].ndim != len(SPEC[name][1]):
+            raise ResultsError(f"{where}: tresca/{name} has {ds[name].ndim} dimensions, the layout wants "
+                               f"{len(SPEC[name][1])}")
+    sizes = {"P": ds["mesh/points"].shape[0], "T": ds["mesh/triangles"].shape[0], "E": ds["mesh/edges"].shape[0],
+             "R": ds["times"].shape[0], "C": ds["contact/edges"].shape[0] if has_contact else 0}
+    if not has_contact and attrs.get("n_contact", 0) > 0:
+        raise ResultsError(f"{where}: n_contact = {attrs['n_contact']} but there is no tresca/contact group: "
+                           "the contact part of the run is missing")
+    if "n_contact" in attrs and attrs["n_contact"] != sizes["C"]:
+        raise ResultsError(f"{where}: n_contact = {attrs['n_contact']} but tresca/contact/edges lists {sizes['C']}")
+    parts = {"contact": has_contact, "errors": "errors" in g}
+    wanted = [n for n, *_ in DATASETS if parts.get(n.split("/")[0], True)]
+    for name in wanted:
+        optional = name == "steps/checksum" or (legacy and name in LEGACY_MISSING)
+        if optional and name not in g:
+            continue
+        ds[name] = _dataset(where, g, name)
+        _check_array(where, name, ds[name].shape, ds[name].dtype, sizes)
+    steps_attrs = g["steps"].attrs if isinstance(g.get("steps"), h5py.Group) else {}
+    if "completed" in steps_attrs:
+        completed = int(np.asarray(steps_attrs["completed"]).reshape(-1)[0])
+    elif legacy:
+        completed = sizes["R"]
+    else:
+        raise ResultsError(f"{where}: attribute completed of tresca/steps is missing")
+    status = attrs.get("status", "completed")
+    _status_rows(where, status, completed, sizes["R"], int(attrs.get("steps", sizes["R"] - 1)))
+    S = completed
+
+    def load(name, series=True):
+        if name not in ds:
+            return None
+        a = ds[name][:S] if series else ds[name][()]
+        return a.astype(SPEC[name][0], copy=False)
+
+    mesh = Mesh(*(load(f"mesh/{k}", False) for k in ("points", "triangles", "edges", "midpoints")))
+    contact = None
+    if has_contact:
+        contact = Contact(*(load(f"contact/{k}", False) for k in CONTACT_STATIC),
+                          *(load(f"contact/{k}") for k in CONTACT_SERIES))
+    errors = {k: load(f"errors/{k}") for k in ERRORS} if "errors" in g else None
+    r = Results(mesh=mesh, times=load("times"), u=load("u"), energy=load("energy"),
+                steps={k: load(f"steps/{k}") for k in STEP_FIELDS}, contact=contact, errors=errors,
+                attrs=attrs, path=where, rows=sizes["R"])
+    validate(r, where)
+    if verify and "steps/checksum" in ds:
+        stored = load("steps/checksum")
+        bad = np.nonzero(r.checksums() != stored)[0]
+        if len(bad):
+            raise ResultsError(f"{where}: step {int(bad[0])} does not match its checksum (tresca/steps/checksum): "
+                               "the file was damaged after it was written; steps before it are intact")
+    return r
+
+
+def read(path, verify=True):
+    """The validated results of the file ``path`` (committed steps only); ResultsError naming the problem.
+    ``verify``: check every step against ``tresca/steps/checksum`` when the file has one."""
+    import h5py
+    try:
+        path = paths.hdf5_file(path)
+    except paths.PathError as err:
+        raise ResultsError(str(err)) from None
+    try:
+        with h5py.File(path, "r") as f:
+            return _read_group(f, path, verify)
+    except ResultsError:
+        raise
+    except (OSError, RuntimeError, KeyError, TypeError, ValueError) as err:
+        msg = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise ResultsError(f"{path}: cannot read it as an HDF5 results file: {msg}") from None
+
+
+def write(path, r, extra_attrs=None):
+    """Write ``r`` as a results file at ``path`` (atomically: built beside it, then renamed into place), with
+    ``status`` (default "completed"), ``steps`` (default: the committed steps − 1), ``n_edges``,
+    ``n_contact``, ``tresca/steps`` attribute ``completed`` and the step checksums. Refuses (ResultsError)
+    results that ``read`` would refuse, before anything is written. A serial Python solver writes its run as
+    ``write(out, Results(mesh=Mesh(points, triangles, edges, midpoints), times=..., u=..., energy=...,
+    steps={"iterations": ..., ...}, contact=Contact(edges, normal, tangent, g, slip, sigma_t, state, mu, dof)
+    or None, errors={"energy": ..., "h1": ..., "l2": ...} or None, attrs={"scene": text, "version": ...,
+    "solver": ..., "E": ..., "nu": ..., ...}))``."""
+    import h5py
+    validate(r, "results to write")
+    try:
+        out = paths.output_file(path, "results file")
+    except paths.PathError as err:
+        raise ResultsError(str(err)) from None
+    attrs = {"status": "completed", "steps": r.completed - 1, **r.attrs, **(extra_attrs or {}),
+             "n_edges": len(r.mesh.edges), "n_contact": 0 if r.contact is None else len(r.contact.edges)}
+    tmp = f"{out}.{os.getpid()}.partial"
+    try:
+        with h5py.File(tmp, "w-") as f:
+            g = f.create_group("tresca")
+            for name, a in {**r.static(), **r.series()}.items():
+                g.create_dataset(name, data=np.asarray(a, SPEC[name][0]))
+            g.create_dataset("steps/checksum", data=r.checksums())
+            for k, v in attrs.items():
+                g.attrs[k] = v
+            g["steps"].attrs["completed"] = np.int64(r.completed)
+        os.replace(tmp, out)
+    except BaseException:
+        if os.path.lexists(tmp):
+            os.unlink(tmp)
+        raise
