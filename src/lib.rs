@@ -36,4 +36,4 @@ pub mod study;
 
 pub use error::{Error, Result};
 pub use scene::Scene;
-pub use stepping::{Problem, StepResult};
+pub use stepping::{Problem, RunOptions, StepResult};

@@ -27,7 +27,7 @@ fn example(refine: u32, steps: usize) -> Scene {
 fn run_written(p: &Problem, path: &Path) -> Vec<StepResult> {
     let mut w = Writer::create(path, &Run::of(p), true).unwrap();
     let mut out = Vec::new();
-    p.run(|r| {
+    p.run(tresca_cr::RunOptions::all(), |r| {
         out.push(r.clone());
         w.write_step(r)
     })
@@ -313,7 +313,7 @@ fn resume_after_drop_is_bit_identical() {
     {
         let mut w = Writer::create(&part, &Run::of(&p), false).unwrap();
         let mut k = 0;
-        let r = p.run(|r| {
+        let r = p.run(tresca_cr::RunOptions::all(), |r| {
             k += 1;
             if k > 9 {
                 return Err(tresca_cr::Error::Linear("stop".into()));
@@ -328,7 +328,7 @@ fn resume_after_drop_is_bit_identical() {
     let (mut w, last) = Writer::resume(&part, &Run::of(&p)).unwrap();
     let last = last.expect("a committed step");
     assert_eq!((last.n, w.completed()), (8, 9));
-    p.run_from(last, |r| w.write_step(r)).unwrap();
+    p.run(tresca_cr::RunOptions::after(last), |r| w.write_step(r)).unwrap();
     w.finish("completed").unwrap();
     same_results(&full, &part);
 }
@@ -356,7 +356,7 @@ fn kill_child_writer() {
     let Ok(path) = std::env::var("TRESCA_KILL_CHILD") else { return };
     let p = Problem::new(example(1, 400)).unwrap();
     let mut w = Writer::create(Path::new(&path), &Run::of(&p), true).unwrap();
-    p.run(|r| {
+    p.run(tresca_cr::RunOptions::all(), |r| {
         std::thread::sleep(Duration::from_micros(300));
         w.write_step(r)
     })
@@ -412,7 +412,7 @@ fn sigkill_at_random_moments_leaves_complete_steps_and_resume_is_bit_identical()
         let (mut w, last) = Writer::resume(&path, &Run::of(&p)).unwrap();
         let last = last.expect("a committed step");
         assert_eq!(last.n + 1, done);
-        p.run_from(last, |r| w.write_step(r)).unwrap();
+        p.run(tresca_cr::RunOptions::after(last), |r| w.write_step(r)).unwrap();
         w.finish("completed").unwrap();
         same_results(&full, &path);
         resumed += 1;
@@ -431,7 +431,7 @@ fn timing_example_5_1_finest() {
     let p = Problem::new(example(refine, steps)).unwrap();
     let setup = t0.elapsed().as_secs_f64();
     let t4 = Instant::now();
-    p.run(|_| Ok(())).unwrap();
+    p.run(tresca_cr::RunOptions::all(), |_| Ok(())).unwrap();
     println!(
         "refine {refine} steps {steps}: unknowns {}, set-up {setup:.3}s, solve without writer {:.3}s",
         p.space.n_dofs,
@@ -448,7 +448,7 @@ fn timing_example_5_1_finest() {
         let mut w = Writer::create_with(&path, &Run::of(&p), &opts).unwrap();
         let create = t1.elapsed().as_secs_f64();
         let t2 = Instant::now();
-        p.run(|r| w.write_step(r)).unwrap();
+        p.run(tresca_cr::RunOptions::all(), |r| w.write_step(r)).unwrap();
         let sec = w.seconds;
         w.finish("completed").unwrap();
         println!(

@@ -39,7 +39,11 @@ fn error_of(from: &str, to: &str) -> String {
         Err(e) => e.to_string(),
         Ok(s) => match Problem::new(s) {
             Err(e) => e.to_string(),
-            Ok(p) => p.run(|_| Ok(())).err().map(|e| e.to_string()).unwrap_or_else(|| panic!("`{to}` was accepted")),
+            Ok(p) => p
+                .run(tresca_cr::RunOptions::all(), |_| Ok(()))
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_else(|| panic!("`{to}` was accepted")),
         },
     }
 }
@@ -54,7 +58,7 @@ fn expect(from: &str, to: &str, needles: &[&str]) {
 #[test]
 fn base_scene_is_valid() {
     let s = Scene::from_str(BASE, "base.toml").unwrap();
-    Problem::new(s).unwrap().run(|_| Ok(())).unwrap();
+    Problem::new(s).unwrap().run(tresca_cr::RunOptions::all(), |_| Ok(())).unwrap();
 }
 
 #[test]
@@ -176,7 +180,7 @@ fn solver_failure_is_reported_with_step_iterations_and_residual() {
     let p = Problem::new(Scene::from_str(&text, "s.toml").unwrap()).unwrap();
     let mut completed = 0;
     let e = p
-        .run(|_| {
+        .run(tresca_cr::RunOptions::all(), |_| {
             completed += 1;
             Ok(())
         })

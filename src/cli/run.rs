@@ -3,7 +3,7 @@
 use super::out::{note, say};
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
-use tresca_cr::{Problem, Scene};
+use tresca_cr::{Problem, RunOptions, Scene};
 
 /// Refuse an output path that is (or whose sidecar is) the scene or its mesh: `--force` would overwrite the
 /// run's own input.
@@ -139,10 +139,7 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     // Without a results file and without true errors, u is formed only at the last step: every step still
     // solves the friction problem (slip, μ, stick/slip), but reconstructing u costs O(n·n_c) per step.
     let want = |k: usize| all || k == n;
-    let result = match first {
-        Some(f) => problem.run_selected(f, want, on_step),
-        None => problem.run_all_selected(want, on_step),
-    };
+    let result = problem.run(RunOptions { after: first, want }, on_step);
     if let Some(z) = problem.friction.as_ref().map(|f| f.zeroed_steps()).filter(|&z| z > 0) {
         note!(
             "note: at {z} steps the friction bound g_a was below the rounding of the load (its effect on the slip \

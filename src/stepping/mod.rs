@@ -32,6 +32,7 @@ mod run;
 mod setup;
 
 pub use conditioning::MAX_CONDITION;
+pub use run::RunOptions;
 pub use setup::Discretised;
 
 /// Everything assembled once per run.
