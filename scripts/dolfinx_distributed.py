@@ -172,21 +172,21 @@ def structured_mesh(comm, scene):
     X = np.stack([xi[i], eta[j]], axis=1)     # reference (unit-square) coordinates
     clo, chi = local_range(rank, n * m, size)
     c = np.arange(clo, chi, dtype=np.int64)
-    I, J = c % n, c // n
-    p00, p10, p11, p01 = J * (n + 1) + I, J * (n + 1) + I + 1, (J + 1) * (n + 1) + I + 1, (J + 1) * (n + 1) + I
+    Ic, J = c % n, c // n
+    p00, p10, p11, p01 = J * (n + 1) + Ic, J * (n + 1) + Ic + 1, (J + 1) * (n + 1) + Ic + 1, (J + 1) * (n + 1) + Ic
     if ms["diagonal"] == "first":             # split along p(i,j)-p(i+1,j+1)  (dolfinx DiagonalType.right)
         tri = np.stack([np.stack([p00, p10, p11], 1), np.stack([p00, p11, p01], 1)], 1)
     else:                                     # split along p(i+1,j)-p(i,j+1)  (dolfinx DiagonalType.left)
         tri = np.stack([np.stack([p00, p10, p01], 1), np.stack([p10, p11, p01], 1)], 1)
     msh = dmesh.create_mesh(comm, tri.reshape(-1, 3), ufl.Mesh(COORD_EL), X, partitioner=partitioner(comm))
-    del tri, X, idx, i, j, c, I, J, p00, p10, p11, p01
+    del tri, X, idx, i, j, c, Ic, J, p00, p10, p11, p01
     top = msh.topology
     top.create_entities(1)
     top.create_connectivity(1, 2)
     bf = dmesh.exterior_facet_indices(top)
     mid = dmesh.compute_midpoints(msh, 1, bf)[:, :2]     # reference coordinates: sides are exact
     side = np.full(len(bf), -1, dtype=np.int64)
-    for s, sel in zip(SIDES, (mid[:, 1] == 0.0, mid[:, 0] == 1.0, mid[:, 1] == 1.0, mid[:, 0] == 0.0)):
+    for s, sel in zip(SIDES, (mid[:, 1] == 0.0, mid[:, 0] == 1.0, mid[:, 1] == 1.0, mid[:, 0] == 0.0), strict=False):
         side[sel] = names.index(s)
     if np.any(side < 0):
         raise Fail("internal: a boundary facet of the structured mesh lies on no side")
@@ -311,7 +311,7 @@ class Problem:
         f2c = top.connectivity(1, 2)
         cell = np.array([f2c.links(f)[0] for f in cf], dtype=np.int64)
         third = np.zeros((len(cf), 2))
-        for q, (f, cc) in enumerate(zip(cf, cell)):
+        for q, (f, cc) in enumerate(zip(cf, cell, strict=False)):
             vs = [v for v in c2v[cc] if v not in f2v[f]]
             third[q] = vx[vs[0]]
         d = b - a
@@ -853,7 +853,7 @@ def main(argv=None):
         if prob.err_forms is not None:
             e = prob.errors(t)
             if root:
-                for key, val in zip(("energy", "h1", "l2"), e):
+                for key, val in zip(("energy", "h1", "l2"), e, strict=False):
                     res["errors"][key][n] = math.sqrt(max(float(val), 0.0))
         if vis is not None and (n % fe == 0 or n == N):
             udg.interpolate(prob.uh)

@@ -19,7 +19,6 @@ assembled distributed (ghost contributions included), gathered to rank 0 in the 
 ordering (edges matched by midpoint coordinates), and the small per-step friction problem is solved
 on rank 0; true errors are assembled distributed again.
 """
-import os
 import sys
 import time
 
@@ -31,7 +30,6 @@ from tresca_py import tresca_scene as ts  # noqa: E402
 import dolfinx_solver  # noqa: E402,F401  (loads libmpi for the wheel; must precede dolfinx)
 from mpi4py import MPI  # noqa: E402
 import basix.ufl  # noqa: E402
-import dolfinx  # noqa: E402
 import ufl  # noqa: E402
 from dolfinx import fem  # noqa: E402
 from dolfinx import mesh as dmesh  # noqa: E402

@@ -17,8 +17,6 @@ sigma(u) = lambda tr eps(u) I + 2 mu eps(u) (plane strain).  Here scikit-fem ass
 true errors are skfem forms with the fixed quadrature rules.  The friction step is solved exactly
 on the condensed contact unknowns (see ``tresca_scene``).
 """
-import os
-import sys
 import time
 
 import numpy as np

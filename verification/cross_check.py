@@ -32,7 +32,7 @@ import time
 import h5py
 import numpy as np
 
-from tresca_py.common import BIN, MPIRUN, PY, ROOT, SCRIPTS  # noqa: E402
+from tresca_py.common import BIN, MPIRUN, PY, ROOT  # noqa: E402
 from tresca_py.common import CASES as CASES_DIR  # noqa: E402
 from tresca_py.common import cmdline  # noqa: E402
 from tresca_py.common import short_path as rel  # noqa: E402

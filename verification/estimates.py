@@ -25,7 +25,6 @@ Requirements (tolerances from the issue and the math, written beside them):
 """
 import math
 import os
-import sys
 
 from tresca_py.common import ROOT  # noqa: E402
 K_REF = 4096  # same-mesh reference of the k sequences (time error 1/16 of the finest level's, corrected exactly)
@@ -56,7 +55,7 @@ def truth(row, kind, n_ref):
 
 def run(study, require, write, quick):
     results = {}
-    for name, kind, scene, levels, ref in CASES:
+    for name, _kind, scene, levels, ref in CASES:
         levels = QUICK.get(name, levels) if quick else levels
         rows, cmd = study(f"verification/cases/{scene}.toml", levels, name, reference=ref)
         results[name] = (rows, cmd)
@@ -77,7 +76,7 @@ def report(results, require, write):
              "|---|---|---|---|---|---|---|---|---|---|"]
     bad, in_range_kinds, checked, refusals, cmds = [], set(), [], {}, []
     f = lambda x: "-" if x is None else f"{x:.4e}"  # noqa: E731
-    for name, kind, scene, levels, ref in CASES:
+    for name, kind, _scene, _levels, _ref in CASES:
         rows, cmd = results[name]
         cmds.append(cmd)
         p = "-" if rows[0]["p"] is None else f"{rows[0]['p']:.3f}"

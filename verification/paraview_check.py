@@ -239,7 +239,7 @@ def check_files(files, me):
             # XDMFReader by a bare relative name (cwd = the run's directory), the Xdmf3 readers by absolute path
             path = "run.xdmf" if reader == "XDMFReader" else os.path.join(d, "run.xdmf")
             p = pvpython([me, "--dump", path, reader, "mid,-1"], cwd=d)  # the middle and the last frame
-            lines = [l for l in p.stdout.splitlines() if l.startswith("JSON")]
+            lines = [line for line in p.stdout.splitlines() if line.startswith("JSON")]
             if not check(p.returncode == 0 and lines, f"{label} / {reader}: pvpython exit {p.returncode} {p.stderr.strip()[-300:]}"):
                 continue
             data = json.loads(lines[0][4:])

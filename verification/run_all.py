@@ -13,7 +13,6 @@ asymptotic range) lie in the band.
 """
 import argparse
 import csv
-import io
 import math
 import os
 import subprocess
@@ -194,7 +193,7 @@ def be_exact_study():
     ok = len(rel_mono) >= 2 and max(rel_mono) <= 1e-12
     require("K2-stick-to-slip", "while the discrete solution only passes from stick to slip, backward Euler shall be exact at the "
             "nodes: solutions of different time grids agree to rounding (≤ 1e-12 relative)", ok,
-            "; ".join(f"N={int(r['steps'])}: {back[int(r['steps'])]} slip→stick, rel. diff {x:.1e}" for r, x in zip(rows[1:], rel)),
+            "; ".join(f"N={int(r['steps'])}: {back[int(r['steps'])]} slip→stick, rel. diff {x:.1e}" for r, x in zip(rows[1:], rel, strict=False)),
             cmd, "reference/be_exact_stick_to_slip.md")
 
 
@@ -239,7 +238,7 @@ def paper_tables(quick):
         return "-" if v is None else f"{v:.4e}"
 
     expected1 = [0.8577, 0.9671, 0.9015, 0.866]
-    ok_rec = all(abs(a - b) < 6e-4 for a, b in zip(o1[1:], expected1))
+    ok_rec = all(abs(a - b) < 6e-4 for a, b in zip(o1[1:], expected1, strict=False))
     ref_level = (6, 2560) if quick else (7, 5120)
     rows1, cmd1 = study("verification/cases/paper_example_5_1.toml", [(k, 40 << k) for k in range(5)], "paper_table_5_1",
                         reference=ref_level)
@@ -253,7 +252,7 @@ def paper_tables(quick):
              "## Table 5.1 (N = 20n)", "",
              "| N | n | DOF | paper error | paper order (printed) | paper order (recomputed) | our consecutive error | our order | our true error vs reference | order |",
              "|---|---|---|---|---|---|---|---|---|---|"]
-    for i, (p, r) in enumerate(zip(t1, rows1)):
+    for i, (p, r) in enumerate(zip(t1, rows1, strict=False)):
         oc = "-" if i == 0 else f"{math.log(rows1[i - 1]['consecutive_T'] / r['consecutive_T']) / math.log(math.sqrt(r['paper_dofs'] / rows1[i - 1]['paper_dofs'])):.4f}" if r["consecutive_T"] and rows1[i - 1]["consecutive_T"] else "-"
         orf = "-" if i == 0 else f"{math.log(rows1[i - 1]['reference_T'] / r['reference_T']) / math.log(rows1[i - 1]['h'] / r['h']):.4f}"
         lines.append(f"| {p['N']} | {2 << i} | {int(r['paper_dofs'])} | {p['error']} | {p['order'] or '-'} | "
@@ -261,12 +260,12 @@ def paper_tables(quick):
     lines += ["", "## Table 5.2 (N = 5n)", "",
               "| N | n | DOF | paper DOF | paper error | paper order (printed) | paper order (recomputed) | recomputed with 7.410e-5 | our consecutive error | our order | ours with N = 20n (Table 5.1) |",
               "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for i, (p, r, r1) in enumerate(zip(t2, rows2, rows1[1:] + [{"consecutive_T": None}])):
+    for i, (p, r, r1) in enumerate(zip(t2, rows2, rows1[1:] + [{"consecutive_T": None}], strict=False)):
         oc = "-" if i == 0 else f"{math.log2(rows2[i - 1]['consecutive_T'] / r['consecutive_T']):.4f}"
         lines.append(f"| {p['N']} | {4 << i} | {int(r['paper_dofs'])} | {p['DOF']} | {p['error']} | {p['order'] or '-'} | "
                      f"{'-' if o2[i] is None else f'{o2[i]:.4f}'} | {'-' if o2c[i] is None else f'{o2c[i]:.4f}'} | {fmt(r['consecutive_T'])} | {oc} | {fmt(r1['consecutive_T'])} |")
     e32, e16, c32 = rows1[4]["reference_T"], rows1[3]["reference_T"], rows1[4]["consecutive_T"]
-    same = all(abs(a["consecutive_T"] - b["consecutive_T"]) <= 1e-12 * a["consecutive_T"] for a, b in zip(rows1[1:], rows2[:-1]))
+    same = all(abs(a["consecutive_T"] - b["consecutive_T"]) <= 1e-12 * a["consecutive_T"] for a, b in zip(rows1[1:], rows2[:-1], strict=False))
     lines += ["", "## What the consecutive-mesh error hides", "",
               f"* **The time step plays no role in Example 5.1.** Our Table 5.2 column (N = 5n) equals our Table 5.1 column (N = 20n) "
               f"{'to 1e-12' if same else '(NOT equal: check)'}: points of Γ_C only pass from stick to slip (all of Γ_C slips by t = 0.025 at "
@@ -289,7 +288,7 @@ def paper_tables(quick):
               "consecutive error and our error against the n = 256, N = 5120 reference run (which costs more than the whole study).", "",
               "| n | N | paper error | our consecutive error | estimated true error | error vs reference | estimate / reference | verdict |",
               "|---|---|---|---|---|---|---|---|"]
-    for (n, e_t, ref_t, con_t, verdict), p in zip(est, t1):
+    for (n, e_t, ref_t, con_t, verdict), p in zip(est, t1, strict=False):
         ratio = "-" if e_t is None else f"{e_t / ref_t:.3f}"
         lines.append(f"| {n} | {p['N']} | {p['error']} | {fmt(con_t)} | {fmt(e_t)} | {ref_t:.4e} | {ratio} | {verdict} |")
     e32_est = est[-1][1]
@@ -311,7 +310,6 @@ def paper_tables(quick):
             ok_rec, ", ".join(f"{v:.4f}" for v in o1[1:]), "verification/run_all.py (paper_tables)", "reference/paper_tables.md")
     h = [r["h"] for r in rows1]
     e = [r["reference_T"] for r in rows1]
-    x = [r["h"] for r in rows1[1:]]
     c = [r["consecutive_T"] for r in rows1[1:]]
     plot("paper_table_5_1", "Example 5.1 (N = 20n): error at T", h, [("true (vs reference)", e)], "h", [1])
     fig = plt.figure()
@@ -326,10 +324,10 @@ def fuzz(quick):
     env = dict(os.environ, TRESCA_FUZZ_CASES=str(cases))
     cmd = ["cargo", "test", "--release", "--test", "fuzz", "--", "--nocapture"]
     p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=env)
-    lines = [l for l in p.stdout.splitlines() if l.startswith("fuzz ")]
+    lines = [line for line in p.stdout.splitlines() if line.startswith("fuzz ")]
     print("\n".join(lines))
     write("fuzz.md", "<!-- generated by verification/run_all.py -->\n# Fuzzing (proptest)\n\n`TRESCA_FUZZ_CASES=%d %s`\n\n" % (cases, " ".join(cmd))
-          + "\n".join(f"- {l}" for l in lines) + "\n")
+          + "\n".join(f"- {line}" for line in lines) + "\n")
     require("F1-fuzz", f"the scene parser, expression evaluation and Gmsh reader shall not panic on {cases} fuzzed inputs each",
             p.returncode == 0 and len(lines) == 3, "; ".join(lines) if lines else p.stderr[-300:], f"TRESCA_FUZZ_CASES={cases} " + " ".join(cmd), "reference/fuzz.md")
 
@@ -360,8 +358,8 @@ def paraview():
     p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
     print(p.stdout[-3000:])
     lines = p.stdout.strip().splitlines() or ["(no output)"]
-    version = next((l for l in lines if l.startswith("ParaView:")), "ParaView: ?")
-    pictures = [l.split("picture ")[1][:120] for l in lines if "picture out/" in l]
+    version = next((line for line in lines if line.startswith("ParaView:")), "ParaView: ?")
+    pictures = [line.split("picture ")[1][:120] for line in lines if "picture out/" in line]
     require("V1-paraview", "ParaView's XDMFReader, Xdmf3ReaderS and Xdmf3ReaderT shall open the files of a finished, a killed and a "
             "resumed run as body and contact-line blocks with /tresca's values at two times, and scripts/paraview_view.py shall "
             "render a picture showing the body and the contact line", p.returncode == 0,
@@ -428,9 +426,9 @@ def stability():
     cmd = [PY, "verification/stability.py"]
     p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
     print(p.stdout[-3000:])
-    cases = list(dict.fromkeys(l for l in p.stdout.splitlines() if l.startswith("[PASS]") or l.startswith("[FAIL]")))
-    for i, l in enumerate(cases):
-        require(f"S{i + 1}-stability", l[7:].strip()[:160], l.startswith("[PASS]"), "see reference/stability.md", " ".join(cmd[1:]),
+    cases = list(dict.fromkeys(line for line in p.stdout.splitlines() if line.startswith("[PASS]") or line.startswith("[FAIL]")))
+    for i, line in enumerate(cases):
+        require(f"S{i + 1}-stability", line[7:].strip()[:160], line.startswith("[PASS]"), "see reference/stability.md", " ".join(cmd[1:]),
                 "reference/stability.md")
     if not cases:
         require("S0-stability", "the stability study shall run", False, p.stderr[-300:], " ".join(cmd[1:]), "reference/stability.md")
@@ -490,7 +488,7 @@ def main():
     else:
         write("summary.md", "\n".join(lines) + "\n")
     print("\n" + "=" * 100 + "\nSUMMARY")
-    for rid, st, ok, m, _, _ in RESULTS:
+    for rid, _st, ok, m, _, _ in RESULTS:
         print(f"  {'PASS' if ok else 'FAIL'}  {rid:<22} {m[:70]}")
     failed = [r for r in RESULTS if not r[2]]
     print(f"{len(RESULTS) - len(failed)} passed, {len(failed)} failed, {time.time() - t0:.0f} s")

@@ -66,7 +66,7 @@ def orders(x, e):
     succ = [observed_order(e[i - 1], e[i], x[i - 1], x[i]) for i in range(1, len(e))]
     lx, le = [math.log(v) for v in x], [math.log(v) for v in e]
     mx, me = sum(lx) / len(lx), sum(le) / len(le)
-    fit = sum((a - mx) * (b - me) for a, b in zip(lx, le)) / sum((a - mx) ** 2 for a in lx)
+    fit = sum((a - mx) * (b - me) for a, b in zip(lx, le, strict=False)) / sum((a - mx) ** 2 for a in lx)
     return succ, fit
 
 

@@ -416,9 +416,9 @@ def structured_mesh(corners, n, m, diagonal="first"):
     def idx(i, j):
         return j * (n + 1) + i
 
-    I, Jj = np.meshgrid(np.arange(n), np.arange(m))
-    I, Jj = I.ravel(), Jj.ravel()
-    p00, p10, p11, p01 = idx(I, Jj), idx(I + 1, Jj), idx(I + 1, Jj + 1), idx(I, Jj + 1)
+    Ii, Jj = np.meshgrid(np.arange(n), np.arange(m))
+    Ii, Jj = Ii.ravel(), Jj.ravel()
+    p00, p10, p11, p01 = idx(Ii, Jj), idx(Ii + 1, Jj), idx(Ii + 1, Jj + 1), idx(Ii, Jj + 1)
     if diagonal == "first":
         tri = np.stack([np.stack([p00, p10, p11], 1), np.stack([p00, p11, p01], 1)], 1)
     else:
@@ -825,10 +825,10 @@ def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True):
     for n, t in enumerate(times):
         tic = time.perf_counter()
         if n > 0:
-            l = load(t)
+            load_t = load(t)
             if root:
                 u_prev = u
-                u, info = stepper.step(l, u_prev)
+                u, info = stepper.step(load_t, u_prev)
                 mu = info["mu"]
                 slip = classify(mu, info["ds"], info["d"], disc.weight)
                 res["sigma_t"][n] = -mu / disc.lengths[disc.contact]

@@ -637,7 +637,7 @@ def check_exmex_binary(d, rng, binary, log):
     out = subprocess.run([binary], input="\n".join(lines) + "\n", capture_output=True, text=True,
                          check=True).stdout.split("\n")
     worst = 0.0
-    for (k, ref), o in zip(refs, out):
+    for (k, ref), o in zip(refs, out, strict=False):
         require(not o.startswith("ERR"), "%s: exmex rejects %s: %s" % (d["name"], k, o))
         worst = max(worst, abs(float(o) - ref) / max(1.0, abs(ref)))
     require(worst < 1e-12, "%s: exmex evaluation differs by %.3e" % (d["name"], worst))
@@ -904,7 +904,8 @@ def main():
         for make in CASES:
             case = make()
             print("== %s: %s" % (case["name"], case["title"]))
-            log = lambda msg: print("   " + msg)
+            def log(msg):
+                return print("   " + msg)
             d = run_checks(case, args.exmex, log)
             log("longest printed expression: %d characters" % max(len(v) for v in d["str"].values()))
             derived.append(d)
