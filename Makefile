@@ -10,7 +10,7 @@ BIN   := target/release/tresca-cr
 PY312 := $(shell for p in $$(pyenv root 2>/dev/null)/versions/3.12*/bin/python3.12 /usr/local/bin/python3.12 /usr/bin/python3.12; do \
            [ -x "$$p" ] && "$$p" -c 'import sys' 2>/dev/null && echo "$$p" && break; done)
 
-.PHONY: all deps paraview getfem build venv test verify reference bench clean-out
+.PHONY: all deps paraview getfem build venv lint test verify reference bench clean-out
 
 all: build
 
@@ -63,7 +63,19 @@ $(VENV)/.stamp: requirements.txt python/pyproject.toml
 
 venv: $(VENV)/.stamp
 
+# The lint half of `make test` (CI): formatting, clippy with warnings as errors, ruff on the Python
+# (config python/pyproject.toml [tool.ruff]) and every path the documentation names exists.
+# TEMPORARY: E501 (line > 120) is ignored here: 217 long lines remain in verification/ (run_all.py 70,
+# distributed.py 43, bench.py 25, …), files the issue-31 harness work is restructuring; drop the
+# --extend-ignore once they are wrapped (`ruff check --config python/pyproject.toml python scripts verification`).
+lint: venv
+	cargo fmt --check
+	cargo clippy --all-targets --locked -- -D warnings
+	$(VENV)/bin/ruff check --config python/pyproject.toml python scripts verification --extend-ignore E501
+	$(PY) verification/check_doc_paths.py
+
 test: build venv getfem
+	$(MAKE) --no-print-directory lint
 	cargo test --release --locked
 	$(PY) -m pytest python/tests -q
 

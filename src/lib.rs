@@ -24,6 +24,7 @@ pub mod error;
 pub mod fem;
 pub mod friction;
 pub mod mesh;
+pub mod names;
 pub mod output;
 pub mod parallel;
 pub mod plan;
@@ -35,4 +36,4 @@ pub mod study;
 
 pub use error::{Error, Result};
 pub use scene::Scene;
-pub use stepping::{Problem, StepResult};
+pub use stepping::{Problem, RunOptions, StepResult};

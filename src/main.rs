@@ -8,6 +8,7 @@ use cli::out::note;
 use cli::run::OutputArgs;
 use std::path::{Path, PathBuf};
 use tresca_cr::scene::budget::{parse_size, Estimate};
+use tresca_cr::scene::Method;
 use tresca_cr::Scene;
 
 #[derive(Parser)]
@@ -40,9 +41,9 @@ enum Cmd {
         /// Uniform time steps (overrides time.steps).
         #[arg(long)]
         steps: Option<usize>,
-        /// Per-step solver (overrides solver.method): ssn, uzawa or pdas.
+        /// Per-step solver (overrides solver.method).
         #[arg(long)]
-        solver: Option<String>,
+        solver: Option<Method>,
         /// Solver tolerance (overrides solver.tol).
         #[arg(long)]
         tol: Option<f64>,
@@ -70,7 +71,7 @@ enum Cmd {
         reference: Option<tresca_cr::study::Level>,
         /// Per-step solver (overrides solver.method).
         #[arg(long)]
-        solver: Option<String>,
+        solver: Option<Method>,
         /// Solver tolerance (overrides solver.tol).
         #[arg(long)]
         tol: Option<f64>,
@@ -90,9 +91,9 @@ enum Cmd {
         /// The error to reach (absolute, in the quantity's units).
         #[arg(long)]
         target: f64,
-        /// energy (energy-norm error, max over the time nodes), max-slip, stick-length, elastic-energy or
-        /// a traction_x_y output of [outputs] (at T).
-        #[arg(long, default_value = "energy")]
+        /// energy-norm (the energy-norm error, max over the time nodes), or an output of [quantities] at T:
+        /// max-slip, stick-length, elastic-energy (½a_h(u,u)) or traction_x_y.
+        #[arg(long, default_value = "energy-norm")]
         quantity: String,
         /// Wall time the planned run may take (e.g. 90s, 10m, 2h).
         #[arg(long, default_value = "1h", value_parser = cli::plan::parse_duration)]
@@ -126,24 +127,15 @@ struct Limits {
 }
 
 /// Apply the --solver and --tol overrides.
-fn solver_overrides(s: &mut Scene, solver: Option<String>, tol: Option<f64>) -> Result<()> {
+fn solver_overrides(s: &mut Scene, solver: Option<Method>, tol: Option<f64>) -> Result<()> {
     if let Some(m) = solver {
-        s.solver.method = method(&m)?;
+        s.solver.method = m;
     }
     if let Some(t) = tol {
         anyhow::ensure!(t.is_finite() && t > 0.0, "--tol {t}: must be a positive number");
         s.solver.tol = t;
     }
     Ok(())
-}
-
-fn method(name: &str) -> Result<tresca_cr::scene::Method> {
-    Ok(match name {
-        "ssn" => tresca_cr::scene::Method::Ssn,
-        "uzawa" => tresca_cr::scene::Method::Uzawa,
-        "pdas" => tresca_cr::scene::Method::Pdas,
-        other => anyhow::bail!("--solver {other}: expected ssn, uzawa or pdas"),
-    })
 }
 
 /// Read the scene, estimate what the run needs (refused when it does not fit: before anything large is
@@ -156,6 +148,9 @@ fn load(
     output: impl FnOnce(&Scene) -> Option<PathBuf>,
 ) -> Result<(Scene, Estimate)> {
     let mut scene = Scene::from_file(path)?;
+    for d in &scene.deprecations {
+        note!("warning: {d}");
+    }
     // the results file whose disk the estimate is for, chosen from the scene just read (parsed once)
     let output = output(&scene);
     let output = output.as_deref();
@@ -188,7 +183,7 @@ fn load(
 /// come from the heap (not one mmap each, returned on free and faulted in again page by page on the
 /// next allocation), the heap grows 64 MiB at a time and is trimmed only beyond 1 GiB. The set-up
 /// allocates and frees many vectors of the mesh's size; at 24,640 unknowns (Example 5.1, n = 64) this
-/// cuts the page faults from 18,900 to 14,500 and the CPU time by about a tenth. (jemalloc with huge
+/// cuts the page faults and the CPU time. (jemalloc with huge
 /// pages cut the faults further but tripled the system time of the 196,608-unknown run, by huge-page
 /// compaction.) Peak memory is the same; numbers do not depend on it.
 fn tune_malloc() {
@@ -244,6 +239,9 @@ fn main() {
         }
         Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory, json } => {
             let no_limits = Limits { max_memory: None, max_disk: None };
+            if let Some(d) = tresca_cr::plan::pilot::Quantity::deprecation(&quantity) {
+                note!("warning: {d}");
+            }
             let options = tresca_cr::plan::Options {
                 target,
                 quantity: tresca_cr::plan::pilot::Quantity::parse(&quantity),

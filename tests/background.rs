@@ -25,7 +25,7 @@ fn example_at(refine: u32, steps: usize) -> Problem {
 
 fn steps(p: &Problem) -> Vec<StepResult> {
     let mut out = Vec::new();
-    p.run(|r| {
+    p.run(tresca_cr::RunOptions::all(), |r| {
         out.push(r.clone());
         Ok(())
     })

@@ -11,8 +11,8 @@ fn collect(p: &Problem, from: Option<StepResult>) -> Vec<StepResult> {
         Ok(())
     };
     match from {
-        Some(f) => p.run_from(f, keep).unwrap(),
-        None => p.run(keep).unwrap(),
+        Some(f) => p.run(tresca_cr::RunOptions::after(f), keep).unwrap(),
+        None => p.run(tresca_cr::RunOptions::all(), keep).unwrap(),
     }
     out
 }

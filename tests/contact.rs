@@ -151,7 +151,7 @@ fn rate_independence() {
 fn pdas_cycles_where_ssn_converges() {
     let s = scene("verification/cases/pdas_cycle.toml");
     let p = Problem::new(with_method(s.clone(), Method::Pdas, 1e-12)).unwrap();
-    let err = p.run(|_| Ok(())).unwrap_err().to_string();
+    let err = p.run(tresca_cr::RunOptions::all(), |_| Ok(())).unwrap_err().to_string();
     assert!(err.contains("cycling"), "{err}");
     let (_, steps) = run(with_method(s, Method::Ssn, 1e-12));
     assert!(steps.iter().all(|r| r.residual <= 1e-12));

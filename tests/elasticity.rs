@@ -51,7 +51,7 @@ fn jitter(raw: &mut RawMesh, amount: f64) {
 fn check_patch(scene: Scene, mesh: Mesh, ab: [f64; 2]) {
     let p = Problem::with_mesh(scene, mesh).unwrap();
     let mut worst: f64 = 0.0;
-    p.run(|r| {
+    p.run(tresca_cr::RunOptions::all(), |r| {
         if r.n == 1 {
             let mid = p.space.midpoint_values(&r.u);
             for (e, m) in mid.iter().enumerate() {

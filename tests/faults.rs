@@ -220,7 +220,7 @@ fn loads_scale_over_the_f64_range() {
             .replace(r#"g_a = "0.0012""#, &format!(r#"g_a = "{f:e}*0.0012""#));
         let p = tresca_cr::Problem::new(tresca_cr::Scene::from_str(&t, "scaled.toml").unwrap()).unwrap();
         let mut us = Vec::new();
-        let r = p.run(|r| {
+        let r = p.run(tresca_cr::RunOptions::all(), |r| {
             us.push(r.u.clone());
             Ok(())
         });
@@ -362,7 +362,7 @@ fn an_ill_conditioned_stiffness_is_refused_before_any_step_is_handed_out() {
     let weak = scene_with("weak.toml", "rho = 10.0", "rho = 1e-12");
     let p = tresca_cr::Problem::new(tresca_cr::Scene::from_file(std::path::Path::new(&weak)).unwrap()).unwrap();
     let mut handed = 0;
-    let e = p.run(|_| {
+    let e = p.run(tresca_cr::RunOptions::all(), |_| {
         handed += 1;
         Ok(())
     });
@@ -376,7 +376,7 @@ fn an_ill_conditioned_stiffness_is_refused_before_any_step_is_handed_out() {
     assert!(!out.exists(), "a results file was written for a refused K");
     let good = tresca_cr::Problem::new(tresca_cr::Scene::from_file(std::path::Path::new(&base())).unwrap()).unwrap();
     let mut steps = Vec::new();
-    good.run(|r| {
+    good.run(tresca_cr::RunOptions::all(), |r| {
         steps.push(r.n);
         Ok(())
     })

@@ -90,7 +90,7 @@ fn scene_parser_and_setup() {
                 outcome = "too large to run";
                 if small(&s) {
                     outcome = match Problem::new(s) {
-                        Ok(p) => match p.run(|_| Ok(())) {
+                        Ok(p) => match p.run(tresca_cr::RunOptions::all(), |_| Ok(())) {
                             Ok(()) => "ran",
                             Err(_) => "run error",
                         },
@@ -178,7 +178,9 @@ fn corpus_replays_without_panic() {
         no_panic("corpus", &name, || match path.extension().and_then(|e| e.to_str()) {
             Some("msh") => assert!(tresca_cr::mesh::parse_gmsh(&text, &name).is_err(), "{name} parsed"),
             Some("toml") => {
-                let ran = Scene::from_str(&text, &name).and_then(Problem::new).and_then(|p| p.run(|_| Ok(())));
+                let ran = Scene::from_str(&text, &name)
+                    .and_then(Problem::new)
+                    .and_then(|p| p.run(tresca_cr::RunOptions::all(), |_| Ok(())));
                 assert!(ran.is_err(), "{name} accepted")
             }
             _ => {}

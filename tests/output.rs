@@ -25,9 +25,9 @@ fn example(refine: u32, steps: usize) -> Scene {
 
 /// Run `p`, writing every step; returns the results.
 fn run_written(p: &Problem, path: &Path) -> Vec<StepResult> {
-    let mut w = Writer::create(path, &Run::of(&p), true).unwrap();
+    let mut w = Writer::create(path, &Run::of(p), true).unwrap();
     let mut out = Vec::new();
-    p.run(|r| {
+    p.run(tresca_cr::RunOptions::all(), |r| {
         out.push(r.clone());
         w.write_step(r)
     })
@@ -162,10 +162,10 @@ fn check_file(p: &Problem, rs: &[StepResult], path: &Path) {
             let vals: Vec<[f64; 2]> =
                 (0..3).map(|j| [want[want.len() - 9 + 3 * j], want[want.len() - 8 + 3 * j]]).collect();
             let mut gu = [[0.0; 2]; 2];
-            for j in 0..3 {
-                for a in 0..2 {
-                    for b in 0..2 {
-                        gu[a][b] += vals[j][a] * el.grad_lambda[j][b];
+            for (v, g) in vals.iter().zip(&el.grad_lambda) {
+                for (row, va) in gu.iter_mut().zip(v) {
+                    for (gab, gb) in row.iter_mut().zip(g) {
+                        *gab += va * gb;
                     }
                 }
             }
@@ -313,7 +313,7 @@ fn resume_after_drop_is_bit_identical() {
     {
         let mut w = Writer::create(&part, &Run::of(&p), false).unwrap();
         let mut k = 0;
-        let r = p.run(|r| {
+        let r = p.run(tresca_cr::RunOptions::all(), |r| {
             k += 1;
             if k > 9 {
                 return Err(tresca_cr::Error::Linear("stop".into()));
@@ -328,7 +328,7 @@ fn resume_after_drop_is_bit_identical() {
     let (mut w, last) = Writer::resume(&part, &Run::of(&p)).unwrap();
     let last = last.expect("a committed step");
     assert_eq!((last.n, w.completed()), (8, 9));
-    p.run_from(last, |r| w.write_step(r)).unwrap();
+    p.run(tresca_cr::RunOptions::after(last), |r| w.write_step(r)).unwrap();
     w.finish("completed").unwrap();
     same_results(&full, &part);
 }
@@ -356,7 +356,7 @@ fn kill_child_writer() {
     let Ok(path) = std::env::var("TRESCA_KILL_CHILD") else { return };
     let p = Problem::new(example(1, 400)).unwrap();
     let mut w = Writer::create(Path::new(&path), &Run::of(&p), true).unwrap();
-    p.run(|r| {
+    p.run(tresca_cr::RunOptions::all(), |r| {
         std::thread::sleep(Duration::from_micros(300));
         w.write_step(r)
     })
@@ -397,7 +397,7 @@ fn sigkill_at_random_moments_leaves_complete_steps_and_resume_is_bit_identical()
         let done = attr_i64(&f, "tresca/steps", "completed") as usize;
         let every = attr_i64(&f, "tresca", "frame_every") as usize;
         let last = p.n_steps();
-        let frames = done.div_ceil(every) + usize::from(done > last && last % every != 0);
+        let frames = done.div_ceil(every) + usize::from(done > last && !last.is_multiple_of(every));
         assert_eq!(attr_i64(&f, "VTKHDF/body/Steps", "NSteps") as usize, frames);
         assert!(shape(&f, "tresca/u")[0] >= done);
         // every completed step equals the uninterrupted run
@@ -412,7 +412,7 @@ fn sigkill_at_random_moments_leaves_complete_steps_and_resume_is_bit_identical()
         let (mut w, last) = Writer::resume(&path, &Run::of(&p)).unwrap();
         let last = last.expect("a committed step");
         assert_eq!(last.n + 1, done);
-        p.run_from(last, |r| w.write_step(r)).unwrap();
+        p.run(tresca_cr::RunOptions::after(last), |r| w.write_step(r)).unwrap();
         w.finish("completed").unwrap();
         same_results(&full, &path);
         resumed += 1;
@@ -431,7 +431,7 @@ fn timing_example_5_1_finest() {
     let p = Problem::new(example(refine, steps)).unwrap();
     let setup = t0.elapsed().as_secs_f64();
     let t4 = Instant::now();
-    p.run(|_| Ok(())).unwrap();
+    p.run(tresca_cr::RunOptions::all(), |_| Ok(())).unwrap();
     println!(
         "refine {refine} steps {steps}: unknowns {}, set-up {setup:.3}s, solve without writer {:.3}s",
         p.space.n_dofs,
@@ -448,7 +448,7 @@ fn timing_example_5_1_finest() {
         let mut w = Writer::create_with(&path, &Run::of(&p), &opts).unwrap();
         let create = t1.elapsed().as_secs_f64();
         let t2 = Instant::now();
-        p.run(|r| w.write_step(r)).unwrap();
+        p.run(tresca_cr::RunOptions::all(), |r| w.write_step(r)).unwrap();
         let sec = w.seconds;
         w.finish("completed").unwrap();
         println!(

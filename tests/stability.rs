@@ -118,7 +118,7 @@ fn extreme_settings_give_finite_results() {
         match Problem::new(s) {
             Err(e) => println!("refused: {e}"),
             Ok(p) => {
-                let r = p.run(|r| {
+                let r = p.run(tresca_cr::RunOptions::all(), |r| {
                     assert!(r.u.iter().chain(&r.mu).chain(&r.slip).all(|v| v.is_finite()), "step {}", r.n);
                     Ok(())
                 });

@@ -39,7 +39,11 @@ fn error_of(from: &str, to: &str) -> String {
         Err(e) => e.to_string(),
         Ok(s) => match Problem::new(s) {
             Err(e) => e.to_string(),
-            Ok(p) => p.run(|_| Ok(())).err().map(|e| e.to_string()).unwrap_or_else(|| panic!("`{to}` was accepted")),
+            Ok(p) => p
+                .run(tresca_cr::RunOptions::all(), |_| Ok(()))
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_else(|| panic!("`{to}` was accepted")),
         },
     }
 }
@@ -54,7 +58,7 @@ fn expect(from: &str, to: &str, needles: &[&str]) {
 #[test]
 fn base_scene_is_valid() {
     let s = Scene::from_str(BASE, "base.toml").unwrap();
-    Problem::new(s).unwrap().run(|_| Ok(())).unwrap();
+    Problem::new(s).unwrap().run(tresca_cr::RunOptions::all(), |_| Ok(())).unwrap();
 }
 
 #[test]
@@ -114,6 +118,7 @@ fn toml_structure() {
     expect("cells = [2, 2]", "cells = [2, 0]", &["mesh.cells"]);
     expect("cells = [2, 2]", "cells = [2, 2]\nfile = \"x.msh\"", &["either `file`"]);
     expect("[time]", "[time]\nsteps_per_second = 3", &["unknown field `steps_per_second`"]);
+    expect("steps = 4", "steps = 4\n[solver]\nmethod = \"newton\"", &["line", "`newton`: expected ssn, uzawa or pdas"]);
 }
 
 #[test]
@@ -175,7 +180,7 @@ fn solver_failure_is_reported_with_step_iterations_and_residual() {
     let p = Problem::new(Scene::from_str(&text, "s.toml").unwrap()).unwrap();
     let mut completed = 0;
     let e = p
-        .run(|_| {
+        .run(tresca_cr::RunOptions::all(), |_| {
             completed += 1;
             Ok(())
         })
@@ -186,4 +191,22 @@ fn solver_failure_is_reported_with_step_iterations_and_residual() {
         "{e}"
     );
     assert_eq!(completed, 1, "step 0 was handed over before the failure");
+}
+
+/// The system shall read the deprecated `[outputs]` table and its `energy` key as `[quantities]` and
+/// `elastic_energy`, saying so once each, and refuse a scene that gives both spellings.
+#[test]
+fn deprecated_quantity_names() {
+    let new = Scene::from_str(&format!("{BASE}[quantities]\nelastic_energy = true\n"), "q.toml").unwrap();
+    assert!(new.deprecations.is_empty(), "{:?}", new.deprecations);
+    let old = Scene::from_str(&format!("{BASE}[outputs]\nenergy = true\n"), "o.toml").unwrap();
+    assert_eq!(old.outputs, new.outputs);
+    assert!(old.outputs.as_ref().is_some_and(|o| o.elastic_energy));
+    assert_eq!(old.deprecations.len(), 2, "{:?}", old.deprecations);
+    assert!(old.deprecations[0].contains("[outputs] is deprecated: write [quantities]"));
+    assert!(old.deprecations[1].contains("energy is deprecated: write elastic_energy"));
+    let both = Scene::from_str(&format!("{BASE}[quantities]\nmax_slip = true\n[outputs]\nmax_slip = true\n"), "b.toml");
+    assert!(both.err().map(|e| e.to_string()).unwrap_or_default().contains("give [quantities] only"));
+    let keys = Scene::from_str(&format!("{BASE}[quantities]\nenergy = true\nelastic_energy = true\n"), "k.toml");
+    assert!(keys.err().map(|e| e.to_string()).unwrap_or_default().contains("give elastic_energy only"));
 }

@@ -206,7 +206,7 @@ fn csv_text(p: &Plan) -> String {
 /// with the time model at its steps, is the achieved estimate; the true error too when the scene has one.
 fn execute_plan(scene: &Scene, p: &Plan, b: &Candidate) -> Result<super::summary::Achieved> {
     let mut s = scene.clone();
-    s.solver.method = tresca_cr::scene::Method::Ssn;
+    s.solver.method = p.solver;
     s.solver.tol = p.tol;
     let first = b.refine.saturating_sub(3).max(scene.mesh_level());
     let levels: Vec<Level> = (first..=b.refine).map(|refine| Level { refine, steps: b.steps }).collect();

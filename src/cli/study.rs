@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 use std::path::PathBuf;
-use tresca_cr::study::{Level, LevelResult, Study};
+use tresca_cr::study::{Axis, Level, LevelResult, Study};
 use tresca_cr::Scene;
 
 pub fn study(
@@ -100,7 +100,7 @@ fn print_estimates(s: &Study) {
             // the truth the estimate is compared with: the exact error on different meshes (else the
             // reference run), the reference run on one mesh (the sequence's limit is the semi-discrete solution)
             let reference = r.reference.map(|v| v[0]);
-            let truth = if e.size == "k" { reference } else { r.common_err.map(|v| v.energy).or(reference) };
+            let truth = if e.size == Axis::K { reference } else { r.common_err.map(|v| v.energy).or(reference) };
             let (t, eff) = truth
                 .map_or((String::new(), String::new()), |t| (format!("{t:.4e}"), format!("{:.3}", l.error[0] / t)));
             println!(

@@ -356,7 +356,7 @@ impl StudySummary {
             levels,
             reference: reference.map(|l| LevelSpec { refine: l.refine, steps: l.steps }),
             estimates: Estimates {
-                size: e.size.into(),
+                size: e.size.to_string(),
                 p: e.model.map(|m| m.p),
                 beta: e.model.map(|m| m.beta),
                 refused: e.refused.clone(),

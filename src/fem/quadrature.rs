@@ -6,6 +6,7 @@
 //!   (degree 5; Neumann loads, edge means of g_a and of u₀), on the parameter s ∈ [0, 1], weights summing to 1.
 
 /// Dunavant degree 4: (barycentric coordinates, weight).
+#[allow(clippy::excessive_precision)] // the rule's published 18 digits, kept to compare with the table; they round to the same f64
 pub const TRI4: [([f64; 3], f64); 6] = {
     const A: f64 = 0.445_948_490_915_964_886;
     const WA: f64 = 0.223_381_589_678_011_466;
@@ -23,12 +24,14 @@ pub const TRI4: [([f64; 3], f64); 6] = {
 
 /// 2-point Gauss–Legendre on [0, 1]: (s, weight).
 pub const GAUSS2: [(f64, f64); 2] = {
+    #[allow(clippy::excessive_precision)] // 18 digits of 1/(2√3); they round to the same f64
     const D: f64 = 0.288_675_134_594_812_882; // 1/(2√3)
     [(0.5 - D, 0.5), (0.5 + D, 0.5)]
 };
 
 /// 3-point Gauss–Legendre on [0, 1]: (s, weight).
 pub const GAUSS3: [(f64, f64); 3] = {
+    #[allow(clippy::excessive_precision)] // 18 digits of √(3/5)/2; they round to the same f64
     const D: f64 = 0.387_298_334_620_741_689; // √(3/5)/2
     [(0.5 - D, 5.0 / 18.0), (0.5, 8.0 / 18.0), (0.5 + D, 5.0 / 18.0)]
 };

@@ -126,8 +126,8 @@ impl CrSpace {
         let mut contact = Vec::new();
         let mut n = 0;
         let mut n_dirichlet = 0;
-        for e in 0..mesh.edges.len() {
-            let kind = edge_part[e].map(|p| &parts[p].kind);
+        for (e, part) in edge_part.iter().enumerate() {
+            let kind = part.map(|p| &parts[p].kind);
             edge_dof.push(match kind {
                 Some(PartKind::Dirichlet) => {
                     n_dirichlet += 1;

@@ -168,12 +168,11 @@ impl Qp<'_> {
     pub fn slip_increment(&self, mu: &[f64]) -> Vec<f64> {
         let n = self.d.len();
         let mut ds = self.d.to_vec();
-        for j in 0..n {
-            let m = mu[j];
+        for (j, &m) in mu.iter().enumerate().take(n) {
             if m != 0.0 {
                 let col = self.c.column(j);
-                for i in 0..n {
-                    ds[i] -= col[i] * m;
+                for (d, c) in ds.iter_mut().zip(col.iter()) {
+                    *d -= c * m;
                 }
             }
         }

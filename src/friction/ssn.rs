@@ -8,6 +8,7 @@
 //! step is accepted and the iteration terminates at the exact solution (residual at rounding level).
 
 use super::{stalled, Qp, Solved};
+use crate::scene::Method;
 use nalgebra::{DMatrix, DVector};
 
 /// Armijo sufficient-decrease constant.
@@ -25,7 +26,7 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Solved {
             return Ok((mu, it, res));
         }
         if it == max_iter {
-            return Err(stalled("ssn", it, res));
+            return Err(stalled(Method::Ssn.name(), it, res));
         }
         let g: Vec<f64> = ds.iter().map(|v| -v).collect();
         // ε-active set (Bertsekas 1982): ε = min(ε₀, ‖μ − P(μ − D⁻¹g)‖)

@@ -40,8 +40,11 @@ fn mat(rows: &[&[f64]]) -> DMatrix<f64> {
     DMatrix::from_fn(rows.len(), rows.len(), |i, j| rows[i][j])
 }
 
+/// A friction problem (C, d, w) and what it exercises.
+type Case = (&'static str, DMatrix<f64>, Vec<f64>, Vec<f64>);
+
 /// Friction problems (C, d, w) and what each exercises.
-fn cases() -> Vec<(&'static str, DMatrix<f64>, Vec<f64>, Vec<f64>)> {
+fn cases() -> Vec<Case> {
     let c2 = mat(&[&[2.0, 0.5], &[0.5, 1.0]]);
     vec![
         ("all stick", c2.clone(), vec![0.5, 0.3], vec![1.0, 1.0]),
@@ -87,8 +90,8 @@ fn solvers_reach_the_kkt_solution() {
             assert!(err <= 1e-9, "{method:?} on {name}: μ {:?}, oracle {want:?}", sol.mu);
             let qp = Qp { c: &c, d: &d, w: &w };
             let ds = qp.slip_increment(&want);
-            for e in 0..d.len() {
-                let slips = ds[e].abs() > 1e-9;
+            for (e, dse) in ds.iter().enumerate() {
+                let slips = dse.abs() > 1e-9;
                 assert_eq!(sol.state[e] == EdgeState::Slip, slips, "{method:?} on {name}, edge {e}");
             }
         }

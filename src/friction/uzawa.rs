@@ -7,6 +7,7 @@
 //! `step = 0` chooses ρ̃ = 1/λ_max(M) (power iteration).
 
 use super::{stalled, Qp, Solved};
+use crate::scene::Method;
 
 /// ρ̃ = 1/λ_max((GW)^{1/2} C (GW)^{1/2}) by power iteration.
 pub fn auto_step(qp: &Qp, g: &[f64]) -> f64 {
@@ -56,5 +57,5 @@ pub fn solve(qp: &Qp, g: &[f64], mu0: &[f64], rho: f64, tol: f64, max_iter: usiz
             return Ok((mu, it, res));
         }
     }
-    Err(stalled("uzawa", max_iter, diff))
+    Err(stalled(Method::Uzawa.name(), max_iter, diff))
 }

@@ -57,116 +57,19 @@ pub fn read(path: &Path) -> Result<RawMesh> {
 /// Parse Gmsh 4.1 ASCII text; `src` names it in messages.
 pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
     let mut tk = Tokens { src: src.to_string(), lines: text.lines().enumerate().peekable(), line_no: 0 };
-    let mut names: HashMap<i64, String> = HashMap::new(); // 1D physical tag → name
-    let mut curve_phys: HashMap<i64, Vec<i64>> = HashMap::new();
-    let mut nodes: HashMap<i64, [f64; 2]> = HashMap::new();
-    let mut tris_tags: Vec<[i64; 3]> = Vec::new();
-    let mut lines_tags: Vec<([i64; 2], i64)> = Vec::new(); // (nodes, curve entity)
-    let mut seen_format = false;
+    let mut file = Sections::default();
     while let Some(&(_, l)) = tk.lines.peek() {
-        let l = l.trim();
-        if l.is_empty() {
+        if l.trim().is_empty() {
             tk.line()?;
             continue;
         }
         let section = tk.line()?.to_string();
         match section.as_str() {
-            "$MeshFormat" => {
-                let f = tk.line()?;
-                let v: Vec<&str> = f.split_whitespace().collect();
-                if v.len() < 3 || !v[0].starts_with("4.1") {
-                    return Err(tk.err(format!("unsupported format `{f}` (need Gmsh 4.1)")));
-                }
-                if v[1] != "0" {
-                    return Err(tk.err("binary .msh files are not supported; save as ASCII 4.1"));
-                }
-                tk.expect("$EndMeshFormat")?;
-                seen_format = true;
-            }
-            "$PhysicalNames" => {
-                let n = tk.nums::<usize>(1)?[0];
-                for _ in 0..n {
-                    let l = tk.line()?;
-                    let mut it = l.splitn(3, char::is_whitespace);
-                    let (dim, tag, name) = (it.next(), it.next(), it.next());
-                    let (Some(dim), Some(tag), Some(name)) = (dim, tag, name) else {
-                        return Err(tk.err("malformed physical name"));
-                    };
-                    let (dim, tag): (i64, i64) = match (dim.parse(), tag.parse()) {
-                        (Ok(d), Ok(t)) => (d, t),
-                        _ => return Err(tk.err("malformed physical name")),
-                    };
-                    if dim == 1 {
-                        names.insert(tag, name.trim().trim_matches('"').to_string());
-                    }
-                }
-                tk.expect("$EndPhysicalNames")?;
-            }
-            "$Entities" => {
-                let c = tk.nums::<usize>(4)?;
-                for _ in 0..c[0] {
-                    tk.line()?;
-                }
-                for _ in 0..c[1] {
-                    let v = tk.nums::<f64>(8)?;
-                    let np = v[7];
-                    if !(np >= 0.0 && np.fract() == 0.0 && v.len() as f64 >= 8.0 + np) {
-                        return Err(tk.err("curve entity lists fewer physical tags than it declares"));
-                    }
-                    curve_phys.insert(v[0] as i64, v[8..8 + np as usize].iter().map(|&x| x as i64).collect());
-                }
-                for _ in 0..c[2] + c[3] {
-                    tk.line()?;
-                }
-                tk.expect("$EndEntities")?;
-            }
-            "$Nodes" => {
-                let h = tk.nums::<usize>(4)?;
-                for _ in 0..h[0] {
-                    let b = tk.nums::<i64>(4)?;
-                    let param = b[2] != 0;
-                    let count = usize::try_from(b[3]).map_err(|_| tk.err(format!("negative node count {}", b[3])))?;
-                    let mut tags = Vec::new();
-                    for _ in 0..count {
-                        tags.push(tk.nums::<i64>(1)?[0]);
-                    }
-                    for tag in tags {
-                        let x = tk.nums::<f64>(if param { 4 } else { 3 })?;
-                        if !(x[0].is_finite() && x[1].is_finite()) {
-                            return Err(tk.err("non-finite node coordinate"));
-                        }
-                        if x[2] != 0.0 {
-                            return Err(
-                                tk.err(format!("node {tag} has z = {} (only planar meshes in the xy plane)", x[2]))
-                            );
-                        }
-                        if nodes.insert(tag, [x[0], x[1]]).is_some() {
-                            return Err(tk.err(format!("node tag {tag} defined twice")));
-                        }
-                    }
-                }
-                tk.expect("$EndNodes")?;
-            }
-            "$Elements" => {
-                let h = tk.nums::<usize>(4)?;
-                for _ in 0..h[0] {
-                    let b = tk.nums::<i64>(4)?;
-                    let (dim, entity, ty) = (b[0], b[1], b[2]);
-                    let count =
-                        usize::try_from(b[3]).map_err(|_| tk.err(format!("negative element count {}", b[3])))?;
-                    for _ in 0..count {
-                        let e = tk.nums::<i64>(2)?;
-                        match (dim, ty) {
-                            (0, 15) => {}
-                            (1, 1) if e.len() == 3 => lines_tags.push(([e[1], e[2]], entity)),
-                            (2, 2) if e.len() == 4 => tris_tags.push([e[1], e[2], e[3]]),
-                            (1, 1) | (2, 2) => return Err(tk.err("wrong number of nodes for the element type")),
-                            _ => return Err(tk.err(format!("unsupported element type {ty} in dimension {dim} (only 3-node triangles and 2-node lines)"))),
-                        }
-                    }
-                }
-                tk.expect("$EndElements")?;
-            }
+            "$MeshFormat" => file.mesh_format(&mut tk)?,
+            "$PhysicalNames" => file.physical_names(&mut tk)?,
+            "$Entities" => file.entities(&mut tk)?,
+            "$Nodes" => file.nodes(&mut tk)?,
+            "$Elements" => file.elements(&mut tk)?,
             s if s.starts_with('$') => {
                 // skip unknown sections
                 let end = format!("$End{}", &s[1..]);
@@ -175,17 +78,156 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
             other => return Err(tk.err(format!("expected a section header, found `{other}`"))),
         }
     }
-    if !seen_format {
+    if !file.seen_format {
         return Err(Error::mesh(src, "missing $MeshFormat section (not a Gmsh file?)"));
     }
-    if tris_tags.is_empty() {
+    if file.tris_tags.is_empty() {
         return Err(Error::mesh(src, "no 3-node triangles"));
     }
-    // keep nodes used by triangles, numbered in order of first use
+    let UsedNodes { index, points, tris } = used_nodes(src, &file.nodes, &file.tris_tags)?;
+    check_duplicate_points(src, &points)?;
+    let (tagged, tag_names) = boundary_lines(src, &file, &index)?;
+    Ok(RawMesh { source: src.to_string(), points, tris, tagged, tag_names })
+}
+
+/// What the sections of a file hold, by Gmsh tag.
+#[derive(Default)]
+struct Sections {
+    /// 1D physical tag → name.
+    names: HashMap<i64, String>,
+    /// Curve entity → its physical tags.
+    curve_phys: HashMap<i64, Vec<i64>>,
+    nodes: HashMap<i64, [f64; 2]>,
+    tris_tags: Vec<[i64; 3]>,
+    /// (nodes, curve entity) of the 2-node lines.
+    lines_tags: Vec<([i64; 2], i64)>,
+    seen_format: bool,
+}
+
+impl Sections {
+    /// `$MeshFormat`: ASCII 4.1 only.
+    fn mesh_format(&mut self, tk: &mut Tokens) -> Result<()> {
+        let f = tk.line()?;
+        let v: Vec<&str> = f.split_whitespace().collect();
+        if v.len() < 3 || !v[0].starts_with("4.1") {
+            return Err(tk.err(format!("unsupported format `{f}` (need Gmsh 4.1)")));
+        }
+        if v[1] != "0" {
+            return Err(tk.err("binary .msh files are not supported; save as ASCII 4.1"));
+        }
+        tk.expect("$EndMeshFormat")?;
+        self.seen_format = true;
+        Ok(())
+    }
+
+    /// `$PhysicalNames`: the names of the 1D physical groups.
+    fn physical_names(&mut self, tk: &mut Tokens) -> Result<()> {
+        let n = tk.nums::<usize>(1)?[0];
+        for _ in 0..n {
+            let l = tk.line()?;
+            let mut it = l.splitn(3, char::is_whitespace);
+            let (dim, tag, name) = (it.next(), it.next(), it.next());
+            let (Some(dim), Some(tag), Some(name)) = (dim, tag, name) else {
+                return Err(tk.err("malformed physical name"));
+            };
+            let (dim, tag): (i64, i64) = match (dim.parse(), tag.parse()) {
+                (Ok(d), Ok(t)) => (d, t),
+                _ => return Err(tk.err("malformed physical name")),
+            };
+            if dim == 1 {
+                self.names.insert(tag, name.trim().trim_matches('"').to_string());
+            }
+        }
+        tk.expect("$EndPhysicalNames")
+    }
+
+    /// `$Entities`: the physical tags of each curve.
+    fn entities(&mut self, tk: &mut Tokens) -> Result<()> {
+        let c = tk.nums::<usize>(4)?;
+        for _ in 0..c[0] {
+            tk.line()?;
+        }
+        for _ in 0..c[1] {
+            let v = tk.nums::<f64>(8)?;
+            let np = v[7];
+            if !(np >= 0.0 && np.fract() == 0.0 && v.len() as f64 >= 8.0 + np) {
+                return Err(tk.err("curve entity lists fewer physical tags than it declares"));
+            }
+            self.curve_phys.insert(v[0] as i64, v[8..8 + np as usize].iter().map(|&x| x as i64).collect());
+        }
+        for _ in 0..c[2] + c[3] {
+            tk.line()?;
+        }
+        tk.expect("$EndEntities")
+    }
+
+    /// `$Nodes`: planar, finite, each tag once.
+    fn nodes(&mut self, tk: &mut Tokens) -> Result<()> {
+        let h = tk.nums::<usize>(4)?;
+        for _ in 0..h[0] {
+            let b = tk.nums::<i64>(4)?;
+            let param = b[2] != 0;
+            let count = usize::try_from(b[3]).map_err(|_| tk.err(format!("negative node count {}", b[3])))?;
+            let mut tags = Vec::new();
+            for _ in 0..count {
+                tags.push(tk.nums::<i64>(1)?[0]);
+            }
+            for tag in tags {
+                let x = tk.nums::<f64>(if param { 4 } else { 3 })?;
+                if !(x[0].is_finite() && x[1].is_finite()) {
+                    return Err(tk.err("non-finite node coordinate"));
+                }
+                if x[2] != 0.0 {
+                    return Err(tk.err(format!("node {tag} has z = {} (only planar meshes in the xy plane)", x[2])));
+                }
+                if self.nodes.insert(tag, [x[0], x[1]]).is_some() {
+                    return Err(tk.err(format!("node tag {tag} defined twice")));
+                }
+            }
+        }
+        tk.expect("$EndNodes")
+    }
+
+    /// `$Elements`: 3-node triangles and 2-node lines (points are passed over).
+    fn elements(&mut self, tk: &mut Tokens) -> Result<()> {
+        let h = tk.nums::<usize>(4)?;
+        for _ in 0..h[0] {
+            let b = tk.nums::<i64>(4)?;
+            let (dim, entity, ty) = (b[0], b[1], b[2]);
+            let count = usize::try_from(b[3]).map_err(|_| tk.err(format!("negative element count {}", b[3])))?;
+            for _ in 0..count {
+                let e = tk.nums::<i64>(2)?;
+                match (dim, ty) {
+                    (0, 15) => {}
+                    (1, 1) if e.len() == 3 => self.lines_tags.push(([e[1], e[2]], entity)),
+                    (2, 2) if e.len() == 4 => self.tris_tags.push([e[1], e[2], e[3]]),
+                    (1, 1) | (2, 2) => return Err(tk.err("wrong number of nodes for the element type")),
+                    _ => {
+                        return Err(tk.err(format!(
+                            "unsupported element type {ty} in dimension {dim} (only 3-node triangles and 2-node lines)"
+                        )))
+                    }
+                }
+            }
+        }
+        tk.expect("$EndElements")
+    }
+}
+
+/// The nodes used by triangles, numbered in order of first use.
+struct UsedNodes {
+    /// Gmsh node tag → point index.
+    index: HashMap<i64, usize>,
+    points: Vec<[f64; 2]>,
+    tris: Vec<[usize; 3]>,
+}
+
+/// [`UsedNodes`] of the triangles `tris_tags`.
+fn used_nodes(src: &str, nodes: &HashMap<i64, [f64; 2]>, tris_tags: &[[i64; 3]]) -> Result<UsedNodes> {
     let mut index: HashMap<i64, usize> = HashMap::new();
     let mut points = Vec::new();
     let mut tris = Vec::with_capacity(tris_tags.len());
-    for t in &tris_tags {
+    for t in tris_tags {
         let mut tri = [0; 3];
         for (k, tag) in t.iter().enumerate() {
             let p =
@@ -197,6 +239,11 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
         }
         tris.push(tri);
     }
+    Ok(UsedNodes { index, points, tris })
+}
+
+/// Two nodes at the same coordinates make a non-conforming mesh: refused.
+fn check_duplicate_points(src: &str, points: &[[f64; 2]]) -> Result<()> {
     let mut sorted: Vec<([u64; 2], usize)> =
         points.iter().enumerate().map(|(i, p)| ([p[0].to_bits(), p[1].to_bits()], i)).collect();
     sorted.sort_unstable();
@@ -207,11 +254,19 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
             format!("duplicate nodes at ({}, {}): the mesh is not conforming there", p[0], p[1]),
         ));
     }
+    Ok(())
+}
+
+/// Boundary edges (vertex pairs) with an index into the part names, as in [`RawMesh`].
+type Tagged = Vec<([usize; 2], usize)>;
+
+/// The named boundary lines as (vertex pair, part index), and the part names in order of first use.
+fn boundary_lines(src: &str, file: &Sections, index: &HashMap<i64, usize>) -> Result<(Tagged, Vec<String>)> {
     let mut tag_names: Vec<String> = Vec::new();
     let mut tagged = Vec::new();
-    for (pair, entity) in lines_tags {
-        let phys = curve_phys.get(&entity).cloned().unwrap_or_default();
-        let named: Vec<&String> = phys.iter().filter_map(|p| names.get(p)).collect();
+    for &(pair, entity) in &file.lines_tags {
+        let phys = file.curve_phys.get(&entity).cloned().unwrap_or_default();
+        let named: Vec<&String> = phys.iter().filter_map(|p| file.names.get(p)).collect();
         let name = match named.as_slice() {
             [] => continue, // an untagged line: its edge will be reported if it is on the boundary
             [n] => (*n).clone(),
@@ -232,7 +287,7 @@ pub fn parse(text: &str, src: &str) -> Result<RawMesh> {
         };
         tagged.push(([a, b], tag));
     }
-    Ok(RawMesh { source: src.to_string(), points, tris, tagged, tag_names })
+    Ok((tagged, tag_names))
 }
 
 #[cfg(test)]

@@ -119,7 +119,7 @@ impl Mesh {
                     ),
                 ));
             }
-            if !(a2.abs() > 1e-12 * scale * scale) {
+            if a2.abs().partial_cmp(&(1e-12 * scale * scale)) != Some(std::cmp::Ordering::Greater) {
                 return Err(Error::mesh(
                     src,
                     format!("triangle {k} at ({:.6}, {:.6}) is degenerate (zero area)", a[0], a[1]),
@@ -236,7 +236,7 @@ impl Mesh {
             self.tag_names.iter().map(|n| parts.iter().position(|p| p == n)).collect();
         let mut out = vec![None; self.edges.len()];
         let mut count = vec![0usize; parts.len()];
-        for e in 0..self.edges.len() {
+        for (e, slot) in out.iter_mut().enumerate() {
             if self.edge_tris[e].1.is_some() {
                 continue;
             }
@@ -254,7 +254,7 @@ impl Mesh {
                 )
             })?;
             count[p] += 1;
-            out[e] = Some(p);
+            *slot = Some(p);
         }
         for (p, c) in parts.iter().zip(&count) {
             if *c == 0 {

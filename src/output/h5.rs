@@ -126,8 +126,7 @@ impl Raw {
 /// results file is read back during a run, so the cache gains nothing from being larger. For the same
 /// reason an object leaves the cache when its last handle closes (`evict_on_close`): the virtual
 /// datasets of the XDMF view, created and closed at once, no longer fill the cache until the file is
-/// closed, where freeing their layouts took about 2 ms at the end of a run (mms_stop refine 4 written:
-/// −2 to −4 ms; Example 5.1 n = 32 written −6 ms; mms_stop refine 5 written −17 ms, interleaved).
+/// closed, where freeing their layouts was serial work at the end of a run.
 ///
 /// The earliest file format that holds the data (superblock 0, symbol-table groups), as HDF5 1.10
 /// wrote by default: HDF5 2 (linked statically, see Cargo.toml) defaults to the 1.8 format, whose

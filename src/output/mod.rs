@@ -2,7 +2,7 @@
 //!
 //! | group | for | content |
 //! |---|---|---|
-//! | `/tresca` | the project's tools (`scripts/`) | the README table, f64, one row per completed step ([`tresca`]) |
+//! | `/tresca` | the project's tools (`scripts/`) | the table of docs/results.md, f64, one row per completed step ([`tresca`]) |
 //! | `/VTKHDF` | ParaView ≥ 5.13, VTK ≥ 9.4 `vtkHDFReader` | temporal PartitionedDataSetCollection: block `body` (broken mesh, 3 points per triangle) and block `contact` (Γ_C line cells), each with only its own f32 fields ([`vtkhdf`], [`fields`]) |
 //! | `/xdmf` | `run.xdmf` (ParaView 5.11's XDMF readers, meshio's `TimeSeriesReader`) | static topologies and per-frame virtual datasets onto `/VTKHDF` arrays, one temporal collection per block ([`xdmf`]) |
 //!
@@ -61,7 +61,7 @@ use crate::fem::elasticity::Elasticity;
 use crate::fem::space::CrSpace;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
-use crate::stepping::{Problem, Problem0, SetupTimes, StepResult};
+use crate::stepping::{Discretised, Problem, SetupTimes, StepResult};
 use fields::{Fields, StepFields};
 use h5::{io, Raw};
 use rows::Rows;
@@ -128,7 +128,7 @@ impl<'a> Run<'a> {
 
     /// The run of a problem whose set-up is still under way ([`Problem::new_beside`]): its set-up times
     /// are zeros until [`Writer::set_setup_times`].
-    pub fn before_setup(p: &'a Problem0) -> Run<'a> {
+    pub fn before_setup(p: &'a Discretised) -> Run<'a> {
         Run::new(&p.scene, &p.mesh, &p.space, p.law, SetupTimes::default())
     }
 

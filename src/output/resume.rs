@@ -91,18 +91,17 @@ impl Writer {
         }
         let every = int("frame_every").max(1) as usize;
         // storage corruption since the steps were written: refuse, naming the first bad step
-        match tresca.first_corrupt_step(completed).map_err(io(path, "--resume: verifying the step checksums"))? {
-            Some(n) => {
-                return Err(Error::Io {
-                    path: path.to_path_buf(),
-                    msg: format!(
-                        "--resume: step {n} does not match its checksum (tresca/steps/checksum): the file was \
-                         damaged after it was written. Steps 0..{} are intact; rerun with --force",
-                        n as i64 - 1
-                    ),
-                })
-            }
-            None => {}
+        if let Some(n) =
+            tresca.first_corrupt_step(completed).map_err(io(path, "--resume: verifying the step checksums"))?
+        {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: format!(
+                    "--resume: step {n} does not match its checksum (tresca/steps/checksum): the file was \
+                     damaged after it was written. Steps 0..{} are intact; rerun with --force",
+                    n as i64 - 1
+                ),
+            });
         }
         let frames = Frames { every, last: run.n_steps() };
         let frames_done = frames.before(completed);

@@ -1,4 +1,4 @@
-//! The `tresca` group of the README (the layout every tool of the project reads), plus
+//! The `tresca` group of docs/results.md (the layout every tool of the project reads), plus
 //! `tresca/energy` (a_h(uⁿ,uⁿ)) and `tresca/contact/mu` (the friction force μ_e, kept bit-exact so
 //! a resumed run is bit-identical; σ_τ = −μ/|e| alone would round) and `tresca/contact/dof` (the contact
 //! unknown of uⁿ, equal to `slip` up to rounding).

@@ -29,6 +29,21 @@ pub const BODY_CELLS: [(&str, usize); 3] = [("strain", TENSOR), ("stress", TENSO
 /// Cell arrays of the contact block (f32 but `stick_slip`, u8).
 pub const CONTACT_CELLS: [(&str, usize); 4] = [("sigma_t", 1), ("slip", 1), ("slip_increment", 1), ("stick_slip", 1)];
 
+/// What a block is: its name and index in the collection, its cells (points per cell and VTK cell
+/// type) and its cell arrays.
+struct BlockKind {
+    name: &'static str,
+    index: i64,
+    per_cell: usize,
+    vtk_type: u8,
+    arrays: &'static [(&'static str, usize)],
+}
+
+/// The body: triangles (VTK type 5).
+const BODY: BlockKind = BlockKind { name: "body", index: 0, per_cell: 3, vtk_type: 5, arrays: &BODY_CELLS };
+/// The contact line: Γ_C edges as lines (VTK type 3).
+const CONTACT: BlockKind = BlockKind { name: "contact", index: 1, per_cell: 2, vtk_type: 3, arrays: &CONTACT_CELLS };
+
 /// Which steps are visualisation frames: n % every == 0, and the last step N.
 #[derive(Clone, Copy, Debug)]
 pub struct Frames {
@@ -38,11 +53,11 @@ pub struct Frames {
 
 impl Frames {
     pub fn is_frame(&self, n: usize) -> bool {
-        n % self.every == 0 || n == self.last
+        n.is_multiple_of(self.every) || n == self.last
     }
     /// Number of frames among steps 0..steps.
     pub fn before(&self, steps: usize) -> usize {
-        steps.div_ceil(self.every) + usize::from(steps > self.last && self.last % self.every != 0)
+        steps.div_ceil(self.every) + usize::from(steps > self.last && !self.last.is_multiple_of(self.every))
     }
     pub fn total(&self) -> usize {
         self.before(self.last + 1)
@@ -116,18 +131,9 @@ fn ordered_group(parent: &Group, name: &str) -> hdf5::Result<Group> {
 }
 
 impl Block {
-    /// Create block `name` of `points` with cells of `per_cell` points each (VTK type `vtk_type`).
-    #[allow(clippy::too_many_arguments)]
-    fn create(
-        root: &Group,
-        name: &str,
-        index: i64,
-        points: &[[f64; 3]],
-        per_cell: usize,
-        vtk_type: u8,
-        arrays: &[(&str, usize)],
-        m: usize,
-    ) -> hdf5::Result<Block> {
+    /// Create block `kind` of `points` (`kind.per_cell` points a cell) with room for `m` frames.
+    fn create(root: &Group, kind: &BlockKind, points: &[[f64; 3]], m: usize) -> hdf5::Result<Block> {
+        let BlockKind { name, index, per_cell, vtk_type, arrays } = *kind;
         let g = root.create_group(name)?;
         attr(&g, "Index", index)?;
         attr_vec(&g, "Version", &[2i64, 2])?;
@@ -214,10 +220,10 @@ impl VtkHdf {
         attr_vec(&root, "Version", &[2i64, 2])?;
         attr_fixed_ascii::<28>(&root, "Type", "PartitionedDataSetCollection")?;
         let assembly = ordered_group(&root, "Assembly")?;
-        let body = Block::create(&root, "body", 0, &f.points, 3, 5, &BODY_CELLS, n_frames)?;
+        let body = Block::create(&root, &BODY, &f.points, n_frames)?;
         assembly.link_soft("/VTKHDF/body", "body")?;
         let contact = if contact {
-            let b = Block::create(&root, "contact", 1, &f.contact_points, 2, 3, &CONTACT_CELLS, n_frames)?;
+            let b = Block::create(&root, &CONTACT, &f.contact_points, n_frames)?;
             assembly.link_soft("/VTKHDF/contact", "contact")?;
             Some(b)
         } else {

@@ -323,8 +323,8 @@ impl Xdmf {
     /// and the two names are exchanged atomically (`renameat2(RENAME_EXCHANGE)`; a plain rename where the
     /// file system cannot exchange), so a reader, or a run killed at any moment, sees the sidecar before
     /// or after the commit's frames, in every block alike; the spare then holds the previous text and is
-    /// rewritten in place next time (no new file per commit: replacing the file by rename cost ~0.4 ms a
-    /// commit, 8 ms on Example 5.1's finest level written). Writing the slots of the blocks in place took
+    /// rewritten in place next time (no new file per commit, which cost a file creation per commit).
+    /// Writing the slots of the blocks in place took
     /// one `pwrite` per block, and a run killed between them (found by `verification/paraview_check.py`)
     /// left a frame in the contact collection without its body grid, which ParaView's Xdmf3 readers show
     /// as a time without the body. Before publishing, the unpublished file is written in place.

@@ -27,11 +27,11 @@ mod search;
 
 use crate::error::{Error, Result};
 use crate::scene::budget::Estimate;
-use crate::scene::Scene;
+use crate::scene::{Method, Scene};
 use crate::study::{Level, LevelResult, Study};
 use model::{CostModel, CostSample, ErrorModel, TimeError};
 use pilot::{fit, pilot_scene, time_pilot, Fit, Quantity, Runner};
-use search::decide;
+use search::{decide, Pilots};
 
 /// Levels of the space pilot before any extension (four: the asymptotic check needs a fourth level).
 pub const SPACE_LEVELS: u32 = 4;
@@ -52,7 +52,7 @@ pub const SAMPLING_SHARE: f64 = 0.1;
 /// limit, at time/space error ratios 2.1, 0.53 and 0.13).
 pub const LAW_SAMPLING_SHARE: f64 = 0.5;
 /// Deepest refinement searched (the scene's own limit).
-pub(crate) const MAX_REFINE: u32 = 12;
+pub(crate) const MAX_REFINE: u32 = crate::scene::MAX_REFINE;
 /// Most steps searched.
 pub(crate) const MAX_STEPS: usize = 1 << 22;
 
@@ -104,7 +104,7 @@ pub struct Plan {
     pub best: Vec<Candidate>,
     /// The cheapest configuration meeting the target beyond the budget, when none fits it.
     pub over_budget: Option<Candidate>,
-    pub solver: &'static str,
+    pub solver: Method,
     pub tol: f64,
     pub notes: Vec<String>,
     pub refused: Option<String>,
@@ -208,7 +208,9 @@ fn space_pilot(
         let cost = CostModel::fit(&space_samples(run.levels()), &samples(&time.levels));
         let predicted = |r: u32| cost.map_or(0.0, |c| c.predict(unknowns(s, r).unwrap_or(0) as f64, nh));
         if run.levels().len() as u32 >= SPACE_LEVELS {
-            let draft = decide(s, options, &run.study(), time, time_fit, *time_ratio, spent + run.spent, vec![])?;
+            let study = run.study();
+            let pilots = Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, wall: spent + run.spent };
+            let draft = decide(s, options, &pilots, vec![])?;
             let extend = match draft.best.first() {
                 _ if draft.space_fit.not_in_range().is_some() => true, // not yet in the asymptotic range
                 Some(b) => b.refine > r - 1 + MAX_EXTRAPOLATION && predicted(r) <= EXTENSION_SHARE * b.wall,
@@ -223,7 +225,9 @@ fn space_pilot(
         if let Some(why) = run.push(Level { refine: r, steps: nh }, predicted(r), options.pilot_budget - spent)? {
             notes.push(why);
             spent += run.spent;
-            let mut done = decide(s, options, &run.study(), time, time_fit, *time_ratio, spent, notes)?;
+            let study = run.study();
+            let pilots = Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, wall: spent };
+            let mut done = decide(s, options, &pilots, notes)?;
             if done.refused.is_none() && (run.levels().len() as u32) < SPACE_LEVELS {
                 done.refused = Some("fewer than four space levels: no asymptotic-range check".into());
                 done.best.clear();

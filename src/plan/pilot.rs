@@ -14,26 +14,30 @@ use super::model::TimeError;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 use crate::study::richardson::Verdict;
-use crate::study::{estimate, Level, LevelResult, Sequence, Study};
+use crate::study::{estimate, Axis, Level, LevelResult, Sequence, Study};
 
 /// The error the planner is asked to bound.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Quantity {
     /// The energy-norm error, max over the time nodes.
     Energy,
-    /// A scalar output of `[outputs]` at T, by its study name (`max_slip`, `energy`, `traction_x_y`, …).
+    /// A scalar output of `[quantities]` at T, by its study name (`max_slip`, `elastic_energy`, `traction_x_y`, …).
     Output(String),
 }
 
 impl Quantity {
-    /// `energy` (the energy-norm error), `elastic-energy` (the output ½a_h(u,u)) or an output name
-    /// (`-` and `_` alike).
+    /// `energy-norm` (the energy-norm error; `energy` is its deprecated name), `elastic-energy` (the
+    /// output ½a_h(u,u)) or an output name (`-` and `_` alike).
     pub fn parse(text: &str) -> Quantity {
         match text.replace('-', "_").as_str() {
-            "energy" => Quantity::Energy,
-            "elastic_energy" => Quantity::Output("energy".into()),
+            "energy_norm" | "energy" => Quantity::Energy,
             other => Quantity::Output(other.into()),
         }
+    }
+
+    /// The message for a deprecated name of a quantity, if `text` is one.
+    pub fn deprecation(text: &str) -> Option<String> {
+        (text == "energy").then(|| "--quantity energy is deprecated: write --quantity energy-norm".to_string())
     }
 
     pub fn describe(&self) -> String {
@@ -47,8 +51,8 @@ impl Quantity {
 /// What a sequence says about the quantity's error.
 #[derive(Clone, Debug)]
 pub struct Fit {
-    /// "h" or "k".
-    pub size: &'static str,
+    /// The axis the levels refine.
+    pub size: Axis,
     /// Level sizes, coarse → fine.
     pub x: Vec<f64>,
     /// Estimated error per level (empty when refused).
@@ -144,14 +148,14 @@ pub fn pilot_scene(scene: &Scene, q: &Quantity) -> Result<Scene> {
         match name.as_str() {
             "max_slip" => o.max_slip = true,
             "stick_length" => o.stick_length = true,
-            "energy" => o.energy = true,
+            "elastic_energy" => o.elastic_energy = true,
             _ => {}
         }
         if !crate::study::outputs::names(&o).contains(name) {
             return Err(Error::scene(
                 &scene.file,
                 "--quantity",
-                format!("`{name}` is not an output of this scene (energy, elastic-energy, max-slip, stick-length, or a traction_x_y of [outputs])"),
+                format!("`{name}` is not an output of this scene (energy-norm, elastic-energy, max-slip, stick-length, or a traction_x_y of [quantities])"),
             ));
         }
         s.outputs = Some(o);

@@ -9,22 +9,22 @@ use super::{
 };
 use crate::error::Result;
 use crate::scene::budget::{available_memory, Estimate};
-use crate::scene::Scene;
+use crate::scene::{Method, Scene};
 use crate::study::Study;
 
+/// What the pilot runs gave: the space and time sequences, the time sequence's fit and grid ratio, and
+/// the wall time they took.
+pub(super) struct Pilots<'a> {
+    pub(super) space: &'a Study,
+    pub(super) time: &'a Study,
+    pub(super) time_fit: &'a Fit,
+    pub(super) time_ratio: usize,
+    pub(super) wall: f64,
+}
+
 /// Fit the models to the pilots and search (module doc).
-#[allow(clippy::too_many_arguments)]
-pub(super) fn decide(
-    s: &Scene,
-    options: &Options,
-    space: &Study,
-    time: &Study,
-    time_fit: &Fit,
-    time_ratio: usize,
-    pilot_wall: f64,
-    mut notes: Vec<String>,
-) -> Result<Plan> {
-    let target = options.target;
+pub(super) fn decide(s: &Scene, options: &Options, pilots: &Pilots, mut notes: Vec<String>) -> Result<Plan> {
+    let Pilots { space, time, time_fit, time_ratio, wall } = *pilots;
     let space_fit = fit(space, &options.quantity)?;
     let cost = CostModel::fit(&space_samples(&space.levels), &samples(&time.levels));
     let mut plan = Plan {
@@ -37,10 +37,10 @@ pub(super) fn decide(
         scene_steps: s.times.len() - 1,
         error: None,
         cost,
-        pilot_wall,
+        pilot_wall: wall,
         best: vec![],
         over_budget: None,
-        solver: "ssn",
+        solver: Method::Ssn,
         tol: 1e-12,
         notes: vec![],
         refused: None,
@@ -50,55 +50,12 @@ pub(super) fn decide(
         plan.notes = notes;
         return Ok(plan);
     }
-    let n0 = s.times.len() - 1;
-    let nt = time.levels[0].steps;
-    let t_total = s.times[n0] - s.times[0];
-    let law = match (time_fit.not_in_range(), time_fit.x.last(), time_fit.errors.last()) {
-        (None, Some(&x), Some(&e)) => Some(TimeError::Law(PowerLaw::through(x, e, time_fit.p))),
-        _ => None,
-    };
-    let time_law = match law {
-        Some(law) => {
-            if time_ratio == 4 {
-                notes.push(format!(
-                    "on time grids doubling from {nt} steps the observed orders were irregular (a slip that stops inside a \
-                     step: the error depends on where in the step it stops); on grids ×4 they are regular, so only \
-                     N = {nt}·4^j is offered"
-                ));
-            }
-            law
-        }
-        None => {
-            let steps: Vec<usize> = time.levels.iter().map(|l| l.steps).collect();
-            let bound = time_fit.time_bound(&steps, n0, time_ratio);
-            let b = bound.at(0.0);
-            if b > target {
-                plan.refused = Some(format!(
-                    "the time pilot (steps {}) is not in the asymptotic range ({}) and its distances only bound the time \
-                     error by {b:.3e}, above the target",
-                    steps_list(time),
-                    time_fit.not_in_range().unwrap_or_default()
-                ));
-                plan.notes = notes;
-                return Ok(plan);
-            }
-            notes.push(if b <= NEGLIGIBLE_SHARE * target {
-                format!(
-                    "the time step does not change the answer: the time levels {} bound the time error by {b:.2e} (≤ {} % \
-                     of the target); backward Euler is exact at the nodes for these data (a proportional load, or points \
-                     that only pass from stick to slip), so the scene's {n0} steps suffice and more steps only add output times",
-                    steps_list(time),
-                    100.0 * NEGLIGIBLE_SHARE
-                )
-            } else {
-                format!(
-                    "the time pilot (steps {}) shows no regular order ({}); its distances bound the time error by {b:.2e} \
-                     for any N ≥ {n0} (see plan::model::TimeError), which the plan uses",
-                    steps_list(time),
-                    time_fit.not_in_range().unwrap_or_default()
-                )
-            });
-            bound
+    let time_law = match time_error(s, options.target, pilots, &mut notes) {
+        Ok(law) => law,
+        Err(why) => {
+            plan.refused = Some(why);
+            plan.notes = notes;
+            return Ok(plan);
         }
     };
     let (hx, he) = (*space_fit.x.last().expect("levels"), *space_fit.errors.last().expect("levels"));
@@ -112,9 +69,69 @@ pub(super) fn decide(
         plan.refused = Some("no pilot run to fit the cost model to".into());
         return Ok(plan);
     };
-    let finest = space.levels.last().expect("levels");
-    let memory_limit = options.max_memory.or_else(available_memory);
-    let ratio = if matches!(error.time, TimeError::Law(_)) { time_ratio } else { 1 };
+    let all = candidates(s, options.target, pilots, &error, &cost)?;
+    choose(&mut plan, all, notes);
+    Ok(plan)
+}
+
+/// The time part of the error model: the time pilot's law when it is in the asymptotic range, else the
+/// bound from its distances (noted), or why neither serves (the bound is above `target`).
+fn time_error(
+    s: &Scene,
+    target: f64,
+    pilots: &Pilots,
+    notes: &mut Vec<String>,
+) -> std::result::Result<TimeError, String> {
+    let Pilots { time, time_fit, time_ratio, .. } = *pilots;
+    let n0 = s.times.len() - 1;
+    let nt = time.levels[0].steps;
+    if let (None, Some(&x), Some(&e)) = (time_fit.not_in_range(), time_fit.x.last(), time_fit.errors.last()) {
+        if time_ratio == 4 {
+            notes.push(format!(
+                "on time grids doubling from {nt} steps the observed orders were irregular (a slip that stops inside a \
+                 step: the error depends on where in the step it stops); on grids ×4 they are regular, so only \
+                 N = {nt}·4^j is offered"
+            ));
+        }
+        return Ok(TimeError::Law(PowerLaw::through(x, e, time_fit.p)));
+    }
+    let steps: Vec<usize> = time.levels.iter().map(|l| l.steps).collect();
+    let bound = time_fit.time_bound(&steps, n0, time_ratio);
+    let b = bound.at(0.0);
+    if b > target {
+        return Err(format!(
+            "the time pilot (steps {}) is not in the asymptotic range ({}) and its distances only bound the time \
+             error by {b:.3e}, above the target",
+            steps_list(time),
+            time_fit.not_in_range().unwrap_or_default()
+        ));
+    }
+    notes.push(if b <= NEGLIGIBLE_SHARE * target {
+        format!(
+            "the time step does not change the answer: the time levels {} bound the time error by {b:.2e} (≤ {} % \
+             of the target); backward Euler is exact at the nodes for these data (a proportional load, or points \
+             that only pass from stick to slip), so the scene's {n0} steps suffice and more steps only add output times",
+            steps_list(time),
+            100.0 * NEGLIGIBLE_SHARE
+        )
+    } else {
+        format!(
+            "the time pilot (steps {}) shows no regular order ({}); its distances bound the time error by {b:.2e} \
+             for any N ≥ {n0} (see plan::model::TimeError), which the plan uses",
+            steps_list(time),
+            time_fit.not_in_range().unwrap_or_default()
+        )
+    });
+    Ok(bound)
+}
+
+/// Per mesh from the scene's up to [`MAX_REFINE`], the fewest steps on the time law's grids predicted to
+/// meet `target`, with its predicted cost and memory.
+fn candidates(s: &Scene, target: f64, pilots: &Pilots, error: &ErrorModel, cost: &CostModel) -> Result<Vec<Candidate>> {
+    let (finest, time) = (pilots.space.levels.last().expect("levels"), pilots.time);
+    let n0 = s.times.len() - 1;
+    let t_total = s.times[n0] - s.times[0];
+    let ratio = if matches!(error.time, TimeError::Law(_)) { pilots.time_ratio } else { 1 };
     let mut all = Vec::new();
     for r in s.mesh_level()..=MAX_REFINE {
         let h = finest.h * 0.5f64.powi(r as i32 - finest.refine as i32);
@@ -153,6 +170,15 @@ pub(super) fn decide(
             n *= ratio;
         }
     }
+    Ok(all)
+}
+
+/// The plan and two runners-up among `all` within the budget and memory, cheapest first, with the
+/// solver tolerance for the plan; or the refusal naming the cheapest configuration beyond them.
+fn choose(plan: &mut Plan, all: Vec<Candidate>, mut notes: Vec<String>) {
+    let options = &plan.options;
+    let finest = plan.space.levels.last().expect("levels");
+    let memory_limit = options.max_memory.or_else(available_memory);
     let fits = |c: &Candidate| memory_limit.is_none_or(|m| c.memory <= m);
     let mut ok: Vec<Candidate> = all.iter().filter(|c| fits(c) && c.wall <= options.budget).cloned().collect();
     ok.sort_by(|a, b| a.wall.total_cmp(&b.wall));
@@ -161,8 +187,8 @@ pub(super) fn decide(
         let cheapest = |f: &dyn Fn(&Candidate) -> bool| {
             all.iter().filter(|c| f(c)).min_by(|a, b| a.wall.total_cmp(&b.wall)).cloned()
         };
-        plan.over_budget = cheapest(&|c| fits(c)).or_else(|| cheapest(&|_| true));
-        plan.refused = Some(match &plan.over_budget {
+        let over_budget = cheapest(&|c| fits(c)).or_else(|| cheapest(&|_| true));
+        plan.refused = Some(match &over_budget {
             Some(c) => format!(
                 "the target is out of reach within the budget of {:.0} s and {} of memory: the cheapest configuration \
                  predicted to meet it (refine {}, {} steps, {} unknowns) would take {:.3e} s and {:.1} GB",
@@ -178,6 +204,7 @@ pub(super) fn decide(
                 "the target is out of reach: no configuration up to refine {MAX_REFINE} and {MAX_STEPS} steps is predicted to meet it"
             ),
         });
+        plan.over_budget = over_budget;
     } else {
         let b = &ok[0];
         if b.refine > finest.refine + MAX_EXTRAPOLATION {
@@ -191,16 +218,16 @@ pub(super) fn decide(
         let scale = match &options.quantity {
             Quantity::Energy => finest.norm_max,
             Quantity::Output(name) => {
-                let i = space.output_names.iter().position(|n| n == name).unwrap_or(0);
+                let i = plan.space.output_names.iter().position(|n| n == name).unwrap_or(0);
                 finest.outputs.get(i).map_or(0.0, |v| v.abs())
             }
         };
+        let target = options.target;
         plan.tol =
             if scale > 0.0 { 10f64.powf((0.01 * target / scale).log10().floor()).clamp(1e-12, 1e-6) } else { 1e-12 };
     }
     plan.best = ok;
     plan.notes = notes;
-    Ok(plan)
 }
 
 fn steps_list(study: &Study) -> String {

@@ -23,7 +23,23 @@ pub(super) struct RawScene {
     /// scene text stored in the results file).
     #[allow(dead_code)]
     pub(super) units: Option<RawUnits>,
-    pub(super) outputs: Option<super::Outputs>,
+    pub(super) quantities: Option<RawQuantities>,
+    /// The deprecated name of `[quantities]`.
+    pub(super) outputs: Option<RawQuantities>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawQuantities {
+    #[serde(default)]
+    pub(super) max_slip: bool,
+    #[serde(default)]
+    pub(super) stick_length: bool,
+    pub(super) elastic_energy: Option<bool>,
+    /// The deprecated name of `elastic_energy`.
+    pub(super) energy: Option<bool>,
+    #[serde(default)]
+    pub(super) traction_at: Vec<[f64; 2]>,
 }
 
 #[derive(Deserialize)]

@@ -79,7 +79,7 @@ fn lanczos_max(n: usize, iters: usize, mut apply: impl FnMut(&[f64], &mut [f64])
         top = top.max(q);
         let b = dot(&w, &w).sqrt();
         // an invariant subspace: the Ritz values are eigenvalues
-        if settled || !(b > 1e-12 * q) {
+        if settled || b.partial_cmp(&(1e-12 * q)) != Some(std::cmp::Ordering::Greater) {
             break;
         }
         beta.push(b);

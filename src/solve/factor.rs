@@ -324,7 +324,7 @@ mod tests {
         let b: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
         let cols = 16;
         let mut y: Vec<f64> =
-            (0..n * cols).map(|i| if (i / n) % 2 == 0 { b[i % n] } else { ((i * 13) % 7) as f64 }).collect();
+            (0..n * cols).map(|i| if (i / n).is_multiple_of(2) { b[i % n] } else { ((i * 13) % 7) as f64 }).collect();
         f.forward_block(&mut y, cols).unwrap();
         f.backward_block(&mut y, cols).unwrap();
         let bits = |c: usize| y[c * n..(c + 1) * n].iter().map(|v| v.to_bits()).collect::<Vec<_>>();

@@ -1,10 +1,8 @@
 //! Fill-reducing ordering P: nested dissection (METIS_NodeND) for K of [`ND_MIN_SIZE`] unknowns or
 //! more, AMD (faer's) below. Why: the factorisation is flop-bound, and on a 2D mesh nested dissection
 //! gives the asymptotically optimal fill, O(n log n) entries and O(n^1.5) flops, with a smaller constant
-//! than AMD: on the 1.57M-unknown benchmark nnz(L) drops from 613M to 462M and the flops from 1.14e12 to
-//! about 5e11, so the numeric phase halves (≈ 60 s → 29 s). But METIS itself takes ≈ 11 s there and
-//! ≈ 2.5 s at 394k unknowns, where it loses overall to AMD (the set-up was 40 % slower), hence the size
-//! threshold. Both order the graph of K with the unknowns of one edge (its two displacement components,
+//! than AMD, so the numeric phase of the largest benchmarks halves; but METIS itself is costly and loses
+//! overall to AMD on mid-sized meshes, hence the size threshold (figures in CHANGELOG.md). Both order the graph of K with the unknowns of one edge (its two displacement components,
 //! numbered consecutively by the space) merged into one (weighted) vertex: this halves the graph and
 //! quarters its edges, so METIS and AMD run 2–3× faster, with the same fill as ordering the full graph
 //! (both components of an edge have the same neighbours). The groups are given by the caller; the
@@ -22,10 +20,10 @@ use std::sync::Mutex;
 
 /// faer's approximate minimum degree ordering of K (position → unknown), computed on the graph with the
 /// groups merged ([`Graph`]; with the two components of an edge as a group): half the vertices and a quarter of the edges of
-/// K's graph, so AMD runs about 3× faster (22 → 7 ms at 24,640 unknowns) for the same fill within a few
+/// K's graph, so AMD runs about 3× faster for the same fill within a few
 /// percent (AMD merges indistinguishable vertices itself, but only after reading the whole graph).
 pub(super) fn amd_order(q: &Graph, control: amd::Control) -> Result<Vec<usize>> {
-    let ng = q.len();
+    let ng = q.n_vertices();
     let (mut fwd, mut inv) = (vec![0usize; ng], vec![0usize; ng]);
     let graph = SymbolicSparseColMatRef::new_checked(ng, ng, &q.start, None, &q.adj);
     let mut buf = MemBuffer::try_new(amd::order_scratch::<usize>(ng, q.adj.len()))
@@ -132,18 +130,18 @@ impl Graph {
     }
 
     /// Number of vertices.
-    pub fn len(&self) -> usize {
+    pub fn n_vertices(&self) -> usize {
         self.first.len() - 1
     }
 
-    /// The unknowns of the vertices in the order `order` (position → vertex).
     /// Unknowns in all.
     pub fn unknowns(&self) -> usize {
-        self.first[self.len()]
+        self.first[self.n_vertices()]
     }
 
+    /// The unknowns of the vertices in the order `order` (position → vertex).
     fn expand(&self, order: impl Iterator<Item = usize>) -> Vec<usize> {
-        let mut fwd = Vec::with_capacity(self.first[self.len()]);
+        let mut fwd = Vec::with_capacity(self.first[self.n_vertices()]);
         for g in order {
             fwd.extend(self.first[g]..self.first[g + 1]);
         }
@@ -155,7 +153,7 @@ impl Graph {
 /// METIS cannot be used: the caller then falls back to AMD.
 pub(super) fn nested_dissection(q: &Graph) -> Option<(Vec<usize>, Vec<usize>)> {
     let n = q.unknowns();
-    let ng = q.len();
+    let ng = q.n_vertices();
     let mut xadj: Vec<i32> = q.start.iter().map(|&v| i32::try_from(v).ok()).collect::<Option<_>>()?;
     let mut adjncy: Vec<i32> = q.adj.iter().map(|&v| i32::try_from(v).ok()).collect::<Option<_>>()?;
     if adjncy.is_empty() {

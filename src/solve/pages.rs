@@ -12,14 +12,12 @@
 //!
 //! Buffers of [`HUGE_MIN`] to [`HUGE_MAX`] bytes are placed on 2 MiB boundaries and marked for
 //! transparent huge pages (`madvise(MADV_HUGEPAGE)`), where the kernel offers them (`enabled` = `always`
-//! or `madvise`): a 29 MB factor then takes 15 faults of 2 MiB instead of 7,300 of 4 KiB (mms_stop at
-//! refine 4: 23.3k → 16.1k page faults in all, 14 ms less CPU). The kernel still zero-fills each page, so
-//! the contents are the same; where it has no free huge page it falls back to 4 KiB pages. Measured on
-//! the project's 2-core VMs (interleaved, medians): mms_stop r4 written −5 ms, Example 5.1 n = 64 −13 ms,
-//! mms_stop r5/64 written (a 163 MB factor) −67 ms; but the 347 MB factor of the 196,608-unknown
-//! benchmark took 0.29 s longer (0.58 → 0.87 s, the system time doubled, nearly all of it zeroing the
-//! huge pages: these VMs hand freed memory back to the host, free page reporting, and large runs of huge
-//! pages then come from memory the host must provide anew), hence the upper bound. Only this one large
+//! or `madvise`): a 29 MB factor then takes 15 faults of 2 MiB instead of 7,300 of 4 KiB. The kernel
+//! still zero-fills each page, so the contents are the same; where it has no free huge page it falls
+//! back to 4 KiB pages. Above [`HUGE_MAX`] huge pages made the factor slower on the project's VMs (the
+//! system time doubled, nearly all of it zeroing the huge pages: these VMs hand freed memory back to the
+//! host, free page reporting, and large runs of huge pages then come from memory the host must provide
+//! anew), hence the upper bound (figures in CHANGELOG.md). Only this one large
 //! buffer, filled once and read to the end of the run, is marked: huge pages for the whole heap (glibc's
 //! `hugetlb` tunable, mimalloc, jemalloc) made small runs slower at times and tripled the system time of
 //! the 196,608-unknown run.

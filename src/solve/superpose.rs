@@ -128,7 +128,7 @@ impl LoadBasis {
     ///
     /// When the loads of the nodes are refused, `assembled` receives those assembled on the way (at most
     /// [`MAX_RANK`] + 1, node and load on the support), for the steps at those nodes to use instead of
-    /// assembling them again (mms_front at refine 4: 2.9 ms a load); otherwise it is left empty.
+    /// assembling them again; otherwise it is left empty.
     pub fn build(
         loads: &Loads,
         times: &[f64],
@@ -158,8 +158,7 @@ impl LoadBasis {
 
     /// When every load term is separated (l(t) = Σ_j τ_j(t) P_j, `fem::loads`), the patterns P_j are
     /// orthonormalised instead of the loads of the nodes, P_j = Σ_i R_ji b_i, and cₙ = Σ_j τ_j(tₙ) R_j:
-    /// no load is formed at a node (at refine 5, mms_stop's 65 loads of 98,432 unknowns were 40 ms of
-    /// Gram–Schmidt). `None` (the nodes' route decides) when there are no patterns or more than
+    /// no load is formed at a node. `None` (the nodes' route decides) when there are no patterns or more than
     /// [`MAX_RANK`] independent ones (the loads at the nodes may still span fewer).
     fn from_patterns(loads: &Loads, times: &[f64], factor: &Factor) -> Result<Option<LoadBasis>> {
         let Some(patterns) = loads.separated().filter(|p| !p.is_empty()) else {

@@ -1,7 +1,7 @@
 //! Backward Euler in time: set-up once (mesh, space, K assembled and factored once, loads, the
 //! condensed friction operator), then for n = 1..N
 //!   uⁿ = argmin ½a_h(v,v) − (lⁿ,v) + j_h(v − uⁿ⁻¹),   u⁰ = I_CR u₀,
-//! in two calls, as the README describes a step: the free response u_f = K⁻¹lⁿ with its contact trace
+//! in two calls, as docs/model.md describes a step: the free response u_f = K⁻¹lⁿ with its contact trace
 //! s_f (`solve::free`), then the friction problem on Γ_C for d = s_f − sⁿ⁻¹ (`friction`), and
 //! uⁿ = u_f − K⁻¹Eμ. Without Γ_C a step is the free response alone. Each completed step is handed to a
 //! callback (the writer), so nothing is lost if a later step fails.
@@ -32,7 +32,8 @@ mod run;
 mod setup;
 
 pub use conditioning::MAX_CONDITION;
-pub use setup::Problem0;
+pub use run::RunOptions;
+pub use setup::Discretised;
 
 /// Everything assembled once per run.
 pub struct Problem {
@@ -117,7 +118,7 @@ impl Problem {
 
     /// As [`Problem::new`] on a given mesh (the scene's `[mesh]` table is ignored).
     pub fn with_mesh(scene: Scene, mesh: Mesh) -> Result<Problem> {
-        Problem::with_mesh_beside(scene, mesh, None::<fn(&Problem0)>).map(|(p, _)| p).map_err(|(e, _)| e)
+        Problem::with_mesh_beside(scene, mesh, None::<fn(&Discretised)>).map(|(p, _)| p).map_err(|(e, _)| e)
     }
 
     /// Number of time steps N.

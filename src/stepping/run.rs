@@ -6,8 +6,8 @@ use super::*;
 
 /// Steps whose true errors are evaluated together (`Problem::finish_block`): the exact solution's
 /// spatial values bound to a chunk of elements are then read from memory once for this many time nodes.
-/// Few enough that the writer thread gets the first steps of a block early (with all 16 steps of a
-/// block at once, mms_stop r4 written took 6 ms longer: the writing no longer overlapped the errors).
+/// Few enough that the writer thread gets the first steps of a block early (with all the steps of a
+/// block at once the writing no longer overlapped the errors).
 const ERROR_BATCH: usize = 4;
 
 /// Bytes of step results held back while K's condition estimate is under way (see [`Held`]); beyond
@@ -18,8 +18,8 @@ const HOLD_BYTES: usize = 4 << 20;
 
 /// The results not handed out yet because K's condition estimate (`conditioning`) is still under way:
 /// step 0, then the steps in order. The steps go on meanwhile; the first step handed out after the
-/// verdict hands these out first. (Waiting for the verdict at the first step instead held Example 5.1
-/// n = 64 for 20 ms after its first block of steps: the estimate's solves end 26 ms after the factor.)
+/// verdict hands these out first. (Waiting for the verdict at the first step instead held the steps
+/// back: the estimate's solves end well after the factor.)
 struct Held {
     first: Option<StepResult>,
     steps: Vec<StepResult>,
@@ -148,26 +148,22 @@ impl Problem {
         Ok(prev)
     }
 
-    /// Run steps from `from` to N, forming u only at the steps `want` selects (see [`Problem::step`]).
-    pub fn run_selected(
+    /// The one way to run the steps: from step 0 (handed out with the first step: both are computed while
+    /// K's condition estimate may still be under way) or after a given step, to N, handing every result to
+    /// `on_step` in order and forming u only at the steps `options.want` selects (see [`Problem::step`]).
+    pub fn run(
         &self,
-        from: StepResult,
-        want: impl Fn(usize) -> bool,
+        options: RunOptions<impl Fn(usize) -> bool>,
         on_step: impl FnMut(&StepResult) -> Result<()>,
     ) -> Result<()> {
-        self.run_handing(from, None, want, on_step)
-    }
-
-    /// Step 0 and all steps, handing every result to `on_step` (step 0 included), forming u only at
-    /// the steps `want` selects. Step 0 is handed out with the first step: both are computed while K's
-    /// condition estimate may still be under way.
-    pub fn run_all_selected(
-        &self,
-        want: impl Fn(usize) -> bool,
-        on_step: impl FnMut(&StepResult) -> Result<()>,
-    ) -> Result<()> {
-        let first = self.initial_unchecked().map_err(|e| self.prefer_conditioning(e))?;
-        self.run_handing(first.clone(), Some(first), want, on_step)
+        let RunOptions { after, want } = options;
+        match after {
+            Some(from) => self.run_handing(from, None, want, on_step),
+            None => {
+                let first = self.initial_unchecked().map_err(|e| self.prefer_conditioning(e))?;
+                self.run_handing(first.clone(), Some(first), want, on_step)
+            }
+        }
     }
 
     /// Run steps from `from` to N; `first`, if given, is handed out before them. Every result is handed
@@ -214,14 +210,25 @@ impl Problem {
         }
         result.map_err(|e| self.prefer_conditioning(e))
     }
+}
 
-    /// Run steps from `from` (whose result is given) to N, handing every result to `on_step`.
-    pub fn run_from(&self, from: StepResult, on_step: impl FnMut(&StepResult) -> Result<()>) -> Result<()> {
-        self.run_selected(from, |_| true, on_step)
+/// Where [`Problem::run`] starts and at which steps it forms u.
+pub struct RunOptions<W> {
+    /// `None`: from step 0 (handed out too); `Some(r)`: the steps after `r` (a resumed run, a study's
+    /// levels after their step 0).
+    pub after: Option<StepResult>,
+    /// The steps at which u is formed (the others carry slip, μ and stick/slip only).
+    pub want: W,
+}
+
+impl RunOptions<fn(usize) -> bool> {
+    /// Every step from step 0, u formed at each.
+    pub fn all() -> Self {
+        RunOptions { after: None, want: |_| true }
     }
 
-    /// Run all steps, including step 0, handing every result to `on_step`.
-    pub fn run(&self, on_step: impl FnMut(&StepResult) -> Result<()>) -> Result<()> {
-        self.run_all_selected(|_| true, on_step)
+    /// The steps after `r`, u formed at each.
+    pub fn after(r: StepResult) -> Self {
+        RunOptions { after: Some(r), want: |_| true }
     }
 }

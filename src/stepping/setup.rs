@@ -5,6 +5,9 @@
 use super::*;
 use faer::sparse::SymbolicSparseColMat;
 
+/// The problem, or the set-up's error, each with the result of the work run beside the set-up.
+type WithBeside<R> = std::result::Result<(Problem, Option<R>), (Error, Option<R>)>;
+
 impl Problem {
     /// As [`Problem::new`], running `beside` on a thread of its own while the rest of the set-up
     /// (assembly, factorisation, condensation) runs: the results file is created there. `beside` sees
@@ -12,7 +15,7 @@ impl Problem {
     /// after it (a writer then closes its file as it would have).
     pub fn new_beside<R: Send>(
         scene: Scene,
-        beside: impl FnOnce(&Problem0) -> R + Send,
+        beside: impl FnOnce(&Discretised) -> R + Send,
     ) -> (Result<Problem>, Option<R>) {
         match Mesh::from_spec(&scene.mesh) {
             Ok(mesh) => match Problem::with_mesh_beside(scene, mesh, Some(beside)) {
@@ -24,32 +27,31 @@ impl Problem {
     }
 
     /// [`Problem::with_mesh`] with [`Problem::new_beside`]'s second thread.
-    #[allow(clippy::type_complexity)]
     pub(super) fn with_mesh_beside<R: Send>(
         scene: Scene,
         mesh: Mesh,
-        beside: Option<impl FnOnce(&Problem0) -> R + Send>,
-    ) -> std::result::Result<(Problem, Option<R>), (Error, Option<R>)> {
+        beside: Option<impl FnOnce(&Discretised) -> R + Send>,
+    ) -> WithBeside<R> {
         let t0 = Instant::now();
         let space = CrSpace::new(&mesh, &scene.parts).map_err(|e| (e, None))?;
         let t1 = Instant::now();
         let law = Elasticity::new(&scene.material);
-        let p0 = Problem0 { scene, mesh, space, law };
+        let p0 = Discretised { scene, mesh, space, law };
         let (rest, r) = p0.set_up(beside);
-        let Problem0 { scene, mesh, space, law } = p0;
+        let Discretised { scene, mesh, space, law } = p0;
         let rest = match rest {
             Ok(rest) => rest,
             Err(e) => return Err((e, r)),
         };
-        let SetUp { stiffness, free, friction, errors, conditioning, step0, t2, t3, t4, t5 } = rest;
+        let Operators { stiffness, free, friction, errors, conditioning, step0, ends } = rest;
         let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
         let p = Problem {
             setup: SetupTimes {
                 space: d(t0, t1),
-                assembly: d(t1, t2),
-                factorisation: d(t2, t3),
-                superposition: d(t3, t4),
-                condensation: d(t4, t5),
+                assembly: d(t1, ends.assembly),
+                factorisation: d(ends.assembly, ends.factorisation),
+                superposition: d(ends.factorisation, ends.superposition),
+                condensation: d(ends.superposition, ends.condensation),
             },
             scene,
             mesh,
@@ -66,35 +68,39 @@ impl Problem {
     }
 }
 
-/// What the set-up starts from: the scene, its mesh and space, and the law.
-pub struct Problem0 {
+/// A discretised problem, what the set-up starts from: the scene, its mesh and CR space, and the law.
+pub struct Discretised {
     pub scene: Scene,
     pub mesh: Mesh,
     pub space: CrSpace,
     pub law: Elasticity,
 }
 
-/// The rest of the set-up, with the instants its phases ended at.
-struct SetUp {
+/// The instants the set-up's phases ended at (the space's end and these give [`SetupTimes`]).
+struct PhaseEnds {
+    assembly: Instant,
+    factorisation: Instant,
+    superposition: Instant,
+    condensation: Instant,
+}
+
+/// The operators the set-up builds from a [`Discretised`] problem, with the instants its phases ended at.
+struct Operators {
     stiffness: SparseColMat<usize, f64>,
     free: FreeResponse,
     friction: Option<Friction>,
     errors: Option<ErrorEvaluator>,
     conditioning: Pending,
     step0: Option<StepResult>,
-    t2: Instant,
-    t3: Instant,
-    t4: Instant,
-    t5: Instant,
+    ends: PhaseEnds,
 }
 
-impl Problem0 {
+impl Discretised {
     /// Assembly, factorisation, superposition and condensation, in three phases:
     /// 1. K's pattern, values and the loads; beside them the ordering (from the graph of the edges, begun
     ///    before K's pattern is made) and the symbolic factorisation (it needs only K's pattern, which is
-    ///    the mesh's; with the loads on a third thread, the results file's
-    ///    creation, beside from the start, got less of the two cores: Example 5.1 n = 32 written
-    ///    65.5 → 63.4 ms, mms_stop r4 written 136.7 → 134.4 ms, interleaved);
+    ///    the mesh's; the loads stay on the main thread, so the results file's creation, beside from the
+    ///    start, keeps its share of the two cores);
     /// 2. the numeric factorisation; beside it the factor's pages are mapped, then λ_max(K) of the
     ///    condition estimate is computed, the exact solution bound to the error quadrature and step 0
     ///    (u⁰ = I_CR u₀ with its true errors) computed;
@@ -103,7 +109,7 @@ impl Problem0 {
     ///
     /// `beside` runs on a thread of its own from the start (on small meshes it is the longest part, for
     /// example creating the results file); its result is returned even when the set-up fails.
-    fn set_up<R: Send>(&self, beside: Option<impl FnOnce(&Problem0) -> R + Send>) -> (Result<SetUp>, Option<R>) {
+    fn set_up<R: Send>(&self, beside: Option<impl FnOnce(&Discretised) -> R + Send>) -> (Result<Operators>, Option<R>) {
         std::thread::scope(|s| {
             let r = beside.map(|f| s.spawn(|| f(self)));
             let rest = self.assemble().and_then(|(k, loads, symbolic)| self.factorise(k, loads, symbolic));
@@ -119,7 +125,7 @@ impl Problem0 {
         let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
         // The ordering needs only the graph of the edges, so the second thread starts on it before K's
         // pattern (of the unknowns) is made, which it needs only for the symbolic factorisation: that
-        // thread ends phase 1 (at refine 5 of mms_stop its 52 ms of work against the main thread's 43).
+        // thread is the longer one and ends phase 1.
         let (tx, rx) = std::sync::mpsc::sync_channel::<Arc<SymbolicSparseColMat<usize>>>(1);
         let (val, loads, symbolic, k_pattern) = std::thread::scope(|s| {
             let (pattern, contact) = (&pattern, &contact);
@@ -148,7 +154,7 @@ impl Problem0 {
     }
 
     /// Phases 2 and 3: the factor, the superposition, the condensation, the condition estimate under way.
-    fn factorise(&self, stiffness: SparseColMat<usize, f64>, loads: Loads, symbolic: Symbolic) -> Result<SetUp> {
+    fn factorise(&self, stiffness: SparseColMat<usize, f64>, loads: Loads, symbolic: Symbolic) -> Result<Operators> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         let t2 = Instant::now();
         let (factor, aside) = Factor::numeric_beside(symbolic, &stiffness, || {
@@ -173,6 +179,7 @@ impl Problem0 {
         let t5 = Instant::now();
         let (free, c) = FreeResponse::new(factor, loads, basis, assembled, condensation, space);
         let friction = c.map(|c| Friction::new(space, c, scene.solver));
-        Ok(SetUp { stiffness, free, friction, errors, conditioning, step0, t2, t3, t4, t5 })
+        let ends = PhaseEnds { assembly: t2, factorisation: t3, superposition: t4, condensation: t5 };
+        Ok(Operators { stiffness, free, friction, errors, conditioning, step0, ends })
     }
 }

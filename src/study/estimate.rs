@@ -12,7 +12,7 @@
 //! more). The theoretical order is 1 in h (H² solutions) and 1 in k (backward Euler).
 
 use super::richardson::{asymptotic, NormModel, Verdict, FS_THREE};
-use super::LevelResult;
+use super::{Axis, LevelResult};
 
 /// The order the paper proves in h and in k.
 pub const THEORETICAL_ORDER: f64 = 1.0;
@@ -30,8 +30,8 @@ pub struct LevelEstimate {
 /// The estimates of a study, or why there are none.
 #[derive(Clone, Debug)]
 pub struct Estimates {
-    /// "h" or "k".
-    pub size: &'static str,
+    /// The axis the levels refine.
+    pub size: Axis,
     pub model: Option<NormModel>,
     /// Per level (empty when no model).
     pub levels: Vec<LevelEstimate>,
@@ -45,11 +45,11 @@ pub fn one_mesh(r: &[LevelResult]) -> bool {
 }
 
 /// The sizes x of the levels (h, or k on one mesh).
-pub fn sizes(r: &[LevelResult]) -> (&'static str, Vec<f64>) {
+pub fn sizes(r: &[LevelResult]) -> (Axis, Vec<f64>) {
     if one_mesh(r) {
-        ("k", r.iter().map(|l| l.k).collect())
+        (Axis::K, r.iter().map(|l| l.k).collect())
     } else {
-        ("h", r.iter().map(|l| l.h).collect())
+        (Axis::H, r.iter().map(|l| l.h).collect())
     }
 }
 

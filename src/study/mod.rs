@@ -21,10 +21,20 @@ pub mod richardson;
 use crate::error::{Error, Result};
 use crate::fem::norms::ErrorNorms;
 use crate::scene::Scene;
-use crate::stepping::{Problem, StepResult};
+use crate::stepping::{Problem, RunOptions, StepResult};
 use measure::{max_last, Kept};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+crate::named_enum! {
+    /// The axis a sequence of levels refines: the mesh size h, or the time step k on one mesh.
+    pub enum Axis {
+        /// The mesh size (the levels' meshes differ).
+        H = "h",
+        /// The time step (all levels on one mesh).
+        K = "k",
+    }
+}
 
 /// A level: uniform refinements and number of uniform time steps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -134,7 +144,7 @@ fn run_level(scene: &Scene, level: Level, common: &[f64], own_nodes: bool, out: 
         Ok(())
     };
     on_step(&first)?;
-    problem.run_selected(first, |n| all || is_common[n], &mut on_step)?;
+    problem.run(RunOptions { after: Some(first), want: |n| all || is_common[n] }, &mut on_step)?;
     if u.len() != common.len() {
         return Err(Error::scene(
             &scene.file,

@@ -1,4 +1,4 @@
-//! Scalar outputs of a level at the final time T (`[outputs]` of the scene), and their Richardson
+//! Scalar outputs of a level at the final time T (`[quantities]` of the scene), and their Richardson
 //! estimates. Each output Q is a number per level; [`super::richardson::ScalarModel`] extrapolates the three
 //! finest levels to Q* = Q₃ + (Q₃ − Q₂)/(r₃₂ᵖ − 1), the estimated error of level l is |Q_l − Q*| and its
 //! GCI F_s |Q_l − Q*| (F_s = 1.25; 3 with two levels, where p is taken as the theoretical order).
@@ -7,10 +7,11 @@
 //! |---|---|
 //! | `max_slip` | max over Γ_C edges of |u_τ(m_e)| |
 //! | `stick_length` | Σ |e| over the Γ_C edges sticking in the last step |
-//! | `energy` | ½ a_h(u, u) |
+//! | `elastic_energy` | ½ a_h(u, u) |
 //! | `traction_<x>_<y>` | σ_τ·τ = −μ_e/|e| on the Γ_C edge nearest to (x, y) |
 
 use super::richardson::{asymptotic, ScalarModel, Verdict, FS_THREE, FS_TWO};
+use super::Axis;
 use crate::friction::EdgeState;
 use crate::scene::{Outputs, Scene};
 use crate::stepping::{Problem, StepResult};
@@ -20,18 +21,18 @@ pub fn selected(scene: &Scene) -> Outputs {
     scene.outputs.clone().unwrap_or(Outputs {
         max_slip: scene.has_contact(),
         stick_length: scene.has_contact(),
-        energy: true,
+        elastic_energy: true,
         traction_at: vec![],
     })
 }
 
-/// The theoretical order of an output in `size` ("h" or "k"): 2 for the energy in h (½a_h(u_h,u_h) −
+/// The theoretical order of an output along `size`: 2 for the elastic energy in h (½a_h(u_h,u_h) −
 /// ½a(u,u) is quadratic in the O(h) energy error, by Galerkin orthogonality up to the nonconformity),
 /// 1 for the energy in k (no orthogonality in time: linear in backward Euler's O(k) error) and 1 for the
 /// others (values and tractions of CR fields on Γ_C, and the position of the stick–slip front, are O(h)
 /// at best).
-pub fn theoretical_order(name: &str, size: &str) -> f64 {
-    if name == "energy" && size == "h" {
+pub fn theoretical_order(name: &str, size: Axis) -> f64 {
+    if name == "elastic_energy" && size == Axis::H {
         2.0
     } else {
         1.0
@@ -41,7 +42,8 @@ pub fn theoretical_order(name: &str, size: &str) -> f64 {
 /// Column names of the outputs, in order.
 pub fn names(o: &Outputs) -> Vec<String> {
     let mut v = Vec::new();
-    for (on, name) in [(o.max_slip, "max_slip"), (o.stick_length, "stick_length"), (o.energy, "energy")] {
+    for (on, name) in [(o.max_slip, "max_slip"), (o.stick_length, "stick_length"), (o.elastic_energy, "elastic_energy")]
+    {
         if on {
             v.push(name.to_string());
         }
@@ -67,7 +69,7 @@ pub fn values(o: &Outputs, p: &Problem, last: &StepResult) -> Vec<f64> {
     if o.stick_length {
         v.push(contact.iter().zip(&last.state).filter(|(_, s)| **s == EdgeState::Stick).map(|(c, _)| c.length).sum());
     }
-    if o.energy {
+    if o.elastic_energy {
         v.push(0.5 * last.energy);
     }
     for &x in &o.traction_at {
@@ -94,7 +96,7 @@ pub struct OutputEstimate {
 }
 
 /// Estimates of every output from sizes x (h or k, named by `size`; coarse → fine) and values q[level][output].
-pub fn estimate(names: &[String], size: &str, x: &[f64], q: &[Vec<f64>]) -> Vec<OutputEstimate> {
+pub fn estimate(names: &[String], size: Axis, x: &[f64], q: &[Vec<f64>]) -> Vec<OutputEstimate> {
     let n = x.len();
     names
         .iter()
@@ -144,13 +146,13 @@ mod tests {
     #[test]
     fn outputs_extrapolate_and_refuse() {
         let x: [f64; 4] = [0.4, 0.2, 0.1, 0.05];
-        let names: Vec<String> = ["max_slip", "energy", "stick_length"].map(String::from).to_vec();
+        let names: Vec<String> = ["max_slip", "elastic_energy", "stick_length"].map(String::from).to_vec();
         let q: Vec<Vec<f64>> = x
             .iter()
             .enumerate()
             .map(|(i, h)| vec![0.05 - 0.02 * h, 1.0 + h.powf(2.5), 0.5 + 0.1 * (-1f64).powi(i as i32) * h])
             .collect();
-        let e = estimate(&names, "h", &x, &q);
+        let e = estimate(&names, Axis::H, &x, &q);
         let m = e[0].model.unwrap();
         assert!((m.limit - 0.05).abs() < 1e-12 && (m.p - 1.0).abs() < 1e-9);
         assert!(e[0].levels.iter().all(|l| l.2 == Verdict::InRange && (l.0 - 0.0).abs() < 0.0081));

@@ -135,7 +135,7 @@ impl ScalarModel {
     /// one sign (monotone convergence) and an order in (0, 8] reproduces them.
     pub fn fit(x: [f64; 3], q: [f64; 3]) -> Option<ScalarModel> {
         let (e21, e32) = (q[1] - q[0], q[2] - q[1]);
-        if !(e21 * e32 > 0.0) {
+        if (e21 * e32).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return None;
         }
         let p = order_three(x, e21.abs(), e32.abs())?;

@@ -13,7 +13,7 @@ pub fn scene(path: &str) -> Scene {
 pub fn run(scene: Scene) -> (Problem, Vec<StepResult>) {
     let p = Problem::new(scene).unwrap();
     let mut out = Vec::new();
-    p.run(|r| {
+    p.run(tresca_cr::RunOptions::all(), |r| {
         out.push(r.clone());
         Ok(())
     })

@@ -17,7 +17,7 @@ from pathlib import Path
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-from tresca_py.external import report, requirements, suite
+from tresca_py.external import report, requirements, suite  # noqa: E402 (after the thread settings above)
 
 ROOT = Path(__file__).resolve().parents[2]
 

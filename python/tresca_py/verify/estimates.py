@@ -78,7 +78,7 @@ def report(hs, results):
              "|---|---|---|---|---|---|---|---|---|---|"]
     bad, in_range_kinds, checked, refusals, cmds = [], set(), [], {}, []
     f = lambda x: "-" if x is None else f"{x:.4e}"  # noqa: E731
-    for name, kind, scene, levels, ref in CASES:
+    for name, kind, _scene, _levels, _ref in CASES:
         rows, cmd = results[name]
         cmds.append(cmd)
         p = "-" if rows[0]["p"] is None else f"{rows[0]['p']:.3f}"

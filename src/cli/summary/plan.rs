@@ -21,7 +21,7 @@ pub struct Pilot {
 impl Pilot {
     fn of(study: &tresca_cr::study::Study, fit: &tresca_cr::plan::pilot::Fit) -> Pilot {
         Pilot {
-            size: fit.size.into(),
+            size: fit.size.to_string(),
             levels: study.levels.iter().map(|r| Level::of(r, None)).collect(),
             x: fit.x.clone(),
             errors: fit.errors.clone(),
@@ -145,7 +145,7 @@ impl PlanSummary {
             plan: p.best.first().map(Candidate::from),
             runners_up: p.best.iter().skip(1).map(Candidate::from).collect(),
             over_budget: p.over_budget.as_ref().map(Candidate::from),
-            solver: p.solver.into(),
+            solver: p.solver.to_string(),
             tol: p.tol,
             notes: p.notes.clone(),
             refused: p.refused.clone(),

@@ -244,7 +244,7 @@ impl Builder {
         match n {
             0 => self.intern(Op::Const(1.0)),
             1 => a,
-            _ if n % 2 == 0 => {
+            _ if n.is_multiple_of(2) => {
                 let h = self.power(a, n / 2);
                 self.intern(Op::Bin(Bin::Mul, h, h))
             }

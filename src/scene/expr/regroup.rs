@@ -8,9 +8,12 @@
 
 use super::sym::{Bin, Sym};
 
+/// Factors of a product, each with `true` for a divisor.
+pub(super) type Factors<'a> = Vec<(&'a Sym, bool)>;
+
 /// The factors of the product at `s` (with `true` for a divisor) and, for each, whether it depends on
 /// t; `None` unless there are factors of both kinds (then regrouping gains nothing).
-pub(super) fn factors(s: &Sym) -> Option<(Vec<(&Sym, bool)>, Vec<bool>)> {
+pub(super) fn factors(s: &Sym) -> Option<(Factors<'_>, Vec<bool>)> {
     let mut factors = Vec::new();
     collect_factors(s, false, &mut factors);
     let timed: Vec<bool> = factors.iter().map(|(f, _)| has_t(f)).collect();

@@ -44,10 +44,10 @@ fn norm_model_on_vectors() {
     // orthogonal increments: e_l = Σ_{k ≥ l} δ_k, δ_k = unit vector k times C √(x_k² − x_{k+1}²), tail C x_last
     let c = 2.0 * norm(&w);
     let mut orth = vec![vec![0.0; x.len()]; x.len()];
-    for l in 0..x.len() {
+    for (l, row) in orth.iter_mut().enumerate() {
         for k in l..x.len() {
             let next = if k + 1 < x.len() { x[k + 1] } else { 0.0 };
-            orth[l][k] = c * (x[k] * x[k] - next * next).sqrt();
+            row[k] = c * (x[k] * x[k] - next * next).sqrt();
         }
     }
     for (e, beta, classical) in [(&par, 0.0, 1.0), (&orth, 1.0, 3f64.sqrt())] {

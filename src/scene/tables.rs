@@ -1,0 +1,230 @@
+//! The tables of a scene file read and checked one by one ([`super::Scene::from_str`] puts them
+//! together): each function takes its raw serde table and returns the validated value, or an error
+//! naming the key.
+
+use super::expr::{Expr, Vec2Expr};
+use super::raw::*;
+use super::values::{positive_finite, sized, uniform_times};
+use super::{Diagonal, Exact, FrictionBound, MeshSpec, Method, Outputs, Part, PartKind, SolverSettings};
+use crate::error::{Error, Result};
+
+/// `[mesh]`: a Gmsh file or a structured quadrilateral, with its refinements.
+pub(super) fn mesh_spec(file: &str, m: &RawMeshTable) -> Result<MeshSpec> {
+    let spec = match (&m.file, m.corners, m.cells) {
+        (Some(p), None, None) => {
+            if m.diagonal.is_some() {
+                return Err(Error::scene(file, "mesh.diagonal", "only for structured meshes"));
+            }
+            MeshSpec::Gmsh { path: p.clone(), refine: m.refine }
+        }
+        (None, Some(corners), Some(cells)) => {
+            if cells[0] == 0 || cells[1] == 0 {
+                return Err(Error::scene(file, "mesh.cells", "cell counts must be at least 1"));
+            }
+            if corners.iter().flatten().any(|c| !c.is_finite()) {
+                return Err(Error::scene(file, "mesh.corners", "corners must be finite"));
+            }
+            let diagonal = m.diagonal.unwrap_or(Diagonal::First);
+            MeshSpec::Structured { corners, cells, diagonal, refine: m.refine }
+        }
+        _ => {
+            return Err(Error::scene(
+                file,
+                "mesh",
+                "give either `file` (Gmsh) or both `corners` and `cells` (structured), not both",
+            ))
+        }
+    };
+    check_refine(file, "mesh.refine", m.refine)?;
+    Ok(spec)
+}
+
+/// `[material]`: E > 0 and −1 < ν < ½ (plane strain).
+pub(super) fn material(file: &str, m: &RawMaterial) -> Result<(f64, f64)> {
+    let e = positive_finite(file, "material.E", m.E)?;
+    let nu = m.nu;
+    if !(nu.is_finite() && nu > -1.0 && nu < 0.5) {
+        return Err(Error::scene(file, "material.nu", format!("must satisfy -1 < nu < 0.5, got {nu}")));
+    }
+    Ok((e, nu))
+}
+
+/// `[[boundary]]`: the parts, named once each, with the data of their kind; at least one Dirichlet part.
+pub(super) fn parts(file: &str, boundary: &[RawBoundary]) -> Result<Vec<Part>> {
+    let mut parts = Vec::new();
+    for (i, b) in boundary.iter().enumerate() {
+        let key = |k: &str| format!("boundary[{i}] ({}).{k}", b.name);
+        if parts.iter().any(|p: &Part| p.name == b.name) {
+            return Err(Error::scene(file, key("name"), "boundary part named twice"));
+        }
+        if b.traction.is_some() && b.kind != RawKind::Neumann {
+            return Err(Error::scene(file, key("traction"), "only neumann parts take a traction"));
+        }
+        if b.g_a.is_some() && b.kind != RawKind::Contact {
+            return Err(Error::scene(file, key("g_a"), "only contact parts take a friction bound g_a"));
+        }
+        let kind = match b.kind {
+            RawKind::Dirichlet => PartKind::Dirichlet,
+            RawKind::Neumann => PartKind::Neumann(match &b.traction {
+                Some(g) => nonzero(Some(Vec2Expr::parse(&key("traction"), sized(file, &key("traction"), g)?)?)),
+                None => None,
+            }),
+            RawKind::Contact => {
+                let text = b.g_a.as_deref().ok_or_else(|| Error::scene(file, key("g_a"), "contact part needs g_a"))?;
+                sized(file, &key("g_a"), &[text.to_string()])?;
+                PartKind::Contact(FrictionBound::parse(file, &key("g_a"), text)?)
+            }
+        };
+        parts.push(Part { name: b.name.clone(), kind });
+    }
+    if !parts.iter().any(|p| matches!(p.kind, PartKind::Dirichlet)) {
+        return Err(Error::scene(
+            file,
+            "boundary",
+            "no dirichlet part: rigid motions are not fixed (the paper requires meas(Γ_D) > 0)",
+        ));
+    }
+    Ok(parts)
+}
+
+/// `[loads] f` and `[initial] u0` (independent of t); `None` where absent or zero.
+pub(super) fn loads(
+    file: &str,
+    loads: Option<RawLoads>,
+    initial: Option<RawInitial>,
+) -> Result<(Option<Vec2Expr>, Option<Vec2Expr>)> {
+    let f = match loads.and_then(|l| l.f) {
+        Some(f) => nonzero(Some(Vec2Expr::parse("loads.f", sized(file, "loads.f", &f)?)?)),
+        None => None,
+    };
+    let u0 = match initial.and_then(|l| l.u0) {
+        Some(u) => {
+            let u = Vec2Expr::parse("initial.u0", sized(file, "initial.u0", &u)?)?;
+            if u.depends_on_t() {
+                return Err(Error::scene(file, "initial.u0", "must not depend on t"));
+            }
+            nonzero(Some(u))
+        }
+        None => None,
+    };
+    Ok((f, u0))
+}
+
+/// `[time]`: the nodes, and whether they are uniform (from `T` and `steps`).
+pub(super) fn time_grid(file: &str, t: RawTime) -> Result<(Vec<f64>, bool)> {
+    match (t.T, t.steps, t.times) {
+        (Some(t), Some(n), None) => {
+            let t = positive_finite(file, "time.T", t)?;
+            Ok((uniform_times(file, t, n)?, true))
+        }
+        (None, None, Some(ts)) => {
+            if ts.len() < 2 {
+                return Err(Error::scene(file, "time.times", "needs at least two time nodes"));
+            }
+            for (k, w) in ts.windows(2).enumerate() {
+                if !(w[0].is_finite() && w[1].is_finite() && w[1] > w[0]) {
+                    return Err(Error::scene(
+                        file,
+                        "time.times",
+                        format!(
+                            "must be finite and strictly increasing: times[{k}] = {}, times[{}] = {}",
+                            w[0],
+                            k + 1,
+                            w[1]
+                        ),
+                    ));
+                }
+            }
+            Ok((ts, false))
+        }
+        _ => Err(Error::scene(file, "time", "give either `T` and `steps`, or `times`")),
+    }
+}
+
+/// `[solver]`, with its defaults (SSN, tolerance 1e-12, the method's iteration limit, automatic Uzawa step).
+pub(super) fn solver_settings(file: &str, raw: Option<RawSolver>) -> Result<SolverSettings> {
+    let rs = raw.unwrap_or(RawSolver { method: None, tol: None, max_iter: None, uzawa_step: None });
+    Ok(SolverSettings {
+        method: rs.method.unwrap_or(Method::Ssn),
+        tol: positive_finite(file, "solver.tol", rs.tol.unwrap_or(1e-12))?,
+        max_iter_given: match rs.max_iter {
+            Some(0) => return Err(Error::scene(file, "solver.max_iter", "must be at least 1")),
+            other => other,
+        },
+        uzawa_step: match rs.uzawa_step {
+            Some(s) if !(s.is_finite() && s >= 0.0) => {
+                return Err(Error::scene(file, "solver.uzawa_step", format!("must be >= 0 (0 = automatic), got {s}")))
+            }
+            Some(s) => s,
+            None => 0.0,
+        },
+    })
+}
+
+/// `[exact]`: u and its gradient, for true errors.
+pub(super) fn exact(file: &str, raw: Option<RawExact>) -> Result<Option<Exact>> {
+    let Some(x) = raw else { return Ok(None) };
+    sized(file, "exact.u", &x.u)?;
+    for row in &x.grad {
+        sized(file, "exact.grad", row)?;
+    }
+    let g = |i: usize, j: usize| Expr::parse(&format!("exact.grad[{i}][{j}]"), &x.grad[i][j]);
+    Ok(Some(Exact { u: Vec2Expr::parse("exact.u", &x.u)?, grad: [[g(0, 0)?, g(0, 1)?], [g(1, 0)?, g(1, 1)?]] }))
+}
+
+/// `[quantities]`, or the deprecated `[outputs]` (a message in `deprecations`), with `energy` read as
+/// `elastic_energy` (likewise).
+pub(super) fn quantities(
+    file: &str,
+    new: Option<RawQuantities>,
+    old: Option<RawQuantities>,
+    deprecations: &mut Vec<String>,
+) -> Result<Option<Outputs>> {
+    let raw = match (new, old) {
+        (Some(_), Some(_)) => {
+            return Err(Error::scene(file, "outputs", "give [quantities] only (`[outputs]` is its deprecated name)"))
+        }
+        (None, Some(o)) => {
+            deprecations.push(format!("{file}: the table [outputs] is deprecated: write [quantities]"));
+            o
+        }
+        (Some(q), None) => q,
+        (None, None) => return Ok(None),
+    };
+    let elastic_energy = match (raw.elastic_energy, raw.energy) {
+        (Some(_), Some(_)) => {
+            return Err(Error::scene(
+                file,
+                "quantities.energy",
+                "give elastic_energy only (`energy` is its deprecated name)",
+            ))
+        }
+        (None, Some(e)) => {
+            deprecations
+                .push(format!("{file}: [quantities] energy is deprecated: write elastic_energy (½ a_h(u, u) at T)"));
+            e
+        }
+        (e, None) => e.unwrap_or(false),
+    };
+    Ok(Some(Outputs {
+        max_slip: raw.max_slip,
+        stick_length: raw.stick_length,
+        elastic_energy,
+        traction_at: raw.traction_at,
+    }))
+}
+
+/// Uniform refinements beyond [`MAX_REFINE`] are refused (4¹² times the triangles is beyond any machine).
+pub(super) fn check_refine(file: &str, key: &str, k: u32) -> Result<()> {
+    if k > MAX_REFINE {
+        return Err(Error::scene(file, key, format!("{k} refinements is beyond any machine")));
+    }
+    Ok(())
+}
+
+/// The most uniform refinements a scene or `--refine` may ask for.
+pub const MAX_REFINE: u32 = 12;
+
+pub(super) fn nonzero(v: Option<Vec2Expr>) -> Option<Vec2Expr> {
+    v.filter(|e| !e.is_zero())
+}

@@ -1,0 +1,28 @@
+"""Check that every path the documentation names exists (README.md, docs/, the READMEs under verification/).
+
+    .venv/bin/python verification/check_doc_paths.py [--root DIR]
+
+Part of `make test`. Exits 1 and lists `doc:line: `ref` does not exist` for each missing reference.
+"""
+
+import argparse
+import os
+import sys
+
+from tresca_py.doccheck import check, default_docs
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--root", default=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    args = ap.parse_args()
+    docs = default_docs(args.root)
+    missing = check(args.root, docs)
+    for m in missing:
+        print(m)
+    print(f"doc paths: {len(docs)} documents, {len(missing)} missing reference(s)")
+    return 1 if missing else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
