@@ -124,7 +124,7 @@ class Rec:
     def per_step(self):
         """(CLI wall - set-up) / N per run, median: step time including the result handling."""
         n = self.info["steps"]
-        return med([(c - sum(s)) / n for c, s in zip(self.cli, self.setups)])
+        return med([(c - sum(s)) / n for c, s in zip(self.cli, self.setups, strict=False)])
 
     @property
     def load(self):
@@ -542,7 +542,7 @@ def mms_section(args, R, tmp, md, csvrows):
         print(md[-1], flush=True)
         tg.append((f"(issue 13) {label} < {fmt_t(target)}", f"{fmt_t(r.wall)} wall, CPU {fmt_t(r.cpu)}", r.wall < target))
     conds = [(lab, r.setup[4], r.info["contact"], r.info["unknowns"]) for lab, r in rec.items() if r.info["unknowns"] >= 1e5 or r.info["contact"] >= 128]
-    for lab, c, nc, n in conds:
+    for _lab, c, nc, n in conds:
         tg.append((f"(issue 13) condensation, {nc} contact unknowns on {n} unknowns < 0.3 s", fmt_t(c), c < 0.3))
     md.append("")
 
@@ -599,7 +599,7 @@ def mms_section(args, R, tmp, md, csvrows):
             walls, cpus, loads, owns = meas[name]
             du = max_du(rust_h5, cmd[4])
             w, c = med(walls), med(cpus)
-            paired = med([a / b for a, b in zip(walls, meas["rust"][0])])
+            paired = med([a / b for a, b in zip(walls, meas["rust"][0], strict=False)])
             md.append(f"| {name} | {fmt_t(w)} | {fmt_t(c)} | {fmt_t(med(owns))} | {w / rw:.1f}× | {paired:.1f}× | "
                       f"{c / rc:.1f}× | {med(owns) / rs:.1f}× | {du:.1e} | {min(loads):.2f}-{max(loads):.2f} |")
             print(md[-1], flush=True)

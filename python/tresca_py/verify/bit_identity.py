@@ -69,7 +69,7 @@ def items(f):
     """{path: bytes-comparable value} of every dataset and attribute under /tresca and /VTKHDF."""
     out = {}
     for group in ("tresca", "VTKHDF"):
-        def visit(name, obj):
+        def visit(name, obj, group=group):
             if isinstance(obj, h5py.Dataset):
                 out[f"{group}/{name}"] = obj[()]
             for k, v in obj.attrs.items():

@@ -500,7 +500,7 @@ def memory_tables(meas, fresh):
           "| ranks | rank | peak RSS (time) MB | peak RSS (getrusage) MB | after mesh | after assembly | after factorisation | after C |",
           "|---|---|---|---|---|---|---|---|"]
     for n, r in (("1", r1), ("2", r2)):
-        for k, (a, b) in enumerate(zip(r["rss_time_mb"], r["rss_self_mb"])):
+        for k, (a, b) in enumerate(zip(r["rss_time_mb"], r["rss_self_mb"], strict=False)):
             sp = r["setup_peak_mb"][k] if k < len(r["setup_peak_mb"]) else {}
             md.append(f"| {n} | {k} | {a:.0f} | {b:.0f} | {sp.get('mesh', 0):.0f} | {sp.get('assembly', 0):.0f} | "
                       f"{sp.get('factorisation', 0):.0f} | {sp.get('condensation', 0):.0f} |")

@@ -16,7 +16,7 @@ def fmt(v):
 def hides(rows1, rows2):
     """What the consecutive-mesh error hides (Markdown lines)."""
     e32, e16, c32 = rows1[4]["reference_T"], rows1[3]["reference_T"], rows1[4]["consecutive_T"]
-    same = all(abs(a["consecutive_T"] - b["consecutive_T"]) <= 1e-12 * a["consecutive_T"] for a, b in zip(rows1[1:], rows2[:-1]))
+    same = all(abs(a["consecutive_T"] - b["consecutive_T"]) <= 1e-12 * a["consecutive_T"] for a, b in zip(rows1[1:], rows2[:-1], strict=False))
     return ["", "## What the consecutive-mesh error hides", "",
               f"* **The time step plays no role in Example 5.1.** Our Table 5.2 column (N = 5n) equals our Table 5.1 column (N = 20n) "
               f"{'to 1e-12' if same else '(NOT equal: check)'}: points of Γ_C only pass from stick to slip (all of Γ_C slips by t = 0.025 at "
@@ -45,7 +45,7 @@ def estimate_section(rows1, t1):
               "consecutive error and our error against the n = 256, N = 5120 reference run (which costs more than the whole study).", "",
               "| n | N | paper error | our consecutive error | estimated true error | error vs reference | estimate / reference | verdict |",
               "|---|---|---|---|---|---|---|---|"]
-    for (n, e_t, ref_t, con_t, verdict), p in zip(est, t1):
+    for (n, e_t, ref_t, con_t, verdict), p in zip(est, t1, strict=False):
         ratio = "-" if e_t is None else f"{e_t / ref_t:.3f}"
         lines.append(f"| {n} | {p['N']} | {p['error']} | {fmt(con_t)} | {fmt(e_t)} | {ref_t:.4e} | {ratio} | {verdict} |")
     e32_est = est[-1][1]
@@ -80,7 +80,7 @@ def paper_tables(hs, quick):
     o2c = rec(t2c, "log2")
 
     expected1 = [0.8577, 0.9671, 0.9015, 0.866]
-    ok_rec = all(abs(a - b) < 6e-4 for a, b in zip(o1[1:], expected1))
+    ok_rec = all(abs(a - b) < 6e-4 for a, b in zip(o1[1:], expected1, strict=False))
     ref_level = (6, 2560) if quick else (7, 5120)
     rows1, cmd1 = study(hs, "verification/cases/paper_example_5_1.toml", [(k, 40 << k) for k in range(5)], "paper_table_5_1",
                         reference=ref_level)
@@ -94,7 +94,7 @@ def paper_tables(hs, quick):
              "## Table 5.1 (N = 20n)", "",
              "| N | n | DOF | paper error | paper order (printed) | paper order (recomputed) | our consecutive error | our order | our true error vs reference | order |",
              "|---|---|---|---|---|---|---|---|---|---|"]
-    for i, (p, r) in enumerate(zip(t1, rows1)):
+    for i, (p, r) in enumerate(zip(t1, rows1, strict=False)):
         oc = "-" if i == 0 else f"{math.log(rows1[i - 1]['consecutive_T'] / r['consecutive_T']) / math.log(math.sqrt(r['paper_dofs'] / rows1[i - 1]['paper_dofs'])):.4f}" if r["consecutive_T"] and rows1[i - 1]["consecutive_T"] else "-"
         orf = "-" if i == 0 else f"{math.log(rows1[i - 1]['reference_T'] / r['reference_T']) / math.log(rows1[i - 1]['h'] / r['h']):.4f}"
         lines.append(f"| {p['N']} | {2 << i} | {int(r['paper_dofs'])} | {p['error']} | {p['order'] or '-'} | "
@@ -102,7 +102,7 @@ def paper_tables(hs, quick):
     lines += ["", "## Table 5.2 (N = 5n)", "",
               "| N | n | DOF | paper DOF | paper error | paper order (printed) | paper order (recomputed) | recomputed with 7.410e-5 | our consecutive error | our order | ours with N = 20n (Table 5.1) |",
               "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for i, (p, r, r1) in enumerate(zip(t2, rows2, rows1[1:] + [{"consecutive_T": None}])):
+    for i, (p, r, r1) in enumerate(zip(t2, rows2, rows1[1:] + [{"consecutive_T": None}], strict=False)):
         oc = "-" if i == 0 else f"{math.log2(rows2[i - 1]['consecutive_T'] / r['consecutive_T']):.4f}"
         lines.append(f"| {p['N']} | {4 << i} | {int(r['paper_dofs'])} | {p['DOF']} | {p['error']} | {p['order'] or '-'} | "
                      f"{'-' if o2[i] is None else f'{o2[i]:.4f}'} | {'-' if o2c[i] is None else f'{o2c[i]:.4f}'} | {fmt(r['consecutive_T'])} | {oc} | {fmt(r1['consecutive_T'])} |")

@@ -167,7 +167,7 @@ def check_files(ss, files, me):
             # XDMFReader by a bare relative name (cwd = the run's directory), the Xdmf3 readers by absolute path
             path = "run.xdmf" if reader == "XDMFReader" else os.path.join(d, "run.xdmf")
             p = ss.pvpython([me, "--dump", path, reader, "mid,-1"], cwd=d)  # the middle and the last frame
-            lines = [l for l in p.stdout.splitlines() if l.startswith("JSON")]
+            lines = [ln for ln in p.stdout.splitlines() if ln.startswith("JSON")]
             if not ss.check(p.returncode == 0 and lines, f"{label} / {reader}: pvpython exit {p.returncode} {p.stderr.strip()[-300:]}"):
                 continue
             data = json.loads(lines[0][4:])

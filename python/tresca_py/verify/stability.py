@@ -423,7 +423,7 @@ def case_finite(st):
         if not p or not os.path.exists(p):
             continue
         with h5py.File(p, "r") as f:
-            def visit(name, obj):
+            def visit(name, obj, p=p):
                 nonlocal n
                 if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f":
                     n += 1

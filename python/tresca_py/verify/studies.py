@@ -84,7 +84,7 @@ def be_exact_study(hs):
     ok = len(rel_mono) >= 2 and max(rel_mono) <= 1e-12
     req(hs, "K2-stick-to-slip", "while the discrete solution only passes from stick to slip, backward Euler shall be exact at the "
             "nodes: solutions of different time grids agree to rounding (≤ 1e-12 relative)", ok,
-            "; ".join(f"N={int(r['steps'])}: {back[int(r['steps'])]} slip→stick, rel. diff {x:.1e}" for r, x in zip(rows[1:], rel)),
+            "; ".join(f"N={int(r['steps'])}: {back[int(r['steps'])]} slip→stick, rel. diff {x:.1e}" for r, x in zip(rows[1:], rel, strict=False)),
             cmd, "reference/be_exact_stick_to_slip.md")
 
 

@@ -64,7 +64,7 @@ def measure(case, full, bare, r, N, solver, tol, repeats, family):
     err, _, l2 = cli_summary.max_errors(s)
     it, dofs = s["run"]["iterations"], s["run"]["paper_dofs"]
     walls, cpus, loads = [], [], []
-    for i in range(repeats):
+    for _i in range(repeats):
         loads.append(load1())
         t = timed(command(bare, r, N, solver, tol))  # raises with the command and its stderr on failure
         walls.append(t.wall)
@@ -122,12 +122,12 @@ def plot(rows, out):
     fig, axes = plt.subplots(1, len(CASES), figsize=(13, 5.2))
     style = {("h", "ssn"): ("o-", "C0"), ("k", "ssn"): ("s-", "C1"), ("joint", "ssn"): ("^-", "C2"),
              ("joint", "uzawa"): ("v--", "C3"), ("tol", "ssn"): ("D:", "C4"), ("tol", "uzawa"): ("x:", "C5")}
-    for ax, case in zip(axes, CASES):
+    for ax, case in zip(axes, CASES, strict=False):
         for (fam, s), (mk, col) in style.items():
             pts = [(r["cpu"], r["error"]) for r in rows if r["case"] == case and r["family"] == fam
                    and r["solver"] == s and r["error"] == r["error"]]
             if pts:
-                ax.loglog(*zip(*pts), mk, color=col, label=f"{fam} ({s})")
+                ax.loglog(*zip(*pts, strict=False), mk, color=col, label=f"{fam} ({s})")
         ax.set_xlabel("CPU time (s, user + sys, median, process, without error evaluation)")
         ax.set_ylabel("true energy error, max over time nodes")
         ax.set_title(case)
