@@ -202,8 +202,18 @@ impl Scene {
             if b.g_a.is_some() && b.kind != RawKind::Contact {
                 return Err(Error::scene(file, key("g_a"), "only contact parts take a friction bound g_a"));
             }
+            if b.u.is_some() && b.kind != RawKind::Dirichlet {
+                return Err(Error::scene(file, key("u"), "only dirichlet parts take boundary values u"));
+            }
+            if b.gap.is_some() && b.kind != RawKind::Contact {
+                return Err(Error::scene(
+                    file,
+                    key("gap"),
+                    "only contact parts take an imposed normal displacement gap",
+                ));
+            }
             let kind = match b.kind {
-                RawKind::Dirichlet => PartKind::Dirichlet,
+                RawKind::Dirichlet => PartKind::Dirichlet(parts::dirichlet_data(file, &key("u"), b.u.as_ref())?),
                 RawKind::Neumann => PartKind::Neumann(match &b.traction {
                     Some(g) => nonzero(Some(Vec2Expr::parse(&key("traction"), sized(file, &key("traction"), g)?)?)),
                     None => None,
@@ -212,12 +222,15 @@ impl Scene {
                     let text =
                         b.g_a.as_deref().ok_or_else(|| Error::scene(file, key("g_a"), "contact part needs g_a"))?;
                     sized(file, &key("g_a"), &[text.to_string()])?;
-                    PartKind::Contact(FrictionBound::parse(file, &key("g_a"), text)?)
+                    PartKind::Contact(
+                        FrictionBound::parse(file, &key("g_a"), text)?,
+                        parts::gap_data(file, &key("gap"), b.gap.as_ref())?,
+                    )
                 }
             };
             parts.push(Part { name: b.name.clone(), kind });
         }
-        if !parts.iter().any(|p| matches!(p.kind, PartKind::Dirichlet)) {
+        if !parts.iter().any(|p| p.kind.is_dirichlet()) {
             return Err(Error::scene(
                 file,
                 "boundary",
@@ -350,8 +363,13 @@ impl Scene {
         }
     }
 
+    /// True if a part imposes nonzero boundary data (u_D or g_n; see [`PartKind`]).
+    pub fn has_boundary_data(&self) -> bool {
+        self.parts.iter().any(|p| p.kind.has_data())
+    }
+
     /// True if the scene has a contact part.
     pub fn has_contact(&self) -> bool {
-        self.parts.iter().any(|p| matches!(p.kind, PartKind::Contact(_)))
+        self.parts.iter().any(|p| matches!(p.kind, PartKind::Contact(..)))
     }
 }

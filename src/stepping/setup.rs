@@ -32,6 +32,7 @@ impl Problem {
     ) -> std::result::Result<(Problem, Option<R>), (Error, Option<R>)> {
         let t0 = Instant::now();
         let space = CrSpace::new(&mesh, &scene.parts).map_err(|e| (e, None))?;
+        crate::fem::lifting::consistency::check(&scene, &mesh, &space).map_err(|e| (e, None))?;
         let t1 = Instant::now();
         let law = Elasticity::new(&scene.material);
         let p0 = Problem0 { scene, mesh, space, law };
@@ -61,6 +62,7 @@ impl Problem {
             errors,
             conditioning,
             step0,
+            forms: Default::default(),
         };
         Ok((p, r))
     }
