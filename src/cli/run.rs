@@ -108,6 +108,8 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
     };
     let mut max_err = tresca_cr::fem::norms::ErrorNorms::default();
     let (mut iters, mut max_res) = (0usize, 0.0f64);
+    // the energy audit (stepping::audit): largest |balance residual| and the largest work of a step
+    let (mut balance, mut work) = (0.0f64, 0.0f64);
     // stick and slip edges of the last step (for the summary; not the whole step, whose u is large)
     let mut last = None;
     let on_step = |r: &tresca_cr::StepResult| -> tresca_cr::Result<()> {
@@ -119,6 +121,10 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
         }
         iters += r.iterations;
         max_res = max_res.max(r.residual);
+        if let Some(a) = r.audit {
+            balance = balance.max(a.balance_residual.abs());
+            work = work.max(a.external_work.abs() + a.boundary_work.abs() + a.friction_dissipation);
+        }
         if verbose {
             let err = r.errors.map(|e| format!("  |||e||| {:.4e}  L2 {:.4e}", e.energy, e.l2)).unwrap_or_default();
             say!(
@@ -188,6 +194,9 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool) -> Result<
         max_res,
         start.elapsed().as_secs_f64()
     );
+    if work > 0.0 {
+        say!("energy balance: max |residual| {balance:.2e} ({:.1e} of the largest work of a step)", balance / work);
+    }
     if let Some((stick, slip)) = last {
         say!("final step: {stick} stick, {slip} slip contact edges");
     }

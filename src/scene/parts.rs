@@ -5,7 +5,7 @@
 //! its edges as edge means (I_CR), and the stabilisation's jump on its edges is u_h − u_D. A contact
 //! part may give `gap = "…"`, g_n(x, y, t): bilateral contact with imposed normal displacement
 //! u·n = g_n (edge means), the tangential part under the same Tresca law. Both default to 0; an
-//! expression that is identically 0 counts as absent (the run is then that of the scene without it).
+//! expression that is the constant 0 counts as absent (the run is then that of the scene without it).
 //! How the data enter the discrete problem: `fem::lifting`.
 
 use super::expr::{Expr, Vec2Expr};
@@ -35,7 +35,7 @@ impl PartKind {
     }
 }
 
-/// The Dirichlet data `u` of scene key `key` (None when absent or identically zero).
+/// The Dirichlet data `u` of scene key `key` (None when absent or the constant 0).
 pub(super) fn dirichlet_data(file: &str, key: &str, u: Option<&[String; 2]>) -> Result<Option<Vec2Expr>> {
     match u {
         None => Ok(None),
@@ -43,7 +43,7 @@ pub(super) fn dirichlet_data(file: &str, key: &str, u: Option<&[String; 2]>) -> 
     }
 }
 
-/// The imposed normal displacement `gap` of scene key `key` (None when absent or identically zero).
+/// The imposed normal displacement `gap` of scene key `key` (None when absent or the constant 0).
 pub(super) fn gap_data(file: &str, key: &str, gap: Option<&String>) -> Result<Option<Expr>> {
     match gap {
         None => Ok(None),
