@@ -19,6 +19,7 @@ It reuses derive.py's printer, parser and building blocks (imported, not edited)
 Cases:
 (a) mms_data_front: mms_front's travelling stick-slip pulse on the bottom side, plus a normal
     displacement g(x,t) on Gamma_C and nonzero values on the Dirichlet top side y = 1.
+(c) mms_data_stop: derive.py's mms_stop (the O(k) case) with the same kind of data as (a).
 (b) mms_data_cep: the Tresca solution of Chouly, Ern & Pignet (SIAM J. Sci. Comput. 2020):
     Omega = (0,1)^2, Gamma_C = {y = 0}, u = (x e^{xy}(1 + 1/(1+lam)), y e^{xy}(-1 + 1/(1+lam)))/6,
     mu = 2, lam = 2e4, g_a = s(x) = mu x^2 (lam/2 + 1)/(3 lam + 3), the three other sides Dirichlet
@@ -114,7 +115,27 @@ locking-free). Derivation and pointwise checks: verification/mms/cases_boundary.
         u=u, g_a=ga, T=1, steps=1, expect={}, static=True)
 
 
-CASES = [case_data_front, case_data_cep]
+def case_data_stop():
+    """(c): derive.py's mms_stop (slip stops abruptly at t* = 1/3: the O(k) case) plus the data field
+    v = (y^2 h - phi1(y) g_x, g) of (a): v = (0, g) on y = 0 and d v1/dy + d v2/dx = 0 there, so v leaves
+    the slip and sigma_t.tau of mms_stop unchanged and adds u.n = -g on Gamma_C and v(x,1) != 0 on the
+    Dirichlet top side."""
+    c = D.case_stop()
+    g = (1 + x / 2) * (1 + t) / 40
+    h = (1 + t) * sp.sin(x) / 20
+    phi1 = y * (1 - y) ** 2
+    v = [y ** 2 * h - phi1 * sp.diff(g, x), g]
+    c = dict(c, u=[c["u"][0] + v[0], c["u"][1] + v[1]], name="mms_data_stop", static=False,
+             title="MMS (issue 30 c): slip stops abruptly at t* = 1/3, with Dirichlet data and imposed normal displacement")
+    c["header"] = c["header"].split("\nMeasured errors")[0] + """
+Plus boundary data (issue 30): u + v with v = (y^2 (1+t) sin(x)/20 - y(1-y)^2 g_x, g), g = (1 + x/2)(1 + t)/40:
+v = (0, g) on y = 0 and dv1/dy + dv2/dx = 0 there, so slip and sigma_t.tau are mms_stop's, u.n = -g on
+Gamma_C (contact `gap`) and u(x,1,t) != 0 on the top side (dirichlet `u`).
+Derivation and pointwise checks: verification/mms/cases_boundary.py."""
+    return c
+
+
+CASES = [case_data_front, case_data_cep, case_data_stop]
 
 
 def derive_data(case):
@@ -199,7 +220,9 @@ def check_tresca(d, log):
     if not d["static"]:
         require(stick.mean() > 0.05, "%s: (almost) no stick samples" % d["name"])
         dsl = np.diff(slip.astype(int), axis=1)
-        require(np.any(dsl == 1) and np.any(dsl == -1), "%s: the front does not move both ways" % d["name"])
+        exp = d["expect"]
+        require(np.any(dsl == 1) == exp["stick_to_slip"] and np.any(dsl == -1) == exp["slip_to_stick"],
+                "%s: stick/slip transitions not as expected" % d["name"])
         require(np.max(st_abs[:, 0] - ga[:, 0]) <= ttol, "%s: u0 incompatible" % d["name"])
     # the sign, with sympy: sigma_t.tau = -g_a and u.tau increasing where slipping (printed numbers)
     st_tau = st1 * tau[0] + st2 * tau[1]
