@@ -107,8 +107,14 @@ impl Problem {
                 .zip(r.slip.iter().zip(&prev.slip))
                 .map(|(c, (s, s0))| c.length * c.g_mean * (s - s0).abs())
                 .sum();
+            // lⁿ on the unknowns: without data the solver's own load (from the superposition's
+            // patterns when superposed, within its span tolerance 1e-13 of the load); with data the
+            // loads f, g alone (the solver's right-hand side then holds the lifting's part too)
             let mut l = Vec::new();
-            self.free.loads().assemble_loads(r.t, &mut l)?;
+            match space.data {
+                None => self.free.load_at(r.n, r.t, &mut l)?,
+                Some(_) => self.free.loads().assemble_loads(r.t, &mut l)?,
+            }
             let mut external: f64 = l.iter().zip(r.u.iter().zip(&prev.w)).map(|(l, (a, b))| l * (a - b)).sum();
             let mut reactions = 0.0;
             if let Some(data) = &space.data {
