@@ -17,15 +17,12 @@ use super::quadrature::{GAUSS2, GAUSS3};
 use super::space::{jump_terms_with, CrSpace, Element};
 use crate::mesh::Mesh;
 
-/// The audit's forms on one mesh.
+/// The audit's forms on one mesh. Only the stabilised edges and the data points are stored (about 8
+/// bytes an edge): the element geometry and the jump terms are recomputed at each [`FullForm::apply`],
+/// so the audit adds no mesh-sized memory to a run.
 pub struct FullForm {
-    elements: Vec<Element>,
-    tri_edges: Vec<[usize; 3]>,
-    /// Per stabilised edge and Gauss point q: 2ρμ ω_q, and its jump terms (edge, signed basis value)
-    /// `terms[first[q]..first[q + 1]]`.
-    weight: Vec<f64>,
-    first: Vec<usize>,
-    terms: Vec<(usize, f64)>,
+    /// The edges carrying the jump term (interior and Dirichlet).
+    stabilised: Vec<usize>,
     /// Per Dirichlet edge with data, per 3-point Gauss point: 2ρμ ω_q and the basis values of the
     /// edge's triangle there (edge, φ).
     data_points: Vec<[(f64, [(usize, f64); 3]); 3]>,
@@ -36,36 +33,27 @@ pub struct FullForm {
 impl FullForm {
     pub fn new(mesh: &Mesh, space: &CrSpace, law: &Elasticity, rho: f64) -> FullForm {
         let pen = 2.0 * rho * law.mu;
-        let elements: Vec<Element> = (0..mesh.tris.len()).map(|t| Element::new(mesh, t)).collect();
-        let (mut weight, mut first, mut terms) = (Vec::new(), vec![0], Vec::new());
-        for e in 0..mesh.edges.len() {
-            if space.is_stabilised(mesh, e) {
-                for (s, w) in GAUSS2 {
-                    weight.push(pen * w);
-                    terms.extend(jump_terms_with(mesh, e, s, |t| elements[t]).0.into_iter().take(jump_len(mesh, e)));
-                    first.push(terms.len());
-                }
-            }
-        }
+        let stabilised = (0..mesh.edges.len()).filter(|&e| space.is_stabilised(mesh, e)).collect();
         let mut data_points = Vec::new();
         if let Some(data) = &space.data {
             for &e in &data.dirichlet {
                 let t = mesh.edge_tris[e].0;
-                let te = mesh.tri_edges[t];
+                let (te, el) = (mesh.tri_edges[t], Element::new(mesh, t));
                 let pts = gauss3_points(mesh, e);
                 data_points.push([0, 1, 2].map(|q| {
-                    let phi = Element::phi(elements[t].bary(pts[q]));
+                    let phi = Element::phi(el.bary(pts[q]));
                     (pen * GAUSS3[q].1, [0, 1, 2].map(|i| (te[i], phi[i])))
                 }));
             }
         }
-        FullForm { elements, tri_edges: mesh.tri_edges.clone(), weight, first, terms, data_points, pen, law: *law }
+        FullForm { stabilised, data_points, pen, law: *law }
     }
 
-    /// A U: the vector with A(U, V) = Σ_e (A U)_e·V_e.
-    pub fn apply(&self, u: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    /// A U on `mesh` (the form's): the vector with A(U, V) = Σ_e (A U)_e·V_e.
+    pub fn apply(&self, mesh: &Mesh, u: &[[f64; 2]]) -> Vec<[f64; 2]> {
         let mut y = vec![[0.0; 2]; u.len()];
-        for (el, te) in self.elements.iter().zip(&self.tri_edges) {
+        for (t, te) in mesh.tri_edges.iter().enumerate() {
+            let el = Element::new(mesh, t);
             let s = self.law.strain_stress(el.gradient(te.map(|e| u[e]))).stress;
             let (sxx, syy, sxy) = (s[0], s[1], s[3]);
             for (i, &e) in te.iter().enumerate() {
@@ -74,15 +62,18 @@ impl FullForm {
                 y[e][1] += el.area * (sxy * g[0] + syy * g[1]);
             }
         }
-        for (w, at) in self.weight.iter().zip(self.first.windows(2)) {
-            let terms = &self.terms[at[0]..at[1]];
-            let mut j = [0.0; 2];
-            for &(e, p) in terms {
-                j = [j[0] + p * u[e][0], j[1] + p * u[e][1]];
-            }
-            for &(e, p) in terms {
-                y[e][0] += w * p * j[0];
-                y[e][1] += w * p * j[1];
+        for &e in &self.stabilised {
+            for (s, w) in GAUSS2 {
+                let (terms, n) = jump_terms_with(mesh, e, s, |t| Element::new(mesh, t));
+                let terms = &terms[..n];
+                let mut j = [0.0; 2];
+                for &(f, p) in terms {
+                    j = [j[0] + p * u[f][0], j[1] + p * u[f][1]];
+                }
+                for &(f, p) in terms {
+                    y[f][0] += self.pen * w * p * j[0];
+                    y[f][1] += self.pen * w * p * j[1];
+                }
             }
         }
         y
@@ -112,11 +103,6 @@ impl FullForm {
         }
         c
     }
-}
-
-/// The number of jump terms of edge e (3 per triangle of the edge).
-fn jump_len(mesh: &Mesh, e: usize) -> usize {
-    3 * (1 + usize::from(mesh.edge_tris[e].1.is_some()))
 }
 
 /// Σ_e a_e·b_e.

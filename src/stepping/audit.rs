@@ -87,7 +87,7 @@ impl Problem {
             Some(d) => d.values(r.t)?,
             None => DataValues::default(),
         };
-        let au = forms.apply(&u);
+        let au = forms.apply(&self.mesh, &u);
         let bp = forms.data_vector(&p, ne);
         let stored = 0.5 * dot2(&au, &u) - dot2(&bp, &u) + 0.5 * forms.data_data(&p, &p);
         if space.data.is_some() {
