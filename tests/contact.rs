@@ -83,7 +83,7 @@ fn clamped_solve(p: &Problem, load: &[f64]) -> Vec<f64> {
 
 fn set_ga(s: &mut Scene, g: &str) {
     for part in &mut s.parts {
-        if let PartKind::Contact(e) = &mut part.kind {
+        if let PartKind::Contact(e, _) = &mut part.kind {
             *e = tresca_cr::scene::FrictionBound::parse("test", "g_a", g).unwrap();
         }
     }

@@ -146,7 +146,7 @@ fn rigid_motions_are_in_the_kernel_and_clamping_makes_k_spd() {
     assert!(u.iter().zip(&ku).map(|(x, y)| x * y).sum::<f64>() > 1.0);
     // with a clamped side the dense matrix is SPD: smallest eigenvalue positive
     let mut clamped = free.clone();
-    clamped[3].kind = PartKind::Dirichlet;
+    clamped[3].kind = PartKind::Dirichlet(None);
     let space = CrSpace::new(&mesh, &clamped).unwrap();
     let k = stiffness(&mesh, &space, &Elasticity::new(&mat), 10.0);
     let n = space.n_dofs;

@@ -39,12 +39,18 @@ pub fn check(scene: Scene, estimate: Estimate, json: Option<std::path::PathBuf>)
     for (p, part) in s.parts.iter().enumerate() {
         let n = sp.edge_part.iter().filter(|&&q| q == Some(p)).count();
         let what = match &part.kind {
-            PartKind::Dirichlet => "dirichlet (u = 0)".to_string(),
+            PartKind::Dirichlet(None) => "dirichlet (u = 0)".to_string(),
+            PartKind::Dirichlet(Some(u)) => {
+                format!("dirichlet, u_D = ({}, {})", short(u.0[0].text()), short(u.0[1].text()))
+            }
             PartKind::Neumann(None) => "neumann, traction free (nothing assembled)".to_string(),
             PartKind::Neumann(Some(g)) => {
                 format!("neumann, g = ({}, {})", short(g.0[0].text()), short(g.0[1].text()))
             }
-            PartKind::Contact(g) => format!("contact u.n = 0, Tresca g_a = {}", short(g.text())),
+            PartKind::Contact(g, None) => format!("contact u.n = 0, Tresca g_a = {}", short(g.text())),
+            PartKind::Contact(g, Some(n)) => {
+                format!("contact u.n = {}, Tresca g_a = {}", short(n.text()), short(g.text()))
+            }
         };
         say!("part       {:<10} {:>6} edges  {}", part.name, n, what);
     }

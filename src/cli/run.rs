@@ -187,6 +187,9 @@ struct Tally {
     max_err: tresca_cr::fem::norms::ErrorNorms,
     iters: usize,
     max_res: f64,
+    /// the energy audit (stepping::audit): largest |balance residual| and the largest work of a step
+    balance: f64,
+    work: f64,
     last: Option<(usize, usize)>,
 }
 
@@ -198,6 +201,10 @@ impl Tally {
         }
         self.iters += r.iterations;
         self.max_res = self.max_res.max(r.residual);
+        if let Some(a) = r.audit {
+            self.balance = self.balance.max(a.balance_residual.abs());
+            self.work = self.work.max(a.external_work.abs() + a.boundary_work.abs() + a.friction_dissipation);
+        }
         if verbose {
             let err = r.errors.map(|e| format!("  |||e||| {:.4e}  L2 {:.4e}", e.energy, e.l2)).unwrap_or_default();
             say!(
@@ -288,6 +295,9 @@ fn print_summary(f: &Facts, t: &Tally, n: usize, wall: f64) {
         st.superposition
     );
     say!("solver {}: {} iterations in all, max residual {:.2e}; wall time {:.3}s", f.method, t.iters, t.max_res, wall);
+    if t.work > 0.0 {
+        say!("energy balance: max |residual| {:.2e} ({:.1e} of the largest work of a step)", t.balance, t.balance / t.work);
+    }
     if let Some((stick, slip)) = t.last {
         say!("final step: {stick} stick, {slip} slip contact edges");
     }

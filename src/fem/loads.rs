@@ -15,7 +15,14 @@
 //! (or one Neumann edge) feed the same three edges, stored once per such group; per point only its three
 //! weights w·φᵢ; the unknowns and vector coefficients of an edge come from one table shared by all terms.
 //! The sums are those of a plain point-by-point scatter, in the same order (the same bits).
+//!
+//! **Boundary data.** With nonzero u_D or g_n (`fem::lifting`) the load of the unknowns also carries
+//! the lifting's right-hand side b_D(tₙ; ·) − a_h(u_Lⁿ, ·) ([`LiftRhs`], evaluated at every node: such
+//! loads are not separated), and [`Loads::constrained`] gives (lⁿ, ·) on the constrained components
+//! (for the reactions of the energy audit). Without data neither exists and nothing changes.
 
+use super::elasticity::Elasticity;
+use super::lifting::{BoundaryData, LiftRhs};
 use super::quadrature::{edge_point, tri_point, GAUSS3, TRI4};
 use super::space::{CrSpace, Element};
 use crate::error::Result;
@@ -82,6 +89,21 @@ pub struct Loads {
     /// The unknowns any load can touch, increasing (all of them with a body force, only boundary ones
     /// with tractions alone).
     support: Vec<usize>,
+    /// The boundary data and their right-hand side (`None` without data).
+    lift: Option<Lift>,
+}
+
+/// What boundary data add to the loads.
+#[derive(Clone, Debug)]
+struct Lift {
+    data: BoundaryData,
+    rhs: LiftRhs,
+    /// The support slot of every unknown (usize::MAX off the support).
+    slot: Vec<usize>,
+    /// The load terms at the points that feed a constrained component: per term its expression bound
+    /// to those points and per point (component, weight w·φ, vector coefficient).
+    constrained: Vec<(BoundSet, Vec<Vec<(usize, f64, [f64; 2])>>)>,
+    n_constrained: usize,
 }
 
 impl Loads {
@@ -138,6 +160,12 @@ impl Loads {
                 }
             }
         }
+        let lift_parts = space.data.as_ref().map(|data| {
+            let law = Elasticity::new(&scene.material);
+            let rhs = LiftRhs::new(mesh, &space.edge_dof, &space.contact, data, &law, scene.rho);
+            rhs.unknowns().for_each(|k| touched[k] = true);
+            (data.clone(), rhs, constrained_terms(&raw, data, space))
+        });
         let support: Vec<usize> = (0..space.n_dofs).filter(|&k| touched[k]).collect();
         let mut slot = vec![usize::MAX; space.n_dofs];
         for (i, &k) in support.iter().enumerate() {
@@ -155,6 +183,13 @@ impl Loads {
             edge_first,
             edge_terms,
             n_dofs: space.n_dofs,
+            lift: lift_parts.map(|(data, rhs, (constrained, n_constrained))| Lift {
+                data,
+                rhs,
+                slot: slot.clone(),
+                constrained,
+                n_constrained,
+            }),
             support,
         };
         let mut factors: Vec<(String, Sym)> = Vec::new();
@@ -196,7 +231,7 @@ impl Loads {
     /// The patterns P_j on the support when every term is separated (l(t) = Σ_j τ_j(t) P_j exactly);
     /// `None` when a term is evaluated at every node.
     pub fn separated(&self) -> Option<&[Vec<f64>]> {
-        self.terms.is_empty().then_some(&self.patterns.vectors[..])
+        (self.terms.is_empty() && self.lift.is_none()).then_some(&self.patterns.vectors[..])
     }
 
     /// The time factors τ_j(t) of the patterns; a non-finite one is an error naming its expression.
@@ -217,8 +252,47 @@ impl Loads {
         &self.support
     }
 
-    /// l(t) restricted to [`Loads::support`], into `out`.
+    /// l(t) restricted to [`Loads::support`], into `out`: the right-hand side of a step, so with
+    /// boundary data the lifting's part included (`fem::lifting`).
     pub fn assemble_on_support(&self, t: f64, out: &mut Vec<f64>) -> Result<()> {
+        self.assemble_loads_on_support(t, out)?;
+        if let Some(lift) = &self.lift {
+            let v = lift.data.values(t)?.flat();
+            lift.rhs.add(&v, &lift.slot, out);
+        }
+        Ok(())
+    }
+
+    /// (lⁿ, ψ_k) of the loads f and g alone (without the lifting's part) on the constrained components
+    /// of `fem::lifting::BoundaryData::constrained`, in that order; empty without boundary data.
+    pub fn constrained(&self, t: f64) -> Result<Vec<f64>> {
+        let Some(lift) = &self.lift else {
+            return Ok(Vec::new());
+        };
+        let mut out = vec![0.0; lift.n_constrained];
+        let mut values = Vec::new();
+        for (expr, points) in &lift.constrained {
+            expr.eval(t, &mut values)?;
+            for (v, feeds) in values.chunks_exact(2).zip(points) {
+                for &(c, w, a) in feeds {
+                    out[c] += w * (a[0] * v[0] + a[1] * v[1]);
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// (lⁿ, ψ_k) of the loads f and g alone on every unknown (with boundary data, l(t) without the
+    /// lifting's part; otherwise [`Loads::assemble`]).
+    pub fn assemble_loads(&self, t: f64, out: &mut Vec<f64>) -> Result<()> {
+        let mut s = Vec::new();
+        self.assemble_loads_on_support(t, &mut s)?;
+        self.expand(&s, out);
+        Ok(())
+    }
+
+    /// The loads f and g alone on the support.
+    fn assemble_loads_on_support(&self, t: f64, out: &mut Vec<f64>) -> Result<()> {
         out.clear();
         out.resize(self.support.len(), 0.0);
         for (c, v) in self.time_factors(t)?.into_iter().zip(&self.patterns.vectors) {
@@ -316,4 +390,35 @@ fn separated(e: &Vec2Expr, factors: &mut Vec<(String, Sym)>, separate: bool) -> 
     *factors = known;
     out.sort_by_key(|(j, _)| *j);
     Some(out)
+}
+
+/// The load terms at their points that feed a constrained component of `data` (both axes of a
+/// Dirichlet edge with data, the normal of a Γ_C edge with a gap), and the number of such components.
+#[allow(clippy::type_complexity)]
+fn constrained_terms(
+    raw: &[(&Vec2Expr, Vec<LoadPoint>)],
+    data: &BoundaryData,
+    space: &CrSpace,
+) -> (Vec<(BoundSet, Vec<Vec<(usize, f64, [f64; 2])>>)>, usize) {
+    let comps = data.constrained(&space.contact);
+    let mut of_edge: Vec<Vec<(usize, [f64; 2])>> = vec![Vec::new(); space.edge_dof.len()];
+    for (c, &(e, a)) in comps.iter().enumerate() {
+        of_edge[e].push((c, a));
+    }
+    let mut out = Vec::new();
+    for (e, pts) in raw {
+        let (mut points, mut feeds) = (Vec::new(), Vec::new());
+        for p in pts {
+            let f: Vec<(usize, f64, [f64; 2])> =
+                p.edges.iter().flat_map(|&(edge, w)| of_edge[edge].iter().map(move |&(c, a)| (c, w, a))).collect();
+            if !f.is_empty() {
+                points.push(p.x);
+                feeds.push(f);
+            }
+        }
+        if !points.is_empty() {
+            out.push((ExprSet::new(&[&e.0[0], &e.0[1]]).bind(points), feeds));
+        }
+    }
+    (out, comps.len())
 }

@@ -5,6 +5,8 @@
 pub mod assemble;
 pub mod elasticity;
 pub mod exact;
+pub mod forms;
+pub mod lifting;
 pub mod loads;
 pub mod norms;
 pub mod prolong;

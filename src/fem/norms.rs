@@ -1,7 +1,8 @@
 //! True errors against an exact solution u (with its exact gradient — never finite differences):
 //!
 //! * energy: |||u − u_h|||² = Σ_T ∫_T σ(u − u_h):ε(u − u_h) + Σ_{e ∈ interior ∪ Dirichlet} (2ρμ/h_e) ∫_e |[u_h]|²
-//!   (the exact u is continuous and vanishes on Γ_D, so the jump of the error is the jump of u_h),
+//!   (the exact u is continuous and vanishes on Γ_D, so the jump of the error is the jump of u_h; with
+//!   boundary data, `fem::lifting`, the jump of the error on a Dirichlet edge is u_h − u),
 //! * broken H¹ seminorm |u − u_h|_{1,h} and L² norm ‖u − u_h‖,
 //!
 //! by the degree-4 triangle rule and the exact 2-point edge rule. The exact u and ∇u (six expressions,
@@ -78,6 +79,9 @@ pub struct ErrorEvaluator {
     bound: Option<ExactAt>,
     /// Per stabilised edge and Gauss point: weight · 2ρμ and the jump terms.
     jumps: Jumps,
+    /// With boundary data: the Gauss points on Γ_D (index into `jumps`, point), where the exact u is
+    /// subtracted from the jump; empty without data.
+    boundary: Vec<(usize, [f64; 2])>,
     law: Elasticity,
 }
 
@@ -99,9 +103,14 @@ impl ErrorEvaluator {
         }
         let pen = 2.0 * rho * law.mu;
         let mut jumps = Jumps { weight: Vec::new(), first: vec![0], edge: Vec::new(), coef: Vec::new() };
+        let mut boundary = Vec::new();
         for e in 0..mesh.edges.len() {
             if space.is_stabilised(mesh, e) {
                 for (s, w) in GAUSS2 {
+                    if space.data.is_some() && mesh.edge_tris[e].1.is_none() {
+                        let [a, b] = mesh.edges[e].map(|v| mesh.points[v]);
+                        boundary.push((jumps.weight.len(), super::quadrature::edge_point(a, b, s)));
+                    }
                     jumps.weight.push(pen * w);
                     for (k, p) in jump_terms(mesh, e, s) {
                         jumps.edge.push(k);
@@ -111,7 +120,7 @@ impl ErrorEvaluator {
                 }
             }
         }
-        ErrorEvaluator { n_elements, geometry, points, bound: None, jumps, law: *law }
+        ErrorEvaluator { n_elements, geometry, points, bound: None, jumps, boundary, law: *law }
     }
 
     /// Bind the exact solution to the quadrature points once: its parts that do not depend on t are then
@@ -185,19 +194,29 @@ impl ErrorEvaluator {
         });
         let failed = failed.into_inner().unwrap_or_else(|p| p.into_inner());
         let good = failed.as_ref().map_or(nf, |((f, _), _)| *f);
-        let norms = (0..good)
-            .map(|f| {
-                let (mut en, mut h1, mut l2) = (0.0f64, 0.0f64, 0.0f64);
-                for [e, h, l] in parts.iter().skip(f).step_by(nf) {
-                    en += e;
-                    h1 += h;
-                    l2 += l;
-                }
+        let mut failed = failed.map(|(_, e)| e);
+        let mut norms = Vec::with_capacity(good);
+        for f in 0..good {
+            let (mut en, mut h1, mut l2) = (0.0f64, 0.0f64, 0.0f64);
+            for [e, h, l] in parts.iter().skip(f).step_by(nf) {
+                en += e;
+                h1 += h;
+                l2 += l;
+            }
+            if self.boundary.is_empty() {
                 en += self.jump_energy(fields[f].0);
-                ErrorNorms { energy: en.max(0.0).sqrt(), h1: h1.sqrt(), l2: l2.sqrt() }
-            })
-            .collect();
-        (norms, failed.map(|(_, e)| e))
+            } else {
+                match self.boundary_values(exact, fields[f].1) {
+                    Ok(v) => en += self.jump_energy_minus(fields[f].0, &v),
+                    Err(e) => {
+                        failed = Some(e);
+                        break;
+                    }
+                }
+            }
+            norms.push(ErrorNorms { energy: en.max(0.0).sqrt(), h1: h1.sqrt(), l2: l2.sqrt() });
+        }
+        (norms, failed)
     }
 
     /// (energy, H¹, L²) squared error contributions of the elements of a batch into `out`: per element
@@ -269,11 +288,26 @@ impl ErrorEvaluator {
 
     /// The stabilisation part Σ_e (2ρμ/h_e) ∫_e |[u_h]|² of a CR field.
     pub fn jump_energy(&self, mid: &[[f64; 2]]) -> f64 {
+        self.jump_energy_minus(mid, &[])
+    }
+
+    /// The exact u at the Γ_D points of `boundary` at time t.
+    fn boundary_values(&self, exact: &Exact, t: f64) -> Result<Vec<(usize, [f64; 2])>> {
+        self.boundary.iter().map(|&(q, x)| Ok((q, exact.u.eval(x[0], x[1], t)?))).collect()
+    }
+
+    /// [`ErrorEvaluator::jump_energy`] with `sub` (jump point, value; increasing points) subtracted
+    /// from the jump at those points.
+    fn jump_energy_minus(&self, mid: &[[f64; 2]], sub: &[(usize, [f64; 2])]) -> f64 {
         let (mut en, jp) = (0.0, &self.jumps);
-        for (w, at) in jp.weight.iter().zip(jp.first.windows(2)) {
+        let mut sub = sub.iter().peekable();
+        for (q, (w, at)) in jp.weight.iter().zip(jp.first.windows(2)).enumerate() {
             let mut j = [0.0; 2];
             for (&e, &p) in jp.edge[at[0]..at[1]].iter().zip(&jp.coef[at[0]..at[1]]) {
                 j = [j[0] + p * mid[e][0], j[1] + p * mid[e][1]];
+            }
+            if let Some((_, u)) = sub.next_if(|(k, _)| *k == q) {
+                j = [j[0] - u[0], j[1] - u[1]];
             }
             en += w * (j[0] * j[0] + j[1] * j[1]);
         }

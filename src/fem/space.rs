@@ -4,12 +4,14 @@
 //! φ_i = 1 − 2λ_i: it is 1 at that edge's midpoint and 0 at the other two, and ∇φ_i = −2∇λ_i is constant.
 //! A vector CR function has one 2-vector per edge midpoint. In V_h the midpoint value is
 //!
-//! * `Fixed` (zero) on Dirichlet edges,
-//! * s_e τ_e on contact edges (τ_e = (−n_y, n_x), n_e outward: the normal part is eliminated), one unknown,
+//! * `Fixed` (zero) on Dirichlet edges (u_D's edge mean, the lifting, is added outside V_h: `lifting`),
+//! * s_e τ_e on contact edges (τ_e = (−n_y, n_x), n_e outward: the normal part is eliminated; an imposed
+//!   normal displacement is part of the lifting), one unknown,
 //! * (u_x, u_y) elsewhere, two unknowns.
 //!
 //! The interpolant I_CR takes edge means (3-point Gauss), which commute with time derivatives.
 
+use super::lifting::BoundaryData;
 use super::quadrature::{edge_point, GAUSS3};
 use crate::error::Result;
 use crate::mesh::Mesh;
@@ -115,6 +117,8 @@ pub struct CrSpace {
     pub contact: Vec<ContactEdge>,
     /// Number of Dirichlet edges.
     pub n_dirichlet: usize,
+    /// Nonzero boundary data u_D, g_n (`None` without: u = w, the unknowns alone).
+    pub data: Option<BoundaryData>,
 }
 
 impl CrSpace {
@@ -129,11 +133,11 @@ impl CrSpace {
         for (e, part) in edge_part.iter().enumerate() {
             let kind = part.map(|p| &parts[p].kind);
             edge_dof.push(match kind {
-                Some(PartKind::Dirichlet) => {
+                Some(PartKind::Dirichlet(_)) => {
                     n_dirichlet += 1;
                     EdgeDof::Fixed
                 }
-                Some(PartKind::Contact(g)) => {
+                Some(PartKind::Contact(g, _)) => {
                     let normal = mesh.outward_normal(e);
                     let tangent = [-normal[1], normal[0]];
                     let [a, b] = mesh.edges[e].map(|v| mesh.points[v]);
@@ -152,7 +156,8 @@ impl CrSpace {
                 }
             });
         }
-        Ok(CrSpace { edge_dof, edge_part, n_dofs: n, contact, n_dirichlet })
+        let data = BoundaryData::new(mesh, parts, &edge_part, &contact);
+        Ok(CrSpace { edge_dof, edge_part, n_dofs: n, contact, n_dirichlet, data })
     }
 
     /// True if edge e carries the stabilisation (interior or Dirichlet).
@@ -188,6 +193,24 @@ impl CrSpace {
                 .iter()
                 .map(|d| d.terms().fold([0.0; 2], |acc, (k, c)| [acc[0] + c[0] * u[k], acc[1] + c[1] * u[k]])),
         );
+    }
+
+    /// The displacement u = w + u_L(t) at every edge midpoint: [`CrSpace::midpoint_values_into`] of the
+    /// unknowns `w` plus the lifting of the boundary data at time t (`fem::lifting`; none without data).
+    pub fn displacement_into(&self, w: &[f64], t: f64, out: &mut Vec<[f64; 2]>) -> Result<()> {
+        self.midpoint_values_into(w, out);
+        if let Some(data) = &self.data {
+            let v = data.values(t)?;
+            data.add_lifting(&self.contact, &v, out);
+        }
+        Ok(())
+    }
+
+    /// [`CrSpace::displacement_into`] into a new vector.
+    pub fn displacement(&self, w: &[f64], t: f64) -> Result<Vec<[f64; 2]>> {
+        let mut out = Vec::with_capacity(self.edge_dof.len());
+        self.displacement_into(w, t, &mut out)?;
+        Ok(out)
     }
 
     /// I_CR v: edge means by 3-point Gauss, restricted to V_h (tangential part on contact edges). The

@@ -111,6 +111,11 @@ impl Friction {
         Ok(FrictionSolution { mu: back(mu), slip_increment: back(slip_increment), state, iterations, residual })
     }
 
+    /// The diagonal C_ee of the condensed operator (the slip of edge e per unit friction force on it).
+    pub fn diagonal(&self) -> Vec<f64> {
+        (0..self.w.len()).map(|e| self.c[(e, e)]).collect()
+    }
+
     /// Number of steps whose friction bound was below the rounding of the load and treated as zero.
     pub fn zeroed_steps(&self) -> usize {
         self.zeroed.load(std::sync::atomic::Ordering::Relaxed)

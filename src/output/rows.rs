@@ -47,6 +47,8 @@ pub struct Rows {
     pub(super) mu: Vec<f64>,
     pub(super) dof: Vec<f64>,
     pub(super) errors: [Vec<f64>; 3],
+    /// The energy audit (`stepping::audit`), in `Audit::as_array`'s order; NaN for a step without one.
+    pub(super) audit: [Vec<f64>; 6],
 }
 
 impl Rows {
@@ -65,6 +67,8 @@ impl Rows {
         self.state.extend(r.state.iter().map(|&s| s as u8));
         append(&mut self.mu, &r.mu);
         append(&mut self.dof, dof);
+        let audit = r.audit.map_or([f64::NAN; 6], |a| a.as_array());
+        self.audit.iter_mut().zip(audit).for_each(|(v, a)| v.push(a));
         if let Some(e) = &r.errors {
             self.errors[0].push(e.energy);
             self.errors[1].push(e.h1);
@@ -90,5 +94,6 @@ impl Rows {
         }
         self.state.clear();
         self.errors.iter_mut().for_each(Vec::clear);
+        self.audit.iter_mut().for_each(Vec::clear);
     }
 }

@@ -43,7 +43,7 @@ impl Unknowns {
             });
         }
         check_finite(path, n, "u", &r.u)?;
-        space.midpoint_values_into(&r.u, &mut mid);
+        space.displacement_into(&r.u, r.t, &mut mid)?;
         let dof = space.contact.iter().map(|c| r.u[c.dof]).collect();
         let r = StepResult { u: Vec::new(), mu: r.mu.clone(), slip: r.slip.clone(), state: r.state.clone(), ..*r };
         Ok(Unknowns { r, mid, dof })

@@ -6,7 +6,17 @@
 //! Time series (first axis = time node, allocated for all N + 1 steps at creation and filled as steps
 //! are committed; rows beyond `completed` hold no data, and a stopped run is cut to its steps):
 //! `times`, `u` (·, E, 2), `energy`, `steps/{iterations, residual, n_stick, n_slip, wall_time}`,
-//! `contact/{slip, sigma_t, state, mu, dof}` (·, C) when Γ_C exists, `errors/{energy, h1, l2}` when `[exact]`.
+//! `contact/{slip, sigma_t, state, mu, dof}` (·, C) when Γ_C exists, `errors/{energy, h1, l2}` when `[exact]`,
+//! and the energy audit of every step (`stepping::audit`, energy units: force × length per unit
+//! thickness) `steps/{external_work, boundary_work, stored_energy, friction_dissipation,
+//! euler_dissipation, balance_residual}`: (lⁿ,δuⁿ); the work of the reactions on Γ_D and of Γ_C's
+//! imposed normal displacement (0 without boundary data); Eⁿ = ½a_h(uⁿ,uⁿ) (Dirichlet jump against
+//! u_D); j_h(δuⁿ); ½a_h(δuⁿ,δuⁿ); and a_h(uⁿ,δuⁿ) + j_h(δuⁿ) − (lⁿ,δuⁿ) − boundary_work, which vanishes
+//! up to rounding and the friction solver's tolerance (NaN where a step had no audit). The audit series
+//! are not part of the checksum below (files before them have none).
+//!
+//! `u` is the displacement at the edge midpoints, the lifting of the boundary data included
+//! (`fem::lifting`); `energy` is a_h(uⁿ,uⁿ) with the Dirichlet jump measured against u_D.
 //! `tresca/steps` carries the attribute `completed` (number of complete steps), written after every
 //! other dataset of a step. `tresca/steps/checksum` (u64) holds per step the XXH64 (seed 0) of the step's
 //! rows of every series above, in the order `times, u, energy, steps/{iterations, residual, n_stick, n_slip,
@@ -42,7 +52,19 @@ pub struct Tresca {
     errors: Option<[Series; 3]>,
     /// XXH64 of each step's rows (`None` in files of versions before it).
     checksum: Option<Series>,
+    /// The energy audit, [`AUDIT`] (`None` in files of versions before it).
+    audit: Option<Vec<Series>>,
 }
+
+/// The audit's series under `steps`, in `stepping::Audit::as_array`'s order.
+pub const AUDIT: [&str; 6] = [
+    "external_work",
+    "boundary_work",
+    "stored_energy",
+    "friction_dissipation",
+    "euler_dissipation",
+    "balance_residual",
+];
 
 /// The XXH64 of each of `k` steps whose rows are the k equal consecutive parts of every slice of
 /// `series` (the bytes of consecutive steps of each series, in the order of the module doc).
@@ -133,7 +155,9 @@ impl Tresca {
         )?;
         attr_str(loc, "status", "running")?;
         attr(&sg, "completed", 0i64)?;
+        let audit = AUDIT.iter().map(|a| Series::create::<f64>(&sg, a, 1, &[], sc)).collect::<hdf5::Result<_>>()?;
         Ok(Tresca {
+            audit: Some(audit),
             checksum: Some(Series::create::<u64>(&sg, "checksum", 1, &[], sc)?),
             times: Series::create::<f64>(&g, "times", 1, &[], sc)?,
             u: Series::create::<f64>(&g, "u", 1, &[ne, 2], sc)?,
@@ -169,6 +193,7 @@ impl Tresca {
             Err(_) => None,
         };
         Ok(Tresca {
+            audit: AUDIT.iter().map(|a| Series::open(&sg, a, 1)).collect::<hdf5::Result<_>>().ok(),
             checksum: Series::open(&sg, "checksum", 1).ok(),
             times: Series::open(&g, SCALARS[0], 1)?,
             u: Series::open(&g, "u", 1)?,
@@ -277,6 +302,11 @@ impl Tresca {
                 s.write_steps(raw, n, k, v)?;
             }
         }
+        if let Some(a) = &self.audit {
+            for (s, v) in a.iter().zip(&b.audit) {
+                s.write_steps(raw, n, k, v)?;
+            }
+        }
         Ok(())
     }
 
@@ -290,6 +320,9 @@ impl Tresca {
     pub fn set_steps(&mut self, raw: &Raw, steps: usize, kept: usize) -> hdf5::Result<()> {
         if let Some(c) = &mut self.checksum {
             c.set_steps(raw, steps, kept)?;
+        }
+        for a in self.audit.iter_mut().flatten() {
+            a.set_steps(raw, steps, kept)?;
         }
         self.all().into_iter().try_for_each(|s| s.set_steps(raw, steps, kept))
     }
@@ -336,6 +369,7 @@ impl Tresca {
             energy: self.energy.read::<f64>(n)?[0],
             errors,
             wall: self.wall.read::<f64>(n)?[0],
+            audit: None,
         })
     }
 

@@ -106,7 +106,7 @@ impl Estimate {
 /// (triangles, edges, contact edges) of the scene's mesh, without building it.
 fn sizes(scene: &Scene) -> Result<(u64, u64, u64)> {
     let contact_parts: Vec<&str> =
-        scene.parts.iter().filter(|p| matches!(p.kind, PartKind::Contact(_))).map(|p| p.name.as_str()).collect();
+        scene.parts.iter().filter(|p| matches!(p.kind, PartKind::Contact(..))).map(|p| p.name.as_str()).collect();
     match &scene.mesh {
         MeshSpec::Structured { cells, refine, .. } => {
             let f = 1u64 << refine;

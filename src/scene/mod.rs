@@ -200,7 +200,12 @@ impl Scene {
     }
 
     /// True if the scene has a contact part.
+    /// True if a part imposes nonzero boundary data (u_D or g_n; see [`PartKind`]).
+    pub fn has_boundary_data(&self) -> bool {
+        self.parts.iter().any(|p| p.kind.has_data())
+    }
+
     pub fn has_contact(&self) -> bool {
-        self.parts.iter().any(|p| matches!(p.kind, PartKind::Contact(_)))
+        self.parts.iter().any(|p| matches!(p.kind, PartKind::Contact(..)))
     }
 }

@@ -77,6 +77,10 @@ pub(super) struct RawBoundary {
     pub(super) kind: RawKind,
     pub(super) traction: Option<[String; 2]>,
     pub(super) g_a: Option<String>,
+    /// Dirichlet data u_D(x, y, t) of a dirichlet part (default 0).
+    pub(super) u: Option<[String; 2]>,
+    /// Imposed normal displacement g_n(x, y, t) of a contact part (default 0).
+    pub(super) gap: Option<String>,
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]

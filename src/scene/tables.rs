@@ -63,8 +63,14 @@ pub(super) fn parts(file: &str, boundary: &[RawBoundary]) -> Result<Vec<Part>> {
         if b.g_a.is_some() && b.kind != RawKind::Contact {
             return Err(Error::scene(file, key("g_a"), "only contact parts take a friction bound g_a"));
         }
+        if b.u.is_some() && b.kind != RawKind::Dirichlet {
+            return Err(Error::scene(file, key("u"), "only dirichlet parts take boundary values u"));
+        }
+        if b.gap.is_some() && b.kind != RawKind::Contact {
+            return Err(Error::scene(file, key("gap"), "only contact parts take an imposed normal displacement gap"));
+        }
         let kind = match b.kind {
-            RawKind::Dirichlet => PartKind::Dirichlet,
+            RawKind::Dirichlet => PartKind::Dirichlet(super::parts::dirichlet_data(file, &key("u"), b.u.as_ref())?),
             RawKind::Neumann => PartKind::Neumann(match &b.traction {
                 Some(g) => nonzero(Some(Vec2Expr::parse(&key("traction"), sized(file, &key("traction"), g)?)?)),
                 None => None,
@@ -72,12 +78,15 @@ pub(super) fn parts(file: &str, boundary: &[RawBoundary]) -> Result<Vec<Part>> {
             RawKind::Contact => {
                 let text = b.g_a.as_deref().ok_or_else(|| Error::scene(file, key("g_a"), "contact part needs g_a"))?;
                 sized(file, &key("g_a"), &[text.to_string()])?;
-                PartKind::Contact(FrictionBound::parse(file, &key("g_a"), text)?)
+                PartKind::Contact(
+                    FrictionBound::parse(file, &key("g_a"), text)?,
+                    super::parts::gap_data(file, &key("gap"), b.gap.as_ref())?,
+                )
             }
         };
         parts.push(Part { name: b.name.clone(), kind });
     }
-    if !parts.iter().any(|p| matches!(p.kind, PartKind::Dirichlet)) {
+    if !parts.iter().any(|p| p.kind.is_dirichlet()) {
         return Err(Error::scene(
             file,
             "boundary",

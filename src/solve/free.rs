@@ -125,6 +125,18 @@ impl FreeResponse {
         self.basis.is_some()
     }
 
+    /// lⁿ = l(tₙ) on every unknown, by the cheapest route: from the superposition's patterns when the
+    /// loads are superposed (equal to the assembled load within its span tolerance), else assembled.
+    pub fn load_at(&self, n: usize, t: f64, out: &mut Vec<f64>) -> Result<()> {
+        match &self.basis {
+            Some(b) => {
+                b.load(n, self.n_dofs, out);
+                Ok(())
+            }
+            None => self.loads.assemble(t, out),
+        }
+    }
+
     /// The load functional.
     pub fn loads(&self) -> &Loads {
         &self.loads

@@ -78,8 +78,7 @@ fn check(kappa: f64, scene: &Scene, mesh: &Mesh, space: &CrSpace) -> std::result
 /// The likeliest reason for an ill-conditioned K, for its message: a piece of the body held by no
 /// Dirichlet edge, slivers, a weak jump term, near-incompressibility.
 fn ill_conditioning_cause(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> String {
-    use crate::scene::PartKind;
-    let dirichlet = |e: usize| space.edge_part[e].is_some_and(|p| matches!(scene.parts[p].kind, PartKind::Dirichlet));
+    let dirichlet = |e: usize| space.edge_part[e].is_some_and(|p| scene.parts[p].kind.is_dirichlet());
     if let Some(p) = mesh.floating_piece(dirichlet) {
         return format!(
             "a piece of the mesh (through ({:e}, {:e})) shares no edge with the rest and has no Dirichlet edge: it \

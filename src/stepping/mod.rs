@@ -4,7 +4,9 @@
 //! in two calls, as docs/model.md describes a step: the free response u_f = K⁻¹lⁿ with its contact trace
 //! s_f (`solve::free`), then the friction problem on Γ_C for d = s_f − sⁿ⁻¹ (`friction`), and
 //! uⁿ = u_f − K⁻¹Eμ. Without Γ_C a step is the free response alone. Each completed step is handed to a
-//! callback (the writer), so nothing is lost if a later step fails.
+//! callback (the writer), so nothing is lost if a later step fails, with its energy audit ([`audit`]).
+//! With boundary data (`fem::lifting`) u above is w, the unknowns; the displacement is w + u_L(tₙ)
+//! (`CrSpace::displacement`), which the errors, the audit and the results file use.
 
 use crate::error::{Error, Result};
 use crate::fem::assemble::{stiffness_values, EdgePattern};
@@ -27,10 +29,12 @@ use faer::sparse::SparseColMat;
 use std::sync::Arc;
 use std::time::Instant;
 
+pub mod audit;
 mod conditioning;
 mod run;
 mod setup;
 
+pub use audit::{Audit, AuditState};
 pub use conditioning::MAX_CONDITION;
 pub use run::RunOptions;
 pub use setup::Discretised;
@@ -55,6 +59,8 @@ pub struct Problem {
     /// Step 0, computed during the set-up beside the numeric factorisation (`None` if that failed: it is
     /// then computed again when asked for, and fails with its error).
     step0: Option<StepResult>,
+    /// The energy audit's forms, made at the first audited step.
+    forms: std::sync::OnceLock<crate::fem::forms::FullForm>,
 }
 
 /// Wall times of the set-up phases (seconds).
@@ -98,6 +104,9 @@ pub struct StepResult {
     pub energy: f64,
     pub errors: Option<ErrorNorms>,
     pub wall: f64,
+    /// The step's energy audit (`None` for a step without u, or not run through [`Problem::run`]'s
+    /// family).
+    pub audit: Option<Audit>,
 }
 
 impl StepResult {
@@ -196,6 +205,7 @@ impl Problem {
                 energy,
                 errors: None,
                 wall: start.elapsed().as_secs_f64(),
+                audit: None,
             };
             return self.finish(r);
         };
@@ -247,6 +257,7 @@ fn contact_result(
         energy,
         errors: None,
         wall,
+        audit: None,
     }
 }
 
@@ -278,6 +289,7 @@ fn initial_state(
         energy,
         errors: None,
         wall: 0.0,
+        audit: None,
     };
     finish(r, scene, mesh, space, errors)
 }
@@ -292,7 +304,7 @@ fn finish(
 ) -> Result<StepResult> {
     let mut r = checked(r)?;
     if let (Some(ev), Some(ex), true) = (errors, &scene.exact, has_u(space, &r)) {
-        r.errors = Some(ev.errors(mesh, ex, &space.midpoint_values(&r.u), r.t)?);
+        r.errors = Some(ev.errors(mesh, ex, &space.displacement(&r.u, r.t)?, r.t)?);
     }
     Ok(r)
 }

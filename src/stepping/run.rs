@@ -67,7 +67,8 @@ impl Problem {
         let (mut norms, mut failed) = (Vec::new(), None);
         if let (Some(ev), Some(ex)) = (&self.errors, &self.scene.exact) {
             let with_u: Vec<&StepResult> = done.iter().filter(|r| self.has_u(r)).collect();
-            let mids: Vec<Vec<[f64; 2]>> = with_u.iter().map(|r| self.space.midpoint_values(&r.u)).collect();
+            let mids: Vec<Vec<[f64; 2]>> =
+                with_u.iter().map(|r| self.space.displacement(&r.u, r.t)).collect::<Result<_>>()?;
             let fields: Vec<(&[[f64; 2]], f64)> = mids.iter().zip(&with_u).map(|(m, r)| (&m[..], r.t)).collect();
             (norms, failed) = ev.errors_at(&self.mesh, ex, &fields);
         }
@@ -175,8 +176,19 @@ impl Problem {
         want: impl Fn(usize) -> bool,
         mut on_step: impl FnMut(&StepResult) -> Result<()>,
     ) -> Result<()> {
+        // the energy audit of every step handed out, against the state of the step before
+        let (first, mut state) = match first {
+            Some(f) => {
+                let (f, s) = self.audited(None, &f)?;
+                (Some(f), s)
+            }
+            None => (None, self.audit_state(&from)?),
+        };
         let mut held = Held { first, steps: Vec::new(), bytes: 0 };
         let mut hand = |r: &StepResult| -> Result<()> {
+            let (r, s) = self.audited(state.as_ref(), r)?;
+            state = s;
+            let r = &r;
             if !self.conditioning.ready() && held.hold(r) {
                 return Ok(());
             }

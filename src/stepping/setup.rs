@@ -34,6 +34,7 @@ impl Problem {
     ) -> WithBeside<R> {
         let t0 = Instant::now();
         let space = CrSpace::new(&mesh, &scene.parts).map_err(|e| (e, None))?;
+        crate::fem::lifting::consistency::check(&scene, &mesh, &space).map_err(|e| (e, None))?;
         let t1 = Instant::now();
         let law = Elasticity::new(&scene.material);
         let p0 = Discretised { scene, mesh, space, law };
@@ -63,6 +64,7 @@ impl Problem {
             errors,
             conditioning,
             step0,
+            forms: Default::default(),
         };
         Ok((p, r))
     }

@@ -32,7 +32,11 @@ from tresca_py.common import ROOT, rel_to
 # agreement with the rows is what --resume and scripts/check_results.py verify)
 VOLATILE = {"steps/wall_time", "steps/checksum", "setup_times", "version", "git_commit", "scene_path"}
 # added by a later version (issue 18: per-step checksums): compared when both files have it, else skipped
-ADDED = {"tresca/steps/checksum"}
+ADDED = {"tresca/steps/checksum"} | {
+    # issue 30: the per-step energy audit (src/stepping/audit.rs)
+    f"tresca/steps/{k}" for k in ("external_work", "boundary_work", "stored_energy", "friction_dissipation",
+                                  "euler_dissipation", "balance_residual")
+}
 
 
 def runs():

@@ -1,0 +1,174 @@
+//! Boundary data that do not fit together are refused before anything is solved:
+//!
+//! * u₀ must equal u_D(·, t₀) on every Dirichlet edge (u_D = 0 where a part gives none),
+//! * u₀·n must equal g_n(·, t₀) on every Γ_C edge (g_n = 0 where a part gives none),
+//! * at a vertex shared by two Dirichlet parts their data must agree, and at a vertex shared by a
+//!   Dirichlet and a contact part u_D·n_e = g_n (n_e the contact edge's normal), at every time node.
+//!
+//! Values are compared at the 3-point Gauss points of the edges (u₀ and the data) and at the shared
+//! vertices. Tolerance: 1e-9 of the size of the data, the largest |u₀| at a mesh vertex or value
+//! compared. Consistent data differ there only by the rounding of their expressions (a few ulps of
+//! that size), while any real mismatch below 1e-9 of the data would be far below what the
+//! discretisation resolves.
+//!
+//! Only scenes with boundary data are checked: without them (u_D = 0, g_n = 0) a u₀ that does not vanish
+//! on Γ_D or whose normal part does not vanish on Γ_C is projected onto V_h (those values dropped), as
+//! in every earlier version, so that such scenes run unchanged.
+
+use super::gauss3_points;
+use crate::error::{Error, Result};
+use crate::fem::space::CrSpace;
+use crate::mesh::Mesh;
+use crate::scene::expr::Vec2Expr;
+use crate::scene::{PartKind, Scene};
+
+/// A mismatch found: (what, where, the two values).
+type Mismatch = (String, [f64; 2], f64, f64);
+
+/// Refuse inconsistent boundary data (module doc), naming the parts, the point and the values.
+pub fn check(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<()> {
+    if !scene.has_boundary_data() {
+        return Ok(());
+    }
+    let mut cmp: Vec<Mismatch> = Vec::new();
+    let t0 = scene.times[0];
+    let zero = |_: f64, _: f64, _: f64| Ok([0.0, 0.0]);
+    let u0 = |x: f64, y: f64| match &scene.u0 {
+        Some(u) => u.eval(x, y, t0),
+        None => zero(x, y, t0),
+    };
+    let ud = |u: &Option<Vec2Expr>, x: f64, y: f64, t: f64| match u {
+        Some(u) => u.eval(x, y, t),
+        None => zero(x, y, t),
+    };
+    for e in 0..mesh.edges.len() {
+        let Some(p) = space.edge_part[e] else { continue };
+        let part = &scene.parts[p];
+        match &part.kind {
+            PartKind::Dirichlet(u) => {
+                if u.is_none() && scene.u0.is_none() {
+                    continue;
+                }
+                for x in gauss3_points(mesh, e) {
+                    let (a, b) = (u0(x[0], x[1])?, ud(u, x[0], x[1], t0)?);
+                    for c in 0..2 {
+                        cmp.push((
+                            format!("initial.u0[{c}] and part `{}`'s u[{c}] at t0 = {t0}", part.name),
+                            x,
+                            a[c],
+                            b[c],
+                        ));
+                    }
+                }
+            }
+            PartKind::Contact(_, g) => {
+                if g.is_none() && scene.u0.is_none() {
+                    continue;
+                }
+                let n = mesh.outward_normal(e);
+                for x in gauss3_points(mesh, e) {
+                    let a = u0(x[0], x[1])?;
+                    let b = match g {
+                        Some(g) => g.eval(x[0], x[1], t0)?,
+                        None => 0.0,
+                    };
+                    cmp.push((
+                        format!("initial.u0·n and part `{}`'s gap at t0 = {t0}", part.name),
+                        x,
+                        a[0] * n[0] + a[1] * n[1],
+                        b,
+                    ));
+                }
+            }
+            PartKind::Neumann(_) => {}
+        }
+    }
+    shared_vertices(scene, mesh, space, &mut cmp)?;
+    let mut scale = cmp.iter().fold(0.0f64, |m, c| m.max(c.2.abs()).max(c.3.abs()));
+    for x in &mesh.points {
+        let v = u0(x[0], x[1])?;
+        scale = scale.max(v[0].abs()).max(v[1].abs());
+    }
+    let tol = 1e-9 * scale;
+    match cmp.into_iter().find(|c| (c.2 - c.3).abs() > tol) {
+        None => Ok(()),
+        Some((what, x, a, b)) => Err(Error::scene(
+            &scene.file,
+            "boundary",
+            format!(
+                "inconsistent boundary data: {what} differ at ({:.6}, {:.6}): {a:e} against {b:e} (tolerance {tol:.1e})",
+                x[0], x[1]
+            ),
+        )),
+    }
+}
+
+/// The comparisons at vertices shared by parts with data (module doc), at every time node.
+fn shared_vertices(scene: &Scene, mesh: &Mesh, space: &CrSpace, cmp: &mut Vec<Mismatch>) -> Result<()> {
+    // per vertex: the boundary edges at it with their parts
+    let mut at: Vec<Vec<(usize, usize)>> = vec![Vec::new(); mesh.points.len()];
+    for e in 0..mesh.edges.len() {
+        if let Some(p) = space.edge_part[e] {
+            for v in mesh.edges[e] {
+                at[v].push((e, p));
+            }
+        }
+    }
+    for (v, edges) in at.iter().enumerate() {
+        let x = mesh.points[v];
+        for (i, &(ea, pa)) in edges.iter().enumerate() {
+            for &(eb, pb) in &edges[i + 1..] {
+                if pa == pb {
+                    continue;
+                }
+                let (a, b) = (&scene.parts[pa], &scene.parts[pb]);
+                if !a.kind.has_data() && !b.kind.has_data() {
+                    continue;
+                }
+                let what = format!("parts `{}` and `{}` at their common vertex", a.name, b.name);
+                for &t in &scene.times {
+                    match (&a.kind, &b.kind) {
+                        (PartKind::Dirichlet(ua), PartKind::Dirichlet(ub)) => {
+                            let (va, vb) = (vec_at(ua, x, t)?, vec_at(ub, x, t)?);
+                            for c in 0..2 {
+                                cmp.push((format!("{what} (u[{c}], t = {t})"), x, va[c], vb[c]));
+                            }
+                        }
+                        (PartKind::Dirichlet(u), PartKind::Contact(_, g)) => {
+                            cmp.push((
+                                format!("{what} (u·n against gap, t = {t})"),
+                                x,
+                                normal_of(mesh, eb, vec_at(u, x, t)?),
+                                gap_at(g, x, t)?,
+                            ));
+                        }
+                        (PartKind::Contact(_, g), PartKind::Dirichlet(u)) => {
+                            cmp.push((
+                                format!("{what} (gap against u·n, t = {t})"),
+                                x,
+                                gap_at(g, x, t)?,
+                                normal_of(mesh, ea, vec_at(u, x, t)?),
+                            ));
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn vec_at(u: &Option<Vec2Expr>, x: [f64; 2], t: f64) -> Result<[f64; 2]> {
+    u.as_ref().map_or(Ok([0.0; 2]), |u| u.eval(x[0], x[1], t))
+}
+
+fn gap_at(g: &Option<crate::scene::expr::Expr>, x: [f64; 2], t: f64) -> Result<f64> {
+    g.as_ref().map_or(Ok(0.0), |g| g.eval(x[0], x[1], t))
+}
+
+/// u·n_e for the outward normal of edge e.
+fn normal_of(mesh: &Mesh, e: usize, u: [f64; 2]) -> f64 {
+    let n = mesh.outward_normal(e);
+    u[0] * n[0] + u[1] * n[1]
+}
