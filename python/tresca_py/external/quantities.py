@@ -8,8 +8,14 @@ points; tresca-cr: the edge state). From them :func:`summarise` adds
 
 * ``max_slip``  = max over the samples of |u·τ| (u_n is imposed, so u·τ is the slip relative to the foundation),
 * ``stick_a``, ``stick_b`` = the first and the last stick↔slip transition along Γ_C (arc length from its
-  start; the stick zone's ends where it is one interior interval, the slip zone's where that is), each
-  halfway between the two neighbouring points whose flags differ; NaN where nothing (or everything) sticks.
+  start), each the zero of the piecewise-linear interpolant of the code's stick margin φ between the two
+  neighbouring points where φ changes sign; NaN where nothing (or everything) sticks. φ is the semismooth
+  active-set indicator, continuous in the solution: Nitsche φ = g_a − |σ_τ(u) − p δu_τ| (p the Nitsche
+  parameter, δu_τ the last step's slip increment) at the contact quadrature points; tresca-cr the same
+  formula with its multiplier σ_τ, its edge slip increment and p = γ_N (λ + 2μ)/|e| at the edge midpoints.
+  φ > 0 sticks, φ < 0 slips. (The earlier definition, halfway between two points whose flags differ, moved
+  in jumps of the quadrature spacing as h changed, and a three-level Richardson estimate of a quantity that
+  jumps by ±h/2 has no meaning; the interpolated zero moves continuously with the solution.)
 """
 from __future__ import annotations
 
@@ -23,17 +29,19 @@ QUANTITIES = ("h1_norm", "energy", "u_tau_1", "u_tau_2", "u_tau_3", "sigma_t_int
 ERRORS = ("err_h1_semi", "err_l2")
 
 
-def stick_ends(s, stick, length):
-    """The first and the last stick↔slip transition along Γ_C (arc length), each halfway between the two
-    points whose flags differ; (NaN, NaN) when all of Γ_C sticks or all of it slips."""
-    s, stick = np.asarray(s, dtype=float), np.asarray(stick, dtype=bool)
+def stick_ends(s, margin):
+    """The first and the last zero of the piecewise-linear interpolant of the stick margin along Γ_C (arc
+    length); (NaN, NaN) when the margin has one sign (all of Γ_C sticks or all of it slips)."""
+    s, m = np.asarray(s, dtype=float), np.asarray(margin, dtype=float)
     order = np.argsort(s, kind="stable")
-    s, stick = s[order], stick[order]
-    change = np.nonzero(stick[1:] != stick[:-1])[0]
+    s, m = s[order], m[order]
+    change = np.nonzero((m[1:] > 0) != (m[:-1] > 0))[0]
     if change.size == 0:
         return math.nan, math.nan
-    a, b = change[0], change[-1]
-    return float(0.5 * (s[a] + s[a + 1])), float(0.5 * (s[b] + s[b + 1]))
+
+    def zero(i):
+        return float(s[i] + (s[i + 1] - s[i]) * m[i] / (m[i] - m[i + 1]))
+    return zero(change[0]), zero(change[-1])
 
 
 def summarise(raw, length):
@@ -42,7 +50,7 @@ def summarise(raw, length):
     for i, v in enumerate(raw["u_tau_points"], start=1):
         row[f"u_tau_{i}"] = float(v)
     row["max_slip"] = float(np.max(np.abs(raw["u_tau_samples"])))
-    row["stick_a"], row["stick_b"] = stick_ends(raw["quad_s"], raw["quad_stick"], length)
+    row["stick_a"], row["stick_b"] = stick_ends(raw["quad_s"], raw["quad_margin"])
     for k in ERRORS:
         if k in raw:
             row[k] = float(raw[k])
