@@ -182,6 +182,7 @@ class Solver:
         xq = np.asarray(md.interpolation("X", mimd2, CONTACT)).reshape(-1, 2).T
         margin = np.asarray(md.interpolation("GA - " + QTAU.replace(SIGMA, sig_expr), mimd1, CONTACT))
         stick = margin > 0
+        dslip = np.asarray(md.interpolation("Norm((Id(2) - Normal@Normal)*(u - UP))", mimd1, CONTACT))
         start = np.asarray(pr["start"])
         s_q = (xq[0] - start[0]) * tau[0] + (xq[1] - start[1]) * tau[1]
 
@@ -190,7 +191,8 @@ class Solver:
             return v[0] * tau[0] + v[1] * tau[1]
         out = {"h1_norm": float(np.hypot(l2, semi)), "energy": float(energy), "sigma_t_integral": float(sig),
                "u_tau_points": probe(pr["points"]).tolist(), "u_tau_samples": probe(pr["samples"]).tolist(),
-               "quad_s": s_q.tolist(), "quad_stick": stick.astype(int).tolist(), "quad_margin": margin.tolist()}
+               "quad_s": s_q.tolist(), "quad_stick": stick.astype(int).tolist(), "quad_margin": margin.tolist(),
+               "quad_dslip": dslip.tolist()}
         if self.prob["exact"] is not None:
             out.update(self.errors(U, t))
         return out

@@ -260,10 +260,15 @@ class Solver:
                "u_tau_points": self._probe(u, pr["points"]).tolist(),
                "u_tau_samples": self._probe(u, pr["samples"]).tolist(),
                "quad_s": s_q.ravel().tolist(), "quad_stick": (np.abs(q) < g).ravel().astype(int).tolist(),
-               "quad_margin": (g - np.abs(q)).ravel().tolist()}
+               "quad_margin": (g - np.abs(q)).ravel().tolist(), "quad_dslip": self._dslip(u, u_prev).ravel().tolist()}
         if self.prob["exact"] is not None:
             out.update(self.errors(ub, t))
         return out
+
+    def _dslip(self, u, u_prev):
+        """|δu_τ| = |(u − u_prev)·τ| at the contact quadrature points."""
+        du = np.asarray(self.fb.interpolate(u[:self.nu] - u_prev[:self.nu]))
+        return np.abs(du[0] * self.tau[0] + du[1] * self.tau[1])
 
     def energy(self, u):
         """½a(u, u) = ½∫σ(u):ε(u)."""

@@ -80,7 +80,8 @@ def read_results(path, probes, pen_scale):
            "sigma_t_integral": float(np.sum(sig * lengths)),
            "u_tau_points": trace(probes["points"]).tolist(), "u_tau_samples": trace(probes["samples"]).tolist(),
            "quad_s": mids.tolist(), "quad_stick": (state == 0).astype(int).tolist(), "dofs": int(2 * len(edges)),
-           "quad_margin": (g_mean - np.abs(sig - pen_scale / lengths * (slip[-1] - slip[0]))).tolist()}
+           "quad_margin": (g_mean - np.abs(sig - pen_scale / lengths * (slip[-1] - slip[0]))).tolist(),
+           "quad_dslip": np.abs(slip[-1] - slip[0]).tolist()}
     if err:
         raw["err_h1_semi"], raw["err_l2"] = err["h1"], err["l2"]
     return raw
