@@ -115,7 +115,7 @@ def test_stick_ends():
     a, b = quantities.stick_ends([0.0, 0.1, 0.2, 0.3, 0.4], [2.0, 0.0, 0.0, -0.0, 4.0], 1.0)
     assert (a, b) == pytest.approx((0.05, 0.325))
     assert all(math.isnan(v) for v in quantities.stick_ends([0.0, 0.1], [0.5, 0.2], 1.0))
-    assert quantities.slip_threshold([0.0, -2.0], 0.5, 1.0, 1) == pytest.approx(0.25 * 2.0)
+    assert quantities.slip_threshold([0.0, -2.0], 0.5, 1.0) == pytest.approx(0.25 * 2.0)
 
 
 def test_problem_rejects_unknown_names(tmp_path):

@@ -28,11 +28,11 @@ def by_code(rows, scene):
 def theory_order(code, scene, q):
     """The theoretical order of quantity q for a code: its H1 order k, except the stick–slip endpoints on a
     scene whose slip grows like the cube of the distance to the fronts (``Scene.cubic_front``): the
-    threshold η_h ∝ h^{k+1} and the slip error O(h^{k+1}) move the threshold's crossing by O(h^{(k+1)/3})
-    (``quantities``), so the endpoints converge at order (k+1)/3 there."""
+    threshold η_h ∝ h² (and a slip error O(h²) or smaller) moves the threshold's crossing by O(h^{2/3})
+    (``quantities``), so the endpoints converge at order 2/3 there."""
     sc = next((s for s in SCENES if s.name == scene), None)
     k = ORDER[code]
-    return (k + 1) / 3 if sc is not None and sc.cubic_front and q in ("stick_a", "stick_b") else k
+    return 2 / 3 if sc is not None and sc.cubic_front and q in ("stick_a", "stick_b") else k
 
 
 def limits(rows, scene):
