@@ -12,9 +12,10 @@ points; tresca-cr: the edge state). From them :func:`summarise` adds
   evaluates its contact state, of ψ = η_h − |δu_τ| (δu_τ the last step's slip increment), i.e. the ends of
   the slip's support measured at the threshold η_h = (h/|Γ_C|)² max_{Γ_C} |δu_τ| (h² ∝ the L∞ accuracy of
   the order-1 codes; one law for every code: the Nitsche codes' stick zones carry a slip of the size of
-  their error, ≈ 7e-6 next to mms_front's Γ_C/Γ_N corner for GetFEM P2 at 16 cells, above (h/|Γ_C|)³ max
-  |δu_τ| ≈ 1.5e-5 at the next coarser level's rate, so an h³ threshold for P2 placed spurious transitions
-  there). NaN where ψ has one sign (nothing or everything slips).
+  their error, ≈ 7e-6 next to mms_front's Γ_C/Γ_N corner for GetFEM P2 at 32 cells, above (h/|Γ_C|)³ max
+  |δu_τ| ≈ 2e-6, so an h^{k+1} threshold for P2 placed spurious transitions there; (h/|Γ_C|)² gives 4e-5
+  there, and 1.1e-5 for GetFEM P1 at 64 cells against its 6e-6). NaN where ψ has one sign (nothing or
+  everything slips).
   Why not the flags themselves: halfway between two points whose flags differ jumps by the point spacing as
   h changes (a three-level Richardson estimate of such a sequence means nothing), and a flag, or the zero of
   the stick margin g_a − |σ_τ|, is ill-conditioned where the margin closes to high order: on the
