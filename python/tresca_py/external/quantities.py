@@ -15,7 +15,10 @@ points; tresca-cr: the edge state). From them :func:`summarise` adds
   their error, ≈ 7e-6 next to mms_front's Γ_C/Γ_N corner for GetFEM P2 at 32 cells, above (h/|Γ_C|)³ max
   |δu_τ| ≈ 2e-6, so an h^{k+1} threshold for P2 placed spurious transitions there; (h/|Γ_C|)² gives 4e-5
   there, and 1.1e-5 for GetFEM P1 at 64 cells against its 6e-6). NaN where ψ has one sign (nothing or
-  everything slips).
+  everything slips). Points within h of an end of Γ_C that lies on Γ_D are left out: there the slip vanishes
+  because u = u_D, not because friction holds it, and the threshold set next to the junction has length
+  ≈ η_h/|∂_s δu_τ| = O(h²) < h (Example 5.1, all slip: the P2 codes otherwise found a stick zone of that
+  length at the clamped end of Γ_C, the order-1 codes none).
   Why not the flags themselves: halfway between two points whose flags differ jumps by the point spacing as
   h changes (a three-level Richardson estimate of such a sequence means nothing), and a flag, or the zero of
   the stick margin g_a − |σ_τ|, is ill-conditioned where the margin closes to high order: on the
@@ -57,14 +60,18 @@ def slip_threshold(dslip, h, length):
     return (h / length) ** 2 * float(np.max(np.abs(dslip)))
 
 
-def summarise(raw, length):
+def summarise(raw, probes):
     """The row of compared quantities (and true errors when present) from a raw result dict."""
+    length = probes["length"]
     row = {k: float(raw[k]) for k in ("h1_norm", "energy", "sigma_t_integral")}
     for i, v in enumerate(raw["u_tau_points"], start=1):
         row[f"u_tau_{i}"] = float(v)
     row["max_slip"] = float(np.max(np.abs(raw["u_tau_samples"])))
-    eta = slip_threshold(raw["quad_dslip"], raw["h"], length)
-    row["stick_a"], row["stick_b"] = stick_ends(raw["quad_s"], raw["quad_dslip"], eta)
+    s_q, dslip = np.asarray(raw["quad_s"], dtype=float), np.asarray(raw["quad_dslip"], dtype=float)
+    start_d, end_d = probes.get("dirichlet_ends", (False, False))
+    keep = ~((start_d & (s_q < raw["h"])) | (end_d & (s_q > length - raw["h"])))
+    eta = slip_threshold(dslip, raw["h"], length)
+    row["stick_a"], row["stick_b"] = stick_ends(s_q[keep], dslip[keep], eta)
     for k in ERRORS:
         if k in raw:
             row[k] = float(raw[k])

@@ -160,13 +160,14 @@ def markdown(rows, scenes, notes, reqs, elapsed, lims, ref_dir):
            "`tresca-cr run`). Nitsche parameter p = γ_N (λ+2μ)/h with γ_N = 10 in every Nitsche code (GetFEM: h =",
            "its `element_size`; scikit-fem: the facet length). The P2 and TH codes run one level below the others",
            "(about equal DOF at the finest level). All codes of a scene use the same backward-Euler steps;",
-           "quantities at T. Stick–slip endpoints: the first and last zero of the interpolated stick margin",
-           "φ = g_a − |σ_τ − p δu_τ| along Γ_C (`tresca_py/external/quantities.py`). Limits: Richardson from each",
+           "quantities at T. Stick–slip endpoints: the ends of the last step's slip support at the threshold",
+           "(h/|Γ_C|)² max|δu_τ|, zeros interpolated along Γ_C (`tresca_py/external/quantities.py`). max_slip:",
+           "max |u·τ| over 513 samples of Γ_C. Limits: Richardson from each",
            "code's three finest levels with Roache's GCI (`tresca_py/external/richardson.py`): factor 1.25 with the",
            "observed order when the three values converge monotonically with p ≥ ½ and the fourth-finest level",
            "confirms p (GCI ratio within 10 %, as `tresca-cr study`), otherwise no extrapolation and the band",
-           "3·max(|d₁|, |d₂|)/(2^p_th − 1) with the theoretical order p_th (the code's H1 order k; k/3 for the",
-           "endpoints on the scenes whose stick margin closes cubically at the fronts). Raw rows:",
+           "3·max(|d₁|, |d₂|)/(2^p_th − 1) with the theoretical order p_th (the code's H1 order k; 2/3 for the",
+           "endpoints on the scenes whose slip grows cubically from the fronts). Raw rows:",
            "`reference/external.csv`.", ""]
     for sc in scenes:
         L = lims[sc.name]

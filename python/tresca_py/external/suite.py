@@ -130,7 +130,7 @@ def run_scene(sc: Scene, codes, out_dir, binary, log=print):
                 raw = tresca.run_level(binary, sc.path, r, sc.steps, work, prob["probes"],
                                        prob["gamma_n"] * (prob["lam"] + 2 * prob["mu"]))
             raw["h"] = prob["h"]
-            row = quantities.summarise(raw, prob["probes"]["length"])
+            row = quantities.summarise(raw, prob["probes"])
             row.update({"scene": sc.name, "code": code, "refine": r, "steps": sc.steps,
                         "process_s": time.perf_counter() - t0})
             rows.append(row)
