@@ -129,3 +129,17 @@ def test_problem_rejects_unknown_names(tmp_path):
 def test_problem_is_json(patch):
     """The problem description shall be JSON-serialisable (it is the GetFEM subprocess's input)."""
     json.dumps(problem.build(patch, 1, degree=1))
+
+
+def test_stick_ends_skip_dirichlet_junction():
+    """The system shall not report as a stick zone the slip's vanishing within h of a Γ_C/Γ_D junction."""
+    s = [0.05, 0.15, 0.25, 0.35, 0.45, 0.55, 0.65, 0.75, 0.85, 0.95]
+    dslip = [1.0] * 9 + [1e-6]     # all slips; the slip → 0 at the clamped end s = 1
+    raw = {"h1_norm": 1.0, "energy": 1.0, "sigma_t_integral": 0.0, "u_tau_points": [0.0, 0.0, 0.0],
+           "u_tau_samples": [0.0], "quad_s": s, "quad_dslip": dslip, "dofs": 1, "wall_s": 0.0, "h": 0.1}
+    probes = {"length": 1.0, "dirichlet_ends": [False, True]}
+    row = quantities.summarise(raw, probes)
+    assert math.isnan(row["stick_a"]) and math.isnan(row["stick_b"])
+    probes["dirichlet_ends"] = [False, False]  # a Neumann end: the same data is a stick zone at the end
+    row = quantities.summarise(raw, probes)
+    assert row["stick_a"] == pytest.approx(0.85 + 0.1 * (0.01 - 1.0) / (0.01 - 1.0 - (0.01 - 1e-6)))
