@@ -5,7 +5,7 @@ import subprocess
 
 import pytest
 
-from tresca_py.external import problem, quantities, richardson, skfem_nitsche, suite
+from tresca_py.external import problem, quantities, richardson, skfem_mixed, skfem_nitsche, suite
 
 # An affine field u = (0.01x + 0.02y, 0.01y) on the unit square: f = 0, u·n = 0 on y = 0, and on y = 0
 # σ_τ = −σ₁₂ = −0.02μ while u_τ = 0.01x > 0: with g_a = 0.02μ the bottom slips everywhere under the exact
@@ -57,11 +57,20 @@ def test_skfem_nitsche_patch(patch):
     _check_patch(skfem_nitsche.solve(problem.build(patch, 0, degree=2)))
 
 
+def test_skfem_mixed_patch(patch):
+    """The system shall reproduce the affine slipping field with the Taylor–Hood P2/P1 Nitsche solver (the
+    pressure −λ div u is constant, in P1)."""
+    _check_patch(skfem_nitsche.solve(problem.build(patch, 0, degree=2), skfem_mixed.MixedSolver))
+
+
 @pytest.mark.skipif(not suite.getfem_available(), reason="GetFEM not installed under /usr/bin/python3 (make getfem)")
-@pytest.mark.parametrize("degree", [1, 2])
-def test_getfem_patch(patch, tmp_path, degree):
-    """The system shall reproduce the affine slipping field with GetFEM P1 and P2."""
-    raw = suite.run_getfem(problem.build(patch, 0, degree=degree), tmp_path)
+@pytest.mark.parametrize("degree,mixed", [(1, False), (2, False), (2, True)])
+def test_getfem_patch(patch, tmp_path, degree, mixed):
+    """The system shall reproduce the affine slipping field with GetFEM P1, P2 and Taylor–Hood P2/P1."""
+    prob = problem.build(patch, 0, degree=degree)
+    prob["mixed"] = mixed
+    raw = suite.run_getfem(prob, tmp_path)
+    assert raw["code"] == ("getfem-TH" if mixed else f"getfem-P{degree}")
     _check_patch(raw)
 
 
@@ -86,14 +95,27 @@ def test_richardson_exact_on_a_power_law():
     assert lim.extrapolated and lim.p == pytest.approx(2.0) and lim.value == pytest.approx(1.0, abs=1e-14)
     assert lim.gci >= 0.01 * 1.0 - 1e-15  # 1.25·|d₂|/3 = 0.0125 ≥ the finest error 0.01
     osc = richardson.limit(h, [1.0, 1.1, 1.05], p_th=1)
-    assert not osc.extrapolated and osc.value == 1.05 and osc.gci == pytest.approx(3 * 0.05)
+    # not monotone: no extrapolation, band 3·max(|d₁|, |d₂|)/(2¹ − 1) (the last difference alone measures a
+    # crossing, not the distance to the limit)
+    assert not osc.extrapolated and osc.value == 1.05 and osc.gci == pytest.approx(3 * 0.1)
+
+
+def test_richardson_fourth_level_check():
+    """The system shall extrapolate only when a fourth level confirms the three finest levels' order."""
+    h = [0.8, 0.4, 0.2, 0.1]
+    ok = richardson.limit(h, [1 + x * x for x in h], p_th=2)
+    assert ok.extrapolated and ok.value == pytest.approx(1.0, abs=1e-14)
+    # the three finest follow 1 + h² but the coarsest does not (error 0.05 at h = 0.8 instead of 0.64)
+    bad = richardson.limit(h, [1.05] + [1 + x * x for x in h[1:]], p_th=2)
+    assert not bad.extrapolated and bad.value == pytest.approx(1.01) and bad.gci == pytest.approx(3 * 0.12 / 3)
 
 
 def test_stick_ends():
-    """The system shall place the stick–slip transitions halfway between differing flags."""
-    a, b = quantities.stick_ends([0.0, 0.1, 0.2, 0.3, 0.4], [0, 1, 1, 1, 0], 0.4)
-    assert (a, b) == pytest.approx((0.05, 0.35))
-    assert all(math.isnan(v) for v in quantities.stick_ends([0.0, 0.1], [1, 1], 0.1))
+    """The system shall place the stick–slip transitions at the zeros of the interpolated ψ = η − |δu_τ|."""
+    a, b = quantities.stick_ends([0.0, 0.1, 0.2, 0.3, 0.4], [2.0, 0.0, 0.0, -0.0, 4.0], 1.0)
+    assert (a, b) == pytest.approx((0.05, 0.325))
+    assert all(math.isnan(v) for v in quantities.stick_ends([0.0, 0.1], [0.5, 0.2], 1.0))
+    assert quantities.slip_threshold([0.0, -2.0], 0.5, 1.0) == pytest.approx(0.25 * 2.0)
 
 
 def test_problem_rejects_unknown_names(tmp_path):
@@ -107,3 +129,17 @@ def test_problem_rejects_unknown_names(tmp_path):
 def test_problem_is_json(patch):
     """The problem description shall be JSON-serialisable (it is the GetFEM subprocess's input)."""
     json.dumps(problem.build(patch, 1, degree=1))
+
+
+def test_stick_ends_skip_dirichlet_junction():
+    """The system shall not report as a stick zone the slip's vanishing within h of a Γ_C/Γ_D junction."""
+    s = [0.05, 0.15, 0.25, 0.35, 0.45, 0.55, 0.65, 0.75, 0.85, 0.95]
+    dslip = [1.0] * 9 + [1e-6]     # all slips; the slip → 0 at the clamped end s = 1
+    raw = {"h1_norm": 1.0, "energy": 1.0, "sigma_t_integral": 0.0, "u_tau_points": [0.0, 0.0, 0.0],
+           "u_tau_samples": [0.0], "quad_s": s, "quad_dslip": dslip, "dofs": 1, "wall_s": 0.0, "h": 0.1}
+    probes = {"length": 1.0, "dirichlet_ends": [False, True]}
+    row = quantities.summarise(raw, probes)
+    assert math.isnan(row["stick_a"]) and math.isnan(row["stick_b"])
+    probes["dirichlet_ends"] = [False, False]  # a Neumann end: the same data is a stick zone at the end
+    row = quantities.summarise(raw, probes)
+    assert row["stick_a"] == pytest.approx(0.85 + 0.1 * (0.01 - 1.0) / (0.01 - 1.0 - (0.01 - 1e-6)))

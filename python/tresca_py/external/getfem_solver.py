@@ -30,6 +30,13 @@ gf.util_trace_level(0)
 gf.util_warning_level(0)
 
 SIGMA = "(lambda*Trace(Grad_u)*Id(2) + mu*(Grad_u + Grad_u'))"
+# mixed (Taylor–Hood P2/P1, p = −λ div u): σ(u, p) = 2μ ε(u) − p I; bulk 2μ(ε(u), ε(v)) − (p, div v) − (q, div u)
+# − (p, q)/λ; symmetric normal Nitsche term with σ(u, p) (θ = 1, as the brick in the displacement form)
+SIGMA_M = "(2*mu*Sym(Grad_u) - p*Id(2))"
+BULK_M = "2*mu*Sym(Grad_u):Grad_Test_u - p*Div_Test_u - Test_p*Div_u - p*Test_p/lambda"
+NITSCHE_M = ("-(" + SIGMA_M + "*Normal).Normal*(Test_u.Normal)"
+             " - ((2*mu*Sym(Grad_Test_u) - Test_p*Id(2))*Normal).Normal*(u.Normal - GAP)"
+             " + (u.Normal - GAP)*(Test_u.Normal)/(gamma0*element_size)")
 PROJ = ("Ball_projection((Id(2) - Normal@Normal)*(" + SIGMA + "*Normal - (u - UP)/(gamma0*element_size)), GA)")
 QTAU = "Norm((Id(2) - Normal@Normal)*(" + SIGMA + "*Normal - (u - UP)/(gamma0*element_size)))"
 FLOOR = 1e-8  # accepted relative residual of a stalled Newton iteration (rounding; see Solver.run)
@@ -70,7 +77,14 @@ class Solver:
         md.add_initialized_data("lambda", prob["lam"])
         md.add_initialized_data("mu", prob["mu"])
         md.add_initialized_data("gamma0", 1.0 / (prob["gamma_n"] * (prob["lam"] + 2 * prob["mu"])))
-        md.add_isotropic_linearized_elasticity_brick(self.mim, "u", "lambda", "mu")
+        self.mixed = bool(prob.get("mixed"))
+        if self.mixed:
+            self.mfp = gf.MeshFem(self.m, 1)
+            self.mfp.set_classical_fem(k - 1)  # continuous P1 pressure with P2 displacement: Taylor–Hood
+            md.add_fem_variable("p", self.mfp)
+            md.add_linear_term(self.mim, BULK_M)
+        else:
+            md.add_isotropic_linearized_elasticity_brick(self.mim, "u", "lambda", "mu")
         self.xd = self.mfd.basic_dof_nodes()
         self.xu = self.mfu.basic_dof_nodes()
         self.data = []  # (name, mf, codes-or-code, component or None)
@@ -94,9 +108,13 @@ class Solver:
         self._scalar_data("GAP", self.contact["gap"])
         self._scalar_data("GA", self.contact["g_a"])
         md.add_initialized_fem_data("UP", self.mfu, np.zeros(self.mfu.nbdof()))
-        md.add_normal_Dirichlet_condition_with_Nitsche_method(self.mim, "u", md.Neumann_term("u", CONTACT),
-                                                              "gamma0", CONTACT, 1.0, "GAP")
-        md.add_nonlinear_term(self.mim, "-" + PROJ + ".Test_u", CONTACT)
+        if self.mixed:
+            md.add_nonlinear_term(self.mim, NITSCHE_M, CONTACT)
+            md.add_nonlinear_term(self.mim, "-" + PROJ.replace(SIGMA, SIGMA_M) + ".Test_u", CONTACT)
+        else:
+            md.add_normal_Dirichlet_condition_with_Nitsche_method(self.mim, "u", md.Neumann_term("u", CONTACT),
+                                                                  "gamma0", CONTACT, 1.0, "GAP")
+            md.add_nonlinear_term(self.mim, "-" + PROJ + ".Test_u", CONTACT)
 
     def _scalar_data(self, name, src):
         self.md.add_initialized_fem_data(name, self.mfd, np.zeros(self.mfd.nbdof()))
@@ -144,7 +162,9 @@ class Solver:
             iters.append(int(nit))
         wall = time.perf_counter() - t0
         out = self.quantities(times[-1])
-        out.update({"code": f"getfem-P{prob['degree']}", "dofs": int(self.mfu.nbdof()), "wall_s": wall,
+        dofs = self.mfu.nbdof() + (self.mfp.nbdof() if self.mixed else 0)
+        out.update({"code": "getfem-TH" if self.mixed else f"getfem-P{prob['degree']}", "dofs": int(dofs),
+                    "wall_s": wall,
                     "newton_iterations": iters})
         return out
 
@@ -153,11 +173,16 @@ class Solver:
         U = md.variable("u")
         tau = np.asarray(pr["tangent"])
         l2, semi = gf.compute_L2_norm(mfu, U, mim), gf.compute_H1_semi_norm(mfu, U, mim)
-        energy = gf.asm("generic", mim, 0, "0.5*(" + SIGMA + "):Sym(Grad_u)", -1, md)
-        sig = gf.asm("generic", mim, 0, "[-Normal(2);Normal(1)]." + PROJ, CONTACT, md)
+        # the mixed form's own energy ½(2μ‖ε(u)‖² + ‖p‖²/λ), = ½a(u, u) when p = −λ div u
+        energy = gf.asm("generic", mim, 0, "mu*Sym(Grad_u):Sym(Grad_u) + 0.5*p*p/lambda" if self.mixed
+                        else "0.5*(" + SIGMA + "):Sym(Grad_u)", -1, md)
+        sig_expr = SIGMA_M if self.mixed else SIGMA
+        sig = gf.asm("generic", mim, 0, "[-Normal(2);Normal(1)]." + PROJ.replace(SIGMA, sig_expr), CONTACT, md)
         mimd2, mimd1 = gf.MeshImData(mim, CONTACT, [2]), gf.MeshImData(mim, CONTACT)
         xq = np.asarray(md.interpolation("X", mimd2, CONTACT)).reshape(-1, 2).T
-        stick = np.asarray(md.interpolation("GA - " + QTAU, mimd1, CONTACT)) > 0
+        margin = np.asarray(md.interpolation("GA - " + QTAU.replace(SIGMA, sig_expr), mimd1, CONTACT))
+        stick = margin > 0
+        dslip = np.asarray(md.interpolation("Norm((Id(2) - Normal@Normal)*(u - UP))", mimd1, CONTACT))
         start = np.asarray(pr["start"])
         s_q = (xq[0] - start[0]) * tau[0] + (xq[1] - start[1]) * tau[1]
 
@@ -166,7 +191,8 @@ class Solver:
             return v[0] * tau[0] + v[1] * tau[1]
         out = {"h1_norm": float(np.hypot(l2, semi)), "energy": float(energy), "sigma_t_integral": float(sig),
                "u_tau_points": probe(pr["points"]).tolist(), "u_tau_samples": probe(pr["samples"]).tolist(),
-               "quad_s": s_q.tolist(), "quad_stick": stick.astype(int).tolist()}
+               "quad_s": s_q.tolist(), "quad_stick": stick.astype(int).tolist(), "quad_margin": margin.tolist(),
+               "quad_dslip": dslip.tolist()}
         if self.prob["exact"] is not None:
             out.update(self.errors(U, t))
         return out

@@ -191,6 +191,10 @@ def at_level(scene, refine, steps=None, degree=2, gamma_n=10.0):
     prob.update({"refine": refine, "degree": degree, "points": pts.tolist(), "triangles": tri.tolist(),
                  "parts": parts, "times": (np.arange(n_steps + 1) * scene["T"] / n_steps).tolist(),
                  "gamma_n": gamma_n, "h": h, "probes": contact_probes(pts, sides[contact["name"]])})
+    # whether Γ_C's start / end vertex lies on a Dirichlet part (quantities.summarise: the slip vanishes there)
+    dir_vertices = {int(v) for p in parts if p["kind"] == "dirichlet" for seg in p["segments"] for v in seg}
+    segs = sides[contact["name"]]
+    prob["probes"]["dirichlet_ends"] = [int(segs[0][0]) in dir_vertices, int(segs[-1][1]) in dir_vertices]
     return prob
 
 

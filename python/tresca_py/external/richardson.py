@@ -1,11 +1,16 @@
-"""Richardson limits with Roache's grid convergence index (GCI) from a code's three finest levels.
+"""Richardson limits with Roache's grid convergence index (GCI) and the project's asymptotic-range check.
 
-With values Q₁, Q₂, Q₃ on h, h/r, h/r² (r = 2 here), d₁ = Q₂ − Q₁, d₂ = Q₃ − Q₂:
+With the three finest values Q₁, Q₂, Q₃ on h, h/r, h/r² (r = 2 here), d₁ = Q₂ − Q₁, d₂ = Q₃ − Q₂:
 
-* monotone (d₁d₂ > 0, |d₂| < |d₁|) with observed order p = log(d₁/d₂)/log r in [½, p_max]:
-  Q* = Q₃ + d₂/(rᵖ − 1), band GCI = 1.25 |d₂|/(rᵖ − 1)  (safety factor 1.25, three grids);
-* otherwise (oscillating, stalled or p out of range): no extrapolation, Q* = Q₃ and the conservative band
-  GCI = 3 |d₂|/(r^{p_th} − 1) with the theoretical order p_th (Roache's factor 3 for unconfirmed orders);
+* extrapolated when the three values converge monotonically (d₁d₂ > 0, |d₂| < |d₁|) with an observed order
+  p = log(d₁/d₂)/log r in [½, p_max], and — given a fourth level Q₀ — the level pair (Q₀, Q₁) confirms p as
+  ``tresca-cr study`` does (``src/study/richardson.rs``): with eⱼ = |Qⱼ − Q*|, |(e₀/e₁)/rᵖ − 1| ≤ RATIO_TOL.
+  Then Q* = Q₃ + d₂/(rᵖ − 1), band GCI = 1.25 |d₂|/(rᵖ − 1) (safety factor 1.25, three grids);
+* otherwise (oscillating, stalled, p out of range or not confirmed by the fourth level: the sequence is not
+  in its asymptotic range) no extrapolation: Q* = Q₃ and the band GCI = 3 max(|d₁|, |d₂|)/(r^{p_th} − 1) with
+  the theoretical order p_th (Roache's factor 3 for unconfirmed orders). The larger of the two differences:
+  a sequence that changes direction can have an arbitrarily small last difference (Example 5.1's P1 corner
+  slip: d₁ = 1.7e-6 then d₂ = −1.4e-8), which measures the crossing, not the distance to the limit;
 * d₂ = 0 (the value no longer changes): Q* = Q₃, GCI = 0.
 """
 from __future__ import annotations
@@ -15,17 +20,32 @@ from dataclasses import dataclass
 
 from tresca_py.common import observed_order
 
+#: GCI-ratio tolerance of the fourth-level check (the value of tresca-cr's ``RATIO_TOL``)
+RATIO_TOL = 0.1
+
 
 @dataclass
 class Limit:
     value: float
     gci: float
-    p: float          # observed order (NaN when not monotone)
+    p: float          # observed order (NaN when not extrapolated)
     extrapolated: bool
 
 
+def _confirmed(h, q, p, qstar):
+    """The fourth-finest level's check of p (True when there is no fourth level to check with)."""
+    if len(q) < 4:
+        return True
+    e0, e1 = abs(q[-4] - qstar), abs(q[-3] - qstar)
+    if e1 == 0.0:
+        return False
+    ratio = (e0 / e1) / (h[-4] / h[-3]) ** p
+    return math.isfinite(ratio) and abs(ratio - 1.0) <= RATIO_TOL
+
+
 def limit(h, q, p_th=1.0, p_max=5.0):
-    """Limit and band from the three finest (h, Q) pairs (h decreasing)."""
+    """Limit and band from the finest (h, Q) pairs (h decreasing; three or more levels)."""
+    h, q = list(h), list(q)
     (_, h2, h3), (q1, q2, q3) = h[-3:], q[-3:]
     if any(not math.isfinite(v) for v in (q1, q2, q3)):
         return Limit(math.nan, math.nan, math.nan, False)
@@ -36,8 +56,10 @@ def limit(h, q, p_th=1.0, p_max=5.0):
     if d1 * d2 > 0 and abs(d2) < abs(d1):
         p = observed_order(abs(d1), abs(d2), r, 1.0)  # equal ratios h₁/h₂ = h₂/h₃ = r (uniform refinement)
         if 0.5 <= p <= p_max:
-            return Limit(q3 + d2 / (r ** p - 1), 1.25 * abs(d2) / (r ** p - 1), p, True)
-    return Limit(q3, 3.0 * abs(d2) / (r ** p_th - 1), math.nan, False)
+            qstar = q3 + d2 / (r ** p - 1)
+            if _confirmed(h, q, p, qstar):
+                return Limit(qstar, 1.25 * abs(d2) / (r ** p - 1), p, True)
+    return Limit(q3, 3.0 * max(abs(d1), abs(d2)) / (r ** p_th - 1), math.nan, False)
 
 
 #: rounding floor of a band, relative to the value: the codes stop Newton at a relative residual of 1e-10

@@ -17,6 +17,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from skfem import Basis, BilinearForm, ElementTriP2, ElementVector, FacetBasis, Functional, LinearForm, MeshTri, asm
 from skfem.models.elasticity import linear_elasticity
@@ -54,9 +55,12 @@ def _facets(mesh, segments):
 class Solver:
     """Set-up (mesh, bases, constant matrices) and the time loop for one problem dict (``problem.build``)."""
 
+    CODE = "skfem-P2-nitsche"
+
     def __init__(self, prob):
         self.prob = prob
         self.lam, self.mu = prob["lam"], prob["mu"]
+        self.lam_s = self.lam  # λ in the boundary stress σ(u)n (0 in the mixed form, where −p I replaces it)
         self.mesh = MeshTri(np.ascontiguousarray(np.asarray(prob["points"]).T),
                             np.ascontiguousarray(np.asarray(prob["triangles"]).T))
         self.basis = Basis(self.mesh, ElementVector(ElementTriP2()), intorder=6)
@@ -70,6 +74,7 @@ class Solver:
                 self.contact = part
                 self.fb = self.parts[part["name"]][2]
         self._setup_dofs()
+        self.nu = self.ndof = self.basis.N  # u unknowns; all unknowns (the mixed variant appends p)
         self.K = asm(linear_elasticity(self.lam, self.mu), self.basis)
         hf = self.mesh.facets  # facet length per contact quadrature point, shape (nel, nqp)
         fac = self.parts[self.contact["name"]][1]
@@ -87,42 +92,50 @@ class Solver:
         self.D = np.unique(np.concatenate(dd)) if dd else np.zeros(0, dtype=np.int64)
 
     def _normal_form(self, u, v, w):
-        lam, mu, n, p = self.lam, self.mu, self.n, self.pen
+        lam, mu, n, p = self.lam_s, self.mu, self.n, self.pen
         un, vn = u[0] * n[0] + u[1] * n[1], v[0] * n[0] + v[1] * n[1]
         return (-_nsn(u.grad, lam, mu, n, n) * vn - _nsn(v.grad, lam, mu, n, n) * un + p * un * vn)
 
     def interpolate(self, codes, t):
         """Nodal P2 interpolant of a 2-vector of expression codes at time t."""
         x, y = self.basis.doflocs
-        out = np.zeros(self.basis.N)
+        out = np.zeros(self.ndof)
         for c in range(2):
-            sel = self.comp == c
+            sel = np.nonzero(self.comp == c)[0]
             out[sel] = evaluate(codes[c], x[sel], y[sel], t)
         return out
 
     def load(self, t):
         """(lⁿ, v) + N(g_n n, v) at time t (data evaluated once at the quadrature points)."""
-        prob, lam, mu, n = self.prob, self.lam, self.mu, self.n
-        rhs = np.zeros(self.basis.N)
+        prob, lam, mu, n = self.prob, self.lam_s, self.mu, self.n
+        rhs = np.zeros(self.ndof)
         if prob["f"] is not None:
             x = self.basis.global_coordinates().value
             fv = [evaluate(prob["f"][c], x[0], x[1], t) for c in range(2)]
-            rhs += asm(LinearForm(lambda v, w: fv[0] * v[0] + fv[1] * v[1]), self.basis)
+            rhs += self.pad(asm(LinearForm(lambda v, w: fv[0] * v[0] + fv[1] * v[1]), self.basis))
         for part, _, fb in self.parts.values():
             if part["kind"] == "neumann":
                 x = fb.global_coordinates().value
                 tv = [evaluate(part["traction"][c], x[0], x[1], t) for c in range(2)]
-                rhs += asm(LinearForm(lambda v, w, tv=tv: tv[0] * v[0] + tv[1] * v[1]), fb)
+                rhs += self.pad(asm(LinearForm(lambda v, w, tv=tv: tv[0] * v[0] + tv[1] * v[1]), fb))
         x = self.fb.global_coordinates().value
         g = evaluate(self.contact["gap"], x[0], x[1], t)
 
         def gap_form(v, w):
             return g * (-_nsn(v.grad, lam, mu, n, n) + self.pen * (v[0] * n[0] + v[1] * n[1]))
-        return rhs + asm(LinearForm(gap_form), self.fb)
+        return rhs + self.pad(asm(LinearForm(gap_form), self.fb)) + self.gap_load_p(g)
+
+    def pad(self, vec):
+        """A u-space vector extended by zeros to all unknowns."""
+        return np.concatenate([vec, np.zeros(self.ndof - self.nu)]) if self.ndof > self.nu else vec
+
+    def gap_load_p(self, g):
+        """The pressure rows of N(g_n n, ·) (none in the displacement formulation)."""
+        return 0.0
 
     def traction(self, u, u_prev, t):
         """(q, P, g) at the contact quadrature points: q = σ_τ(u) − p(u_τ − u_τ_prev), P = proj(q)."""
-        fu, fp = self.fb.interpolate(u), self.fb.interpolate(u_prev)
+        fu, fp = self.fb.interpolate(u[:self.nu]), self.fb.interpolate(u_prev[:self.nu])
         du = np.asarray(fu) - np.asarray(fp)
         q = _nsn(fu.grad, self.lam, self.mu, self.tau, self.n) - self.pen * (du[0] * self.tau[0] + du[1] * self.tau[1])
         x = self.fb.global_coordinates().value
@@ -133,7 +146,7 @@ class Solver:
         """R(u) and the stick indicator χ at the contact quadrature points."""
         q, P, g = self.traction(u, u_prev, t)
         tau = self.tau
-        res = A @ u - rhs - asm(LinearForm(lambda v, w: P * (v[0] * tau[0] + v[1] * tau[1])), self.fb)
+        res = A @ u - rhs - self.pad(asm(LinearForm(lambda v, w: P * (v[0] * tau[0] + v[1] * tau[1])), self.fb))
         return res, (np.abs(q) < g).astype(float)
 
     def _factor(self):
@@ -141,12 +154,12 @@ class Solver:
         the Newton matrix is A + E_B M (M: the friction rows, nonzero on B only), solved by Woodbury."""
         if getattr(self, "_lu", None) is None:
             A = (self.K + self.A_n).tocsr()
-            self.free = np.setdiff1d(np.arange(self.basis.N), self.D)
-            pos = -np.ones(self.basis.N, dtype=np.int64)
+            self.free = np.setdiff1d(np.arange(self.ndof), self.D)
+            pos = -np.ones(self.ndof, dtype=np.int64)
             pos[self.free] = np.arange(self.free.size)
             cdofs = self.basis.get_dofs(facets=self.parts[self.contact["name"]][1]).all()
             self.B = pos[np.setdiff1d(cdofs, self.D)]
-            self._lu = spla.splu(A[self.free][:, self.free].tocsc(), permc_spec="MMD_AT_PLUS_A")  # symmetric A
+            self._lu = spla.splu(A[self.free][:, self.free].tocsc(), permc_spec="MMD_AT_PLUS_A")  # symmetric pattern
             E = np.zeros((self.free.size, self.B.size))
             E[self.B, np.arange(self.B.size)] = 1.0
             self._Z = self._lu.solve(E)
@@ -181,7 +194,7 @@ class Solver:
             def jac(du, v, w, chi=chi):
                 return -chi * (_nsn(du.grad, lam, mu, tau, n) - self.pen * (du[0] * tau[0] + du[1] * tau[1])) \
                     * (v[0] * tau[0] + v[1] * tau[1])
-            M = asm(BilinearForm(jac), self.fb).tocsr()[free][:, free][B]
+            M = self.embed(asm(BilinearForm(jac), self.fb)).tocsr()[free][:, free][B]
             y = lu.solve(-res[free])
             du = np.zeros_like(u)
             du[free] = y - Z @ np.linalg.solve(np.eye(B.size) + M @ Z, M @ y)
@@ -195,8 +208,14 @@ class Solver:
         raise NotConverged(f"skfem-nitsche: step at t={t:g} did not converge in {max_iter} Newton iterations "
                            f"(relative residual {rnorm:.3e})")
 
+    def embed(self, mat):
+        """A u-space matrix as the u block of a matrix on all unknowns."""
+        if self.ndof == self.nu:
+            return mat
+        return sp.bmat([[mat, None], [None, sp.csr_matrix((self.ndof - self.nu,) * 2)]])
+
     def interpolate_dirichlet(self, t):
-        out = np.zeros(self.basis.N)
+        out = np.zeros(self.ndof)
         for part, fac, _ in self.parts.values():
             if part["kind"] == "dirichlet":
                 dofs = self.basis.get_dofs(facets=fac).all()
@@ -208,7 +227,7 @@ class Solver:
         prob = self.prob
         t0 = time.perf_counter()
         times = prob["times"]
-        u = self.interpolate(prob["u0"], times[0]) if prob["u0"] is not None else np.zeros(self.basis.N)
+        u = self.initial(times[0])
         iters = []
         u_prev = u
         for t in times[1:]:
@@ -217,35 +236,50 @@ class Solver:
             iters.append(it)
         wall = time.perf_counter() - t0
         out = self.quantities(u, u_prev, times[-1])
-        out.update({"code": "skfem-P2-nitsche", "dofs": int(self.basis.N), "wall_s": wall,
+        out.update({"code": self.CODE, "dofs": int(self.ndof), "wall_s": wall,
                     "newton_iterations": iters, "h": float(self.mesh.params().max())})
         return out
 
+    def initial(self, t0):
+        """u⁰ (nodal interpolant of the scene's u0, or 0) on all unknowns."""
+        return self.interpolate(self.prob["u0"], t0) if self.prob["u0"] is not None else np.zeros(self.ndof)
+
     def quantities(self, u, u_prev, t):
         """The compared quantities at T (see ``quantities.summarise`` for the stick-zone and slip ones)."""
-        lam, mu, tau = self.lam, self.mu, self.tau
-        ub = self.basis.interpolate(u)
+        tau = self.tau
+        ub = self.basis.interpolate(u[:self.nu])
         h1 = Functional(lambda w: w.u[0] ** 2 + w.u[1] ** 2 + np.sum(w.u.grad ** 2, axis=(0, 1)))
-        energy = Functional(lambda w: 0.5 * np.sum(_sig(w.u.grad, lam, mu) * 0.5 * (w.u.grad + np.swapaxes(
-            w.u.grad, 0, 1)), axis=(0, 1)))
         q, P, g = self.traction(u, u_prev, t)
         xq = self.fb.global_coordinates().value
         start = np.asarray(self.prob["probes"]["start"])
         s_q = (xq[0] - start[0]) * tau[0] + (xq[1] - start[1]) * tau[1]
         sig_int = asm(Functional(lambda w: P), self.fb)
         pr = self.prob["probes"]
-        out = {"h1_norm": float(np.sqrt(asm(h1, self.basis, u=ub))), "energy": float(asm(energy, self.basis, u=ub)),
+        out = {"h1_norm": float(np.sqrt(asm(h1, self.basis, u=ub))), "energy": self.energy(u),
                "sigma_t_integral": float(sig_int),
                "u_tau_points": self._probe(u, pr["points"]).tolist(),
                "u_tau_samples": self._probe(u, pr["samples"]).tolist(),
-               "quad_s": s_q.ravel().tolist(), "quad_stick": (np.abs(q) < g).ravel().astype(int).tolist()}
+               "quad_s": s_q.ravel().tolist(), "quad_stick": (np.abs(q) < g).ravel().astype(int).tolist(),
+               "quad_margin": (g - np.abs(q)).ravel().tolist(), "quad_dslip": self._dslip(u, u_prev).ravel().tolist()}
         if self.prob["exact"] is not None:
             out.update(self.errors(ub, t))
         return out
 
+    def _dslip(self, u, u_prev):
+        """|δu_τ| = |(u − u_prev)·τ| at the contact quadrature points."""
+        du = np.asarray(self.fb.interpolate(u[:self.nu] - u_prev[:self.nu]))
+        return np.abs(du[0] * self.tau[0] + du[1] * self.tau[1])
+
+    def energy(self, u):
+        """½a(u, u) = ½∫σ(u):ε(u)."""
+        lam, mu = self.lam, self.mu
+        form = Functional(lambda w: 0.5 * np.sum(_sig(w.u.grad, lam, mu) * 0.5 * (w.u.grad + np.swapaxes(
+            w.u.grad, 0, 1)), axis=(0, 1)))
+        return float(asm(form, self.basis, u=self.basis.interpolate(u[:self.nu])))
+
     def _probe(self, u, pts):
         P = self.basis.probes(np.asarray(pts).T)
-        vals = (P @ u).reshape(2, -1) if P.shape[0] == 2 * len(pts) else None
+        vals = (P @ u[:self.nu]).reshape(2, -1) if P.shape[0] == 2 * len(pts) else None
         if vals is None:
             raise RuntimeError("unexpected probe matrix shape")
         return vals[0] * self.tau[0] + vals[1] * self.tau[1]
@@ -264,10 +298,11 @@ class Solver:
                 "err_l2": float(np.sqrt(asm(Functional(l2), self.basis, u=ub)))}
 
 
-def solve(prob):
-    """Run one problem dict; returns the result dict."""
+def solve(prob, solver_class=Solver):
+    """Run one problem dict with ``solver_class`` (this displacement solver or the mixed one in
+    ``skfem_mixed``); returns the result dict."""
     t0 = time.perf_counter()
-    solver = Solver(prob)
+    solver = solver_class(prob)
     setup = time.perf_counter() - t0
     out = solver.run()
     out["wall_s"] += setup  # set-up + time loop; the post-processing of the quantities is not counted

@@ -15,12 +15,16 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import problem, quantities, skfem_nitsche, tresca
+from . import problem, quantities, skfem_mixed, skfem_nitsche, tresca
 
 GETFEM_PYTHON = "/usr/bin/python3"
-CODES = ("getfem-P1", "getfem-P2", "skfem-P2-nitsche", "tresca-cr")
-#: theoretical H1 order of each code (CR and P1: 1, P2: 2 where the regularity allows)
-ORDER = {"getfem-P1": 1, "getfem-P2": 2, "skfem-P2-nitsche": 2, "tresca-cr": 1}
+CODES = ("getfem-P1", "getfem-P2", "skfem-P2-nitsche", "getfem-TH", "skfem-TH-nitsche", "tresca-cr")
+#: theoretical H1 order of each code (CR and P1: 1, P2 and Taylor–Hood P2/P1: 2 where the regularity allows)
+ORDER = {"getfem-P1": 1, "getfem-P2": 2, "skfem-P2-nitsche": 2, "getfem-TH": 2, "skfem-TH-nitsche": 2,
+         "tresca-cr": 1}
+#: the displacement-only codes, whose error constants grow with λ/μ (locking); the mixed (TH) variants do not
+DISPLACEMENT_ONLY = ("getfem-P1", "getfem-P2", "skfem-P2-nitsche")
+DEFAULT_CODES = ("getfem-P1", "getfem-P2", "skfem-P2-nitsche", "tresca-cr")
 
 
 @dataclass(frozen=True)
@@ -37,6 +41,12 @@ class Scene:
     #: time error (≈ 4e-4 in H1) that the P2 codes' spatial error reaches at 32 cells (their order 1.36 there
     #: becomes 1.88 with N = 16: reference/external.md)
     xo_max_order: int = 2
+    #: the codes run on this scene
+    codes: tuple = DEFAULT_CODES
+    #: λ/μ ≥ 10³: the displacement-only codes are locking witnesses (no XO; getfem-P1 out of XA), see README
+    locking: bool = False
+    #: the manufactured stick margin closes cubically at the fronts: the endpoints' theoretical order is k/3
+    cubic_front: bool = False
 
     def levels_of(self, code):
         return tuple(r + P2_SHIFT for r in self.levels) if ORDER[code] == 2 else self.levels
@@ -48,13 +58,14 @@ SCENES = (
           "Example 5.1 (proportional load: N = 4 steps instead of the paper's 40)"),
     Scene("mms_front", "verification/cases/mms_front.toml", (0, 1, 2, 3, 4), 4,
           "manufactured, moving stick-slip fronts (its energy error does not depend on N, scene note)",
-          xo_max_order=1),
+          xo_max_order=1, cubic_front=True),
     Scene("cep", "verification/external/scenes/cep_tresca.toml", (1, 2, 3, 4, 5), 1,
-          "Chouly-Ern-Pignet Tresca, lambda/mu = 1e4, nonzero Dirichlet data"),
+          "Chouly-Ern-Pignet Tresca, lambda/mu = 1e4, nonzero Dirichlet data",
+          codes=DEFAULT_CODES[:3] + ("getfem-TH", "skfem-TH-nitsche", "tresca-cr"), locking=True),
     Scene("imposed", "verification/external/scenes/imposed_normal.toml", (1, 2, 3, 4, 5), 1,
           "static, imposed normal displacement -0.1 on Gamma_C"),
     Scene("mms_rotated", "verification/cases/mms_rotated.toml", (0, 1, 2, 3, 4), 4,
-          "manufactured, rotated square (contact side not axis-aligned)"),
+          "manufactured, rotated square (contact side not axis-aligned)", cubic_front=True),
 )
 
 
@@ -66,7 +77,7 @@ def getfem_available():
 def run_getfem(prob, work):
     """Solve one problem with GetFEM in a subprocess; the raw result dict."""
     work.mkdir(parents=True, exist_ok=True)
-    tag = f"getfem_P{prob['degree']}_r{prob['refine']}"
+    tag = f"getfem_{'TH' if prob.get('mixed') else 'P' + str(prob['degree'])}_r{prob['refine']}"
     pin, pout = work / f"{tag}_problem.json", work / f"{tag}_result.json"
     pin.write_text(json.dumps(prob))
     script = importlib.util.find_spec("tresca_py.external.getfem_solver").origin
@@ -101,21 +112,25 @@ def run_scene(sc: Scene, codes, out_dir, binary, log=print):
     use_getfem = any(c.startswith("getfem") for c in codes)
     if use_getfem and not getfem_available():
         raise RuntimeError(f"{GETFEM_PYTHON} cannot import getfem: run `make getfem`")
-    for code in codes:
+    for code in (c for c in codes if c in sc.codes):
         if code == "tresca-cr" and not use_tresca:
             continue
         for r in sc.levels_of(code):
             k = 1 if code == "getfem-P1" else 2
             prob = problem.at_level(scene, r, sc.steps, degree=k)
+            prob["mixed"] = "-TH" in code
             t0 = time.perf_counter()
             if code.startswith("getfem"):
                 raw = run_getfem(prob, work)
             elif code == "skfem-P2-nitsche":
                 raw = skfem_nitsche.solve(prob)
+            elif code == "skfem-TH-nitsche":
+                raw = skfem_nitsche.solve(prob, skfem_mixed.MixedSolver)
             else:
-                raw = tresca.run_level(binary, sc.path, r, sc.steps, work, prob["probes"])
+                raw = tresca.run_level(binary, sc.path, r, sc.steps, work, prob["probes"],
+                                       prob["gamma_n"] * (prob["lam"] + 2 * prob["mu"]))
             raw["h"] = prob["h"]
-            row = quantities.summarise(raw, prob["probes"]["length"])
+            row = quantities.summarise(raw, prob["probes"])
             row.update({"scene": sc.name, "code": code, "refine": r, "steps": sc.steps,
                         "process_s": time.perf_counter() - t0})
             rows.append(row)

@@ -5,7 +5,8 @@ The CR field is evaluated from the results file: on a triangle with vertices v�
 U_i on the edge opposite vᵢ, u(x) = Σᵢ U_i (1 − 2λᵢ(x)) (λ the barycentric coordinates); ‖u‖²_L2 is exact by the
 midpoint rule (|T|/3 Σ|U_i|²), ∇u = −2 Σᵢ U_i ⊗ ∇λᵢ (broken H1). Along Γ_C the trace is taken in the triangle
 owning the contact edge. ½a_h(u,u) = ½ ``tresca/energy`` (with the jump term); ∫σ_τ = Σ_e σ_τ,e |e|; the stick
-flag of a contact edge (its midpoint) is its last-step state 0.
+flag of a contact edge (its midpoint) is its last-step state 0, its stick margin (``quantities.stick_ends``)
+φ_e = g_e − |σ_τ,e − p_e δu_τ,e| with the last step's slip increment δu_τ,e and p_e = γ_N (λ + 2μ)/|e|.
 """
 from __future__ import annotations
 
@@ -33,7 +34,7 @@ def _bary_grads(P):
     return np.stack([-g1 - g2, g1, g2], 1), 0.5 * np.abs(det)
 
 
-def read_results(path, probes):
+def read_results(path, probes, pen_scale):
     """The raw result dict (``quantities.summarise`` format) at the last time of a results file."""
     with h5py.File(path, "r") as f:
         g = f["tresca"]
@@ -41,6 +42,8 @@ def read_results(path, probes):
         U = g["u"][-1]
         cedges = g["contact/edges"][:]
         sig, state = g["contact/sigma_t"][-1], g["contact/state"][-1]
+        slip = g["contact/slip"][-2:]
+        g_mean = g["contact/g"][:]
         energy = 0.5 * float(g["energy"][-1])
         err = {k: float(g[f"errors/{k}"][-1]) for k in ("h1", "l2")} if "errors" in g else {}
     te = _tri_edges(tri, edges)
@@ -76,13 +79,15 @@ def read_results(path, probes):
     raw = {"h1_norm": float(np.sqrt(l2 + semi)), "energy": energy,
            "sigma_t_integral": float(np.sum(sig * lengths)),
            "u_tau_points": trace(probes["points"]).tolist(), "u_tau_samples": trace(probes["samples"]).tolist(),
-           "quad_s": mids.tolist(), "quad_stick": (state == 0).astype(int).tolist(), "dofs": int(2 * len(edges))}
+           "quad_s": mids.tolist(), "quad_stick": (state == 0).astype(int).tolist(), "dofs": int(2 * len(edges)),
+           "quad_margin": (g_mean - np.abs(sig - pen_scale / lengths * (slip[-1] - slip[0]))).tolist(),
+           "quad_dslip": np.abs(slip[-1] - slip[0]).tolist()}
     if err:
         raw["err_h1_semi"], raw["err_l2"] = err["h1"], err["l2"]
     return raw
 
 
-def run_level(binary, scene, refine, steps, out_dir, probes):
+def run_level(binary, scene, refine, steps, out_dir, probes, pen_scale):
     """``tresca-cr run`` at one level; the raw result with its wall time (the run's own ``wall_time`` sum)."""
     out = Path(out_dir) / f"tresca_r{refine}.h5"
     cmd = [str(binary), "run", str(scene), "--refine", str(refine), "--steps", str(steps), "-o", str(out),
@@ -92,7 +97,7 @@ def run_level(binary, scene, refine, steps, out_dir, probes):
     wall = time.perf_counter() - t0
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({proc.returncode}): {proc.stderr.strip()[-400:]}")
-    raw = read_results(out, probes)
+    raw = read_results(out, probes, pen_scale)
     raw.update({"wall_s": wall, "code": "tresca-cr (CR)", "cmd": cmd})
     return raw
 
