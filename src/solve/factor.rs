@@ -139,6 +139,11 @@ impl Factor {
         Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last, fwd })
     }
 
+    /// Entries of L kept (supernodal blocks included).
+    pub fn len_val(&self) -> usize {
+        self.values.len()
+    }
+
     /// The unknowns ordered last (see [`Factor::with_last`]).
     pub fn last(&self) -> &[usize] {
         &self.last
