@@ -1,12 +1,12 @@
-//! Fill-reducing ordering P: nested dissection (METIS_NodeND) for K of [`ND_MIN_SIZE`] unknowns or
-//! more, AMD (faer's) below. Why: the factorisation is flop-bound, and on a 2D mesh nested dissection
-//! gives the asymptotically optimal fill, O(n log n) entries and O(n^1.5) flops, with a smaller constant
-//! than AMD: on the 1.57M-unknown benchmark nnz(L) drops from 613M to 462M and the flops from 1.14e12 to
-//! about 5e11, so the numeric phase halves (≈ 60 s → 29 s). But METIS itself takes ≈ 11 s there and
-//! ≈ 2.5 s at 394k unknowns, where it loses overall to AMD (the set-up was 40 % slower), hence the size
-//! threshold. Both order the graph of K with the unknowns of one edge (its two displacement components,
-//! numbered consecutively by the space) merged into one (weighted) vertex: this halves the graph and
-//! quarters its edges, so METIS and AMD run 2–3× faster, with the same fill as ordering the full graph
+//! Fill-reducing ordering P: nested dissection for K of [`ND_MIN_SIZE`] unknowns or more, AMD (faer's)
+//! below. Why: the factorisation is flop-bound, and on a 2D mesh nested dissection gives the
+//! asymptotically optimal fill, O(n log n) entries and O(n^1.5) flops, with a smaller constant than AMD.
+//! A run knows its unknowns' points (edge midpoints), so its nested dissection is by coordinate
+//! bisection ([`super::dissect`]: 0.36 s of CPU at 1.57M unknowns, Example 5.1 refine 8); without
+//! points (a matrix alone, [`super::factor::Factor::with_groups`]) METIS_NodeND is used, which costs
+//! ≈ 11 s there and ≈ 2.5 s at 394k unknowns. Both order the graph of K with the unknowns of one edge
+//! (its two displacement components, numbered consecutively by the space) merged into one (weighted)
+//! vertex: this halves the graph and quarters its edges, with the same fill as ordering the full graph
 //! (both components of an edge have the same neighbours). The groups are given by the caller; the
 //! result is a valid permutation whatever they are (a group per unknown orders the full graph).
 //! Deterministic: adjacency lists sorted, a fixed seed, and calls serialised by a lock (METIS
@@ -136,13 +136,18 @@ impl Graph {
         self.first.len() - 1
     }
 
-    /// The unknowns of the vertices in the order `order` (position → vertex).
+    /// The vertices adjacent to vertex g.
+    pub fn neighbours(&self, g: usize) -> &[usize] {
+        &self.adj[self.start[g]..self.start[g + 1]]
+    }
+
     /// Unknowns in all.
     pub fn unknowns(&self) -> usize {
         self.first[self.len()]
     }
 
-    fn expand(&self, order: impl Iterator<Item = usize>) -> Vec<usize> {
+    /// The unknowns of the vertices in the order `order` (position → vertex).
+    pub(super) fn expand(&self, order: impl Iterator<Item = usize>) -> Vec<usize> {
         let mut fwd = Vec::with_capacity(self.first[self.len()]);
         for g in order {
             fwd.extend(self.first[g]..self.first[g + 1]);

@@ -17,7 +17,7 @@ use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::solve::condense::{condense, Condensation};
 use crate::solve::condition;
-use crate::solve::factor::{fill_order, Factor, Symbolic};
+use crate::solve::factor::{fill_order_at, Factor, Symbolic};
 use crate::solve::free::FreeResponse;
 use crate::solve::ordering::{Graph, ND_MIN_SIZE};
 use crate::solve::superpose::LoadBasis;

@@ -180,6 +180,16 @@ impl MeshSetUp {
     pub fn times(&self) -> SetupTimes {
         self.times
     }
+
+    /// The factor of K.
+    pub fn factor(&self) -> &Factor {
+        &self.factor
+    }
+
+    /// K (both triangles).
+    pub fn stiffness(&self) -> &SparseColMat<usize, f64> {
+        &self.stiffness
+    }
 }
 
 /// The factor and what is computed beside it.
@@ -251,7 +261,8 @@ impl Problem0 {
                 let (first, start, adj) = pattern.unknown_graph(space);
                 let graph = Graph::new(first, start, adj)
                     .ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
-                let order = fill_order(&graph, space.n_dofs >= ND_MIN_SIZE)?;
+                let points = EdgePattern::unknown_points(mesh, space);
+                let order = fill_order_at(&graph, Some(&points), space.n_dofs >= ND_MIN_SIZE)?;
                 let k_pattern = rx.recv().map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
                 Symbolic::new(k_pattern.as_ref().as_ref(), contact, order)
             });
