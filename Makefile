@@ -61,8 +61,9 @@ test: build venv
 verify: build venv paraview
 	$(PY) verification/run_all.py
 
-bench: build venv
+bench: build venv bench-env
 	$(PY) verification/bench.py
+	$(MAKE) bench-factorisation
 
 # The factorisation bench (issue 32): tresca-cr's set-up against CHOLMOD (scikit-sparse 0.4.16, built against
 # Debian's libsuitesparse-dev: SuiteSparse 5.12; 0.5.0 does not build against it), MKL PARDISO (pypardiso)
@@ -90,4 +91,4 @@ bench-env: $(BENCH_VENV)/.stamp
 FACTOR_REFINES ?= 6 7 8
 bench-factorisation: build bench-env
 	cargo build --release --locked --example export_matrix
-	$(BENCH_VENV)/bin/python verification/bench/factorisation.py --refine $(FACTOR_REFINES)
+	$(BENCH_VENV)/bin/python verification/bench/factorisation.py --refine $(FACTOR_REFINES) --write reference/performance.md

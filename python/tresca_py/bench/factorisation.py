@@ -109,6 +109,47 @@ def table(rows, rate1):
     return "\n".join(out)
 
 
+HEADING = "## 7. Factorisation at scale (issue 32)"
+
+
+def section(rows, rate1, rate_all, refines, rounds):
+    """The markdown section of reference/performance.md."""
+    tre = [r for r in rows if r["solver"] == "tresca-cr"]
+    return f"""{HEADING}
+
+Example 5.1's reduced stiffness (the unknowns of V_h, u·n = 0 on Γ_C eliminated) at refine {", ".join(map(str, refines))},
+set up by each solver in a process of its own, {rounds} interleaved rounds (the order rotated each round), medians.
+tresca-cr: `target/release/examples/export_matrix SCENE R --time` (mesh and space, assembly with the ordering and
+symbolic factorisation beside it, numeric factorisation; its "analysis" is everything before the numeric
+factorisation, its CPU the whole process's); the others from the matrix written by `export_matrix SCENE R DIR`:
+CHOLMOD 5.12 supernodal (scikit-sparse 0.4.16, Debian libsuitesparse-dev; AMD and METIS orderings), MKL PARDISO
+(pypardiso 0.4.7, analysis = phase 11, factorisation = phase 22), MUMPS (petsc4py 3.25, PC cholesky, one
+set-up). Wall times in seconds, CPU seconds of all threads in parentheses: the machine was shared (the load column
+is the 1-minute load average on its 2 cores), so the CPU times are the comparable figures. flops = Σ_j c_j² over
+the columns of L (tresca-cr, CHOLMOD; PARDISO and MUMPS report their own counts, iparm(19) and RINFOG(3)); the
+rate is flops / CPU seconds of the factorisation (tresca-cr and MUMPS: of the whole set-up, a lower bound).
+Dense-kernel floor: numpy (OpenBLAS) Cholesky of order 4000, {rate1:.3g} flop/s by CPU time on one thread
+({rate_all:.3g} with all threads, busy-waiting included).
+
+Command: `make bench-env && .venv-bench/bin/python verification/bench/factorisation.py --refine {" ".join(map(str, refines))} --rounds {rounds}`
+
+{table(rows, rate1)}
+
+tresca-cr's orderings: AMD below 1,000,000 unknowns, nested dissection by coordinate bisection from there
+(`solve::ordering`); {len(tre)} tresca-cr set-ups in this table.
+"""
+
+
+def write_section(path, text):
+    """Replace the section in `path` (or append it)."""
+    old = open(path).read() if os.path.exists(path) else ""
+    if HEADING in old:
+        head, rest = old.split(HEADING, 1)
+        nxt = rest.find("\n## ")
+        old = head + (rest[nxt + 1:] if nxt >= 0 else "")
+    open(path, "w").write(old.rstrip("\n") + "\n\n" + text)
+
+
 def main(argv=None):
     import argparse
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -116,11 +157,21 @@ def main(argv=None):
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--scene", default="verification/cases/paper_example_5_1.toml")
     ap.add_argument("--json", default=None, help="write the rows here")
+    ap.add_argument("--from-json", default=None, help="report the rows of an earlier --json instead of running")
+    ap.add_argument("--write", default=None, help="put the section into this markdown file (reference/performance.md)")
     a = ap.parse_args(argv)
-    root = os.getcwd()
-    rate1, rate_all = dense_rates(sys.executable)
-    print(f"dense Cholesky n = 4000: {rate1:.3g} flops/s on one thread, {rate_all:.3g} on all", flush=True)
-    rows = bench(root, a.scene, a.refine, a.rounds, sys.executable)
+    if a.from_json:
+        d = json.load(open(a.from_json))
+        rows, rate1, rate_all = d["rows"], d["dense_rate_1"], d["dense_rate_all"]
+    else:
+        rate1, rate_all = dense_rates(sys.executable)
+        print(f"dense Cholesky n = 4000: {rate1:.3g} flops/s on one thread, {rate_all:.3g} on all", flush=True)
+        rows = bench(os.getcwd(), a.scene, a.refine, a.rounds, sys.executable)
     if a.json:
         json.dump(dict(rows=rows, dense_rate_1=rate1, dense_rate_all=rate_all), open(a.json, "w"), indent=1)
-    print(table(rows, rate1))
+    refines = sorted({r["refine"] for r in rows})
+    rounds = max(r["round"] for r in rows) + 1
+    text = section(rows, rate1, rate_all, refines, rounds)
+    print(text)
+    if a.write:
+        write_section(a.write, text)
