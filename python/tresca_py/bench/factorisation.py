@@ -59,7 +59,7 @@ def normalise(solver, out):
                 factorisation_cpu=out["factorisation_cpu"], total_cpu=out["analysis_cpu"] + out["factorisation_cpu"])
 
 
-def bench(root, scene, refines, rounds, python, log=print):
+def bench(root, scene, refines, rounds, python, log=print, solvers=SOLVERS):
     rows = []
     with tempfile.TemporaryDirectory(prefix="factorisation_") as tmp:
         exe = os.path.join(root, "target", "release", "examples", "export_matrix")
@@ -67,7 +67,7 @@ def bench(root, scene, refines, rounds, python, log=print):
             d = os.path.join(tmp, f"K{r}")
             subprocess.run([exe, scene, str(r), d], check=True)
             for k in range(rounds):
-                order = SOLVERS[k % len(SOLVERS):] + SOLVERS[:k % len(SOLVERS)]
+                order = solvers[k % len(solvers):] + solvers[:k % len(solvers)]
                 for s in order:
                     load = load1()
                     out, wall, rss = run_json(command(s, root, scene, r, d, python))
@@ -95,7 +95,8 @@ def table(rows, rate1):
     key = sorted({(r["refine"], r["solver"]) for r in rows}, key=lambda x: (x[0], SOLVERS.index(x[1])))
     for refine, s in key:
         rs = [r for r in rows if r["refine"] == refine and r["solver"] == s]
-        def med(f):
+
+        def med(f, rs=rs):
             return statistics.median([r[f] for r in rs]) if all(r[f] is not None for r in rs) else float("nan")
 
         fl = med("flops")
@@ -115,10 +116,12 @@ HEADING = "## 7. Factorisation at scale (issue 32)"
 def section(rows, rate1, rate_all, refines, rounds):
     """The markdown section of reference/performance.md."""
     tre = [r for r in rows if r["solver"] == "tresca-cr"]
+    refine_args = " ".join(map(str, refines))
     return f"""{HEADING}
 
-Example 5.1's reduced stiffness (the unknowns of V_h, u·n = 0 on Γ_C eliminated) at refine {", ".join(map(str, refines))},
-set up by each solver in a process of its own, {rounds} interleaved rounds (the order rotated each round), medians.
+Example 5.1's reduced stiffness (the unknowns of V_h, u·n = 0 on Γ_C eliminated) at refine
+{", ".join(map(str, refines))}, set up by each solver in a process of its own, {rounds} interleaved rounds
+(the order rotated each round), medians.
 tresca-cr: `target/release/examples/export_matrix SCENE R --time` (mesh and space, assembly with the ordering and
 symbolic factorisation beside it, numeric factorisation; its "analysis" is everything before the numeric
 factorisation, its CPU the whole process's); the others from the matrix written by `export_matrix SCENE R DIR`:
@@ -131,7 +134,8 @@ rate is flops / CPU seconds of the factorisation (tresca-cr and MUMPS: of the wh
 Dense-kernel floor: numpy (OpenBLAS) Cholesky of order 4000, {rate1:.3g} flop/s by CPU time on one thread
 ({rate_all:.3g} with all threads, busy-waiting included).
 
-Command: `make bench-env && .venv-bench/bin/python verification/bench/factorisation.py --refine {" ".join(map(str, refines))} --rounds {rounds}`
+Command: `make bench-env && .venv-bench/bin/python verification/bench/factorisation.py --refine {refine_args}
+--rounds {rounds}`
 
 {table(rows, rate1)}
 
@@ -143,11 +147,13 @@ tresca-cr's orderings: AMD below 1,000,000 unknowns, nested dissection by coordi
 def write_section(path, text):
     """Replace the section in `path` (or append it)."""
     old = open(path).read() if os.path.exists(path) else ""
-    if HEADING in old:
-        head, rest = old.split(HEADING, 1)
-        nxt = rest.find("\n## ")
-        old = head + (rest[nxt + 1:] if nxt >= 0 else "")
-    open(path, "w").write(old.rstrip("\n") + "\n\n" + text)
+    if HEADING not in old:
+        open(path, "w").write(old.rstrip("\n") + "\n\n" + text)
+        return
+    head, rest = old.split(HEADING, 1)
+    nxt = rest.find("\n## ")
+    tail = "\n" + rest[nxt + 1:] if nxt >= 0 else ""
+    open(path, "w").write(head + text + tail)
 
 
 def main(argv=None):
@@ -156,6 +162,7 @@ def main(argv=None):
     ap.add_argument("--refine", type=int, nargs="+", default=[6, 7, 8])
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--scene", default="verification/cases/paper_example_5_1.toml")
+    ap.add_argument("--solvers", nargs="+", default=SOLVERS, choices=SOLVERS)
     ap.add_argument("--json", default=None, help="write the rows here")
     ap.add_argument("--from-json", default=None, help="report the rows of an earlier --json instead of running")
     ap.add_argument("--write", default=None, help="put the section into this markdown file (reference/performance.md)")
@@ -166,7 +173,7 @@ def main(argv=None):
     else:
         rate1, rate_all = dense_rates(sys.executable)
         print(f"dense Cholesky n = 4000: {rate1:.3g} flops/s on one thread, {rate_all:.3g} on all", flush=True)
-        rows = bench(os.getcwd(), a.scene, a.refine, a.rounds, sys.executable)
+        rows = bench(os.getcwd(), a.scene, a.refine, a.rounds, sys.executable, solvers=a.solvers)
     if a.json:
         json.dump(dict(rows=rows, dense_rate_1=rate1, dense_rate_all=rate_all), open(a.json, "w"), indent=1)
     refines = sorted({r["refine"] for r in rows})
