@@ -10,7 +10,7 @@ BIN   := target/release/tresca-cr
 PY312 := $(shell for p in $$(pyenv root 2>/dev/null)/versions/3.12*/bin/python3.12 /usr/local/bin/python3.12 /usr/bin/python3.12; do \
            [ -x "$$p" ] && "$$p" -c 'import sys' 2>/dev/null && echo "$$p" && break; done)
 
-.PHONY: all deps paraview getfem build venv lint test verify reference bench clean-out
+.PHONY: all deps paraview getfem build venv lint test verify reference bench bench-env bench-factorisation clean-out
 
 all: build
 
@@ -88,6 +88,35 @@ reference: venv
 	$(PY) -m tresca_py.verify.harness publish
 
 # Timings live here only (no pass/fail of make verify or make test depends on a time).
-bench: build venv
+bench: build venv bench-env
 	$(PY) verification/bench.py
 	$(PY) verification/planner.py --costs
+	$(MAKE) bench-factorisation
+
+# The factorisation bench (issue 32): tresca-cr's set-up against CHOLMOD (scikit-sparse 0.4.16, built against
+# Debian's libsuitesparse-dev: SuiteSparse 5.12; 0.5.0 does not build against it), MKL PARDISO (pypardiso)
+# and MUMPS (petsc4py of the dolfinx wheel) on the same matrices. These live in a bench-only venv,
+# .venv-bench, which `make test` and `make verify` never create.
+BENCH_VENV := .venv-bench
+BENCH_REQ  := verification/bench/requirements-bench.txt
+
+$(BENCH_VENV)/.stamp: requirements.txt $(BENCH_REQ)
+	@test -n "$(PY312)" || { echo "error: Python 3.12 not found (pyenv install 3.12.1)"; exit 1; }
+	@test -f /usr/include/suitesparse/cholmod.h || \
+	  (apt-get update -qq && apt-get install -y -qq -o DPkg::Lock::Timeout=600 libsuitesparse-dev) >/dev/null || \
+	  (sudo apt-get update -qq && sudo apt-get install -y -qq -o DPkg::Lock::Timeout=600 libsuitesparse-dev) >/dev/null
+	$(PY312) -m venv $(BENCH_VENV)
+	$(BENCH_VENV)/bin/pip install -q --upgrade pip
+	$(BENCH_VENV)/bin/pip install -q -r requirements.txt
+	SUITESPARSE_INCLUDE_DIR=/usr/include/suitesparse $(BENCH_VENV)/bin/pip install -q -r $(BENCH_REQ)
+	$(BENCH_VENV)/bin/pip install -q --no-deps --no-build-isolation -e python
+	touch $@
+
+bench-env: $(BENCH_VENV)/.stamp
+
+# Only the factorisation section: exports Example 5.1's reduced stiffness (refine 6, 7, 8 by default) and
+# sets it up with the four solvers, interleaved. FACTOR_REFINES="6 7" for a shorter run.
+FACTOR_REFINES ?= 6 7 8
+bench-factorisation: build bench-env
+	cargo build --release --locked --example export_matrix
+	$(BENCH_VENV)/bin/python verification/bench/factorisation.py --refine $(FACTOR_REFINES) --write reference/performance.md

@@ -1,18 +1,20 @@
-//! Single-thread cost of each stage of a run's set-up (median of 7 passes), the numbers behind the
-//! schedule of `stepping::setup` (which stages run beside which), with the sizes of K and of its factor.
+//! Single-thread cost of each stage of a run's set-up (median of PASSES passes, default 7), the numbers
+//! behind the schedule of `stepping::setup` (which stages run beside which), with the sizes of K and of
+//! its factor. Each stage is timed by the thread's CPU clock (the machine is shared: wall times carry
+//! the other processes' load) with its minor page faults; ORDERING is `auto` (the run's choice: nested
+//! dissection by coordinates from `ND_MIN_SIZE` unknowns), `amd`, `nd` (by coordinates) or `metis`.
 //!
-//! `RAYON_NUM_THREADS=1 cargo run --release --example setup_cost verification/cases/mms_stop.toml 4`
+//! `RAYON_NUM_THREADS=1 cargo run --release --example setup_cost verification/cases/mms_stop.toml 4 [PASSES] [ORDERING]`
 //!
 //! In a real run every buffer is fresh memory, whose first touch costs about 2.4 µs a page on the
 //! project's VMs; from the second pass on the allocator reuses memory, so these are compute costs.
-use std::time::Instant;
 use tresca_cr::fem::assemble::{stiffness_values, EdgePattern};
 use tresca_cr::fem::elasticity::Elasticity;
 use tresca_cr::fem::loads::Loads;
 use tresca_cr::fem::norms::ErrorEvaluator;
 use tresca_cr::fem::space::CrSpace;
 use tresca_cr::mesh::Mesh;
-use tresca_cr::solve::factor::{fill_order, Factor, Symbolic};
+use tresca_cr::solve::factor::{fill_order_at, Factor, Symbolic};
 use tresca_cr::solve::ordering::Graph;
 use tresca_cr::Scene;
 
@@ -20,62 +22,99 @@ fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();
     let mut scene = Scene::from_file(std::path::Path::new(&a[0])).unwrap();
     scene.set_refine(a[1].parse().unwrap()).unwrap();
-    let mut rows: Vec<(&str, Vec<f64>)> = Vec::new();
-    let mut tm = |name: &'static str, d: f64| match rows.iter_mut().find(|r| r.0 == name) {
+    let passes: usize = a.get(2).map_or(7, |p| p.parse().unwrap());
+    let n_est = tresca_cr::scene::budget::Estimate::of(&scene, 1, false).unwrap().unknowns as usize;
+    let nested = match a.get(3).map_or("auto", |s| s.as_str()) {
+        "auto" => n_est >= tresca_cr::solve::ordering::ND_MIN_SIZE,
+        "nd" | "metis" => true,
+        "amd" => false,
+        o => panic!("ordering `{o}`: auto, amd, nd (by coordinates) or metis"),
+    };
+    let metis = a.get(3).is_some_and(|s| s == "metis");
+    let mut rows: Vec<(&str, Vec<(f64, f64)>)> = Vec::new();
+    let mut tm = |name: &'static str, d: (f64, f64)| match rows.iter_mut().find(|r| r.0 == name) {
         Some(r) => r.1.push(d),
         None => rows.push((name, vec![d])),
     };
     let mut sizes = (0, 0);
-    for _ in 0..7 {
-        let t = Instant::now();
+    for _ in 0..passes {
+        let t = Clock::now();
         let mesh = Mesh::from_spec(&scene.mesh).unwrap();
-        tm("mesh", t.elapsed().as_secs_f64());
-        let t = Instant::now();
+        tm("mesh", t.elapsed());
+        let t = Clock::now();
         let space = CrSpace::new(&mesh, &scene.parts).unwrap();
-        tm("space", t.elapsed().as_secs_f64());
+        tm("space", t.elapsed());
         let law = Elasticity::new(&scene.material);
-        let t = Instant::now();
+        let t = Clock::now();
         let pattern = EdgePattern::new(&mesh);
-        tm("edge pattern", t.elapsed().as_secs_f64());
-        let t = Instant::now();
+        tm("edge pattern", t.elapsed());
+        let t = Clock::now();
         let (f, s, adj) = pattern.unknown_graph(&space);
         let graph = Graph::new(f, s, adj).unwrap();
-        tm("graph", t.elapsed().as_secs_f64());
-        let t = Instant::now();
-        let order = fill_order(&graph, false).unwrap();
-        tm("amd", t.elapsed().as_secs_f64());
-        let t = Instant::now();
+        tm("graph", t.elapsed());
+        let t = Clock::now();
+        let points = (!metis).then(|| EdgePattern::unknown_points(&mesh, &space));
+        let order = fill_order_at(&graph, points.as_deref(), nested).unwrap();
+        tm(if nested { "nested dissection" } else { "amd" }, t.elapsed());
+        let t = Clock::now();
         let pat = pattern.unknown_pattern(&space);
-        tm("unknown pattern", t.elapsed().as_secs_f64());
+        tm("unknown pattern", t.elapsed());
         let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
-        let t = Instant::now();
+        let t = Clock::now();
         let sym = Symbolic::new(pat.as_ref(), &contact, order).unwrap();
-        tm("symbolic", t.elapsed().as_secs_f64());
+        tm("symbolic", t.elapsed());
         sizes = (pat.compute_nnz(), sym.len_val());
-        let t = Instant::now();
+        let t = Clock::now();
         let val = stiffness_values(&pattern, pat.as_ref(), &mesh, &space, &law, scene.rho);
-        tm("stiffness", t.elapsed().as_secs_f64());
+        tm("stiffness", t.elapsed());
         let k = faer::sparse::SparseColMat::new(pat, val);
-        let t = Instant::now();
+        let t = Clock::now();
         let loads = Loads::new(&scene, &mesh, &space).unwrap();
-        tm("loads", t.elapsed().as_secs_f64());
-        let t = Instant::now();
+        tm("loads", t.elapsed());
+        let t = Clock::now();
         let factor = Factor::numeric(sym, &k).unwrap();
-        tm("numeric", t.elapsed().as_secs_f64());
-        let t = Instant::now();
+        tm("numeric", t.elapsed());
+        let t = Clock::now();
         let top = tresca_cr::solve::condition::largest_eigenvalue(&k, 12);
-        tm("lambda_max", t.elapsed().as_secs_f64());
-        let t = Instant::now();
+        tm("lambda_max", t.elapsed());
+        let t = Clock::now();
         let inv = tresca_cr::solve::condition::largest_inverse_eigenvalue(&factor, k.nrows(), 12);
-        tm("inverse", t.elapsed().as_secs_f64());
-        let t = Instant::now();
+        tm("inverse", t.elapsed());
+        let t = Clock::now();
         let ev = scene.exact.as_ref().map(|x| ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(x));
-        tm("error evaluator", t.elapsed().as_secs_f64());
+        tm("error evaluator", t.elapsed());
         std::hint::black_box((loads, top, inv, ev));
     }
     println!("entries of K {}, of its factor {}", sizes.0, sizes.1);
+    println!("{:>17} {:>11} {:>12}", "stage", "CPU", "minor faults");
     for (name, mut v) in rows {
-        v.sort_by(f64::total_cmp);
-        println!("{name:>16} {:8.2} ms", v[v.len() / 2] * 1e3);
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (cpu, faults) = v[v.len() / 2];
+        println!("{name:>17} {:8.2} ms {faults:12.0}", cpu * 1e3);
+    }
+}
+
+/// The thread's CPU time and minor page faults at a point, for the stage that starts there.
+struct Clock(f64, f64);
+
+impl Clock {
+    fn read() -> (f64, f64) {
+        // SAFETY: plain system calls filling the structs given.
+        unsafe {
+            let mut ts: libc::timespec = std::mem::zeroed();
+            libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts);
+            let mut ru: libc::rusage = std::mem::zeroed();
+            libc::getrusage(libc::RUSAGE_THREAD, &mut ru);
+            (ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9, ru.ru_minflt as f64)
+        }
+    }
+    fn now() -> Clock {
+        let (c, f) = Clock::read();
+        Clock(c, f)
+    }
+    /// (CPU seconds, minor faults) since `now`.
+    fn elapsed(&self) -> (f64, f64) {
+        let (c, f) = Clock::read();
+        (c - self.0, f - self.1)
     }
 }

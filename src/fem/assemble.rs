@@ -92,6 +92,13 @@ impl EdgePattern {
         }
         (first, start, adj)
     }
+
+    /// The points of the vertices of [`EdgePattern::unknown_graph`]: the midpoints of the edges with
+    /// unknowns, in the same order (for the ordering by coordinate bisection, `solve::dissect`).
+    pub fn unknown_points(mesh: &Mesh, space: &CrSpace) -> Vec<[f64; 2]> {
+        let with_unknowns = |e: &usize| space.edge_dof[*e].terms().next().is_some();
+        (0..space.edge_dof.len()).filter(with_unknowns).map(|e| mesh.midpoint(e)).collect()
+    }
 }
 
 /// K's values, summed in place in the mesh's pattern ([`EdgePattern::unknown_pattern`]).

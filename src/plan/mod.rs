@@ -28,6 +28,7 @@ mod search;
 use crate::error::{Error, Result};
 use crate::scene::budget::Estimate;
 use crate::scene::{Method, Scene};
+use crate::study::SetupCache;
 use crate::study::{Level, LevelResult, Study};
 use model::{CostModel, CostSample, ErrorModel, TimeError};
 use pilot::{fit, pilot_scene, time_pilot, Fit, Quantity, Runner};
@@ -116,7 +117,8 @@ pub(crate) fn samples(levels: &[LevelResult]) -> Vec<(CostSample, usize)> {
         .iter()
         .map(|r| {
             let step = (r.wall - r.setup).max(0.0) / r.steps as f64;
-            (CostSample { n: r.dofs as f64, setup: r.setup, step }, r.steps)
+            // the set-up of a run of the level alone, also where the pilot shared its mesh's set-up
+            (CostSample { n: r.dofs as f64, setup: r.setup + r.reused_setup, step }, r.steps)
         })
         .collect()
 }
@@ -127,6 +129,12 @@ pub(crate) fn space_samples(levels: &[LevelResult]) -> Vec<CostSample> {
 
 /// Make the plan (module doc).
 pub fn plan(scene: &Scene, options: &Options) -> Result<Plan> {
+    plan_with_cache(scene, options, &SetupCache::default())
+}
+
+/// [`plan`] with the pilots' set-ups in `cache` (one assembly and factorisation per pilot mesh; the
+/// caller can count them, [`SetupCache::factorised`]). `cache` must be new or hold this plan's only.
+pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> Result<Plan> {
     let target = options.target;
     if !(target.is_finite() && target > 0.0) {
         return Err(Error::scene(&scene.file, "--target", format!("{target}: must be a positive number")));
@@ -135,7 +143,7 @@ pub fn plan(scene: &Scene, options: &Options) -> Result<Plan> {
     let (r0, n0) = (s.mesh_level(), s.times.len() - 1);
     let q = &options.quantity;
     let nt = time_base(n0);
-    let time_pilot_run = time_pilot(&s, r0 + 2, nt, n0, q, TIME_BOUND_SHARE * target, options.pilot_budget)?;
+    let time_pilot_run = time_pilot(&s, r0 + 2, nt, n0, q, TIME_BOUND_SHARE * target, options.pilot_budget, cache)?;
     let (time, _, spent) = &time_pilot_run;
     let time_fit = fit(time, q)?;
     let mesh = time.levels[0].refine;
@@ -147,7 +155,7 @@ pub fn plan(scene: &Scene, options: &Options) -> Result<Plan> {
         // inside a step is partly missed on coarse grids, and so is its spatial error). The space pilot
         // runs on the coarsest grid of the law's family whose time error is at most LAW_SAMPLING_SHARE of
         // the spatial error on the time pilot's mesh (first found with the scene's steps).
-        let first = space_pilot(&s, options, &time_pilot_run, &time_fit, n0, *spent)?;
+        let first = space_pilot(&s, options, &time_pilot_run, &time_fit, n0, *spent, cache)?;
         let (Some(e), Some(TimeError::Law(law))) = (on_mesh(&first), first.error.map(|m| m.time)) else {
             return Ok(first);
         };
@@ -159,7 +167,7 @@ pub fn plan(scene: &Scene, options: &Options) -> Result<Plan> {
         if n == n0 {
             return Ok(first);
         }
-        let mut p = space_pilot(&s, options, &time_pilot_run, &time_fit, n, first.pilot_wall)?;
+        let mut p = space_pilot(&s, options, &time_pilot_run, &time_fit, n, first.pilot_wall, cache)?;
         p.notes.insert(
             0,
             format!(
@@ -170,14 +178,14 @@ pub fn plan(scene: &Scene, options: &Options) -> Result<Plan> {
         );
         return Ok(p);
     }
-    let coarse = space_pilot(&s, options, &time_pilot_run, &time_fit, nt, *spent)?;
+    let coarse = space_pilot(&s, options, &time_pilot_run, &time_fit, nt, *spent, cache)?;
     // sampling time on nt steps is sound when the time grids change the solution on the time pilot's
     // mesh by at most SAMPLING_SHARE of that mesh's spatial error
     let moved = time_fit.distances.iter().copied().fold(0.0, f64::max);
     match on_mesh(&coarse).as_ref() {
         Some(&e) if moved <= SAMPLING_SHARE * e => Ok(coarse),
         _ => {
-            let mut p = space_pilot(&s, options, &time_pilot_run, &time_fit, n0, coarse.pilot_wall)?;
+            let mut p = space_pilot(&s, options, &time_pilot_run, &time_fit, n0, coarse.pilot_wall, cache)?;
             p.notes.insert(
                 0,
                 format!(
@@ -199,9 +207,10 @@ fn space_pilot(
     time_fit: &Fit,
     nh: usize,
     mut spent: f64,
+    cache: &SetupCache,
 ) -> Result<Plan> {
     let r0 = s.mesh_level();
-    let mut run = Runner::new(s, nh)?;
+    let mut run = Runner::new(s, nh, cache)?;
     let mut notes = Vec::new();
     let mut r = r0;
     loop {

@@ -14,7 +14,7 @@ use super::model::TimeError;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 use crate::study::richardson::Verdict;
-use crate::study::{estimate, Axis, Level, LevelResult, Sequence, Study};
+use crate::study::{estimate, Axis, Level, LevelResult, Sequence, SetupCache, Study};
 
 /// The error the planner is asked to bound.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -170,8 +170,11 @@ pub struct Runner<'a> {
 }
 
 impl<'a> Runner<'a> {
-    pub fn new(scene: &'a Scene, min_steps: usize) -> Result<Runner<'a>> {
-        Ok(Runner { seq: Sequence::new(scene, min_steps, None, None)?.without_consecutive(), spent: 0.0 })
+    /// A pilot sequence whose levels take their set-ups from `cache` (one per mesh for all the pilots of
+    /// a plan: the time pilot's levels share one mesh, and the space pilot returns to it).
+    pub fn new(scene: &'a Scene, min_steps: usize, cache: &SetupCache) -> Result<Runner<'a>> {
+        let seq = Sequence::with_cache(scene, min_steps, None, None, cache.clone())?.without_consecutive();
+        Ok(Runner { seq, spent: 0.0 })
     }
 
     /// Run `level`, unless `predicted` seconds would take the pilot past `budget` or the level would not
@@ -225,7 +228,7 @@ impl Fit {
 /// `steps` (at least four), then N, 4N, 16N, 64N from `first` if the doubling sequence is not in the
 /// asymptotic range (module doc) and its distances do not already bound the time error of grids of
 /// `steps` steps or more by `enough` ([`Fit::time_bound`]). Returns the study, the ratio used and the
-/// seconds spent. (On a coarser mesh the time grids move the solution more — a stick–slip front crosses
+/// seconds spent; the levels' set-ups come from `cache`. (On a coarser mesh the time grids move the solution more — a stick–slip front crosses
 /// fewer, larger edges — so the bound would be looser and the space pilot could not sample time coarsely.)
 pub fn time_pilot(
     scene: &Scene,
@@ -235,6 +238,7 @@ pub fn time_pilot(
     q: &Quantity,
     enough: f64,
     budget: f64,
+    cache: &SetupCache,
 ) -> Result<(Study, usize, f64)> {
     let mut spent = 0.0;
     let mut last = None;
@@ -244,7 +248,7 @@ pub fn time_pilot(
             let next = grids.last().expect("grids").checked_mul(ratio);
             grids.push(next.ok_or_else(|| Error::scene(&scene.file, "steps", "too many steps"))?);
         }
-        let mut run = Runner::new(scene, first)?;
+        let mut run = Runner::new(scene, first, cache)?;
         for &n in &grids {
             // a step costs about the same at every N: the next level costs ratio × the last one's steps
             let predicted = run.levels().last().map_or(0.0, |r| (r.wall - r.setup) * ratio as f64 + r.setup);

@@ -3,9 +3,12 @@
 //! estimates; `check` and `run` refuse a run whose estimate exceeds what the machine has (MemAvailable of
 //! `/proc/meminfo`, free space of the output's file system) or the limits the user gives.
 //!
-//! Calibration (Example 5.1, refine 3..6, 25k..1.6M unknowns): peak memory of the set-up is 3.8–3.9 kB
-//! per unknown, nearly constant (nested-dissection fill grows like n log n, slowly). The estimate uses
-//! 4 kB per unknown plus the dense parts, so it is an estimate, not a bound.
+//! Calibration (Example 5.1 `--steps 4 -o`, peak RSS by `/usr/bin/time`, 2026-11-26): 3.17, 3.07, 3.45
+//! and 3.51 kB per unknown at refine 5, 6, 7, 8 (24,640 to 1,573,376 unknowns). The factor's fill grows
+//! like n log n, so the estimate is n (α + β log₂ n) plus the two buffers of a block of steps
+//! (`solve::free`, 16 bytes a value, at most 16 columns and 2²⁴ values) and the dense contact parts:
+//! α and β fitted to refine 7 and 8, it gives refine 5 and 6 within −0.4 % and +7.6 %. An estimate,
+//! not a bound: the fill also depends on the ordering (AMD below 1M unknowns, nested dissection above).
 
 use super::{MeshSpec, PartKind, Scene};
 use crate::error::{human, Error, Result};
@@ -25,8 +28,13 @@ pub struct Estimate {
     pub disk: u64,
 }
 
-/// Peak bytes per unknown of the set-up (mesh, space, K, factor; measured, see the module doc).
-const BYTES_PER_UNKNOWN: u64 = 4000;
+/// Peak bytes per unknown of the set-up (mesh, space, K, factor) are BYTES_PER_UNKNOWN +
+/// BYTES_PER_UNKNOWN_LOG2 · log₂(unknowns) (fitted, see the module doc).
+const BYTES_PER_UNKNOWN: f64 = 1830.0;
+const BYTES_PER_UNKNOWN_LOG2: f64 = 73.4;
+/// The values of the block of steps' buffers (`solve::free`): at most 16 columns and 2²⁴ values each.
+const BLOCK_COLUMNS: u64 = 16;
+const BLOCK_VALUES: u64 = 1 << 24;
 /// Bytes per time step kept in memory (time node, load coefficients, contact state at hand).
 const BYTES_PER_STEP: u64 = 64;
 /// Frames of the visualisation views by default (`output::AUTO_FRAMES`).
@@ -39,10 +47,10 @@ impl Estimate {
         let unknowns = 2 * edges;
         let contact = boundary_contact;
         let steps = steps as u64;
-        let z = (unknowns.saturating_mul(contact)).min(50_000_000) * 8;
-        let memory = BYTES_PER_UNKNOWN
-            .saturating_mul(unknowns)
-            .saturating_add(z)
+        let per_unknown = BYTES_PER_UNKNOWN + BYTES_PER_UNKNOWN_LOG2 * (unknowns.max(2) as f64).log2();
+        let blocks = 16 * unknowns.saturating_mul(BLOCK_COLUMNS).min(BLOCK_VALUES);
+        let memory = ((per_unknown * unknowns as f64).min(u64::MAX as f64 / 2.0) as u64)
+            .saturating_add(blocks)
             .saturating_add(contact.saturating_mul(contact).saturating_mul(16))
             .saturating_add(steps.saturating_mul(BYTES_PER_STEP));
         let disk = if results {

@@ -13,6 +13,7 @@ use crate::error::{Error, Result};
 use nalgebra::DMatrix;
 
 /// C (symmetrised) and W = L_cc⁻¹, rows and columns in the order of the contact unknowns.
+#[derive(Clone)]
 pub struct Condensation {
     pub c: DMatrix<f64>,
     pub w: DMatrix<f64>,

@@ -17,7 +17,7 @@
 
 use super::ordering::{Graph, ND_MIN_SIZE};
 use super::pages::Pages;
-pub use super::symbolic::{fill_order, Symbolic};
+pub use super::symbolic::{fill_order, fill_order_at, Symbolic};
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
@@ -137,6 +137,29 @@ impl Factor {
         let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
             .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
         Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last, fwd })
+    }
+
+    /// Entries of L kept (supernodal blocks included).
+    pub fn len_val(&self) -> usize {
+        self.values.len()
+    }
+
+    /// Floating-point operations of the numeric factorisation, Σ_j c_j² over the columns j of L with
+    /// c_j entries each (diagonal included; the count CHOLMOD reports), and the entries of L without
+    /// the supernodal blocks' upper triangles, Σ_j c_j.
+    pub fn flops_and_entries(&self) -> (f64, f64) {
+        let Some(llt) = self.supernodal() else { return (f64::NAN, f64::NAN) };
+        let (mut flops, mut entries) = (0.0, 0.0);
+        for s in 0..llt.symbolic().n_supernodes() {
+            let sn = llt.supernode(s);
+            let (width, below) = (sn.val().ncols(), sn.pattern().len());
+            for jj in 0..width {
+                let c = (width - jj + below) as f64;
+                flops += c * c;
+                entries += c;
+            }
+        }
+        (flops, entries)
     }
 
     /// The unknowns ordered last (see [`Factor::with_last`]).

@@ -5,6 +5,7 @@
 mod block;
 pub mod condense;
 pub mod condition;
+pub mod dissect;
 pub mod factor;
 pub mod free;
 pub mod ordering;

@@ -1,10 +1,12 @@
-//! Fill-reducing ordering P: nested dissection (METIS_NodeND) for K of [`ND_MIN_SIZE`] unknowns or
-//! more, AMD (faer's) below. Why: the factorisation is flop-bound, and on a 2D mesh nested dissection
-//! gives the asymptotically optimal fill, O(n log n) entries and O(n^1.5) flops, with a smaller constant
-//! than AMD, so the numeric phase of the largest benchmarks halves; but METIS itself is costly and loses
-//! overall to AMD on mid-sized meshes, hence the size threshold (figures in CHANGELOG.md). Both order the graph of K with the unknowns of one edge (its two displacement components,
-//! numbered consecutively by the space) merged into one (weighted) vertex: this halves the graph and
-//! quarters its edges, so METIS and AMD run 2–3× faster, with the same fill as ordering the full graph
+//! Fill-reducing ordering P: nested dissection for K of [`ND_MIN_SIZE`] unknowns or more, AMD (faer's)
+//! below. Why: the factorisation is flop-bound, and on a 2D mesh nested dissection gives the
+//! asymptotically optimal fill, O(n log n) entries and O(n^1.5) flops, with a smaller constant than AMD.
+//! A run knows its unknowns' points (edge midpoints), so its nested dissection is by coordinate
+//! bisection ([`super::dissect`], linear in the unknowns); without points (a matrix alone,
+//! [`super::factor::Factor::with_groups`]) METIS_NodeND is used, which costs far more (figures in
+//! reference/performance.md). Both order the graph of K with the unknowns of one edge
+//! (its two displacement components, numbered consecutively by the space) merged into one (weighted)
+//! vertex: this halves the graph and quarters its edges, with the same fill as ordering the full graph
 //! (both components of an edge have the same neighbours). The groups are given by the caller; the
 //! result is a valid permutation whatever they are (a group per unknown orders the full graph).
 //! Deterministic: adjacency lists sorted, a fixed seed, and calls serialised by a lock (METIS
@@ -134,13 +136,18 @@ impl Graph {
         self.first.len() - 1
     }
 
+    /// The vertices adjacent to vertex g.
+    pub fn neighbours(&self, g: usize) -> &[usize] {
+        &self.adj[self.start[g]..self.start[g + 1]]
+    }
+
     /// Unknowns in all.
     pub fn unknowns(&self) -> usize {
         self.first[self.n_vertices()]
     }
 
     /// The unknowns of the vertices in the order `order` (position → vertex).
-    fn expand(&self, order: impl Iterator<Item = usize>) -> Vec<usize> {
+    pub(super) fn expand(&self, order: impl Iterator<Item = usize>) -> Vec<usize> {
         let mut fwd = Vec::with_capacity(self.first[self.n_vertices()]);
         for g in order {
             fwd.extend(self.first[g]..self.first[g + 1]);

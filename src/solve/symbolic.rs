@@ -2,6 +2,7 @@
 //! with the unknowns ordered last moved to its end, and the structure of L. It needs only K's pattern,
 //! so `stepping` computes it while K's values are assembled.
 
+use super::dissect::coordinate_dissection;
 use super::ordering::{amd_order, nested_dissection, Graph};
 use crate::error::{Error, Result};
 use faer::perm::PermRef;
@@ -64,6 +65,17 @@ impl Symbolic {
 /// The fill-reducing ordering of the unknowns of `graph` (position → unknown): nested dissection when
 /// `nested` (falling back to AMD where METIS cannot be used), else AMD. See [`super::ordering`].
 pub fn fill_order(graph: &Graph, nested: bool) -> Result<Vec<usize>> {
+    fill_order_at(graph, None, nested)
+}
+
+/// As [`fill_order`], with the nested dissection by coordinate bisection of the vertices at `points`
+/// ([`super::dissect`]) instead of METIS's when they are given (and fit the graph).
+pub fn fill_order_at(graph: &Graph, points: Option<&[[f64; 2]]>, nested: bool) -> Result<Vec<usize>> {
+    if nested {
+        if let Some(order) = points.and_then(|p| coordinate_dissection(graph, p)) {
+            return Ok(graph.expand(order.into_iter()));
+        }
+    }
     match if nested { nested_dissection(graph) } else { None } {
         Some((fwd, _)) => Ok(fwd),
         None => amd_order(graph, CholeskySymbolicParams::default().amd_params),

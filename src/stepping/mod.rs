@@ -17,9 +17,9 @@ use crate::fem::space::CrSpace;
 use crate::friction::{EdgeState, Friction, FrictionSolution};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
-use crate::solve::condense::condense;
+use crate::solve::condense::{condense, Condensation};
 use crate::solve::condition;
-use crate::solve::factor::{fill_order, Factor, Symbolic};
+use crate::solve::factor::{fill_order_at, Factor, Symbolic};
 use crate::solve::free::FreeResponse;
 use crate::solve::ordering::{Graph, ND_MIN_SIZE};
 use crate::solve::superpose::LoadBasis;
@@ -37,7 +37,7 @@ mod setup;
 pub use audit::{Audit, AuditState};
 pub use conditioning::MAX_CONDITION;
 pub use run::RunOptions;
-pub use setup::Discretised;
+pub use setup::{Discretised, MeshSetUp};
 
 /// Everything assembled once per run.
 pub struct Problem {
@@ -52,10 +52,15 @@ pub struct Problem {
     /// The friction problem on Γ_C (`None` without Γ_C: plain elasticity).
     pub friction: Option<Friction>,
     /// True errors (when the scene gives `[exact]`).
-    pub errors: Option<ErrorEvaluator>,
+    pub errors: Option<Arc<ErrorEvaluator>>,
     pub setup: SetupTimes,
-    /// The condition estimate of K, known by the time a step result is handed out.
-    conditioning: conditioning::Pending,
+    /// The set-up phases' times of the mesh's shared set-up when this problem reused one
+    /// ([`Problem::on_shared`]: K was neither assembled nor factorised again; `setup` holds only its own
+    /// load superposition); `None` when it made its own.
+    pub reused: Option<SetupTimes>,
+    /// The condition estimate of K, known by the time a step result is handed out (shared with the
+    /// other problems on the same [`MeshSetUp`]).
+    conditioning: Arc<conditioning::Pending>,
     /// Step 0, computed during the set-up beside the numeric factorisation (`None` if that failed: it is
     /// then computed again when asked for, and fails with its error).
     step0: Option<StepResult>,
@@ -160,13 +165,13 @@ impl Problem {
     fn initial_unchecked(&self) -> Result<StepResult> {
         match &self.step0 {
             Some(r) => Ok(r.clone()),
-            None => initial_state(&self.scene, &self.mesh, &self.space, &self.stiffness, self.errors.as_ref()),
+            None => initial_state(&self.scene, &self.mesh, &self.space, &self.stiffness, self.errors.as_deref()),
         }
     }
 
     /// Finiteness check and true errors.
     fn finish(&self, r: StepResult) -> Result<StepResult> {
-        finish(r, &self.scene, &self.mesh, &self.space, self.errors.as_ref())
+        finish(r, &self.scene, &self.mesh, &self.space, self.errors.as_deref())
     }
 
     /// True if `r` carries u (it is formed only at the steps a run wants; an empty space has none).

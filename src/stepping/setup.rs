@@ -54,6 +54,7 @@ impl Problem {
                 superposition: d(ends.factorisation, ends.superposition),
                 condensation: d(ends.superposition, ends.condensation),
             },
+            reused: None,
             scene,
             mesh,
             space,
@@ -68,6 +69,140 @@ impl Problem {
         };
         Ok((p, r))
     }
+
+    /// The problem of `scene` on the set-up `shared` of its mesh (made by [`MeshSetUp::new`] from a scene
+    /// that differs from this one at most in its time grid): only the load superposition, which depends
+    /// on the time nodes, is computed; K, its factor, the condensation and the condition estimate are
+    /// shared (the same values, so the same results as [`Problem::new`], bit for bit).
+    pub fn on_shared(scene: Scene, shared: &MeshSetUp) -> Result<Problem> {
+        let m = shared;
+        if scene.times.first() != m.t0.as_ref() {
+            return Err(Error::Linear("internal: a shared set-up used with another initial time".into()));
+        }
+        let t3 = Instant::now();
+        let mut assembled = Vec::new();
+        let basis = LoadBasis::build(&m.loads, &scene.times, &m.factor, &mut assembled)?;
+        let t4 = Instant::now();
+        let (free, c) = FreeResponse::new(
+            Arc::clone(&m.factor),
+            m.loads.clone(),
+            basis,
+            assembled,
+            m.condensation.clone(),
+            &m.space,
+        );
+        let friction = c.map(|c| Friction::new(&m.space, c, scene.solver));
+        Ok(Problem {
+            setup: SetupTimes { superposition: (t4 - t3).as_secs_f64(), ..SetupTimes::default() },
+            reused: Some(m.times),
+            scene,
+            mesh: m.mesh.clone(),
+            space: m.space.clone(),
+            law: m.law,
+            stiffness: m.stiffness.clone(),
+            free,
+            friction,
+            errors: m.errors.clone(),
+            conditioning: Arc::clone(&m.conditioning),
+            step0: m.step0.clone(),
+            forms: Default::default(),
+        })
+    }
+}
+
+/// The part of a set-up that depends on the mesh and not on the time grid: K, the loads' quadrature, the
+/// factor of K, the condensation onto Γ_C, the condition estimate and step 0. The levels of a study or a
+/// plan that share a mesh (same refinement, other steps) share one ([`Problem::on_shared`]), so the mesh
+/// is assembled and factorised once (`study::SetupCache`).
+pub struct MeshSetUp {
+    mesh: Mesh,
+    space: CrSpace,
+    law: Elasticity,
+    stiffness: SparseColMat<usize, f64>,
+    loads: Loads,
+    factor: Arc<Factor>,
+    condensation: Option<Condensation>,
+    conditioning: Arc<Pending>,
+    errors: Option<Arc<ErrorEvaluator>>,
+    step0: Option<StepResult>,
+    /// The initial time the set-up was made for (step 0 depends on it).
+    t0: Option<f64>,
+    /// Wall times of its phases (no superposition: that is each run's own).
+    times: SetupTimes,
+}
+
+impl MeshSetUp {
+    /// The set-up of `scene`'s mesh (assembly, factorisation, condensation; the phases of
+    /// [`Problem::new`] but the load superposition).
+    pub fn new(scene: &Scene) -> Result<MeshSetUp> {
+        let t0 = Instant::now();
+        let mesh = Mesh::from_spec(&scene.mesh)?;
+        let space = CrSpace::new(&mesh, &scene.parts)?;
+        let t1 = Instant::now();
+        let law = Elasticity::new(&scene.material);
+        let p0 = Discretised { scene: scene.clone(), mesh, space, law };
+        let (stiffness, loads, symbolic) = p0.assemble()?;
+        let t2 = Instant::now();
+        let f = p0.factor(&stiffness, symbolic)?;
+        let t3 = Instant::now();
+        let condensation = p0.condense(&f.factor)?;
+        let t5 = Instant::now();
+        let Discretised { mesh, space, law, .. } = p0;
+        let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
+        Ok(MeshSetUp {
+            mesh,
+            space,
+            law,
+            stiffness,
+            loads,
+            factor: f.factor,
+            condensation,
+            conditioning: f.conditioning,
+            errors: f.errors,
+            step0: f.step0,
+            t0: scene.times.first().copied(),
+            times: SetupTimes {
+                space: d(t0, t1),
+                assembly: d(t1, t2),
+                factorisation: d(t2, t3),
+                superposition: 0.0,
+                condensation: d(t3, t5),
+            },
+        })
+    }
+
+    /// Unknowns of the mesh.
+    pub fn unknowns(&self) -> usize {
+        self.space.n_dofs
+    }
+
+    /// Bytes held: the factor's values and K (the mesh and space are a few percent of them).
+    pub fn bytes(&self) -> usize {
+        8 * self.factor.len_val() + 16 * self.stiffness.compute_nnz()
+    }
+
+    /// Wall times of its phases (no superposition: that is each run's own).
+    pub fn times(&self) -> SetupTimes {
+        self.times
+    }
+
+    /// The factor of K.
+    pub fn factor(&self) -> &Factor {
+        &self.factor
+    }
+
+    /// K (both triangles).
+    pub fn stiffness(&self) -> &SparseColMat<usize, f64> {
+        &self.stiffness
+    }
+}
+
+/// The factor and what is computed beside it.
+struct Factored {
+    factor: Arc<Factor>,
+    conditioning: Arc<Pending>,
+    errors: Option<Arc<ErrorEvaluator>>,
+    step0: Option<StepResult>,
 }
 
 /// A discretised problem, what the set-up starts from: the scene, its mesh and CR space, and the law.
@@ -91,8 +226,8 @@ struct Operators {
     stiffness: SparseColMat<usize, f64>,
     free: FreeResponse,
     friction: Option<Friction>,
-    errors: Option<ErrorEvaluator>,
-    conditioning: Pending,
+    errors: Option<Arc<ErrorEvaluator>>,
+    conditioning: Arc<Pending>,
     step0: Option<StepResult>,
     ends: PhaseEnds,
 }
@@ -135,7 +270,8 @@ impl Discretised {
                 let (first, start, adj) = pattern.unknown_graph(space);
                 let graph = Graph::new(first, start, adj)
                     .ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
-                let order = fill_order(&graph, space.n_dofs >= ND_MIN_SIZE)?;
+                let points = EdgePattern::unknown_points(mesh, space);
+                let order = fill_order_at(&graph, Some(&points), space.n_dofs >= ND_MIN_SIZE)?;
                 let k_pattern = rx.recv().map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
                 Symbolic::new(k_pattern.as_ref().as_ref(), contact, order)
             });
@@ -157,31 +293,44 @@ impl Discretised {
 
     /// Phases 2 and 3: the factor, the superposition, the condensation, the condition estimate under way.
     fn factorise(&self, stiffness: SparseColMat<usize, f64>, loads: Loads, symbolic: Symbolic) -> Result<Operators> {
-        let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
+        let (scene, space) = (&self.scene, &self.space);
         let t2 = Instant::now();
-        let (factor, aside) = Factor::numeric_beside(symbolic, &stiffness, || {
-            let top = condition::largest_eigenvalue(&stiffness, 12);
-            let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, law, scene.rho).with_exact(x));
-            let step0 = initial_state(scene, mesh, space, &stiffness, errors.as_ref()).ok();
-            (top, errors, step0)
-        });
-        let factor = factor?;
-        let (top, errors, step0) = aside.unwrap_or((f64::NAN, None, None));
+        let Factored { factor, conditioning, errors, step0 } = self.factor(&stiffness, symbolic)?;
         let t3 = Instant::now();
-        // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
-        // ranges) factorises without complaint but returns meaningless displacements: it is refused
-        // by the condition estimate, whose solves run on their own thread from here on (conditioning).
-        let factor = Arc::new(factor);
-        let conditioning = Pending::start(&factor, stiffness.nrows(), top);
         let mut assembled = Vec::new();
         let basis = LoadBasis::build(&loads, &scene.times, &factor, &mut assembled)?;
         let t4 = Instant::now();
-        let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
-        let condensation = (!contact.is_empty()).then(|| condense(&contact, &factor)).transpose()?;
+        let condensation = self.condense(&factor)?;
         let t5 = Instant::now();
         let (free, c) = FreeResponse::new(factor, loads, basis, assembled, condensation, space);
         let friction = c.map(|c| Friction::new(space, c, scene.solver));
         let ends = PhaseEnds { assembly: t2, factorisation: t3, superposition: t4, condensation: t5 };
         Ok(Operators { stiffness, free, friction, errors, conditioning, step0, ends })
+    }
+
+    /// Phase 2: the numeric factorisation; beside it λ_max(K), the error quadrature and step 0; after it
+    /// the condition estimate's solves are started.
+    fn factor(&self, stiffness: &SparseColMat<usize, f64>, symbolic: Symbolic) -> Result<Factored> {
+        let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
+        let (factor, aside) = Factor::numeric_beside(symbolic, stiffness, || {
+            let top = condition::largest_eigenvalue(stiffness, 12);
+            let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, law, scene.rho).with_exact(x));
+            let step0 = initial_state(scene, mesh, space, stiffness, errors.as_ref()).ok();
+            (top, errors, step0)
+        });
+        let factor = factor?;
+        let (top, errors, step0) = aside.unwrap_or((f64::NAN, None, None));
+        // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
+        // ranges) factorises without complaint but returns meaningless displacements: it is refused
+        // by the condition estimate, whose solves run on their own thread from here on (conditioning).
+        let factor = Arc::new(factor);
+        let conditioning = Arc::new(Pending::start(&factor, stiffness.nrows(), top));
+        Ok(Factored { factor, conditioning, errors: errors.map(Arc::new), step0 })
+    }
+
+    /// C = EᵀK⁻¹E and W from the factor (`None` without Γ_C).
+    fn condense(&self, factor: &Factor) -> Result<Option<Condensation>> {
+        let contact: Vec<usize> = self.space.contact.iter().map(|c| c.dof).collect();
+        (!contact.is_empty()).then(|| condense(&contact, factor)).transpose()
     }
 }

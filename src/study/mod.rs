@@ -10,6 +10,7 @@
 //! distances at the common time nodes — the nodes of the coarsest time grid — where alone u is kept, so
 //! long runs stay cheap (with an exact solution u is formed at every node for the true errors).
 
+pub mod cache;
 pub mod csv;
 pub mod differences;
 pub mod estimate;
@@ -21,7 +22,8 @@ pub mod richardson;
 use crate::error::{Error, Result};
 use crate::fem::norms::ErrorNorms;
 use crate::scene::Scene;
-use crate::stepping::{Problem, RunOptions, StepResult};
+use crate::stepping::{RunOptions, StepResult};
+pub use cache::SetupCache;
 use measure::{max_last, Kept};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -68,8 +70,15 @@ pub struct LevelResult {
     pub paper_dofs: usize,
     /// Wall time of the level: set-up and steps (seconds).
     pub wall: f64,
-    /// The set-up part of `wall` (mesh, assembly, factorisation, condensation).
+    /// The set-up part of `wall` (mesh, assembly, factorisation, condensation; with a set-up shared with
+    /// an earlier level on the same mesh, only the load superposition).
     pub setup: f64,
+    /// Whether this level assembled and factorised K (false: it shared the set-up of an earlier level on
+    /// the same mesh, [`SetupCache`]).
+    pub factorised: bool,
+    /// Seconds of set-up shared from that earlier level (0 when factorised): `setup` plus this is the
+    /// set-up of a run of the level alone.
+    pub reused_setup: f64,
     pub iterations: usize,
     /// True errors, max over the level's own time nodes ("max over n").
     pub max_err: Option<ErrorNorms>,
@@ -106,12 +115,19 @@ pub struct Study {
 
 /// Run one level; `own_nodes`: form u at every node for the true errors' max over the level's own nodes
 /// (else only at the common nodes, as for a reference run).
-fn run_level(scene: &Scene, level: Level, common: &[f64], own_nodes: bool, out: &mut LevelResult) -> Result<Kept> {
+fn run_level(
+    scene: &Scene,
+    cache: &SetupCache,
+    level: Level,
+    common: &[f64],
+    own_nodes: bool,
+    out: &mut LevelResult,
+) -> Result<Kept> {
     let mut s = scene.clone();
     s.set_refine(level.refine)?;
     s.set_steps(level.steps)?;
     let start = Instant::now();
-    let problem = Problem::new(s)?;
+    let problem = cache.problem(s, level.refine)?;
     let mut u = Vec::new();
     let (mut max_err, mut common_err, mut final_err) = (None::<ErrorNorms>, None::<ErrorNorms>, None);
     let (mut iterations, mut norm_max) = (0, 0.0f64);
@@ -161,6 +177,8 @@ fn run_level(scene: &Scene, level: Level, common: &[f64], own_nodes: bool, out: 
         paper_dofs: problem.space.paper_dofs(),
         wall: start.elapsed().as_secs_f64(),
         setup: problem.setup.as_array().iter().sum(),
+        factorised: problem.reused.is_none(),
+        reused_setup: problem.reused.map_or(0.0, |t| t.as_array().iter().sum()),
         iterations,
         max_err,
         common_err,
@@ -177,6 +195,8 @@ fn run_level(scene: &Scene, level: Level, common: &[f64], own_nodes: bool, out: 
 /// coarsest grid (`common`: e.g. steps doubling, or all levels with the same steps).
 pub struct Sequence<'a> {
     scene: &'a Scene,
+    /// The set-ups of the meshes run, shared by the levels on one mesh.
+    cache: SetupCache,
     common: Vec<f64>,
     reference: Option<Kept>,
     differences: Option<&'a Path>,
@@ -199,6 +219,18 @@ impl<'a> Sequence<'a> {
         reference: Option<Level>,
         differences: Option<&'a Path>,
     ) -> Result<Sequence<'a>> {
+        Sequence::with_cache(scene, min_steps, reference, differences, SetupCache::default())
+    }
+
+    /// As [`Sequence::new`], with the levels' set-ups taken from (and added to) `cache`, which must
+    /// hold set-ups of `scene`'s meshes only.
+    pub fn with_cache(
+        scene: &'a Scene,
+        min_steps: usize,
+        reference: Option<Level>,
+        differences: Option<&'a Path>,
+        cache: SetupCache,
+    ) -> Result<Sequence<'a>> {
         if !scene.uniform_time {
             return Err(Error::scene(
                 &scene.file,
@@ -209,11 +241,12 @@ impl<'a> Sequence<'a> {
         let (t0, t1) = (scene.times[0], *scene.times.last().expect("nodes"));
         let common: Vec<f64> = (0..=min_steps).map(|i| t0 + (t1 - t0) * i as f64 / min_steps as f64).collect();
         let reference = match reference {
-            Some(l) => Some(run_level(scene, l, &common, false, &mut LevelResult::default())?),
+            Some(l) => Some(run_level(scene, &cache, l, &common, false, &mut LevelResult::default())?),
             None => None,
         };
         Ok(Sequence {
             scene,
+            cache,
             common,
             reference,
             differences,
@@ -235,7 +268,7 @@ impl<'a> Sequence<'a> {
     /// Run one more level and compare it with the previous two (and the reference run).
     pub fn push(&mut self, level: Level) -> Result<&LevelResult> {
         let mut r = LevelResult::default();
-        let kept = run_level(self.scene, level, &self.common, true, &mut r)?;
+        let kept = run_level(self.scene, &self.cache, level, &self.common, true, &mut r)?;
         r.jumps = measure::jumps(&kept);
         if let Some(p) = &self.prev {
             if self.consecutive {

@@ -1,0 +1,1 @@
+"""Benchmark helpers (make bench): the factorisation peers of verification/bench/factorisation.py."""

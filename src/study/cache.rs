@@ -1,0 +1,82 @@
+//! Factor once per mesh: the set-ups ([`MeshSetUp`]) of the meshes a study or a plan runs, by
+//! refinement level, shared by its levels on the same mesh (a k-study's levels, the planner's time
+//! pilot and the space pilot's level on the same mesh). A cache belongs to one scene: its levels differ
+//! from it only in refinement and steps, so the refinement alone names the mesh.
+//!
+//! It keeps the set-ups of several meshes while they hold at most [`SHARE_OF_MEMORY`] of the memory
+//! available when a set-up is added (the newest is always kept): the planner returns to its pilot
+//! meshes, and studies usually hold one mesh at a time. Which set-ups it keeps only changes speed:
+//! a shared set-up has the values of a fresh one.
+
+use crate::error::Result;
+use crate::scene::budget::available_memory;
+use crate::scene::Scene;
+use crate::stepping::{MeshSetUp, Problem, SetupTimes};
+use std::sync::{Arc, Mutex};
+
+/// At most this share of the available memory is kept in set-ups other than the newest.
+const SHARE_OF_MEMORY: f64 = 0.25;
+
+/// Shared handle (clones share the cache) on the set-ups of one scene's meshes.
+#[derive(Clone, Default)]
+pub struct SetupCache {
+    inner: Arc<Mutex<Inner>>,
+}
+
+#[derive(Default)]
+struct Inner {
+    /// Set-ups by refinement, oldest first.
+    entries: Vec<(u32, Arc<MeshSetUp>)>,
+    /// Set-ups made, by refinement (a mesh made twice was dropped in between).
+    made: Vec<u32>,
+    /// Problems handed out.
+    problems: usize,
+}
+
+impl SetupCache {
+    /// The problem of `scene` (at refinement `refine`): on the cached set-up of that mesh, made first if
+    /// there is none ([`Problem::on_shared`]).
+    /// The problem that made the set-up reports its phases as its own (`reused` is `None`).
+    pub fn problem(&self, scene: Scene, refine: u32) -> Result<Problem> {
+        let (shared, made) = self.set_up(&scene, refine)?;
+        self.lock().problems += 1;
+        let mut p = Problem::on_shared(scene, &shared)?;
+        if made {
+            p.setup = SetupTimes { superposition: p.setup.superposition, ..shared.times() };
+            p.reused = None;
+        }
+        Ok(p)
+    }
+
+    /// The set-up of the mesh at `refine`, and whether it was made now.
+    fn set_up(&self, scene: &Scene, refine: u32) -> Result<(Arc<MeshSetUp>, bool)> {
+        if let Some((_, m)) = self.lock().entries.iter().find(|(r, _)| *r == refine) {
+            return Ok((Arc::clone(m), false));
+        }
+        let m = Arc::new(MeshSetUp::new(scene)?);
+        let mut inner = self.lock();
+        inner.made.push(refine);
+        inner.entries.push((refine, Arc::clone(&m)));
+        let limit = available_memory().map_or(0.0, |a| a as f64 * SHARE_OF_MEMORY);
+        while inner.entries.len() > 1
+            && inner.entries[..inner.entries.len() - 1].iter().map(|(_, m)| m.bytes() as f64).sum::<f64>() > limit
+        {
+            inner.entries.remove(0);
+        }
+        Ok((m, true))
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Inner> {
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Set-ups made so far (assemblies and numeric factorisations of K), by refinement, in order.
+    pub fn factorised(&self) -> Vec<u32> {
+        self.lock().made.clone()
+    }
+
+    /// Problems handed out so far (one per level run).
+    pub fn problems(&self) -> usize {
+        self.lock().problems
+    }
+}
