@@ -51,8 +51,8 @@
 //! time); `space_pilot`, `time_pilot` ([`Pilot`]: `size`, `levels` ([`Level`] without true errors: the
 //! pilots run the scene without `[exact]`), `x`, `errors`, `verdicts`, `p`, `beta`, `refused`); `time_ratio`,
 //! `scene_steps`; `error_model` (`space_c`, `space_p`; `time_c`, `time_p` for a power law or `time_bound`;
-//! `combine`: `quadrature` or `sum`); `cost_model` (`setup_c`, `setup_p`, `step`: wall = setup_c n^setup_p
-//! + N · step · n ln n); `plan` and `runners_up` ([`Candidate`]: `refine`, `steps`, `unknowns`, `h`, `k`,
+//! `combine`: `quadrature` or `sum`); `cost_model` (`setup_c`, `setup_p`, `step`: wall = setup_c n^setup_p +
+//! N · step · n ln n); `plan` and `runners_up` ([`Candidate`]: `refine`, `steps`, `unknowns`, `h`, `k`,
 //! `error`, `space_error`, `time_error`, `wall`, `memory`), `over_budget`; `solver`, `tol`; `notes`;
 //! `refused`; `achieved` (with `--run`, [`Achieved`]: `estimate`, `space`, `time`, `true_error`, `met`,
 //! `levels`).
