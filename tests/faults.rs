@@ -204,7 +204,8 @@ fn resume_checks_settings_and_checksums() {
     if py.exists() && Command::new(&py).args(["-c", "import vtk, meshio"]).output().is_ok_and(|o| o.status.success()) {
         let o = Command::new(&py).arg(root("scripts/check_results.py")).arg(&out).output().unwrap();
         assert!(!o.status.success());
-        let text = String::from_utf8_lossy(&o.stdout);
+        // the checker names a damaged file on standard error (one error line, exit 2)
+        let text = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
         assert!(text.contains("step 50 does not match its checksum"), "{text}");
     }
 }
