@@ -16,6 +16,9 @@ use tresca_cr::Scene;
 pub const REFUSED: i32 = 3;
 
 pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool) -> Result<i32> {
+    if let Some(path) = &csv {
+        super::run::not_an_input(&[path.clone()], &scene, "--csv")?;
+    }
     say!("Planning {} for the {} ≤ {:e}", scene.file, options.quantity.describe(), options.target);
     let p = plan(&scene, &options)?;
     print_evidence(&p);
@@ -27,6 +30,7 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool) 
     }
     if let Some(why) = &p.refused {
         say!("\nNo plan: {why}");
+        super::out::report_written(csv.as_deref())?;
         return Ok(REFUSED);
     }
     say!(
@@ -71,6 +75,7 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool) 
     if execute {
         execute_plan(&scene, &p, b)?;
     }
+    super::out::report_written(csv.as_deref())?;
     Ok(0)
 }
 

@@ -25,6 +25,7 @@ impl Writer {
             }
             return Err(Error::Io { path: path.to_path_buf(), msg: "no results file to --resume".into() });
         }
+        paths::check_target(path, true)?;
         let file = hdf5::File::with_options()
             .with_fapl(h5::file_access)
             .open_rw(path)

@@ -95,7 +95,7 @@ pub struct Outputs {
     #[serde(default)]
     pub energy: bool,
     /// σ_τ·τ on the Γ_C edge nearest to each point.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "raw::points")]
     pub traction_at: Vec<[f64; 2]>,
 }
 
@@ -133,8 +133,7 @@ fn nonzero(v: Option<Vec2Expr>) -> Option<Vec2Expr> {
 impl Scene {
     /// Read and validate a scene file.
     pub fn from_file(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::Io { path: path.to_path_buf(), msg: format!("cannot read scene: {e}") })?;
+        let text = crate::input::read_text(path, "scene")?;
         let mut scene = Self::from_str(&text, &path.display().to_string())?;
         // relative mesh paths are relative to the scene file
         if let MeshSpec::Gmsh { path: p, .. } = &mut scene.mesh {
@@ -266,6 +265,7 @@ impl Scene {
             _ => return Err(Error::scene(file, "time", "give either `T` and `steps`, or `times`")),
         };
         let rho = positive_finite(file, "discretisation.rho", raw.discretisation.map(|d| d.rho).unwrap_or(10.0))?;
+        values::representable(file, e, nu, rho)?;
         let rs = raw.solver.unwrap_or(RawSolver { method: None, tol: None, max_iter: None, uzawa_step: None });
         let method = rs.method.unwrap_or(Method::Ssn);
         let solver = SolverSettings {
