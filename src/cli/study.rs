@@ -49,6 +49,9 @@ fn check_memory(scene: &Scene, levels: &[Level], reference: Option<Level>, max_m
         s.set_refine(l.refine)?;
         Ok(Estimate::of(&s, l.steps, false)?)
     };
+    if let Some(r) = reference {
+        estimate(r)?.check(max_memory, None, None).with_context(|| format!("--reference {}:{}", r.refine, r.steps))?;
+    }
     let kept = reference.map(estimate).transpose()?.map_or(0, |e| e.memory);
     let each = levels.iter().map(|&l| estimate(l)).collect::<Result<Vec<_>>>()?;
     for (i, (l, e)) in levels.iter().zip(&each).enumerate() {
@@ -60,9 +63,6 @@ fn check_memory(scene: &Scene, levels: &[Level], reference: Option<Level>, max_m
                 l.refine, l.steps
             )
         })?;
-    }
-    if let Some(r) = reference {
-        estimate(r)?.check(max_memory, None, None).with_context(|| format!("--reference {}:{}", r.refine, r.steps))?;
     }
     Ok(())
 }
