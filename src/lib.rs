@@ -23,6 +23,7 @@
 pub mod error;
 pub mod fem;
 pub mod friction;
+pub mod input;
 pub mod mesh;
 pub mod names;
 pub mod output;

@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 use cli::out::note;
 use cli::run::OutputArgs;
 use std::path::{Path, PathBuf};
-use tresca_cr::scene::budget::{parse_size, Estimate};
+use tresca_cr::scene::budget::Estimate;
 use tresca_cr::scene::Method;
 use tresca_cr::Scene;
 
@@ -23,9 +23,9 @@ enum Cmd {
     /// Validate a scene and print what it will model, with the memory and disk a run will need.
     Check {
         scene: PathBuf,
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::refine)]
         refine: Option<u32>,
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::count)]
         steps: Option<usize>,
         #[command(flatten)]
         limits: Limits,
@@ -36,16 +36,16 @@ enum Cmd {
     Run {
         scene: PathBuf,
         /// Uniform refinements (overrides mesh.refine).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::refine)]
         refine: Option<u32>,
         /// Uniform time steps (overrides time.steps).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::count)]
         steps: Option<usize>,
         /// Per-step solver (overrides solver.method).
         #[arg(long)]
         solver: Option<Method>,
         /// Solver tolerance (overrides solver.tol).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         tol: Option<f64>,
         #[command(flatten)]
         out: OutputArgs,
@@ -64,16 +64,16 @@ enum Cmd {
     Study {
         scene: PathBuf,
         /// Levels as refine:steps, comma separated, e.g. 0:40,1:80,2:160,3:320.
-        #[arg(long, value_delimiter = ',', required = true)]
+        #[arg(long, value_delimiter = ',', required = true, allow_hyphen_values = true, value_parser = cli::args::level)]
         levels: Vec<tresca_cr::study::Level>,
         /// A finer reference run (refine:steps) to measure errors against.
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true, value_parser = cli::args::level)]
         reference: Option<tresca_cr::study::Level>,
         /// Per-step solver (overrides solver.method).
         #[arg(long)]
         solver: Option<Method>,
         /// Solver tolerance (overrides solver.tol).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         tol: Option<f64>,
         /// Write the table as CSV.
         #[arg(long)]
@@ -81,6 +81,9 @@ enum Cmd {
         /// Write per level the elementwise energy density of u_l − P u_{l−1} (XDMF, ParaView) into DIR.
         #[arg(long, value_name = "DIR")]
         differences: Option<PathBuf>,
+        /// Refuse a study whose levels' estimated peak memory exceeds this (default: available memory).
+        #[arg(long, allow_hyphen_values = true, value_parser = cli::args::size)]
+        max_memory: Option<u64>,
         #[command(flatten)]
         json: cli::summary::JsonArg,
     },
@@ -89,17 +92,17 @@ enum Cmd {
     Plan {
         scene: PathBuf,
         /// The error to reach (absolute, in the quantity's units).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         target: f64,
         /// energy-norm (the energy-norm error, max over the time nodes), or an output of [quantities] at T:
         /// max-slip, stick-length, elastic-energy (½a_h(u,u)) or traction_x_y.
         #[arg(long, default_value = "energy-norm")]
         quantity: String,
         /// Wall time the planned run may take (e.g. 90s, 10m, 2h).
-        #[arg(long, default_value = "1h", value_parser = cli::plan::parse_duration)]
+        #[arg(long, default_value = "1h", allow_hyphen_values = true, value_parser = cli::plan::parse_duration)]
         budget: f64,
         /// Wall time the pilot runs may take (default: a tenth of the budget).
-        #[arg(long, value_parser = cli::plan::parse_duration)]
+        #[arg(long, allow_hyphen_values = true, value_parser = cli::plan::parse_duration)]
         pilot_budget: Option<f64>,
         /// Run the plan and report the achieved error estimate (and the true error with [exact]).
         #[arg(long)]
@@ -108,7 +111,7 @@ enum Cmd {
         #[arg(long)]
         csv: Option<PathBuf>,
         /// Refuse configurations whose estimated peak memory exceeds this (default: available memory).
-        #[arg(long, value_parser = parse_size)]
+        #[arg(long, allow_hyphen_values = true, value_parser = cli::args::size)]
         max_memory: Option<u64>,
         #[command(flatten)]
         json: cli::summary::JsonArg,
@@ -119,10 +122,10 @@ enum Cmd {
 #[derive(clap::Args, Clone, Copy)]
 struct Limits {
     /// Refuse a run whose estimated peak memory exceeds this (e.g. 800M, 16G; default: available memory).
-    #[arg(long, value_parser = parse_size)]
+    #[arg(long, allow_hyphen_values = true, value_parser = cli::args::size)]
     max_memory: Option<u64>,
     /// Refuse a run whose estimated results file exceeds this (e.g. 2G; default: free disk space).
-    #[arg(long, value_parser = parse_size)]
+    #[arg(long, allow_hyphen_values = true, value_parser = cli::args::size)]
     max_disk: Option<u64>,
 }
 
@@ -139,13 +142,15 @@ fn solver_overrides(s: &mut Scene, solver: Option<Method>, tol: Option<f64>) -> 
 }
 
 /// Read the scene, estimate what the run needs (refused when it does not fit: before anything large is
-/// allocated), then apply --refine and --steps. `output`: the results file, if one is written.
+/// allocated), then apply --refine and --steps. `output`: the results file, if one is written; `creates`:
+/// this process will create it (`run`), so a path that cannot be a results file is refused first.
 fn load(
     path: &Path,
     refine: Option<u32>,
     steps: Option<usize>,
     limits: Limits,
     output: impl FnOnce(&Scene) -> Option<PathBuf>,
+    creates: bool,
 ) -> Result<(Scene, Estimate)> {
     let mut scene = Scene::from_file(path)?;
     for d in &scene.deprecations {
@@ -154,6 +159,10 @@ fn load(
     // the results file whose disk the estimate is for, chosen from the scene just read (parsed once)
     let output = output(&scene);
     let output = output.as_deref();
+    if let Some(p) = output.filter(|_| creates) {
+        tresca_cr::output::check_target(p, false)?;
+        tresca_cr::output::check_writable(p)?;
+    }
     if scene.rho < 1.0 {
         // a_h is coercive only through the jump term (plain CR fails Korn's inequality): the discrete
         // Korn constant, and with it the error, degrades like 1/ρ (reference/stability.md: ρ = 1e-4 gives
@@ -214,7 +223,7 @@ fn main() {
             // the estimate of the results file is for the scene's [output] path, else the current directory
             let out = |s: &Scene| Some(s.output.clone().unwrap_or_else(|| PathBuf::from("run.h5")));
             cli::summary::check_path(json.json.as_deref())
-                .and_then(|()| load(&scene, refine, steps, limits, out))
+                .and_then(|()| load(&scene, refine, steps, limits, out, false))
                 .and_then(|(s, e)| cli::check::check(s, e, json.json))
         }
         Cmd::Run { scene, refine, steps, solver, tol, out, verbose, quiet, limits, json } => {
@@ -222,19 +231,19 @@ fn main() {
             let (given, resume) = (out.output.clone(), out.resume);
             let new_file = move |s: &Scene| given.or_else(|| s.output.clone()).filter(|_| !resume);
             cli::summary::check_path(json.json.as_deref())
-                .and_then(|()| load(&scene, refine, steps, limits, new_file))
+                .and_then(|()| load(&scene, refine, steps, limits, new_file, true))
                 .and_then(|(mut s, _)| {
                     solver_overrides(&mut s, solver, tol)?;
                     cli::run::run(s, out, verbose, quiet, json.json)
                 })
         }
-        Cmd::Study { scene, levels, reference, solver, tol, csv, differences, json } => {
+        Cmd::Study { scene, levels, reference, solver, tol, csv, differences, max_memory, json } => {
             let no_limits = Limits { max_memory: None, max_disk: None };
             cli::summary::check_path(json.json.as_deref())
-                .and_then(|()| load(&scene, None, None, no_limits, |_| None))
+                .and_then(|()| load(&scene, None, None, no_limits, |_| None, false))
                 .and_then(|(mut s, _)| {
                     solver_overrides(&mut s, solver, tol)?;
-                    cli::study::study(s, &levels, reference, csv, differences, json.json)
+                    cli::study::study(s, &levels, reference, csv, differences, max_memory, json.json)
                 })
         }
         Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory, json } => {
@@ -250,7 +259,7 @@ fn main() {
                 max_memory,
             };
             cli::summary::check_path(json.json.as_deref())
-                .and_then(|()| load(&scene, None, None, no_limits, |_| None))
+                .and_then(|()| load(&scene, None, None, no_limits, |_| None, false))
                 .and_then(|(s, _)| {
                     let code = cli::plan::run(s, options, csv, run, json.json)?;
                     if code != 0 {

@@ -2,7 +2,9 @@
 //! on arbitrary or mutated input — they return a value or a typed error. The number of cases is
 //! TRESCA_FUZZ_CASES (default 500 per target; `make verify` runs more). Each target prints how many
 //! inputs ran and how they ended. Inputs that once panicked, aborted or were misreported (issue 18: a
-//! mesh whose areas underflow, slivers, steps beyond memory, loads whose energy overflows) are kept in
+//! mesh whose areas underflow, slivers, steps beyond memory, loads whose energy overflows; issue 34:
+//! arrays longer than the schema, collapsing time steps, NaN output points, unrepresentable E, ρ and
+//! coordinates) are kept in
 //! `tests/fuzz_corpus/` and replayed by `corpus_replays_without_panic`: each must end in an error.
 
 use proptest::prelude::*;

@@ -26,6 +26,9 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool, 
         }
         super::summary::write(j, &s)
     };
+    if let Some(path) = &csv {
+        super::run::not_an_input(&[path.clone()], &scene, "--csv")?;
+    }
     say!("Planning {} for the {} ≤ {:e}", scene.file, options.quantity.describe(), options.target);
     let p = plan(&scene, &options)?;
     print_evidence(&p);
@@ -38,6 +41,7 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool, 
     if let Some(why) = &p.refused {
         say!("\nNo plan: {why}");
         summarise(&p, None)?;
+        super::out::report_written(csv.as_deref())?;
         return Ok(REFUSED);
     }
     say!(
@@ -81,6 +85,7 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool, 
     );
     let achieved = if execute { Some(execute_plan(&scene, &p, b)?) } else { None };
     summarise(&p, achieved)?;
+    super::out::report_written(csv.as_deref())?;
     Ok(0)
 }
 

@@ -5,22 +5,21 @@ use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 use tresca_cr::{Problem, RunOptions, Scene};
 
-/// Refuse an output path that is (or whose sidecar is) the scene or its mesh: `--force` would overwrite the
-/// run's own input.
-fn not_an_input(path: &Path, scene: &Scene) -> Result<()> {
-    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
+/// Refuse output paths (`what`: the option) that are the scene or its mesh, as files (a link or another
+/// name of them counts): writing them would overwrite the run's own input.
+pub fn not_an_input(outs: &[PathBuf], scene: &Scene, what: &str) -> Result<()> {
+    use std::os::unix::fs::MetadataExt;
+    let id = |p: &Path| std::fs::metadata(p).ok().map(|m| (m.dev(), m.ino()));
     let mut inputs = vec![PathBuf::from(&scene.file)];
     if let tresca_cr::scene::MeshSpec::Gmsh { path, .. } = &scene.mesh {
         inputs.push(path.clone());
     }
-    for out in [path.to_path_buf(), tresca_cr::output::sidecar(path)] {
-        if let Some(i) = inputs.iter().find(|i| same(&out, i)) {
+    for out in outs {
+        let Some(o) = id(out) else { continue };
+        if let Some(i) = inputs.iter().find(|i| id(i) == Some(o)) {
             anyhow::bail!(
-                "{}: the output would overwrite the run's input {}; choose another -o",
-                path.display(),
+                "{}: {what} would overwrite the run's input {}; choose another path",
+                out.display(),
                 i.display()
             );
         }
@@ -41,11 +40,11 @@ pub struct OutputArgs {
     #[arg(long)]
     pub resume: bool,
     /// Visualisation frame (VTKHDF/XDMF) every k steps, plus the last; default about 50 frames in all.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = super::args::count)]
     pub frame_every: Option<usize>,
     /// Seconds between commits (write + flush) of completed steps; 0 (default) commits every step as soon
     /// as the writer thread has it (with the steps queued behind it).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = super::args::non_negative)]
     pub commit_interval: f64,
 }
 
@@ -128,7 +127,7 @@ fn check_output_args(out: &OutputArgs, path: Option<&Path>, scene: &Scene) -> Re
         "--commit-interval must be a non-negative number of seconds"
     );
     match path {
-        Some(p) => not_an_input(p, scene)?,
+        Some(p) => not_an_input(&[p.to_path_buf(), tresca_cr::output::sidecar(p)], scene, "the output")?,
         None => note!("note: no results file (give -o FILE or an [output] path): the steps are solved and only this summary is kept"),
     }
     Ok(())

@@ -1,10 +1,71 @@
 //! `tresca-cr study`: a convergence study printed as a table (and written as CSV), then the error
 //! estimates without an exact solution (Richardson, GCI, asymptotic-range verdict per level).
 
+use super::out::say;
 use anyhow::{Context, Result};
 use std::path::PathBuf;
+use tresca_cr::scene::budget::Estimate;
 use tresca_cr::study::{Axis, Level, LevelResult, Study};
 use tresca_cr::Scene;
+
+/// Refuse levels that make no study: one given twice, a level coarser than the one before it (in
+/// refinements or steps: the estimates compare each level with the coarser ones before it), a reference
+/// that is not finer than every level (its error would be 0 against itself, or the order negative).
+fn check_levels(levels: &[Level], reference: Option<Level>) -> Result<()> {
+    let name = |l: &Level| format!("{}:{}", l.refine, l.steps);
+    for (i, l) in levels.iter().enumerate() {
+        if let Some(p) = levels[..i].iter().find(|p| *p == l) {
+            anyhow::bail!("--levels: the level {} is given twice", name(p));
+        }
+        if let Some(p) = i.checked_sub(1).map(|j| &levels[j]) {
+            if l.refine < p.refine || l.steps < p.steps {
+                anyhow::bail!(
+                    "--levels: {} after {} is coarser (in refinements or steps); give the levels from coarse to fine",
+                    name(l),
+                    name(p)
+                );
+            }
+        }
+    }
+    if let Some(r) = reference {
+        if let Some(l) = levels.iter().find(|l| r.refine < l.refine || r.steps < l.steps || **l == r) {
+            anyhow::bail!(
+                "--reference {}: a reference must be finer than every level (at least the refinements and steps of \
+                 each, and not one of them), but the level {} is not coarser than it",
+                name(&r),
+                name(l)
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Refuse the study before any level is built when a level cannot fit in memory: the estimate of
+/// `run`/`check` ([`Estimate`]) of the level, plus those of the two levels before it and the reference
+/// run, which the study holds at the same time.
+fn check_memory(scene: &Scene, levels: &[Level], reference: Option<Level>, max_memory: Option<u64>) -> Result<()> {
+    let estimate = |l: Level| -> Result<Estimate> {
+        let mut s = scene.clone();
+        s.set_refine(l.refine)?;
+        Ok(Estimate::of(&s, l.steps, false)?)
+    };
+    if let Some(r) = reference {
+        estimate(r)?.check(max_memory, None, None).with_context(|| format!("--reference {}:{}", r.refine, r.steps))?;
+    }
+    let kept = reference.map(estimate).transpose()?.map_or(0, |e| e.memory);
+    let each = levels.iter().map(|&l| estimate(l)).collect::<Result<Vec<_>>>()?;
+    for (i, (l, e)) in levels.iter().zip(&each).enumerate() {
+        let held: u64 = each[i.saturating_sub(2)..i].iter().map(|e| e.memory).sum();
+        let together = Estimate { memory: e.memory.saturating_add(held).saturating_add(kept), ..*e };
+        together.check(max_memory, None, None).with_context(|| {
+            format!(
+                "study level {}:{} (with the levels before it and the reference it is held beside)",
+                l.refine, l.steps
+            )
+        })?;
+    }
+    Ok(())
+}
 
 pub fn study(
     scene: Scene,
@@ -12,14 +73,33 @@ pub fn study(
     reference: Option<Level>,
     csv: Option<PathBuf>,
     differences: Option<PathBuf>,
+    max_memory: Option<u64>,
     json: Option<PathBuf>,
 ) -> Result<()> {
     let start = std::time::Instant::now();
     use tresca_cr::study::orders::observed_order;
     use tresca_cr::study::run_study;
-    println!(
+    check_levels(levels, reference)?;
+    if let Some(p) = &csv {
+        super::run::not_an_input(&[p.clone()], &scene, "--csv")?;
+    }
+    check_memory(&scene, levels, reference, max_memory)?;
+    say!(
         "{:>3} {:>6} {:>9} {:>9} {:>8} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>8}",
-        "ref", "steps", "h", "k", "DOF", "energy", "ord", "L2", "ord", "consec(T)", "ord", "vs ref(T)", "ord", "wall s"
+        "ref",
+        "steps",
+        "h",
+        "k",
+        "DOF",
+        "energy",
+        "ord",
+        "L2",
+        "ord",
+        "consec(T)",
+        "ord",
+        "vs ref(T)",
+        "ord",
+        "wall s"
     );
     let mut prev: Option<LevelResult> = None;
     let study = run_study(&scene, levels, reference, differences.as_deref(), |r| {
@@ -36,7 +116,7 @@ pub fn study(
         let l2 = |r: &LevelResult| r.max_err.map(|e| e.l2);
         let co = |r: &LevelResult| r.consecutive.map(|e| e[1]);
         let rf = |r: &LevelResult| r.reference.map(|e| e[1]);
-        println!(
+        say!(
             "{:>3} {:>6} {:>9.3e} {:>9.3e} {:>8} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>8.3}",
             r.refine,
             r.steps,
@@ -55,13 +135,13 @@ pub fn study(
         );
         prev = Some(r.clone());
     })?;
-    println!("(energy, L2: true errors, max over each level's own time nodes)");
+    say!("(energy, L2: true errors, max over each level's own time nodes)");
     print_estimates(&study);
     for f in &study.difference_files {
-        println!("wrote {}", f.display());
+        say!("wrote {}", f.display());
     }
-    if let Some(path) = csv {
-        std::fs::write(&path, tresca_cr::study::csv::text(&study))
+    if let Some(path) = &csv {
+        std::fs::write(path, tresca_cr::study::csv::text(&study))
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(j) = &json {
@@ -69,25 +149,25 @@ pub fn study(
         summary.study = Some(super::summary::StudySummary::of(&study, reference));
         super::summary::write(j, &summary)?;
     }
-    Ok(())
+    super::out::report_written(csv.as_deref())
 }
 
 /// The estimates: energy norm per level, then every scalar output.
 fn print_estimates(s: &Study) {
     let e = &s.estimates;
-    println!();
+    say!("");
     match (&e.model, &e.refused) {
-        (Some(m), _) => println!(
+        (Some(m), _) => say!(
             "Error estimate without an exact solution (energy norm, order in {}): p = {:.3}, β = {:.3} from the three finest levels",
             e.size, m.p, m.beta
         ),
         (None, why) => {
-            println!("No error estimate (energy norm): not yet: refine further ({})", why.clone().unwrap_or_default());
+            say!("No error estimate (energy norm): not yet: refine further ({})", why.clone().unwrap_or_default());
         }
     }
     if e.model.is_some() {
         let true_col = s.levels.iter().any(|r| r.common_err.is_some() || r.reference.is_some());
-        println!(
+        say!(
             "{:>3} {:>6} {:>11} {:>11} {:>11} {:>7}  verdict",
             "ref",
             "steps",
@@ -103,7 +183,7 @@ fn print_estimates(s: &Study) {
             let truth = if e.size == Axis::K { reference } else { r.common_err.map(|v| v.energy).or(reference) };
             let (t, eff) = truth
                 .map_or((String::new(), String::new()), |t| (format!("{t:.4e}"), format!("{:.3}", l.error[0] / t)));
-            println!(
+            say!(
                 "{:>3} {:>6} {:>11.4e} {:>11.4e} {:>11} {:>7}  {}",
                 r.refine,
                 r.steps,
@@ -117,12 +197,12 @@ fn print_estimates(s: &Study) {
     }
     for o in &s.outputs {
         match o.model {
-            Some(m) => println!("\nOutput {} at T: extrapolated {:.6e}, p = {:.3}", o.name, m.limit, m.p),
-            None => println!("\nOutput {} at T: no extrapolation", o.name),
+            Some(m) => say!("\nOutput {} at T: extrapolated {:.6e}, p = {:.3}", o.name, m.limit, m.p),
+            None => say!("\nOutput {} at T: no extrapolation", o.name),
         }
         for (r, (l, q)) in s.levels.iter().zip(o.levels.iter().zip(s.levels.iter().map(|r| r.outputs.clone()))) {
             let idx = s.outputs.iter().position(|x| x.name == o.name).unwrap_or(0);
-            println!(
+            say!(
                 "{:>3} {:>6} value {:>12.5e}  est {:>10.3e}  GCI {:>10.3e}  {}",
                 r.refine,
                 r.steps,

@@ -49,8 +49,7 @@ impl<'a> Tokens<'a> {
 
 /// Read a Gmsh 4.1 ASCII file.
 pub fn read(path: &Path) -> Result<RawMesh> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| Error::Io { path: path.to_path_buf(), msg: format!("cannot read mesh: {e}") })?;
+    let text = crate::input::read_text(path, "mesh")?;
     parse(&text, &path.display().to_string())
 }
 

@@ -109,6 +109,16 @@ impl Mesh {
             let a2 = area2(a, b, c);
             let scale =
                 [(a, b), (b, c), (c, a)].iter().map(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1])).fold(0.0, f64::max);
+            if !(scale * scale).is_finite() {
+                return Err(Error::mesh(
+                    src,
+                    format!(
+                        "triangle {k} at ({:e}, {:e}) has edges of {scale:.1e}: its area overflows f64 (beyond \
+                         1.8e308); give the mesh in smaller units (the answer scales with them)",
+                        a[0], a[1]
+                    ),
+                ));
+            }
             if scale > 0.0 && scale * scale < 1e4 * f64::MIN_POSITIVE {
                 return Err(Error::mesh(
                     src,

@@ -3,6 +3,13 @@
 
 use super::*;
 
+/// The file a new one replaces, held open for reading (see [`Pending`]); not through a symbolic link,
+/// and without waiting on a FIFO.
+fn open_old(path: &Path) -> Option<std::fs::File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK).open(path).ok()
+}
+
 impl Writer {
     /// Create `path` (and `run.xdmf` next to it) with mesh, static data and attributes. An existing file
     /// is refused unless `force`.
@@ -30,35 +37,64 @@ impl Writer {
                         .into(),
             });
         }
+        let side = sidecar(path);
+        if side.exists() && !opts.force {
+            return Err(Error::Io {
+                path: side,
+                msg: "an XDMF file exists under the name of this run's sidecar; pass --force to overwrite it".into(),
+            });
+        }
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(ioerr(path, "cannot create the directory"))?;
         }
         // Build the file under a temporary name, renamed at its first commit (`publish`): a kill before
         // that leaves no half-made file under `path` and an old file as it was (the handles follow the rename).
+        // created exclusively (O_EXCL): a name planted under `.partial` is never opened, let alone truncated
         let partial = partial_path(path);
+        paths::clear_stale(&partial, "partial results file")?;
         let file = hdf5::File::with_options()
             .with_fapl(h5::file_access)
-            .create(&partial)
+            .create_excl(&partial)
             .map_err(io(path, "cannot create HDF5 file"))?;
-        let fields = Fields::new(run);
-        let contact = !run.space.contact.is_empty();
-        let n = run.n_steps();
-        let every = opts.frame_every.unwrap_or(n.div_ceil(AUTO_FRAMES - 1)).max(1);
-        let frames = Frames { every, last: n };
-        let tresca = Tresca::create(&file, run).map_err(io(path, "writing the tresca group"))?;
-        h5::attr(&tresca.group, "frame_every", every as i64).map_err(io(path, "attribute frame_every"))?;
-        let vtk =
-            VtkHdf::create(&file, &fields, frames.total(), contact).map_err(io(path, "writing the VTKHDF group"))?;
-        let xdmf = Xdmf::create(&file, path, &fields, contact, frames.total())
-            .map_err(ioerr(path, "writing the XDMF sidecar"))?;
-        file.flush().map_err(io(path, "flush"))?;
-        let raw = Raw::open(&partial).map_err(ioerr(path, "cannot open the new file for writing"))?;
-        let pending = Some(Pending { old: std::fs::File::open(path).ok(), partial });
+        let opened = Writer::fill(&file, path, &partial, run, opts).map_err(|e| {
+            // nothing of a new file is left when it cannot be made (a full disk: the series are allocated
+            // for the whole run, so the partial file would be large)
+            let _ = std::fs::remove_file(&partial);
+            e
+        })?;
+        let (fields, tresca, vtk, xdmf, frames, raw) = opened;
+        let old = paths::lstat(path)?.is_some().then(|| open_old(path)).flatten();
+        let pending = Some(Pending { old, partial });
         let mut w = Writer::from_opened(path, run, fields, Opened { file, raw, tresca, vtk, xdmf, frames }, 0, None);
         w.interval = opts.commit_interval;
         w.pending = pending;
         w.lock = Some(lock);
         Ok(w)
+    }
+
+    /// The groups of a new file `file` (built at `partial`), with its sidecar started.
+    #[allow(clippy::type_complexity)]
+    fn fill(
+        file: &hdf5::File,
+        path: &Path,
+        partial: &Path,
+        run: &Run,
+        opts: &Options,
+    ) -> Result<(Fields, Tresca, VtkHdf, Xdmf, Frames, Raw)> {
+        let fields = Fields::new(run);
+        let contact = !run.space.contact.is_empty();
+        let n = run.n_steps();
+        let every = opts.frame_every.unwrap_or(n.div_ceil(AUTO_FRAMES - 1)).max(1);
+        let frames = Frames { every, last: n };
+        let tresca = Tresca::create(file, run).map_err(io(path, "writing the tresca group"))?;
+        h5::attr(&tresca.group, "frame_every", every as i64).map_err(io(path, "attribute frame_every"))?;
+        let vtk =
+            VtkHdf::create(file, &fields, frames.total(), contact).map_err(io(path, "writing the VTKHDF group"))?;
+        let xdmf = Xdmf::create(file, path, &fields, contact, frames.total())
+            .map_err(ioerr(path, "writing the XDMF sidecar"))?;
+        file.flush().map_err(io(path, "flush"))?;
+        let raw = Raw::open(partial).map_err(ioerr(path, "cannot open the new file for writing"))?;
+        Ok((fields, tresca, vtk, xdmf, frames, raw))
     }
 
     /// Record the set-up times of a file created before they were known ([`crate::Problem::new_beside`]).

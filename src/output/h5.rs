@@ -99,7 +99,8 @@ pub struct Raw(pub std::fs::File);
 
 impl Raw {
     pub fn open(path: &Path) -> std::io::Result<Raw> {
-        Ok(Raw(std::fs::OpenOptions::new().write(true).open(path)?))
+        // the file this run created or resumes: a regular file with one link, not through a symbolic link
+        Ok(Raw(super::paths::open_own(path)?))
     }
 
     /// All of `bytes` at byte `offset` (one `pwrite` on Unix).

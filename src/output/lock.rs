@@ -3,13 +3,14 @@
 //! files, the sidecar, an old file under `--resume`) and released when the writer is dropped (the lock
 //! file is removed) or when the process ends in any way, including SIGKILL: the kernel drops the locks of
 //! a dead process, so a lock file left by a killed run is stale and simply taken over. A second run on
-//! the same path is refused at once, naming the process that holds it. The lock does not depend on
+//! the same path is refused at once, naming the process that holds it. The lock file is created with
+//! `O_EXCL` (see [`super::paths`]); a stale one is removed while held, never truncated. The lock does not depend on
 //! HDF5's own file locking (which `HDF5_USE_FILE_LOCKING=FALSE` turns off).
 
 use crate::error::{Error, Result};
 use std::fs::{File, OpenOptions};
-use std::io::{Read, Seek, Write};
-use std::os::unix::fs::MetadataExt;
+use std::io::{Read, Write};
+use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
 use std::os::unix::io::AsRawFd;
 use std::path::{Path, PathBuf};
 
@@ -36,17 +37,21 @@ impl OutputLock {
     pub fn acquire(target: &Path) -> Result<OutputLock> {
         let lock_path = lock_path(target);
         let err = |msg: String| Error::Io { path: target.to_path_buf(), msg };
+        super::paths::check_target(target, false)?;
         if let Some(dir) = target.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| err(format!("cannot create the directory: {e}")))?;
         }
         loop {
-            let mut file = OpenOptions::new()
-                .read(true)
-                .write(true)
-                .create(true)
-                .truncate(false)
-                .open(&lock_path)
-                .map_err(|e| err(format!("cannot create the lock file {}: {e}", lock_path.display())))?;
+            // the lock file is this run's own (O_EXCL); one that exists is opened only to see whether a
+            // live run holds it, never truncated or written
+            let (mut file, created) = match super::paths::create_new(&lock_path) {
+                Ok(f) => (f, true),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => match open_existing(&lock_path)? {
+                    Some(f) => (f, false),
+                    None => continue, // removed meanwhile
+                },
+                Err(e) => return Err(err(format!("cannot create the lock file {}: {e}", lock_path.display()))),
+            };
             // SAFETY: flock on a file descriptor this function owns; no memory is passed.
             if unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) } != 0 {
                 let e = std::io::Error::last_os_error();
@@ -62,16 +67,21 @@ impl OutputLock {
             }
             // A holder removes the lock file before it unlocks it: the file locked here must still be the
             // one under the name, else another run may lock a new one; take it again.
-            let same = match (file.metadata(), std::fs::metadata(&lock_path)) {
+            let same = match (file.metadata(), std::fs::symlink_metadata(&lock_path)) {
                 (Ok(a), Ok(b)) => a.ino() == b.ino() && a.dev() == b.dev(),
                 _ => false,
             };
             if !same {
                 continue;
             }
+            if !created {
+                // the lock of a run that ended without removing it (killed): remove it while holding it,
+                // then create this run's own
+                std::fs::remove_file(&lock_path)
+                    .map_err(|e| err(format!("cannot remove the stale lock file {}: {e}", lock_path.display())))?;
+                continue;
+            }
             let mut record = || -> std::io::Result<()> {
-                file.set_len(0)?;
-                file.rewind()?;
                 let exe = std::env::args().next().unwrap_or_default();
                 write!(file, "{} ({exe})", std::process::id())?;
                 file.flush()
@@ -85,6 +95,31 @@ impl OutputLock {
     pub fn target(&self) -> &Path {
         &self.target
     }
+}
+
+/// Open an existing lock file to test its lock: refused unless it is a regular file with one link (a
+/// symbolic link, a hard link to another file, a device or a FIFO planted under the name); `None` when
+/// it disappeared meanwhile.
+fn open_existing(lock_path: &Path) -> Result<Option<File>> {
+    let refuse = |msg: String| Error::Io { path: lock_path.to_path_buf(), msg };
+    let opened = OpenOptions::new().read(true).custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK).open(lock_path);
+    let file = match opened {
+        Ok(f) => f,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) if e.raw_os_error() == Some(libc::ELOOP) => {
+            return Err(refuse("the lock file's name is a symbolic link (not one this program made); remove it".into()))
+        }
+        Err(e) => return Err(refuse(format!("cannot open the lock file: {e}"))),
+    };
+    let m = file.metadata().map_err(|e| refuse(format!("cannot inspect the lock file: {e}")))?;
+    if !m.file_type().is_file() || m.nlink() != 1 {
+        return Err(refuse(format!(
+            "the lock file's name is {} with {} link(s) (not one this program made); remove it",
+            crate::input::kind_of(m.file_type()),
+            m.nlink()
+        )));
+    }
+    Ok(Some(file))
 }
 
 impl Drop for OutputLock {

@@ -49,6 +49,7 @@ mod create;
 pub mod fields;
 mod h5;
 mod lock;
+mod paths;
 mod resume;
 mod rows;
 mod take;
@@ -73,6 +74,7 @@ use xdmf::Xdmf;
 
 pub use background::Background;
 pub use lock::{lock_path, OutputLock};
+pub use paths::{check_target, check_writable};
 pub use take::Unknowns;
 pub use xdmf::sidecar;
 
@@ -324,7 +326,9 @@ impl Writer {
     }
 
     fn close(&mut self, status: &str) -> Result<()> {
-        self.commit()?;
+        // a last commit that fails (a full disk) does not end the closing: the file is still cut to its
+        // completed steps and records why it stopped, and a file without a step is removed
+        let committed = self.commit();
         self.finished = true;
         let path = self.path.clone();
         if self.completed == 0 {
@@ -333,9 +337,14 @@ impl Writer {
                 let _ = std::fs::remove_file(partial);
                 self.xdmf.discard();
             }
-            return Ok(());
+            return committed;
         }
-        if self.completed < self.frames.last + 1 {
+        let status = match &committed {
+            Err(e) if !status.starts_with("stopped") => format!("stopped: {e}"),
+            _ => status.to_string(),
+        };
+        let all = self.frames.last + 1;
+        if self.completed < all || committed.is_err() {
             // a stopped run: series of exactly the completed steps, so no reader meets unwritten rows
             let (steps, frames) = (self.completed, self.frames_done);
             let mut shrink = || -> hdf5::Result<()> {
@@ -343,9 +352,13 @@ impl Writer {
                 self.vtk.set_frames(&self.raw, frames, frames)?;
                 self.xdmf.drop_frames_from(frames)
             };
-            shrink().map_err(io(&path, "shrinking the series of a stopped run"))?;
+            let shrunk = shrink().map_err(io(&path, "shrinking the series of a stopped run"));
+            let shrunk = committed.and(shrunk);
+            let marked = self.tresca.set_status(&status).map_err(io(&path, "attribute status"));
+            let flushed = self.file.flush().map_err(io(&path, "flush"));
+            return shrunk.and(marked).and(flushed).and(self.publish());
         }
-        self.tresca.set_status(status).map_err(io(&path, "attribute status"))?;
+        self.tresca.set_status(&status).map_err(io(&path, "attribute status"))?;
         self.file.flush().map_err(io(&path, "flush"))?;
         self.publish()
     }

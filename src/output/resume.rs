@@ -25,6 +25,7 @@ impl Writer {
             }
             return Err(Error::Io { path: path.to_path_buf(), msg: "no results file to --resume".into() });
         }
+        paths::check_target(path, true)?;
         let file = hdf5::File::with_options()
             .with_fapl(h5::file_access)
             .open_rw(path)
@@ -72,7 +73,19 @@ impl Writer {
         let pts =
             tresca.group.dataset("mesh/points").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "mesh/points"))?;
         if pts != run.mesh.points.as_flattened() {
-            return Err(mismatch("mesh (vertex coordinates)"));
+            // the scene text and the mesh's sizes are the file's: the coordinates come from them, unless a
+            // Gmsh file they name was edited since
+            let msg = match &run.scene.mesh {
+                crate::mesh::MeshSpec::Gmsh { path: m, .. } => format!(
+                    "--resume: the stored vertex coordinates (tresca/mesh/points) differ from those of {}: the mesh \
+                     file was changed since the run, or the results file was damaged; rerun with --force",
+                    m.display()
+                ),
+                _ => "--resume: the stored vertex coordinates (tresca/mesh/points) differ from the mesh the scene \
+                      (the file's own text) generates: the file was damaged after it was written; rerun with --force"
+                    .into(),
+            };
+            return Err(Error::Io { path: path.to_path_buf(), msg });
         }
         let contact = !run.space.contact.is_empty();
         let mut vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
@@ -84,12 +97,19 @@ impl Writer {
                     .into(),
             });
         }
+        let every = int("frame_every").max(1) as usize;
         let times: Vec<f64> =
             tresca.group.dataset("times").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "tresca/times"))?;
-        if times[..completed] != run.scene.times[..completed] {
-            return Err(mismatch("time grid"));
+        if completed > run.n_steps() + 1 || completed > times.len() {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: format!(
+                    "--resume: the file's counter of committed steps (tresca/steps completed = {completed}) exceeds the \
+                     {} steps it has room for: the file was damaged after it was written; rerun with --force",
+                    times.len().min(run.n_steps() + 1)
+                ),
+            });
         }
-        let every = int("frame_every").max(1) as usize;
         // storage corruption since the steps were written: refuse, naming the first bad step
         if let Some(n) =
             tresca.first_corrupt_step(completed).map_err(io(path, "--resume: verifying the step checksums"))?
@@ -102,6 +122,10 @@ impl Writer {
                     n as i64 - 1
                 ),
             });
+        }
+        // the steps match their checksums, so these are the times they were solved at
+        if times[..completed] != run.scene.times[..completed] {
+            return Err(mismatch("time grid"));
         }
         let frames = Frames { every, last: run.n_steps() };
         let frames_done = frames.before(completed);

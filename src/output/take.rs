@@ -20,6 +20,25 @@ fn check_finite(path: &Path, n: usize, what: &str, v: &[f64]) -> Result<()> {
     }
 }
 
+/// Refuse a frame whose displacement is not zero in f64 (`mid`, the midpoint values u(m_e)) but lies
+/// wholly below f32's normal range (1.2e-38): the VTKHDF/XDMF views would show zeros, or a few subnormal
+/// digits, where `/tresca` holds the answer (a scene scaled by 1e-300). The views' other fields are
+/// derived from u; its largest value is what must survive the conversion.
+fn underflows(path: &Path, n: usize, mid: &[[f64; 2]]) -> Result<()> {
+    let largest = mid.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    if largest > 0.0 && largest < f32::MIN_POSITIVE as f64 {
+        return Err(Error::Io {
+            path: path.to_path_buf(),
+            msg: format!(
+                "step {n}: the displacement (largest |u| = {largest:.3e}) is below the single-precision range (1.2e-38) \
+                 of the VTKHDF/XDMF views, which would show zeros; the step was not written (u is linear in the \
+                 loads, u₀ and g_a: scale them up)"
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// The part of taking a step that needs only its unknowns and the space: the check of u, and the
 /// midpoint values and contact unknowns written of it. [`Background`] evaluates it on the caller's
 /// thread, beside the writer thread, and hands the writer this instead of u.
@@ -101,6 +120,7 @@ impl Writer {
                     });
                 }
             }
+            underflows(path, n, &mid)?;
             self.frame_rows.push(r.t, &self.buf);
             self.frame_steps.push(n);
         }

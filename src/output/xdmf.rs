@@ -187,7 +187,8 @@ impl Xdmf {
             .collect::<hdf5::Result<Vec<_>>>()
             .map_err(std::io::Error::other)?;
         let h5_name = h5_path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        let file = std::fs::File::create(&partial)?;
+        super::paths::clear_stale(&partial, "partial XDMF sidecar").map_err(std::io::Error::other)?;
+        let file = super::paths::create_new(&partial)?;
         let mut x = Xdmf {
             path,
             partial,
@@ -334,7 +335,7 @@ impl Xdmf {
         }
         let spare = match self.spare.take() {
             Some(f) => f,
-            None => std::fs::File::create(&self.partial)?,
+            None => super::paths::create_new(&self.partial)?,
         };
         spare.write_all_at(&self.text, 0)?;
         if exchange(&self.partial, &self.path)? {
@@ -349,9 +350,10 @@ impl Xdmf {
 }
 
 impl Drop for Xdmf {
-    /// A published sidecar leaves no spare behind.
+    /// A published sidecar leaves no spare behind, an unpublished one (its file was never completed) no
+    /// text.
     fn drop(&mut self) {
-        if self.published && self.spare.is_some() {
+        if !self.published || self.spare.is_some() {
             let _ = std::fs::remove_file(&self.partial);
         }
     }

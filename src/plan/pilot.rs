@@ -144,6 +144,14 @@ pub fn pilot_scene(scene: &Scene, q: &Quantity) -> Result<Scene> {
     let mut s = scene.clone();
     s.exact = None;
     if let Quantity::Output(name) = q {
+        let on_contact = ["max_slip", "stick_length"].contains(&name.as_str()) || name.starts_with("traction_");
+        if on_contact && !scene.has_contact() {
+            return Err(Error::scene(
+                &scene.file,
+                "--quantity",
+                format!("`{name}` is measured on the contact part, and this scene has none (no boundary part of kind contact)"),
+            ));
+        }
         let mut o = crate::study::outputs::selected(&s);
         match name.as_str() {
             "max_slip" => o.max_slip = true,

@@ -129,8 +129,7 @@ fn sizes(scene: &Scene) -> Result<(u64, u64, u64)> {
             Ok((tris, edges, contact_parts.iter().map(|s| side(s)).sum()))
         }
         MeshSpec::Gmsh { path, refine } => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| Error::Io { path: path.clone(), msg: format!("cannot read mesh: {e}") })?;
+            let text = crate::input::read_text(path, "mesh")?;
             let raw = crate::mesh::parse_gmsh(&text, &path.display().to_string())?;
             let f = 1u64 << (2 * refine);
             let tris = (raw.tris.len() as u64).saturating_mul(f);

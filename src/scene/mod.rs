@@ -118,8 +118,7 @@ pub struct Scene {
 impl Scene {
     /// Read and validate a scene file.
     pub fn from_file(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::Io { path: path.to_path_buf(), msg: format!("cannot read scene: {e}") })?;
+        let text = crate::input::read_text(path, "scene")?;
         let mut scene = Self::from_str(&text, &path.display().to_string())?;
         // relative mesh paths are relative to the scene file
         if let MeshSpec::Gmsh { path: p, .. } = &mut scene.mesh {
@@ -146,6 +145,7 @@ impl Scene {
         let (f, u0) = loads(file, raw.loads, raw.initial)?;
         let (times, uniform_time) = time_grid(file, raw.time)?;
         let rho = positive_finite(file, "discretisation.rho", raw.discretisation.map(|d| d.rho).unwrap_or(10.0))?;
+        values::representable(file, e, nu, rho)?;
         let solver = solver_settings(file, raw.solver)?;
         let exact = exact(file, raw.exact)?;
         Ok(Scene {

@@ -2,8 +2,62 @@
 //! expression compilation happen in the parent module.
 
 use super::{Diagonal, Method};
-use serde::Deserialize;
+use serde::de::Error as _;
+use serde::{Deserialize, Deserializer};
 use std::path::PathBuf;
+
+/// An array of exactly N values. serde's own `[T; N]` reads the first N values of a longer TOML array and
+/// drops the rest without a word (`cells = [2, 2, 2]`, a third traction component), so every fixed-size
+/// array of a scene is read through this: longer arrays are refused like shorter ones.
+struct Exactly<T, const N: usize>([T; N]);
+
+impl<'de, T: Deserialize<'de>, const N: usize> Deserialize<'de> for Exactly<T, N> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = Vec::<T>::deserialize(d)?;
+        let n = v.len();
+        v.try_into().map(Exactly).map_err(|_| D::Error::custom(format!("expected {N} values, found {n}")))
+    }
+}
+
+/// An optional array of exactly N values ([`Exactly`]).
+fn opt_exactly<'de, D: Deserializer<'de>, T: Deserialize<'de>, const N: usize>(
+    d: D,
+) -> Result<Option<[T; N]>, D::Error> {
+    Ok(Option::<Exactly<T, N>>::deserialize(d)?.map(|a| a.0))
+}
+
+/// An array of exactly N values ([`Exactly`]).
+fn exactly<'de, D: Deserializer<'de>, T: Deserialize<'de>, const N: usize>(d: D) -> Result<[T; N], D::Error> {
+    Ok(Exactly::<T, N>::deserialize(d)?.0)
+}
+
+/// `[exact] grad`: exactly 2 × 2 expressions.
+fn grad<'de, D: Deserializer<'de>>(d: D) -> Result<[[String; 2]; 2], D::Error> {
+    Ok(Exactly::<Exactly<String, 2>, 2>::deserialize(d)?.0.map(|r| r.0))
+}
+
+/// The corners of a structured mesh: four points (x, y). The generator maps the unit square onto a
+/// quadrilateral, so a polygon of other than four corners is refused rather than cut to its first four.
+fn corners<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[[f64; 2]; 4]>, D::Error> {
+    let Some(v) = Option::<Vec<Exactly<f64, 2>>>::deserialize(d)? else { return Ok(None) };
+    let n = v.len();
+    let v: Vec<[f64; 2]> = v.into_iter().map(|p| p.0).collect();
+    v.try_into().map(Some).map_err(|_| {
+        D::Error::custom(format!(
+            "a structured mesh is a quadrilateral: expected 4 corners, found {n} (other polygons need a Gmsh mesh, \
+             `file`)"
+        ))
+    })
+}
+
+/// Points (x, y) of `[outputs] traction_at`: two finite coordinates each.
+pub(super) fn points<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+    let v = Vec::<Exactly<f64, 2>>::deserialize(d)?;
+    match v.iter().position(|p| !p.0.iter().all(|c| c.is_finite())) {
+        Some(k) => Err(D::Error::custom(format!("point {k} ({:?}) is not finite", v[k].0))),
+        None => Ok(v.into_iter().map(|p| p.0).collect()),
+    }
+}
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -38,7 +92,7 @@ pub(super) struct RawQuantities {
     pub(super) elastic_energy: Option<bool>,
     /// The deprecated name of `elastic_energy`.
     pub(super) energy: Option<bool>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "points")]
     pub(super) traction_at: Vec<[f64; 2]>,
 }
 
@@ -54,7 +108,9 @@ pub(super) struct RawUnits {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawMeshTable {
+    #[serde(default, deserialize_with = "corners")]
     pub(super) corners: Option<[[f64; 2]; 4]>,
+    #[serde(default, deserialize_with = "opt_exactly")]
     pub(super) cells: Option<[usize; 2]>,
     pub(super) diagonal: Option<Diagonal>,
     pub(super) file: Option<PathBuf>,
@@ -75,6 +131,7 @@ pub(super) struct RawMaterial {
 pub(super) struct RawBoundary {
     pub(super) name: String,
     pub(super) kind: RawKind,
+    #[serde(default, deserialize_with = "opt_exactly")]
     pub(super) traction: Option<[String; 2]>,
     pub(super) g_a: Option<String>,
     /// Dirichlet data u_D(x, y, t) of a dirichlet part (default 0).
@@ -94,12 +151,14 @@ pub(super) enum RawKind {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawLoads {
+    #[serde(default, deserialize_with = "opt_exactly")]
     pub(super) f: Option<[String; 2]>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawInitial {
+    #[serde(default, deserialize_with = "opt_exactly")]
     pub(super) u0: Option<[String; 2]>,
 }
 
@@ -130,7 +189,9 @@ pub(super) struct RawSolver {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawExact {
+    #[serde(deserialize_with = "exactly")]
     pub(super) u: [String; 2],
+    #[serde(deserialize_with = "grad")]
     pub(super) grad: [[String; 2]; 2],
 }
 

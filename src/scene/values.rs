@@ -28,6 +28,59 @@ pub(super) fn positive_finite(file: &str, key: &str, v: f64) -> Result<f64> {
     }
 }
 
+/// Bound on the geometric factors of the stiffness entries: (λ+2μ)·|e|²/|T| (elastic) and ρμ·|e|/h
+/// (jump) have factors of about 4 on the right isosceles triangles of the structured meshes and of
+/// order one on any shape-regular mesh; slivers beyond it are refused as ill-conditioned.
+const GEOMETRY: f64 = 10.0;
+
+/// Refuse material data whose stiffness cannot be handled in f64: the set-up forms squares of the
+/// entries (the condition estimate's ‖Kx‖², the energy a_h(u, u)), so the entries must lie within the
+/// square root of f64's normal range, [1.5e-154, 1.3e154] (E = 1e308 or ρ = 1e300 overflow, E = 5e-324
+/// underflows); and the jump term must not be so small or so large against the elastic one (ρ outside
+/// [ε, 1/ε], ε = 2.2e-16) that one of the two is lost in the rounding of their sum. Such a K fails its
+/// factorisation or its condition estimate, which would otherwise blame the mesh or the Dirichlet parts.
+pub(super) fn representable(file: &str, e: f64, nu: f64, rho: f64) -> Result<()> {
+    let (top, bottom) = (f64::MAX.sqrt(), f64::MIN_POSITIVE.sqrt());
+    let mu = e / (2.0 * (1.0 + nu));
+    let stiff = e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)); // λ + 2μ
+    let largest = stiff.max(rho * mu) * GEOMETRY;
+    if !(largest <= top) {
+        return Err(Error::scene(
+            file,
+            "material.E, discretisation.rho",
+            format!(
+                "E = {e:e}, rho = {rho:e}: the stiffness entries (λ+2μ = {stiff:.3e}, ρμ = {:.3e}, times the mesh's \
+                 geometric factors) overflow when squared (beyond √(1.8e308) = 1.3e154); give the data in other units \
+                 (u scales with load/E)",
+                rho * mu
+            ),
+        ));
+    }
+    if !(mu.min(rho * mu) / GEOMETRY >= bottom) {
+        return Err(Error::scene(
+            file,
+            "material.E, discretisation.rho",
+            format!(
+                "E = {e:e}, rho = {rho:e}: the stiffness entries (μ = {mu:.3e}, ρμ = {:.3e}, times the mesh's \
+                 geometric factors) underflow when squared (below √(2.2e-308) = 1.5e-154); give the data in other units",
+                rho * mu
+            ),
+        ));
+    }
+    if !(f64::EPSILON..=1.0 / f64::EPSILON).contains(&rho) {
+        return Err(Error::scene(
+            file,
+            "discretisation.rho",
+            format!(
+                "rho = {rho:e} is outside [ε, 1/ε] = [2.2e-16, 4.5e15]: the {} term of the stiffness is below the \
+                 rounding of the other (relative ε) and is lost, so K is singular in floating point",
+                if rho < 1.0 { "jump (stabilisation)" } else { "elastic" }
+            ),
+        ));
+    }
+    Ok(())
+}
+
 pub(super) fn uniform_times(file: &str, t: f64, n: usize) -> Result<Vec<f64>> {
     if n == 0 {
         return Err(Error::scene(file, "time.steps", "must be at least 1"));
@@ -47,6 +100,22 @@ pub(super) fn uniform_times(file: &str, t: f64, n: usize) -> Result<Vec<f64>> {
         ));
     }
     times.extend((0..=n).map(|k| t * k as f64 / n as f64));
+    // T/N below the spacing of the floating-point numbers near the nodes (T = 5e-324 with 8 steps gives
+    // 0, 0, 0, 0, 0, 5e-324, ...): steps of zero length, refused as a `times` list with repeated nodes is
+    if let Some(k) = times.windows(2).position(|w| w[1] <= w[0]) {
+        return Err(Error::scene(
+            file,
+            "time",
+            format!(
+                "T = {t:e} in {n} steps: the time nodes collapse (t[{k}] = {:e}, t[{}] = {:e}): the step T/steps = \
+                 {:e} is below the resolution of floating point there (underflow); use a larger T or fewer steps",
+                times[k],
+                k + 1,
+                times[k + 1],
+                t / n as f64
+            ),
+        ));
+    }
     Ok(times)
 }
 
