@@ -6,6 +6,7 @@ import time
 
 import numpy as np
 
+from tresca_py.errors import InputError
 from tresca_py.skfem_cr.cr import Discretisation
 from tresca_py.skfem_cr.friction import StepSolver, classify
 
@@ -46,7 +47,10 @@ def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True, step
     for n, t in enumerate(times):
         tic = time.perf_counter()
         if n > 0:
-            load_t = load(t)
+            try:
+                load_t = load(t)
+            except InputError as err:
+                raise InputError(f"step {n} (t = {t:.6g}): {err}") from None
             if root:
                 u_prev = u
                 u, info = stepper.step(load_t, u_prev)
