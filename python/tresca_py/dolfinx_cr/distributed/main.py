@@ -13,7 +13,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from tresca_py.dolfinx_cr.distributed.mesh import Fail
-from tresca_py.dolfinx_cr.distributed.output import PartWriter, write_main
+from tresca_py.dolfinx_cr.distributed.output import PartWriter, setup_time_attrs, write_main
 from tresca_py.dolfinx_cr.distributed.problem import Problem, peak_mb
 from tresca_py.cli import FAILURES, message, output_path
 from tresca_py.errors import InputError
@@ -238,7 +238,7 @@ def main(argv=None):
     comm.barrier()                     # every part is closed before the virtual datasets point at them
     if comm.rank == 0:
         attrs = {"total_time": total, "setup_time": setup_time, "mpi_size": comm.size,
-                 "setup_times": json.dumps(prob.times_setup),
+                 **setup_time_attrs(prob.times_setup),
                  "step_time_median": float(np.median(step_times[1:])) if N else 0.0,
                  "peak_rss_mb": np.array(peaks), "setup_peak_rss_mb": json.dumps(mem_setup),
                  "mumps": json.dumps(prob.mumps), "linear_solver": args.ksp, "condensation": prob.condense_path,
