@@ -1,9 +1,7 @@
 """The re-implementations (scripts/skfem_solve.py, dolfinx_solve.py, dolfinx_distributed.py) on scene errors
-(issue 34, section 6): each must refuse what the Rust solver refuses with one ``error:`` line and a non-zero
-exit, write no results file, and never show a traceback (uncaught SceneError / RuntimeError / OSError).
-
-The scripts are being restructured on the pypkg branch; these cases are expected to fail until that work is
-merged (then the lead removes the xfail marks)."""
+(issue 34, section 6): each must refuse what the Rust solver refuses with one ``error:`` line naming the
+problem as the Rust solver names it, a non-zero exit and no results file, and never show a traceback
+(uncaught SceneError / RuntimeError / OSError)."""
 import os
 import subprocess
 import sys
@@ -14,7 +12,6 @@ from tresca_py import hostile
 from tresca_py.common import SCRIPTS, case
 
 SOLVERS = ["skfem_solve.py", "dolfinx_solve.py", "dolfinx_distributed.py"]
-PENDING = pytest.mark.xfail(strict=False, reason="pending pypkg merge")
 
 
 def elastic(**replace):
@@ -26,7 +23,85 @@ def elastic(**replace):
     return "\n".join(lines) + "\n"
 
 
-# (name, scene text, extra arguments, what the Rust solver says of the same scene)
+# A Gmsh 4.1 unit square (two triangles) whose bottom edge is in two physical groups, "bottom" and "floor"
+TWO_GROUPS_MSH = """$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+6
+1 1 "bottom"
+1 2 "right"
+1 3 "top"
+1 4 "left"
+1 5 "floor"
+2 10 "body"
+$EndPhysicalNames
+$Entities
+0 5 1 0
+1 0 0 0 1 0 0 1 1 0
+2 1 0 0 1 1 0 1 2 0
+3 0 1 0 1 1 0 1 3 0
+4 0 0 0 0 1 0 1 4 0
+5 0 0 0 1 0 0 1 5 0
+10 0 0 0 1 1 0 1 10 0
+$EndEntities
+$Nodes
+1 4 1 4
+2 10 0 4
+1
+2
+3
+4
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+$EndNodes
+$Elements
+6 7 1 7
+1 1 1 1
+1 1 2
+1 2 1 1
+2 2 3
+1 3 1 1
+3 3 4
+1 4 1 1
+4 4 1
+1 5 1 1
+5 1 2
+2 10 2 2
+6 1 2 3
+7 1 3 4
+$EndElements
+"""
+TWO_GROUPS_SCENE = """[mesh]
+file = "two.msh"
+[material]
+E = 100.0
+nu = 0.3
+[[boundary]]
+name = "left"
+kind = "dirichlet"
+[[boundary]]
+name = "bottom"
+kind = "neumann"
+[[boundary]]
+name = "right"
+kind = "neumann"
+[[boundary]]
+name = "top"
+kind = "neumann"
+traction = ["0", "-1"]
+[[boundary]]
+name = "floor"
+kind = "contact"
+g_a = "1"
+[time]
+T = 1.0
+steps = 2
+"""
+
+# (name, scene text, extra arguments, what the Rust solver says of the same scene, other files of the scene)
 SCENES = [
     ("load NaN everywhere", elastic(**{"f = ": 'f = ["log(x - 5)", "0"]'}), [], "value NaN"),
     ("load NaN for t > 0.5", elastic(**{"f = ": 'f = ["log(0.6 - t)", "0"]'}), ["--steps", "4"], "value NaN"),
@@ -36,7 +111,17 @@ SCENES = [
     ("three mesh cells", elastic(**{"cells = ": "cells = [2, 2, 2]"}), [], "cells"),
     ("missing Gmsh mesh", elastic(**{"corners = ": 'file = "nope.msh"', "cells = ": "", "diagonal = ": ""}), [],
      "nope.msh"),
+    ("Gmsh edge in two groups", TWO_GROUPS_SCENE, [], "in two parts", {"two.msh": TWO_GROUPS_MSH}),
 ]
+SCENES = [s if len(s) == 5 else (*s, {}) for s in SCENES]
+
+
+def write_scene(directory, text, files):
+    for name, data in files.items():
+        (directory / name).write_text(data)
+    scene = directory / "scene.toml"
+    scene.write_text(text)
+    return scene
 OUTPUTS = ["directory", "read-only directory"]
 
 
@@ -53,22 +138,21 @@ def refused(rc, err):
     assert len(lines) == 1 and lines[0].startswith("error: "), err
 
 
-@PENDING
 class TestSceneErrors:
     """The system shall refuse a scene the Rust solver refuses, in every re-implementation, with one error line
     and no results file."""
 
     @pytest.mark.parametrize("script", SOLVERS)
-    @pytest.mark.parametrize("name,text,args,rust", SCENES, ids=[s[0] for s in SCENES])
-    def test_scene(self, tmp_path, script, name, text, args, rust):
-        scene = tmp_path / "scene.toml"
-        scene.write_text(text)
+    @pytest.mark.parametrize("name,text,args,rust,files", SCENES, ids=[s[0] for s in SCENES])
+    def test_scene(self, tmp_path, script, name, text, args, rust, files):
+        scene = write_scene(tmp_path, text, files)
         out = tmp_path / "out.h5"
-        refused(*solve(script, scene, out, *args)[::2])
-        assert not out.exists()
+        rc, _, err = solve(script, scene, out, *args)
+        refused(rc, err)
+        assert rust.lower() in err.lower(), err
+        assert sorted(os.listdir(tmp_path)) == sorted(["scene.toml", *files]), "the run left files behind"
 
 
-@PENDING
 class TestOutputErrors:
     """The system shall refuse an output path it cannot write, before solving, with one error line."""
 
@@ -92,16 +176,15 @@ RUST_PENDING = {"three mesh cells": "issue 34 section 3: the Rust scene reader c
                                     "pending that fix"}
 
 
-@pytest.mark.parametrize("name,text,args,rust", [
+@pytest.mark.parametrize("name,text,args,rust,files", [
     pytest.param(*s, marks=pytest.mark.xfail(strict=False, reason=RUST_PENDING[s[0]])) if s[0] in RUST_PENDING
     else s for s in SCENES], ids=[s[0] for s in SCENES])
-def test_rust_refuses_the_same_scene(tmp_path, name, text, args, rust):
+def test_rust_refuses_the_same_scene(tmp_path, name, text, args, rust, files):
     """The system shall (in its Rust solver, the reference for the cases above) refuse every scene of SCENES."""
     from tresca_py.common import BIN
     if not os.path.exists(BIN):
         pytest.skip("target/release/tresca-cr is not built")
-    scene = tmp_path / "scene.toml"
-    scene.write_text(text)
+    scene = write_scene(tmp_path, text, files)
     p = subprocess.run([BIN, "run", str(scene), "-o", str(tmp_path / "r.h5"), *args], capture_output=True,
                        text=True, timeout=120)
     assert p.returncode != 0 and rust.lower() in p.stderr.lower(), p.stderr

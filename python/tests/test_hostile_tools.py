@@ -13,6 +13,7 @@ import pytest
 
 from tresca_py import check, compare, hostile, render
 from tresca_py.common import SCRIPTS
+from tresca_py.xvfb import VirtualDisplay
 
 IDS = [h[0] for h in hostile.RESULTS]
 FILE_LEVEL = [h for h in hostile.RESULTS if h[3] == "file"]
@@ -174,37 +175,15 @@ class TestCompare:
         one_error_line(err, "is a directory")
 
 
-class VirtualDisplay:
-    """An Xvfb of our own, on a display it picks and reports."""
-
-    def __init__(self):
-        self.server = subprocess.Popen(["Xvfb", "-displayfd", "1", "-screen", "0", "1600x1200x24", "-nolisten",
-                                        "tcp"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-        self.env = dict(os.environ, DISPLAY=":" + self.server.stdout.readline().strip())
-
-    def stop(self):
-        self.server.terminate()
-        self.server.wait()
-
-
 @pytest.fixture(scope="class")
 def pv():
-    """pvpython scripts/paraview_view.py ARGS -> (exit code, stdout, stderr) on a virtual display. Other
-    sessions on this machine start and stop X servers at the same time; when pvpython loses its server ("bad X
-    server connection", SIGABRT: seen 3 times in about 40 runs, with ``xvfb-run -a`` and with a server of our own)
-    the run is repeated once on a new server: the outcome under test is the script's, not the server's."""
-    display = [VirtualDisplay()]
-
-    def run(*args, prefix=()):
-        for attempt in range(2):
-            p = subprocess.run([*prefix, "pvpython", os.path.join(SCRIPTS, "paraview_view.py"), *map(str, args)],
-                               capture_output=True, text=True, timeout=300, env=display[0].env)
-            if "bad X server connection" not in p.stderr or attempt:
-                return p.returncode, p.stdout, p.stderr
-            display[0].stop()
-            display[0] = VirtualDisplay()
-    yield run
-    display[0].stop()
+    """pvpython scripts/paraview_view.py ARGS -> (exit code, stdout, stderr) on a virtual display of our own,
+    repeated once on a new server if pvpython lost its X server (``tresca_py.xvfb``)."""
+    with VirtualDisplay() as display:
+        def run(*args, prefix=()):
+            p = display.pvpython([os.path.join(SCRIPTS, "paraview_view.py"), *args], prefix=prefix, timeout=300)
+            return p.returncode, p.stdout, p.stderr
+        yield run
 
 
 @pytest.mark.skipif(not PVPYTHON, reason="pvpython or Xvfb missing (make paraview)")

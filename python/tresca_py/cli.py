@@ -1,9 +1,15 @@
-"""The common command line of the Python solvers: SCENE.toml -o OUT.h5 [--refine k] [--steps N] [-q]."""
+"""The common command line of the Python solvers: SCENE.toml -o OUT.h5 [--refine k] [--steps N] [-q], and
+how they fail: bad input (scene, mesh, loads, output path) ends the run with one ``error: …`` line and a
+non-zero exit, never a traceback, and leaves no results file."""
+import contextlib
 import sys
 
+from tresca_py import paths, results
 from tresca_py.errors import InputError
 from tresca_py.scene import SceneError, load_scene
-from tresca_py.skfem_cr.cr import Discretisation
+
+#: what a solver reports as bad input instead of a traceback
+FAILURES = (InputError, paths.PathError, results.ResultsError, OSError)
 
 
 def cli(description, argv=None):
@@ -19,14 +25,39 @@ def cli(description, argv=None):
     return args
 
 
-def open_scene(args):
-    """Load scene + discretisation, turning bad input (InputError) into a clean exit message."""
+def message(err):
+    """One line naming the problem (an OSError names its file)."""
+    if isinstance(err, OSError) and not isinstance(err, paths.PathError) and err.strerror:
+        return f"{err.filename}: {err.strerror}" if err.filename else err.strerror
+    return " ".join(str(err).split()) or type(err).__name__
+
+
+@contextlib.contextmanager
+def exit_on_failure(report=True):
+    """Turn a ``FAILURES`` exception into ``error: <message>`` on stderr (if ``report``: rank 0 of an MPI run
+    reports, the others exit silently) and exit status 2."""
     try:
+        yield
+    except FAILURES as err:
+        if report:
+            print(f"error: {message(err)}", file=sys.stderr, flush=True)
+        sys.exit(2)
+
+
+def output_path(args, scene):
+    """The results path (``-o`` or the scene's ``[output] path``), made absolute, checked before any work:
+    not a directory or other non-regular file, in a directory where files can be created."""
+    out = args.output or scene.output
+    if not out:
+        raise SceneError("no output path: give -o OUT.h5 or [output] path in the scene")
+    return paths.output_file(out, "results file")
+
+
+def open_scene(args, report=True):
+    """Scene, its discretisation and the checked output path; bad input exits with one error line."""
+    from tresca_py.skfem_cr.cr import Discretisation
+    with exit_on_failure(report):
         scene = load_scene(args.scene, refine=args.refine, steps=args.steps)
-        out = args.output or scene.output
-        if not out:
-            raise SceneError("no output path: give -o OUT.h5 or [output] path in the scene")
+        out = output_path(args, scene)
         disc = Discretisation(scene)
-    except InputError as err:
-        sys.exit(f"error: {err}")
     return scene, disc, out

@@ -250,7 +250,10 @@ class Expr:
             val = np.asarray(self._f(x, y, float(t)), dtype=float)
         val = np.broadcast_to(val, np.broadcast(x, y).shape).copy()
         if not np.all(np.isfinite(val)):
-            raise ExprError(f"{self.key}: expression {self.text!r} is not finite at t={t}")
+            k = np.unravel_index(np.argmin(np.isfinite(val)), val.shape)
+            xk, yk = np.broadcast_to(x, val.shape)[k], np.broadcast_to(y, val.shape)[k]
+            raise ExprError(f"{self.key}: expression {self.text!r} has the value {val[k]} at "
+                            f"(x, y) = ({xk:.6g}, {yk:.6g}), t = {float(t):.6g}")
         return val
 
 

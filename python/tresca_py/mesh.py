@@ -126,7 +126,29 @@ def gmsh_mesh(path) -> Mesh:
             if int(tag) not in names:
                 raise SceneError(f"{path}: physical line tag {tag} has no name")
             segs[names[int(tag)]] = L[T == tag]
+    check_segments(path, pts, tri, segs)
     return Mesh(pts, tri, segs)
+
+
+def check_segments(path, pts, tri, segs):
+    """Every tagged line is a boundary edge of the triangles, in at most one part (as src/mesh does it:
+    an edge in two parts would be given two boundary conditions)."""
+    loc = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+    keys, counts = np.unique(loc, axis=0, return_counts=True)
+    count = {(int(a), int(b)): int(c) for (a, b), c in zip(keys, counts, strict=True)}
+    owner = {}
+    for name, seg in segs.items():
+        for a, b in np.sort(seg, axis=1).tolist():
+            x, y = pts[a]
+            where = f"({x:.6f}, {y:.6f})"
+            if (a, b) not in count:
+                raise SceneError(f"{path}: boundary element at {where} of part '{name}' is not an edge of any "
+                                 "triangle")
+            if count[(a, b)] > 1:
+                raise SceneError(f"{path}: interior edge at {where} is tagged as boundary part '{name}'")
+            other = owner.setdefault((a, b), name)
+            if other != name:
+                raise SceneError(f"{path}: boundary edge at {where} is in two parts: '{other}' and '{name}'")
 
 
 def build_mesh(scene: Scene) -> Mesh:

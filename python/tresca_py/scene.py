@@ -190,6 +190,10 @@ def _read_boundaries(doc):
             if bd.g_a.depends_on_t:
                 raise SceneError(f"boundary '{name}' g_a must not depend on t")
         bnds.append(bd)
+    if not any(b.kind == "dirichlet" for b in bnds):
+        # a_h (even with the jump term) is singular on rigid motions unless a Dirichlet part fixes them
+        raise SceneError("[boundary] no dirichlet part: rigid motions are not fixed "
+                         "(the paper requires meas(Gamma_D) > 0)")
     return bnds
 
 
@@ -251,3 +255,21 @@ def load_scene(path, refine=None, steps=None):
     return Scene(path=str(path), text=text, title=str(doc.get("title", "")), mesh=mesh, E=float(E),
                  nu=float(nu), boundaries=bnds, f=f, u0=u0, times=times, rho=float(rho), solver=solver,
                  exact_u=exact_u, exact_grad=exact_grad, output=out)
+
+
+def check_loads(scene, t, triangles_xy, neumann_xy):
+    """Raise ``ExprError`` naming the load expression, a point and ``t`` where the loads of ``scene`` are not
+    finite at a quadrature point of the load functional: ``[loads] f`` at the 6-point Dunavant points of the
+    triangles ``triangles_xy`` (T, 3, 2), the traction of Neumann part ``name`` at the 3-point Gauss points of
+    the edges ``neumann_xy[name]`` (k, 2, 2). A framework that assembles the loads itself (UFL) calls this to
+    name the cause of a load vector that is not finite."""
+    from tresca_py.quadrature import DUNAVANT_BARY, GAUSS3_S
+    tri = np.asarray(triangles_xy, dtype=float).reshape(-1, 3, 2)
+    if not scene.f.is_zero and len(tri):
+        q = np.einsum("pk,tkd->tpd", DUNAVANT_BARY, tri)
+        scene.f(q[..., 0], q[..., 1], t)
+    for b in scene.boundaries:
+        seg = np.asarray(neumann_xy.get(b.name, np.zeros((0, 2, 2))), dtype=float).reshape(-1, 2, 2)
+        if b.kind == "neumann" and not b.traction.is_zero and len(seg):
+            q = seg[:, None, 0] + GAUSS3_S[None, :, None] * (seg[:, None, 1] - seg[:, None, 0])
+            b.traction(q[..., 0], q[..., 1], t)

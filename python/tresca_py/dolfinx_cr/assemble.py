@@ -10,7 +10,9 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from tresca_py.dolfinx_cr.forms import error_forms, load_form
+from tresca_py.errors import InputError
 from tresca_py.mesh import match_points
+from tresca_py.scene import check_loads
 from tresca_py.skfem_cr.cr import Discretisation
 
 
@@ -105,6 +107,8 @@ class DolfinxProblem:
         else:
             b = fem.assemble_vector(self.L)       # owned + ghost entries, ghosts not accumulated
             vals, idx = b.array.copy(), self.canon
+        if self.comm.allreduce(not np.all(np.isfinite(vals)), op=MPI.LOR):
+            self._name_nonfinite_load(t)
         allv = self.comm.gather((idx, vals), root=0)
         if self.comm.rank:
             return None
@@ -112,6 +116,14 @@ class DolfinxProblem:
         for i, v in allv:
             np.add.at(out, i, v)
         return out
+
+    def _name_nonfinite_load(self, t):
+        """Raise InputError naming the load expression that is not finite at a quadrature point (every rank
+        holds the whole Discretisation, so every rank raises the same error)."""
+        disc = self.disc
+        p = disc.points
+        check_loads(disc.scene, t, p[disc.triangles], {name: p[disc.edges[e]] for name, e in disc.neumann.items()})
+        raise InputError(f"the load vector at t = {t:.6g} is not finite (NaN or Inf)")
 
     def errors(self, t, u_canon):
         self.t.value = t

@@ -3,8 +3,6 @@ boundary parts, contact normals/tangents and friction weights, the CR interpolan
 u = P r to the constrained space (module docstring of ``tresca_py.skfem_cr``)."""
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 import scipy.sparse as sp
 
@@ -97,9 +95,6 @@ class Discretisation:
         self.neumann = {b.name: np.flatnonzero(self.part_of_edge == ip)
                         for ip, b in enumerate(scene.boundaries) if b.kind == "neumann"}
         self.interior = np.flatnonzero(~bnd)
-        if len(self.dirichlet) == 0:
-            # with the jump term a_h is still definite only if rigid motions are excluded
-            print("warning: no Dirichlet edges; a_h may be singular", file=sys.stderr)
 
     def _contact_data(self):
         """Normals, tangents and the edge means gbar of g_a (3-point Gauss) on the contact edges."""

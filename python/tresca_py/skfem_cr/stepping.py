@@ -6,6 +6,7 @@ import time
 
 import numpy as np
 
+from tresca_py.errors import InputError
 from tresca_py.skfem_cr.cr import Discretisation
 from tresca_py.skfem_cr.friction import StepSolver, classify
 
@@ -46,7 +47,10 @@ def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True, step
     for n, t in enumerate(times):
         tic = time.perf_counter()
         if n > 0:
-            load_t = load(t)
+            try:
+                load_t = load(t)
+            except InputError as err:
+                raise InputError(f"step {n} (t = {t:.6g}): {err}") from None
             if root:
                 u_prev = u
                 u, info = stepper.step(load_t, u_prev)
@@ -96,44 +100,23 @@ def git_commit():
 
 
 def write_results(path, disc: Discretisation, res, solver_name, extra_attrs=None):
-    """Write the README ``tresca`` group (plus ``tresca/energy`` = a_h(u^n, u^n), ``contact/mu`` = the
-    friction force mu_e and ``contact/dof`` = the contact unknown s_e of the reduced vector r).
-    The one place the Python re-implementations write results (to become ``tresca_py.results.write``)."""
-    import h5py
+    """Write the run as a results file of the one ``/tresca`` layout (``tresca_py.results.write``: atomic,
+    with status, completed steps and step checksums; ``contact/mu`` = the friction force mu_e and
+    ``contact/dof`` = the contact unknown s_e of the reduced vector r; no contact group without Gamma_C)."""
+    from tresca_py import results
     scene = disc.scene
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    with h5py.File(path, "w") as h5:
-        g = h5.create_group("tresca")
-        g.create_dataset("mesh/points", data=disc.points)
-        g.create_dataset("mesh/triangles", data=disc.triangles)
-        g.create_dataset("mesh/edges", data=disc.edges)
-        g.create_dataset("mesh/midpoints", data=disc.midpoints)
-        g.create_dataset("times", data=scene.times)
-        g.create_dataset("u", data=res["u"])
-        g.create_dataset("energy", data=res["energy"])
-        g.create_dataset("contact/edges", data=disc.contact)
-        g.create_dataset("contact/normal", data=disc.normal)
-        g.create_dataset("contact/tangent", data=disc.tangent)
-        g.create_dataset("contact/slip", data=res["slip"])
-        g.create_dataset("contact/sigma_t", data=res["sigma_t"])
-        g.create_dataset("contact/g", data=disc.gbar)
-        g.create_dataset("contact/state", data=res["state"])
-        g.create_dataset("contact/mu", data=res["mu"])
-        g.create_dataset("contact/dof", data=res["dof"])
-        for k in ("iterations", "residual", "n_stick", "n_slip", "wall_time"):
-            g.create_dataset(f"steps/{k}", data=res[k])
-        if "errors" in res:
-            for k, v in res["errors"].items():
-                g.create_dataset(f"errors/{k}", data=v)
-        attrs = {"scene": scene.text, "scene_path": os.path.abspath(scene.path), "version": "python-1",
-                 "git_commit": git_commit(), "solver": solver_name,
-                 "method": "primal active set on the condensed dual (exact)",
-                 "tol": float(scene.solver.get("tol", 1e-12)), "rho": scene.rho, "E": scene.E, "nu": scene.nu,
-                 "refine": int(scene.mesh["refine"]), "steps": len(scene.times) - 1,
-                 "n_edges": len(disc.edges), "n_contact": len(disc.contact),
-                 "factor_time": float(res.get("factor_time", 0.0))}
-        attrs.update(extra_attrs or {})
-        for k, v in attrs.items():
-            g.attrs[k] = v
-
-
+    contact = None
+    if len(disc.contact):
+        contact = results.Contact(disc.contact, disc.normal, disc.tangent, disc.gbar, res["slip"], res["sigma_t"],
+                                  res["state"], res["mu"], res["dof"])
+    r = results.Results(
+        mesh=results.Mesh(disc.points, disc.triangles, disc.edges, disc.midpoints), times=scene.times,
+        u=res["u"], energy=res["energy"], steps={k: res[k] for k in results.STEP_FIELDS}, contact=contact,
+        errors=res.get("errors"),
+        attrs={"scene": scene.text, "scene_path": os.path.abspath(scene.path), "title": scene.title,
+               "version": "python-2", "git_commit": git_commit(), "solver": solver_name,
+               "method": "primal active set on the condensed dual (exact)",
+               "tol": float(scene.solver.get("tol", 1e-12)), "rho": scene.rho, "E": scene.E, "nu": scene.nu,
+               "refine": int(scene.mesh["refine"]), "steps": len(scene.times) - 1,
+               "factor_time": float(res.get("factor_time", 0.0)), **(extra_attrs or {})})
+    results.write(path, r)

@@ -39,6 +39,7 @@ from tresca_py.common import run as common_run  # noqa: E402
 from tresca_py.common import short_path as rel  # noqa: E402
 
 from tresca_py import compare  # noqa: E402
+from tresca_py.dolfinx_cr.distributed.output import setup_times  # noqa: E402
 from tresca_py.verify.harness import Harness, out_dir  # noqa: E402
 from tresca_py.verify import cross_check  # noqa: E402  (scenes, quick levels)
 
@@ -230,7 +231,7 @@ def memory(work, binary, with_rust):
         rss = parse_rss(p.stderr)
         meas["runs"][str(n)] = dict(
             wall=wall, rss_time_mb=rss, rss_self_mb=[float(x) for x in np.atleast_1d(a["peak_rss_mb"])],
-            setup_time=float(a["setup_time"]), setup_times=json.loads(a["setup_times"]),
+            setup_time=float(a["setup_time"]), setup_times=setup_times(a),
             setup_peak_mb=json.loads(a["setup_peak_rss_mb"]), step_median=float(a["step_time_median"]),
             total=float(a["total_time"]), unknowns=int(a["n_dofs"]), n_contact=int(a["n_contact"]),
             mumps=json.loads(a["mumps"]), file=rel(out))
@@ -313,7 +314,7 @@ def solver_compare(work):
             res["runs"][k] = dict(error=(p.stderr or p.stdout).strip()[-300:])
             continue
         a = attrs(out)
-        res["runs"][k] = dict(wall=wall, rss_mb=parse_rss(p.stderr)[0], setup=json.loads(a["setup_times"]),
+        res["runs"][k] = dict(wall=wall, rss_mb=parse_rss(p.stderr)[0], setup=setup_times(a),
                               step=float(a["step_time_median"]), solves=int(a["linear_solves"]),
                               its=int(a["ksp_iterations_max"]), unknowns=int(a["n_dofs"]), n_contact=int(a["n_contact"]))
     if all("error" not in r for r in res["runs"].values()) and len(res["runs"]) == 2:

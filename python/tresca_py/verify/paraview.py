@@ -12,6 +12,7 @@ import subprocess
 
 from tresca_py.common import BIN, ROOT
 from tresca_py.verify.harness import Harness, out_dir
+from tresca_py.xvfb import VirtualDisplay
 
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 OUT = os.path.join(ROOT, "out", "paraview")
@@ -23,7 +24,7 @@ class Session:
     """One check: its virtual X server and the checks' outcomes (printed as they are made)."""
 
     def __init__(self):
-        self.proc, self.env = None, None
+        self.display = None
         self.messages, self.failed = [], []
 
     def check(self, ok, msg):
@@ -34,20 +35,16 @@ class Session:
         return ok
 
     def xserver(self):
-        """Start one Xvfb for every pvpython of the check (on a free display it reports when ready).
-        Measured: `xvfb-run -a pvpython` per call aborted 3 times in 4 with "bad X server connection" on
-        this machine while another Xvfb ran; one server of our own never did."""
-        self.proc = subprocess.Popen(["Xvfb", "-displayfd", "1", "-screen", "0", "1600x1200x24", "-nolisten", "tcp"],
-                                     stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-        self.env = dict(os.environ, DISPLAY=":" + self.proc.stdout.readline().strip())
+        """One Xvfb of our own for every pvpython of the check (``tresca_py.xvfb``)."""
+        self.display = VirtualDisplay()
 
     def stop(self):
-        if self.proc is not None:
-            self.proc.terminate()
-            self.proc.wait()
+        if self.display is not None:
+            self.display.stop()
 
     def pvpython(self, args, cwd):
-        return subprocess.run(["pvpython"] + args, cwd=cwd, capture_output=True, text=True, timeout=600, env=self.env)
+        """pvpython ARGS on the check's display, repeated once on a new server if it lost its X server."""
+        return self.display.pvpython(args, cwd=cwd, timeout=600)
 
 
 def state(h5):
@@ -55,11 +52,13 @@ def state(h5):
     import h5py
     with h5py.File(h5, "r") as f:
         g = f["tresca"]
-        return int(g["steps"].attrs["completed"]), str(g.attrs["status"]), int(g.attrs["steps"]), int(g.attrs["frame_every"])
+        return (int(g["steps"].attrs["completed"]), str(g.attrs["status"]), int(g.attrs["steps"]),
+                int(g.attrs["frame_every"]))
 
 
 def runs(ss):
-    """A finished run, a killed one (SIGKILL in the step phase) and the killed one resumed: out/paraview/<kind>/run.h5."""
+    """A finished run, a killed one (SIGKILL in the step phase) and the killed one resumed:
+    out/paraview/<kind>/run.h5."""
     cmd = [BIN, "run", EX51, "--refine", "3", "--steps", "2000", "-q"]
     dirs = {k: os.path.join(OUT, k) for k in ("finished", "killed", "resumed")}
     for d in dirs.values():
@@ -110,7 +109,8 @@ def compare(ss, label, h5, reader, data):
         frames = [n for n in range(S) if n % every == 0 or n == last]
         times = g["times"][:S][frames]
         disp, vm, _ = reference(g, S)
-        slip, state_, T, C = g["contact/slip"][:S], g["contact/state"][:S], len(g["mesh/triangles"]), len(g["contact/edges"])
+        slip, state_ = g["contact/slip"][:S], g["contact/state"][:S]
+        T, C = len(g["mesh/triangles"]), len(g["contact/edges"])
     ok = ss.check(len(data["times"]) == len(frames) and np.allclose(data["times"], times, rtol=0, atol=1e-12),
                f"{label} / {reader}: {len(data['times'])} time steps, expected the {len(frames)} committed frames")
     for k, blocks in data["frames"].items():
@@ -137,7 +137,8 @@ def compare(ss, label, h5, reader, data):
         if not np.array_equal(np.asarray(c["arrays"]["stick_slip"])[:, 0], state_[n]):
             errs.append("stick_slip differs from /tresca/contact/state")
         ok &= ss.check(not errs, f"{label} / {reader}: frame {k} (step {n}, t = {times[int(k)]:.4g}): "
-                    + ("; ".join(errs) if errs else f"body and contact blocks equal /tresca (max rel. diff {max(e):.1e})"))
+                    + ("; ".join(errs) if errs
+                       else f"body and contact blocks equal /tresca (max rel. diff {max(e):.1e})"))
     return ok
 
 
@@ -167,8 +168,9 @@ def check_files(ss, files, me):
             # XDMFReader by a bare relative name (cwd = the run's directory), the Xdmf3 readers by absolute path
             path = "run.xdmf" if reader == "XDMFReader" else os.path.join(d, "run.xdmf")
             p = ss.pvpython([me, "--dump", path, reader, "mid,-1"], cwd=d)  # the middle and the last frame
-            lines = [ln for ln in p.stdout.splitlines() if ln.startswith("JSON")]
-            if not ss.check(p.returncode == 0 and lines, f"{label} / {reader}: pvpython exit {p.returncode} {p.stderr.strip()[-300:]}"):
+            lines = [line for line in p.stdout.splitlines() if line.startswith("JSON")]
+            if not ss.check(p.returncode == 0 and lines,
+                            f"{label} / {reader}: pvpython exit {p.returncode} {p.stderr.strip()[-300:]}"):
                 continue
             data = json.loads(lines[0][4:])
             ss.check(len(data["frames"]) == 2, f"{label} / {reader}: read frames {sorted(data['frames'])}")
@@ -176,7 +178,8 @@ def check_files(ss, files, me):
         png = os.path.join(OUT, f"{label}.png")
         if os.path.exists(png):
             os.remove(png)
-        p = ss.pvpython([os.path.join(ROOT, "scripts", "paraview_view.py"), os.path.relpath(h5, ROOT), "-o", png], cwd=ROOT)
+        p = ss.pvpython([os.path.join(ROOT, "scripts", "paraview_view.py"), os.path.relpath(h5, ROOT), "-o", png],
+                        cwd=ROOT)
         ss.check(p.returncode == 0, f"{label}: paraview_view.py exit {p.returncode} {p.stderr.strip()[-300:]}")
         picture(ss, label, png)
 

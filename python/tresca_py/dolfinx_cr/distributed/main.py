@@ -13,8 +13,9 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from tresca_py.dolfinx_cr.distributed.mesh import Fail
-from tresca_py.dolfinx_cr.distributed.output import PartWriter, write_main
+from tresca_py.dolfinx_cr.distributed.output import PartWriter, setup_time_attrs, write_main
 from tresca_py.dolfinx_cr.distributed.problem import Problem, peak_mb
+from tresca_py.cli import FAILURES, message, output_path
 from tresca_py.errors import InputError
 from tresca_py.scene import load_scene
 from tresca_py.dolfinx_cr.friction import TaoBoxQP, natural_residual
@@ -60,9 +61,10 @@ def set_up(comm, args, log):
             scene = load_scene(args.scene, refine=args.refine, steps=args.steps)
         except InputError as e:
             raise Fail(str(e)) from None
-        out = args.output or scene.output
-        if not out:
-            raise Fail("no output path: give -o OUT.h5 or [output] path in the scene")
+        try:
+            out = output_path(args, scene)
+        except FAILURES as e:
+            raise Fail(message(e)) from None
         if args.rhs_block < 1:
             raise Fail("--rhs-block must be >= 1")
         if args.frame_every is not None and args.frame_every < 0:
@@ -72,11 +74,33 @@ def set_up(comm, args, log):
         except InputError as e:
             raise Fail(str(e)) from None
     except Fail as e:
-        if comm.rank == 0:
-            print(f"error: {e}", file=sys.stderr, flush=True)
-        comm.Barrier()
-        sys.exit(2)
-    return scene, os.path.abspath(out), prob
+        stop(comm, e)
+    return scene, out, prob
+
+
+def stop(comm, err):
+    """Every rank: the error on rank 0's stderr as one line, exit status 2."""
+    if comm.rank == 0:
+        print(f"error: {err}", file=sys.stderr, flush=True)
+    comm.Barrier()
+    sys.exit(2)
+
+
+def remove_partial(comm, out, writer_dir):
+    """Rank 0, after a failed time loop: the files this run wrote (the parts, the visualisation frames), so
+    no half-written result is left."""
+    comm.barrier()
+    if comm.rank:
+        return
+    vtk = os.path.splitext(out)[0] + "_vtk"
+    for d, keep in ((writer_dir, lambda f: not (f.startswith("rank") and f.endswith(".h5"))),
+                    (vtk, lambda f: not f.startswith("displacement"))):
+        if os.path.isdir(d):
+            for f in os.listdir(d):
+                if not keep(f):
+                    os.remove(os.path.join(d, f))
+            if not os.listdir(d):
+                os.rmdir(d)
 
 
 def new_results(scene, nc):
@@ -154,7 +178,13 @@ def time_loop(prob, args, out, log):
     for n, t in enumerate(times):
         tic = time.perf_counter()
         if n > 0:
-            solve_step(prob, friction, n, t, res)
+            try:
+                solve_step(prob, friction, n, t, res)
+            except Fail as e:
+                vis = None                   # destroyed (and its .pvd written) before its files are removed
+                writer.close()
+                remove_partial(comm, out, writer.dir)
+                raise Fail(f"step {n} (t = {t:.6g}): {e}") from None
         if root:
             res["slip"][n] = friction.s_prev
             res["n_slip"][n] = int(res["state"][n].sum())
@@ -196,7 +226,10 @@ def main(argv=None):
     setup_time = time.perf_counter() - t_start
     log(f"set-up {setup_time:.2f} s: " + ", ".join(f"{k} {v:.2f} s" for k, v in prob.times_setup.items())
         + f"; {2 * prob.nb_glob} unknowns, {prob.n_c} contact edges, {comm.size} rank(s)")
-    res, step_times, writer = time_loop(prob, args, out, log)
+    try:
+        res, step_times, writer = time_loop(prob, args, out, log)
+    except Fail as e:
+        stop(comm, e)
     N = len(scene.times) - 1
     sizes = comm.gather(dict(points=len(prob.points), triangles=len(prob.triangles), edges=prob.nb_own), root=0)
     total = time.perf_counter() - t_start
@@ -205,7 +238,7 @@ def main(argv=None):
     comm.barrier()                     # every part is closed before the virtual datasets point at them
     if comm.rank == 0:
         attrs = {"total_time": total, "setup_time": setup_time, "mpi_size": comm.size,
-                 "setup_times": json.dumps(prob.times_setup),
+                 **setup_time_attrs(prob.times_setup),
                  "step_time_median": float(np.median(step_times[1:])) if N else 0.0,
                  "peak_rss_mb": np.array(peaks), "setup_peak_rss_mb": json.dumps(mem_setup),
                  "mumps": json.dumps(prob.mumps), "linear_solver": args.ksp, "condensation": prob.condense_path,

@@ -39,6 +39,19 @@ class PartWriter:
         self.h5.close()
 
 
+def setup_time_attrs(times):
+    """The set-up wall times {stage: s} as the results layout has them (as the Rust solver writes them): the
+    float array ``setup_times`` and ``setup_times_meaning`` naming its entries."""
+    return {"setup_times": np.array(list(times.values()), dtype=float),
+            "setup_times_meaning": ", ".join(times) + " (s)"}
+
+
+def setup_times(attrs):
+    """{stage: s} back from a distributed run's /tresca attributes (``setup_time_attrs``)."""
+    names = str(attrs["setup_times_meaning"]).removesuffix(" (s)").split(", ")
+    return dict(zip(names, (float(v) for v in attrs["setup_times"]), strict=True))
+
+
 def write_main(out, prob, res, writer_dirname, sizes, attrs):
     """Rank 0: the README /tresca layout, the big arrays as virtual datasets over the parts."""
     import h5py

@@ -20,7 +20,9 @@ from petsc4py import PETSc
 from tresca_py.dolfinx_cr.distributed.linear import condense, factorise_relaxed, petsc_lib
 from tresca_py.dolfinx_cr.distributed.mesh import Fail, agree, gmsh_mesh, structured_mesh
 from tresca_py.dolfinx_cr.forms import error_forms, load_form
+from tresca_py.errors import InputError
 from tresca_py.quadrature import GAUSS3_S, GAUSS3_W
+from tresca_py.scene import check_loads
 
 
 def peak_mb():
@@ -68,6 +70,7 @@ class Problem:
         nf_loc = top.index_map(1).size_local + top.index_map(1).num_ghosts
         part_of_facet = np.full(nf_loc, -1, np.int64)
         part_of_facet[bf] = side
+        self.part_of_facet = part_of_facet
         own, A, B, vx, f2v, c2v = self._space(msh, top)
         pb = part_of_facet[own]
         self._kinds(pb)
@@ -308,9 +311,29 @@ class Problem:
             self.t.value = t
             dolfinx.fem.petsc.assemble_vector(b, self.L)
             b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        if not np.isfinite(b.norm()):                      # collective
+            self._name_nonfinite_load(t)
         self.R.multTranspose(b, self.rhs)
         self.rhs.array[self.cons_local] = 0.0
         return self.rhs
+
+    def _name_nonfinite_load(self, t):
+        """Collective: Fail naming the load expression that is not finite at a quadrature point of some rank's
+        cells or Neumann facets (``tresca_py.scene.check_loads``)."""
+        msh, scene = self.msh, self.scene
+        x = msh.geometry.x[:, :2]
+        neumann = {}
+        for ip, b in enumerate(scene.boundaries):
+            facets = np.flatnonzero(self.part_of_facet == ip).astype(np.int32)
+            if b.kind == "neumann" and len(facets):
+                neumann[b.name] = x[dmesh.entities_to_geometry(msh, 1, facets)]
+        msg = None
+        try:
+            check_loads(scene, t, x[msh.geometry.dofmap], neumann)
+        except InputError as err:
+            msg = str(err)
+        agree(self.comm, msg)
+        raise Fail(f"the load vector at t = {t:.6g} is not finite (NaN or Inf)")
 
     def to_function(self, ur):
         self.R.mult(ur, self.uh.x.petsc_vec)
