@@ -1,4 +1,4 @@
-//! The `tresca-cr` command line: `check`, `run`, `study`, `plan`. Library errors become messages and exit codes here.
+//! The `tresca-cr` command line: `check`, `run`, `study`, `plan`, `adapt`. Library errors become messages and exit codes here.
 
 mod cli;
 
@@ -76,6 +76,46 @@ enum Cmd {
         /// Write per level the elementwise energy density of u_l − P u_{l−1} (XDMF, ParaView) into DIR.
         #[arg(long, value_name = "DIR")]
         differences: Option<PathBuf>,
+    },
+    /// Adaptive meshes: solve, estimate the error per triangle, mark (Dörfler) and bisect, level by
+    /// level, each level a whole run; a table per level (exit code 3 when stopped before the goal).
+    Adapt {
+        scene: PathBuf,
+        /// Stop once the estimator is at most this (energy norm, max over the time nodes).
+        #[arg(long, required_unless_present = "levels")]
+        target: Option<f64>,
+        /// Number of levels (solves), the starting mesh included.
+        #[arg(long)]
+        levels: Option<usize>,
+        /// Dörfler's parameter: mark the fewest triangles carrying this share of η².
+        #[arg(long, default_value_t = 0.5)]
+        theta: f64,
+        /// Starting mesh: uniform refinements (overrides mesh.refine).
+        #[arg(long)]
+        refine: Option<u32>,
+        /// Uniform time steps (overrides time.steps).
+        #[arg(long)]
+        steps: Option<usize>,
+        /// Per-step solver (overrides solver.method).
+        #[arg(long)]
+        solver: Option<String>,
+        /// Solver tolerance (overrides solver.tol).
+        #[arg(long)]
+        tol: Option<f64>,
+        /// Write DIR/level_<k>.h5, each level's results file with its mesh.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Overwrite existing level files.
+        #[arg(long)]
+        force: bool,
+        /// Write the table as CSV.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Wall time the whole loop may take (e.g. 90s, 10m).
+        #[arg(long, value_parser = cli::plan::parse_duration)]
+        budget: Option<f64>,
+        #[command(flatten)]
+        limits: Limits,
     },
     /// Plan the cheapest run that meets a target accuracy: pilot runs, error and cost models, the
     /// cheapest (refine, steps, solver, tolerance) and two runners-up, or a refusal (exit code 3).
@@ -226,6 +266,23 @@ fn main() {
             load(&scene, None, None, no_limits, |_| None).and_then(|(mut s, _)| {
                 solver_overrides(&mut s, solver, tol)?;
                 cli::study::study(s, &levels, reference, csv, differences)
+            })
+        }
+        Cmd::Adapt { scene, target, levels, theta, refine, steps, solver, tol, out, force, csv, budget, limits } => {
+            load(&scene, refine, steps, limits, |_| None).and_then(|(mut s, _)| {
+                solver_overrides(&mut s, solver, tol)?;
+                if let Some(t) = target {
+                    anyhow::ensure!(t.is_finite() && t > 0.0, "--target {t}: must be a positive number");
+                }
+                anyhow::ensure!(levels != Some(0), "--levels must be at least 1");
+                let (max_memory, max_disk) = (limits.max_memory, limits.max_disk);
+                let opts =
+                    tresca_cr::adapt::Options { levels, target, theta, out, force, max_memory, max_disk, budget };
+                let code = cli::adapt::run(s, opts, csv)?;
+                if code != 0 {
+                    std::process::exit(code);
+                }
+                Ok(())
             })
         }
         Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory } => {
