@@ -114,6 +114,10 @@ enum Cmd {
         /// Wall time the whole loop may take (e.g. 90s, 10m).
         #[arg(long, value_parser = cli::plan::parse_duration)]
         budget: Option<f64>,
+        /// Measure every level against a reference solution on the finest mesh refined until every
+        /// triangle has at least this bisection generation (a uniform mesh of that generation nests in it).
+        #[arg(long, value_name = "GENERATION")]
+        reference: Option<u32>,
         #[command(flatten)]
         limits: Limits,
     },
@@ -268,23 +272,45 @@ fn main() {
                 cli::study::study(s, &levels, reference, csv, differences)
             })
         }
-        Cmd::Adapt { scene, target, levels, theta, refine, steps, solver, tol, out, force, csv, budget, limits } => {
-            load(&scene, refine, steps, limits, |_| None).and_then(|(mut s, _)| {
-                solver_overrides(&mut s, solver, tol)?;
-                if let Some(t) = target {
-                    anyhow::ensure!(t.is_finite() && t > 0.0, "--target {t}: must be a positive number");
-                }
-                anyhow::ensure!(levels != Some(0), "--levels must be at least 1");
-                let (max_memory, max_disk) = (limits.max_memory, limits.max_disk);
-                let opts =
-                    tresca_cr::adapt::Options { levels, target, theta, out, force, max_memory, max_disk, budget };
-                let code = cli::adapt::run(s, opts, csv)?;
-                if code != 0 {
-                    std::process::exit(code);
-                }
-                Ok(())
-            })
-        }
+        Cmd::Adapt {
+            scene,
+            target,
+            levels,
+            theta,
+            refine,
+            steps,
+            solver,
+            tol,
+            out,
+            force,
+            csv,
+            budget,
+            reference,
+            limits,
+        } => load(&scene, refine, steps, limits, |_| None).and_then(|(mut s, _)| {
+            solver_overrides(&mut s, solver, tol)?;
+            if let Some(t) = target {
+                anyhow::ensure!(t.is_finite() && t > 0.0, "--target {t}: must be a positive number");
+            }
+            anyhow::ensure!(levels != Some(0), "--levels must be at least 1");
+            let (max_memory, max_disk) = (limits.max_memory, limits.max_disk);
+            let opts = tresca_cr::adapt::Options {
+                levels,
+                target,
+                theta,
+                out,
+                force,
+                max_memory,
+                max_disk,
+                budget,
+                reference,
+            };
+            let code = cli::adapt::run(s, opts, csv)?;
+            if code != 0 {
+                std::process::exit(code);
+            }
+            Ok(())
+        }),
         Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory } => {
             let no_limits = Limits { max_memory: None, max_disk: None };
             let options = tresca_cr::plan::Options {

@@ -13,18 +13,17 @@
 //! refused when the time so far plus the last level's time scaled by the growth in unknowns exceeds it.
 
 pub mod estimator;
+pub mod reference;
 
 use crate::error::{Error, Result};
-use crate::fem::norms::ErrorEvaluator;
-use crate::fem::prolong::parent_triangles;
 use crate::mesh::bisect::{bisect, dorfler, label_longest_edge};
 use crate::mesh::{raw_from_spec, Mesh};
 use crate::output::{Run, Writer};
 use crate::scene::budget::Estimate;
 use crate::scene::Scene;
 use crate::stepping::{Problem, StepResult};
-use crate::study::measure::Pair;
 use estimator::{Accumulated, Estimator};
+use reference::{distance, overlay, Kept};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -44,6 +43,9 @@ pub struct Options {
     pub max_disk: Option<u64>,
     /// Wall-time budget of the whole loop, seconds.
     pub budget: Option<f64>,
+    /// Measure every level against a reference: the finest level's mesh refined to at least this
+    /// generation ([`reference::overlay`]).
+    pub reference: Option<u32>,
 }
 
 /// One level's figures.
@@ -62,24 +64,30 @@ pub struct Row {
     pub error: Option<f64>,
     /// Distance to the next level (max over the nodes), known once it is solved.
     pub vs_next: Option<f64>,
+    /// Distance to the reference solution (with [`Options::reference`]).
+    pub vs_reference: Option<f64>,
+    /// Largest bisection generation of a triangle.
+    pub generation: u32,
     pub min_angle: f64,
     pub marked: usize,
     pub wall: f64,
 }
 
 impl Row {
-    /// The error the estimator is compared with: the true one, else the distance to the next level.
+    /// The error the estimator is compared with: the true one, else the distance to the reference,
+    /// else to the next level.
     pub fn error_or_estimate(&self) -> Option<f64> {
-        self.error.or(self.vs_next)
+        self.error.or(self.vs_reference).or(self.vs_next)
     }
 }
 
-/// A solved level kept for the comparison with the next one.
+/// A solved level: its fields at every node, the accumulated indicator, the true error.
 struct Solved {
-    problem: Problem,
-    u: Vec<Vec<f64>>,
+    kept: Kept,
     acc: Accumulated,
     error: Option<f64>,
+    unknowns: usize,
+    paper_dofs: usize,
 }
 
 /// The finished loop: the rows and, if it stopped before its goal, why.
@@ -123,22 +131,9 @@ fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool) -> Result
         w.finish(&status)?;
     }
     result?;
-    Ok(Solved { problem, u, acc, error })
-}
-
-/// max over the nodes of |||u_fine − u_coarse||| on nested meshes: the broken energy on the fine
-/// triangles plus the coarse level's own jump energy (`study::measure::reference_error`).
-fn distance(fine: &Solved, coarse: &Solved) -> Result<f64> {
-    let (fp, cp) = (&fine.problem, &coarse.problem);
-    let pair = Pair::new(fp, cp, parent_triangles(&cp.mesh, &fp.mesh)?);
-    let jumps = ErrorEvaluator::new(&cp.mesh, &cp.space, &cp.law, cp.scene.rho);
-    let mut worst = 0.0f64;
-    for (uf, uc) in fine.u.iter().zip(&coarse.u) {
-        let grad: f64 = pair.density(uf, uc).iter().enumerate().map(|(t, d)| fp.mesh.area(t) * d).sum();
-        let jump = jumps.jump_energy(&cp.space.midpoint_values(uc));
-        worst = worst.max((grad + jump).max(0.0).sqrt());
-    }
-    Ok(worst)
+    let (unknowns, paper_dofs) = (problem.space.n_dofs, problem.space.paper_dofs());
+    let kept = Kept { mesh: problem.mesh.clone(), space: problem.space.clone(), u };
+    Ok(Solved { kept, acc, error, unknowns, paper_dofs })
 }
 
 /// Number of contact edges of `mesh` under `scene`'s parts.
@@ -153,71 +148,94 @@ fn contact_edges(scene: &Scene, mesh: &Mesh) -> u64 {
 }
 
 /// Run the adaptive loop; `report` sees each row as soon as its level is solved (the row of level k
-/// again, with `vs_next`, is in the outcome).
+/// again, with `vs_next` and `vs_reference`, is in the outcome).
 pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Result<Outcome> {
     if !(opts.theta > 0.0 && opts.theta <= 1.0) {
         return Err(Error::scene(&scene.file, "adapt", format!("theta = {}: must be in (0, 1]", opts.theta)));
     }
     let start = Instant::now();
     let mut mesh = initial_mesh(scene)?;
-    let (mut rows, mut prev, mut stopped) = (Vec::<Row>::new(), None::<Solved>, None);
-    let steps = scene.times.len() - 1;
+    let mut root_area: Vec<f64> = (0..mesh.tris.len()).map(|t| mesh.area(t)).collect();
+    let (mut rows, mut levels, mut stopped) = (Vec::<Row>::new(), Vec::<Kept>::new(), None);
+    let mut last_root = root_area.clone();
     for level in 0.. {
         if opts.levels.is_some_and(|k| level >= k) {
             break;
         }
-        let sizes = (mesh.tris.len() as u64, mesh.edges.len() as u64, contact_edges(scene, &mesh));
-        let estimate = Estimate::of_sizes(sizes, steps, opts.out.is_some());
-        if let Err(e) = estimate.check(opts.max_memory, opts.max_disk, opts.out.as_deref()) {
-            stopped = Some(format!("level {level} does not fit: {e}"));
+        if let Some(why) = refusal(scene, &mesh, opts, level, &rows, start) {
+            stopped = Some(why);
             break;
-        }
-        if let (Some(b), Some(last)) = (opts.budget, rows.last()) {
-            let growth = 2.0 * mesh.edges.len() as f64 / last.unknowns.max(1) as f64;
-            let predicted = start.elapsed().as_secs_f64() + last.wall * growth.max(1.0).powf(1.2);
-            if predicted > b {
-                stopped = Some(format!(
-                    "level {level} ({} unknowns) would end at about {predicted:.0} s, beyond the budget of {b:.0} s",
-                    2 * mesh.edges.len()
-                ));
-                break;
-            }
         }
         let t0 = Instant::now();
         let min_angle = mesh.min_angle();
+        let generation = reference::generations(&mesh, &root_area).into_iter().max().unwrap_or(0);
         let out = opts.out.as_ref().map(|d| d.join(format!("level_{level}.h5")));
         let solved = solve(scene, mesh, out, opts.force)?;
-        let p = &solved.problem;
         let marked = dorfler(&solved.acc.eta2, opts.theta);
         let mut row = Row {
             level,
-            triangles: p.mesh.tris.len(),
-            unknowns: p.space.n_dofs,
-            paper_dofs: p.space.paper_dofs(),
+            triangles: solved.kept.mesh.tris.len(),
+            unknowns: solved.unknowns,
+            paper_dofs: solved.paper_dofs,
             estimator: solved.acc.global,
             terms: solved.acc.terms,
             worst_step: solved.acc.step,
             error: solved.error,
-            vs_next: None,
             min_angle,
+            generation,
             marked: marked.iter().filter(|&&m| m).count(),
-            wall: 0.0,
+            ..Row::default()
         };
-        if let (Some(pv), Some(last)) = (&prev, rows.last_mut()) {
-            last.vs_next = Some(distance(&solved, pv)?);
+        let law = crate::fem::elasticity::Elasticity::new(&scene.material);
+        if let (Some(pv), Some(last)) = (levels.last(), rows.last_mut()) {
+            last.vs_next = Some(distance(&solved.kept, pv, &law, scene.rho)?);
         }
-        mesh = Mesh::build(bisect(&p.mesh, &marked).0)?;
+        let (raw, parent) = bisect(&solved.kept.mesh, &marked);
+        let next_root = parent.iter().map(|&p| root_area[p]).collect();
+        last_root = std::mem::replace(&mut root_area, next_root);
+        mesh = Mesh::build(raw)?;
         row.wall = t0.elapsed().as_secs_f64();
         report(&row);
         let done = opts.target.is_some_and(|t| row.estimator <= t);
         rows.push(row);
-        prev = Some(solved);
+        if opts.reference.is_none() {
+            levels.clear();
+        }
+        levels.push(solved.kept);
         if done {
             break;
         }
     }
-    if opts.target.is_some() && stopped.is_none() && rows.last().is_some_and(|r| r.estimator > opts.target.unwrap()) {
+    if let (Some(g), Some(finest)) = (opts.reference, levels.last()) {
+        let (ref_mesh, _) = overlay(finest.mesh.clone(), last_root, g)?;
+        let rf = solve(scene, ref_mesh, None, false)?;
+        let law = crate::fem::elasticity::Elasticity::new(&scene.material);
+        for (row, kept) in rows.iter_mut().zip(&levels) {
+            row.vs_reference = Some(distance(&rf.kept, kept, &law, scene.rho)?);
+        }
+    }
+    if stopped.is_none() && rows.last().is_some_and(|r| opts.target.is_some_and(|t| r.estimator > t)) {
         stopped = Some(format!("the target was not reached in {} levels", rows.len()));
     }
     Ok(Outcome { rows, stopped })
+}
+
+/// Why level `level` on `mesh` is not run: its memory or results file does not fit, or the budget would
+/// be exceeded (module doc); `None` if it may run.
+fn refusal(scene: &Scene, mesh: &Mesh, opts: &Options, level: usize, rows: &[Row], start: Instant) -> Option<String> {
+    let steps = scene.times.len() - 1;
+    let sizes = (mesh.tris.len() as u64, mesh.edges.len() as u64, contact_edges(scene, mesh));
+    let estimate = Estimate::of_sizes(sizes, steps, opts.out.is_some());
+    if let Err(e) = estimate.check(opts.max_memory, opts.max_disk, opts.out.as_deref()) {
+        return Some(format!("level {level} does not fit: {e}"));
+    }
+    let (b, last) = (opts.budget?, rows.last()?);
+    let growth = 2.0 * mesh.edges.len() as f64 / last.unknowns.max(1) as f64;
+    let predicted = start.elapsed().as_secs_f64() + last.wall * growth.max(1.0).powf(1.2);
+    (predicted > b).then(|| {
+        format!(
+            "level {level} ({} unknowns) would end at about {predicted:.0} s, beyond the budget of {b:.0} s",
+            2 * mesh.edges.len()
+        )
+    })
 }

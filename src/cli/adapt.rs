@@ -12,27 +12,36 @@ use tresca_cr::Scene;
 /// The CSV of the rows: one line per level.
 pub fn csv_text(rows: &[Row], exact: bool) -> String {
     let mut s = String::from(
-        "level,triangles,unknowns,paper_dofs,estimator,error,error_kind,effectivity,min_angle_deg,marked,wall_s,worst_step",
+        "level,triangles,unknowns,paper_dofs,generation,estimator,error,error_kind,effectivity,vs_next,vs_reference,min_angle_deg,marked,wall_s,worst_step",
     );
     for t in TERMS {
         let _ = write!(s, ",eta_{t}");
     }
     s.push('\n');
-    let kind = if exact { "true" } else { "vs_next" };
     for r in rows {
+        let kind = if exact {
+            "true"
+        } else if r.vs_reference.is_some() {
+            "vs_reference"
+        } else {
+            "vs_next"
+        };
         let e = r.error_or_estimate();
         let f = |x: Option<f64>| x.map(|v| format!("{v:.6e}")).unwrap_or_default();
         let _ = write!(
             s,
-            "{},{},{},{},{:.6e},{},{},{},{:.4},{},{:.4},{}",
+            "{},{},{},{},{},{:.6e},{},{},{},{},{},{:.4},{},{:.4},{}",
             r.level,
             r.triangles,
             r.unknowns,
             r.paper_dofs,
+            r.generation,
             r.estimator,
             f(e),
             if e.is_some() { kind } else { "" },
             f(e.map(|e| r.estimator / e)),
+            f(r.vs_next),
+            f(r.vs_reference),
             r.min_angle,
             r.marked,
             r.wall,
@@ -81,11 +90,20 @@ pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>) -> Result<i32> {
         );
     })?;
     if !exact {
-        say!("distance to the next level (the error estimate of each level) and effectivity:");
+        say!("errors estimated by the distance to the next level and to the reference (effectivity against the latter, else the former):");
+        say!("{:>5} {:>9} {:>11} {:>11} {:>11} {:>6}", "level", "unknowns", "estimator", "vs next", "vs ref", "eff");
         for r in &outcome.rows {
-            if let Some(d) = r.vs_next {
-                say!("{:>5} {:>9} {:>11.4e} {:>11.4e} {:>6.3}", r.level, r.unknowns, r.estimator, d, r.estimator / d);
-            }
+            let f = |x: Option<f64>| x.map(|v| format!("{v:.4e}")).unwrap_or_else(|| "-".into());
+            let eff = r.error_or_estimate().map(|e| format!("{:.3}", r.estimator / e)).unwrap_or_default();
+            say!(
+                "{:>5} {:>9} {:>11.4e} {:>11} {:>11} {:>6}",
+                r.level,
+                r.unknowns,
+                r.estimator,
+                f(r.vs_next),
+                f(r.vs_reference),
+                eff
+            );
         }
     }
     if let Some(path) = csv {
