@@ -108,6 +108,9 @@ enum Cmd {
         /// Overwrite existing level files.
         #[arg(long)]
         force: bool,
+        /// With --out: also write each level's mesh as DIR/level_<k>.msh (Gmsh 4.1 ASCII).
+        #[arg(long, requires = "out")]
+        gmsh: bool,
         /// Write the table as CSV.
         #[arg(long)]
         csv: Option<PathBuf>,
@@ -283,6 +286,7 @@ fn main() {
             tol,
             out,
             force,
+            gmsh,
             csv,
             budget,
             reference,
@@ -299,6 +303,7 @@ fn main() {
                 target,
                 theta,
                 out,
+                gmsh,
                 force,
                 max_memory,
                 max_disk,

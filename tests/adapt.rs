@@ -16,6 +16,7 @@ fn options(levels: usize, theta: f64, reference: Option<u32>) -> Options {
         target: None,
         theta,
         out: None,
+        gmsh: false,
         force: false,
         max_memory: None,
         max_disk: None,

@@ -56,6 +56,9 @@ struct Bound {
     edge: Vec<usize>,
 }
 
+/// A stabilised edge and, per 2-point Gauss point, the (edge, signed basis value) terms of [u_h].
+type EdgeJumps = (usize, [Vec<(usize, f64)>; 2]);
+
 /// What the indicator of a mesh needs once: elements, edge data and bound loads.
 pub struct Estimator {
     elements: Vec<Element>,
@@ -64,7 +67,7 @@ pub struct Estimator {
     body: Option<Bound>,
     neumann: Vec<Bound>,
     /// Per stabilised edge (interior or Dirichlet), per Gauss point: the jump terms.
-    jumps: Vec<(usize, [Vec<(usize, f64)>; 2])>,
+    jumps: Vec<EdgeJumps>,
     /// Contact edges: (edge, index in the friction force vector).
     contact: Vec<(usize, usize)>,
     two_mu: f64,

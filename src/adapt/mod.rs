@@ -13,6 +13,7 @@
 //! refused when the time so far plus the last level's time scaled by the growth in unknowns exceeds it.
 
 pub mod estimator;
+pub mod export;
 pub mod reference;
 
 use crate::error::{Error, Result};
@@ -38,6 +39,8 @@ pub struct Options {
     pub theta: f64,
     /// Write `level_<k>.h5` here.
     pub out: Option<PathBuf>,
+    /// Also write each level's mesh as `level_<k>.msh` (Gmsh 4.1) into `out`.
+    pub gmsh: bool,
     pub force: bool,
     pub max_memory: Option<u64>,
     pub max_disk: Option<u64>,
@@ -170,6 +173,9 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
         let min_angle = mesh.min_angle();
         let generation = reference::generations(&mesh, &root_area).into_iter().max().unwrap_or(0);
         let out = opts.out.as_ref().map(|d| d.join(format!("level_{level}.h5")));
+        if let (Some(dir), true) = (&opts.out, opts.gmsh) {
+            export::write_gmsh(&mesh, &dir.join(format!("level_{level}.msh")))?;
+        }
         let solved = solve(scene, mesh, out, opts.force)?;
         let marked = dorfler(&solved.acc.eta2, opts.theta);
         let mut row = Row {
