@@ -14,12 +14,14 @@
 //! | friction | [`friction`] | the per-step box QP on Γ_C by SSN, Uzawa or PDAS |
 //! | time stepping | [`stepping`] | set-up once, then backward Euler steps |
 //! | studies | [`study`] | convergence studies, observed orders, error estimates without an exact solution (Richardson, GCI) |
+//! | adaptivity | [`adapt`] | error indicator, Dörfler marking, bisection between whole runs |
 //! | planning | [`plan`] | target accuracy → the cheapest (refine, steps, solver, tolerance), from pilot runs |
 //! | output | [`output`] | HDF5 results (`/tresca`, VTKHDF, XDMF), resume |
 //!
 //! Each backward-Euler step solves
 //! uⁿ = argmin_{v ∈ V_h} ½ a_h(v,v) − (lⁿ, v) + Σ_{e ⊂ Γ_C} |e| ḡ_e |v_τ(m_e) − uⁿ⁻¹_τ(m_e)|.
 
+pub mod adapt;
 pub mod error;
 pub mod fem;
 pub mod friction;

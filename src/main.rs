@@ -1,4 +1,4 @@
-//! The `tresca-cr` command line: `check`, `run`, `study`, `plan`. Library errors become messages and exit codes here.
+//! The `tresca-cr` command line: `check`, `run`, `study`, `plan`, `adapt`. Library errors become messages and exit codes here.
 
 mod cli;
 
@@ -86,6 +86,53 @@ enum Cmd {
         max_memory: Option<u64>,
         #[command(flatten)]
         json: cli::summary::JsonArg,
+    },
+    /// Adaptive meshes: solve, estimate the error per triangle, mark (Dörfler) and bisect, level by
+    /// level, each level a whole run; a table per level (exit code 3 when stopped before the goal).
+    Adapt {
+        scene: PathBuf,
+        /// Stop once the estimator is at most this (energy norm, max over the time nodes).
+        #[arg(long, required_unless_present = "levels")]
+        target: Option<f64>,
+        /// Number of levels (solves), the starting mesh included.
+        #[arg(long)]
+        levels: Option<usize>,
+        /// Dörfler's parameter: mark the fewest triangles carrying this share of η².
+        #[arg(long, default_value_t = 0.5)]
+        theta: f64,
+        /// Starting mesh: uniform refinements (overrides mesh.refine).
+        #[arg(long)]
+        refine: Option<u32>,
+        /// Uniform time steps (overrides time.steps).
+        #[arg(long)]
+        steps: Option<usize>,
+        /// Per-step solver (overrides solver.method).
+        #[arg(long)]
+        solver: Option<Method>,
+        /// Solver tolerance (overrides solver.tol).
+        #[arg(long)]
+        tol: Option<f64>,
+        /// Write DIR/level_<k>.h5, each level's results file with its mesh.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Overwrite existing level files.
+        #[arg(long)]
+        force: bool,
+        /// With --out: also write each level's mesh as DIR/level_<k>.msh (Gmsh 4.1 ASCII).
+        #[arg(long, requires = "out")]
+        gmsh: bool,
+        /// Write the table as CSV.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Wall time the whole loop may take (e.g. 90s, 10m).
+        #[arg(long, value_parser = cli::plan::parse_duration)]
+        budget: Option<f64>,
+        /// Measure every level against a reference solution on the finest mesh refined until every
+        /// triangle has at least this bisection generation (a uniform mesh of that generation nests in it).
+        #[arg(long, value_name = "GENERATION")]
+        reference: Option<u32>,
+        #[command(flatten)]
+        limits: Limits,
     },
     /// Plan the cheapest run that meets a target accuracy: pilot runs, error and cost models, the
     /// cheapest (refine, steps, solver, tolerance) and two runners-up, or a refusal (exit code 3).
@@ -246,6 +293,47 @@ fn main() {
                     cli::study::study(s, &levels, reference, csv, differences, max_memory, json.json)
                 })
         }
+        Cmd::Adapt {
+            scene,
+            target,
+            levels,
+            theta,
+            refine,
+            steps,
+            solver,
+            tol,
+            out,
+            force,
+            gmsh,
+            csv,
+            budget,
+            reference,
+            limits,
+        } => load(&scene, refine, steps, limits, |_| None, false).and_then(|(mut s, _)| {
+            solver_overrides(&mut s, solver, tol)?;
+            if let Some(t) = target {
+                anyhow::ensure!(t.is_finite() && t > 0.0, "--target {t}: must be a positive number");
+            }
+            anyhow::ensure!(levels != Some(0), "--levels must be at least 1");
+            let (max_memory, max_disk) = (limits.max_memory, limits.max_disk);
+            let opts = tresca_cr::adapt::Options {
+                levels,
+                target,
+                theta,
+                out,
+                gmsh,
+                force,
+                max_memory,
+                max_disk,
+                budget,
+                reference,
+            };
+            let code = cli::adapt::run(s, opts, csv)?;
+            if code != 0 {
+                std::process::exit(code);
+            }
+            Ok(())
+        }),
         Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory, json } => {
             let no_limits = Limits { max_memory: None, max_disk: None };
             if let Some(d) = tresca_cr::plan::pilot::Quantity::deprecation(&quantity) {

@@ -1,5 +1,6 @@
 //! The subcommands of the command line, one file each.
 
+pub mod adapt;
 pub mod args;
 pub mod check;
 pub mod out;

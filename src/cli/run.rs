@@ -295,7 +295,11 @@ fn print_summary(f: &Facts, t: &Tally, n: usize, wall: f64) {
     );
     say!("solver {}: {} iterations in all, max residual {:.2e}; wall time {:.3}s", f.method, t.iters, t.max_res, wall);
     if t.work > 0.0 {
-        say!("energy balance: max |residual| {:.2e} ({:.1e} of the largest work of a step)", t.balance, t.balance / t.work);
+        say!(
+            "energy balance: max |residual| {:.2e} ({:.1e} of the largest work of a step)",
+            t.balance,
+            t.balance / t.work
+        );
     }
     if let Some((stick, slip)) = t.last {
         say!("final step: {stick} stick, {slip} slip contact edges");

@@ -4,8 +4,9 @@
 //! Built from a [`RawMesh`] (points, triangles, tagged boundary edges) produced by the structured
 //! generator or the Gmsh reader, after optional red refinement. [`Mesh::build`] rejects degenerate and
 //! overlapping triangles, non-manifold edges and tags on interior edges; [`Mesh::bind_parts`] checks
-//! that every boundary edge belongs to exactly one declared part.
+//! that every boundary edge belongs to exactly one declared part. [`bisect`] refines locally.
 
+pub mod bisect;
 mod edge_index;
 mod gmsh;
 mod quality;
@@ -74,23 +75,27 @@ pub fn area2(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
     (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
 }
 
+/// The raw mesh a scene describes, refined as asked (before topology is built).
+pub fn raw_from_spec(spec: &MeshSpec) -> Result<RawMesh> {
+    Ok(match spec {
+        MeshSpec::Structured { corners, cells, diagonal, refine } => {
+            let f = 1usize << refine;
+            structured::generate(corners, [cells[0] * f, cells[1] * f], *diagonal)?
+        }
+        MeshSpec::Gmsh { path, refine } => {
+            let mut raw = gmsh::read(path)?;
+            for _ in 0..*refine {
+                raw = refine::red(&raw);
+            }
+            raw
+        }
+    })
+}
+
 impl Mesh {
     /// Generate or read the mesh a scene describes, refined as asked.
     pub fn from_spec(spec: &MeshSpec) -> Result<Mesh> {
-        let raw = match spec {
-            MeshSpec::Structured { corners, cells, diagonal, refine } => {
-                let f = 1usize << refine;
-                structured::generate(corners, [cells[0] * f, cells[1] * f], *diagonal)?
-            }
-            MeshSpec::Gmsh { path, refine } => {
-                let mut raw = gmsh::read(path)?;
-                for _ in 0..*refine {
-                    raw = refine::red(&raw);
-                }
-                raw
-            }
-        };
-        Mesh::build(raw)
+        Mesh::build(raw_from_spec(spec)?)
     }
 
     /// Build edges and adjacency, orient triangles counter-clockwise, and validate.

@@ -43,7 +43,12 @@ const FRAMES: u64 = 51;
 impl Estimate {
     /// The estimate of `scene` run with `steps` time steps; `results`: a results file is written.
     pub fn of(scene: &Scene, steps: usize, results: bool) -> Result<Estimate> {
-        let (triangles, edges, boundary_contact) = sizes(scene)?;
+        Ok(Estimate::of_sizes(sizes(scene)?, steps, results))
+    }
+
+    /// The estimate of a run on a mesh of (triangles, edges, contact edges) with `steps` time steps (an
+    /// adapted mesh, whose sizes are known once built).
+    pub fn of_sizes((triangles, edges, boundary_contact): (u64, u64, u64), steps: usize, results: bool) -> Estimate {
         let unknowns = 2 * edges;
         let contact = boundary_contact;
         let steps = steps as u64;
@@ -63,7 +68,7 @@ impl Estimate {
         } else {
             0
         };
-        Ok(Estimate { triangles, edges, unknowns, contact, steps, memory, disk })
+        Estimate { triangles, edges, unknowns, contact, steps, memory, disk }
     }
 
     /// Refuse the run when memory or disk exceed what there is: the limits given (bytes), else what the

@@ -1,0 +1,245 @@
+//! Adaptive meshes: the loop solve → estimate → mark → refine over whole runs (one mesh for the whole
+//! time interval, refined between runs).
+//!
+//! Level 0 is the scene's mesh (with its `refine`), each triangle labelled for newest-vertex bisection
+//! by its longest side (`mesh::bisect`). Each level runs every time step, computes the indicator of
+//! every node ([`estimator`]), keeps per triangle its max over the nodes, marks by Dörfler's rule with
+//! θ, bisects with completion and goes on — until `levels` levels are done or the estimator is at most
+//! the target. Each level reports its unknowns, estimator, the true error (max over the nodes) when
+//! the scene has `[exact]`, else, once the next level is solved, the distance to it (the `study`-style
+//! estimate: |||u_{k+1} − u_k||| as `study::measure::reference_error` measures it), the minimum angle
+//! and the wall time. Before a level is set up its memory (and results file) are estimated from the
+//! built mesh and refused when they do not fit, as `run` does; with a wall-time budget a level is
+//! refused when the time so far plus the last level's time scaled by the growth in unknowns exceeds it.
+
+pub mod estimator;
+pub mod export;
+pub mod reference;
+
+use crate::error::{Error, Result};
+use crate::mesh::bisect::{bisect, dorfler, label_longest_edge};
+use crate::mesh::{raw_from_spec, Mesh};
+use crate::output::{Run, Writer};
+use crate::scene::budget::Estimate;
+use crate::scene::Scene;
+use crate::stepping::{Problem, StepResult};
+use estimator::{Accumulated, Estimator};
+use reference::{distance, overlay, Kept};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// What the adaptive loop is asked to do.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Number of levels (solves), level 0 included.
+    pub levels: Option<usize>,
+    /// Stop once the estimator is at most this.
+    pub target: Option<f64>,
+    /// Dörfler's θ in (0, 1].
+    pub theta: f64,
+    /// Write `level_<k>.h5` here.
+    pub out: Option<PathBuf>,
+    /// Also write each level's mesh as `level_<k>.msh` (Gmsh 4.1) into `out`.
+    pub gmsh: bool,
+    pub force: bool,
+    pub max_memory: Option<u64>,
+    pub max_disk: Option<u64>,
+    /// Wall-time budget of the whole loop, seconds.
+    pub budget: Option<f64>,
+    /// Measure every level against a reference: the finest level's mesh refined to at least this
+    /// generation ([`reference::overlay`]).
+    pub reference: Option<u32>,
+}
+
+/// One level's figures.
+#[derive(Clone, Debug, Default)]
+pub struct Row {
+    pub level: usize,
+    pub triangles: usize,
+    pub unknowns: usize,
+    pub paper_dofs: usize,
+    /// η = max over the nodes of (Σ_T η_T²)^{1/2}.
+    pub estimator: f64,
+    /// The squared terms of η at its worst node (`estimator::TERMS`) and that node.
+    pub terms: [f64; 5],
+    pub worst_step: usize,
+    /// True energy error, max over the nodes (with `[exact]`).
+    pub error: Option<f64>,
+    /// Distance to the next level (max over the nodes), known once it is solved.
+    pub vs_next: Option<f64>,
+    /// Distance to the reference solution (with [`Options::reference`]).
+    pub vs_reference: Option<f64>,
+    /// Largest bisection generation of a triangle.
+    pub generation: u32,
+    pub min_angle: f64,
+    pub marked: usize,
+    pub wall: f64,
+}
+
+impl Row {
+    /// The error the estimator is compared with: the true one, else the distance to the reference,
+    /// else to the next level.
+    pub fn error_or_estimate(&self) -> Option<f64> {
+        self.error.or(self.vs_reference).or(self.vs_next)
+    }
+}
+
+/// A solved level: its fields at every node, the accumulated indicator, the true error.
+struct Solved {
+    kept: Kept,
+    acc: Accumulated,
+    error: Option<f64>,
+    unknowns: usize,
+    paper_dofs: usize,
+}
+
+/// The finished loop: the rows and, if it stopped before its goal, why.
+pub struct Outcome {
+    pub rows: Vec<Row>,
+    pub stopped: Option<String>,
+}
+
+/// The labelled starting mesh of `scene`.
+pub fn initial_mesh(scene: &Scene) -> Result<Mesh> {
+    let mut raw = raw_from_spec(&scene.mesh)?;
+    label_longest_edge(&mut raw);
+    Mesh::build(raw)
+}
+
+/// Solve every step of `scene` on `mesh`, with the indicator at every node; write the results file.
+fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool) -> Result<Solved> {
+    let problem = Problem::with_mesh(scene.clone(), mesh)?;
+    let est = Estimator::new(&problem)?;
+    let mut writer = match &out {
+        Some(p) => Some(Writer::create(p, &Run::of(&problem), force)?),
+        None => None,
+    };
+    let (mut acc, mut u, mut error) = (Accumulated::default(), Vec::new(), None::<f64>);
+    let mut on_step = |r: &StepResult| -> Result<()> {
+        acc.push(r.n, &est.at(&problem, r)?);
+        if let Some(e) = r.errors {
+            error = Some(error.map_or(e.energy, |m| m.max(e.energy)));
+        }
+        if let Some(w) = writer.as_mut() {
+            w.write_step(r)?;
+        }
+        u.push(r.u.clone());
+        Ok(())
+    };
+    let result = problem.run(crate::stepping::RunOptions::all(), &mut on_step);
+    let status = result.as_ref().map_or_else(|e| format!("stopped: {e}"), |()| "completed".to_string());
+    if let Some(w) = writer {
+        w.finish(&status)?;
+    }
+    result?;
+    let (unknowns, paper_dofs) = (problem.space.n_dofs, problem.space.paper_dofs());
+    let kept = Kept { mesh: problem.mesh.clone(), space: problem.space.clone(), u };
+    Ok(Solved { kept, acc, error, unknowns, paper_dofs })
+}
+
+/// Number of contact edges of `mesh` under `scene`'s parts.
+fn contact_edges(scene: &Scene, mesh: &Mesh) -> u64 {
+    let contact: Vec<&str> = scene
+        .parts
+        .iter()
+        .filter(|p| matches!(p.kind, crate::scene::PartKind::Contact(..)))
+        .map(|p| p.name.as_str())
+        .collect();
+    mesh.edge_tag.iter().flatten().filter(|&&t| contact.contains(&mesh.tag_names[t].as_str())).count() as u64
+}
+
+/// Run the adaptive loop; `report` sees each row as soon as its level is solved (the row of level k
+/// again, with `vs_next` and `vs_reference`, is in the outcome).
+pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Result<Outcome> {
+    if !(opts.theta > 0.0 && opts.theta <= 1.0) {
+        return Err(Error::scene(&scene.file, "adapt", format!("theta = {}: must be in (0, 1]", opts.theta)));
+    }
+    let start = Instant::now();
+    let mut mesh = initial_mesh(scene)?;
+    let mut root_area: Vec<f64> = (0..mesh.tris.len()).map(|t| mesh.area(t)).collect();
+    let (mut rows, mut levels, mut stopped) = (Vec::<Row>::new(), Vec::<Kept>::new(), None);
+    let mut last_root = root_area.clone();
+    for level in 0.. {
+        if opts.levels.is_some_and(|k| level >= k) {
+            break;
+        }
+        if let Some(why) = refusal(scene, &mesh, opts, level, &rows, start) {
+            stopped = Some(why);
+            break;
+        }
+        let t0 = Instant::now();
+        let min_angle = mesh.min_angle();
+        let generation = reference::generations(&mesh, &root_area).into_iter().max().unwrap_or(0);
+        let out = opts.out.as_ref().map(|d| d.join(format!("level_{level}.h5")));
+        if let (Some(dir), true) = (&opts.out, opts.gmsh) {
+            export::write_gmsh(&mesh, &dir.join(format!("level_{level}.msh")))?;
+        }
+        let solved = solve(scene, mesh, out, opts.force)?;
+        let marked = dorfler(&solved.acc.eta2, opts.theta);
+        let mut row = Row {
+            level,
+            triangles: solved.kept.mesh.tris.len(),
+            unknowns: solved.unknowns,
+            paper_dofs: solved.paper_dofs,
+            estimator: solved.acc.global,
+            terms: solved.acc.terms,
+            worst_step: solved.acc.step,
+            error: solved.error,
+            min_angle,
+            generation,
+            marked: marked.iter().filter(|&&m| m).count(),
+            ..Row::default()
+        };
+        let law = crate::fem::elasticity::Elasticity::new(&scene.material);
+        if let (Some(pv), Some(last)) = (levels.last(), rows.last_mut()) {
+            last.vs_next = Some(distance(&solved.kept, pv, &law, scene.rho)?);
+        }
+        let (raw, parent) = bisect(&solved.kept.mesh, &marked);
+        let next_root = parent.iter().map(|&p| root_area[p]).collect();
+        last_root = std::mem::replace(&mut root_area, next_root);
+        mesh = Mesh::build(raw)?;
+        row.wall = t0.elapsed().as_secs_f64();
+        report(&row);
+        let done = opts.target.is_some_and(|t| row.estimator <= t);
+        rows.push(row);
+        if opts.reference.is_none() {
+            levels.clear();
+        }
+        levels.push(solved.kept);
+        if done {
+            break;
+        }
+    }
+    if let (Some(g), Some(finest)) = (opts.reference, levels.last()) {
+        let (ref_mesh, _) = overlay(finest.mesh.clone(), last_root, g)?;
+        let rf = solve(scene, ref_mesh, None, false)?;
+        let law = crate::fem::elasticity::Elasticity::new(&scene.material);
+        for (row, kept) in rows.iter_mut().zip(&levels) {
+            row.vs_reference = Some(distance(&rf.kept, kept, &law, scene.rho)?);
+        }
+    }
+    if stopped.is_none() && rows.last().is_some_and(|r| opts.target.is_some_and(|t| r.estimator > t)) {
+        stopped = Some(format!("the target was not reached in {} levels", rows.len()));
+    }
+    Ok(Outcome { rows, stopped })
+}
+
+/// Why level `level` on `mesh` is not run: its memory or results file does not fit, or the budget would
+/// be exceeded (module doc); `None` if it may run.
+fn refusal(scene: &Scene, mesh: &Mesh, opts: &Options, level: usize, rows: &[Row], start: Instant) -> Option<String> {
+    let steps = scene.times.len() - 1;
+    let sizes = (mesh.tris.len() as u64, mesh.edges.len() as u64, contact_edges(scene, mesh));
+    let estimate = Estimate::of_sizes(sizes, steps, opts.out.is_some());
+    if let Err(e) = estimate.check(opts.max_memory, opts.max_disk, opts.out.as_deref()) {
+        return Some(format!("level {level} does not fit: {e}"));
+    }
+    let (b, last) = (opts.budget?, rows.last()?);
+    let growth = 2.0 * mesh.edges.len() as f64 / last.unknowns.max(1) as f64;
+    let predicted = start.elapsed().as_secs_f64() + last.wall * growth.max(1.0).powf(1.2);
+    (predicted > b).then(|| {
+        format!(
+            "level {level} ({} unknowns) would end at about {predicted:.0} s, beyond the budget of {b:.0} s",
+            2 * mesh.edges.len()
+        )
+    })
+}

@@ -1,0 +1,120 @@
+//! `tresca-cr adapt`: the adaptive loop (solve → estimate → mark → refine over whole runs) printed as a
+//! table per level and written as CSV; each level's results file in `--out DIR`.
+
+use super::out::{note, say};
+use anyhow::{Context, Result};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use tresca_cr::adapt::estimator::TERMS;
+use tresca_cr::adapt::{adapt, Options, Row};
+use tresca_cr::Scene;
+
+/// The CSV of the rows: one line per level.
+pub fn csv_text(rows: &[Row], exact: bool) -> String {
+    let mut s = String::from(
+        "level,triangles,unknowns,paper_dofs,generation,estimator,error,error_kind,effectivity,vs_next,vs_reference,min_angle_deg,marked,wall_s,worst_step",
+    );
+    for t in TERMS {
+        let _ = write!(s, ",eta_{t}");
+    }
+    s.push('\n');
+    for r in rows {
+        let kind = if exact {
+            "true"
+        } else if r.vs_reference.is_some() {
+            "vs_reference"
+        } else {
+            "vs_next"
+        };
+        let e = r.error_or_estimate();
+        let f = |x: Option<f64>| x.map(|v| format!("{v:.6e}")).unwrap_or_default();
+        let _ = write!(
+            s,
+            "{},{},{},{},{},{:.6e},{},{},{},{},{},{:.4},{},{:.4},{}",
+            r.level,
+            r.triangles,
+            r.unknowns,
+            r.paper_dofs,
+            r.generation,
+            r.estimator,
+            f(e),
+            if e.is_some() { kind } else { "" },
+            f(e.map(|e| r.estimator / e)),
+            f(r.vs_next),
+            f(r.vs_reference),
+            r.min_angle,
+            r.marked,
+            r.wall,
+            r.worst_step
+        );
+        for v in r.terms {
+            let _ = write!(s, ",{:.6e}", v.max(0.0).sqrt());
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Run the loop and report; returns the exit code (3: stopped before the goal, with the reason).
+pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>) -> Result<i32> {
+    if let Some(dir) = &opts.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    let exact = scene.exact.is_some();
+    say!(
+        "{:>5} {:>9} {:>9} {:>11} {:>11} {:>6} {:>8} {:>7} {:>8}",
+        "level",
+        "triangles",
+        "unknowns",
+        "estimator",
+        if exact { "error" } else { "vs next" },
+        "eff",
+        "min ang",
+        "marked",
+        "wall s"
+    );
+    let outcome = adapt(&scene, &opts, |r| {
+        let e = r.error.map(|e| format!("{e:.4e}")).unwrap_or_else(|| "-".into());
+        let eff = r.error.map(|e| format!("{:.3}", r.estimator / e)).unwrap_or_default();
+        say!(
+            "{:>5} {:>9} {:>9} {:>11.4e} {:>11} {:>6} {:>8.3} {:>7} {:>8.3}",
+            r.level,
+            r.triangles,
+            r.unknowns,
+            r.estimator,
+            e,
+            eff,
+            r.min_angle,
+            r.marked,
+            r.wall
+        );
+    })?;
+    if !exact {
+        say!("errors estimated by the distance to the next level and to the reference (effectivity against the latter, else the former):");
+        say!("{:>5} {:>9} {:>11} {:>11} {:>11} {:>6}", "level", "unknowns", "estimator", "vs next", "vs ref", "eff");
+        for r in &outcome.rows {
+            let f = |x: Option<f64>| x.map(|v| format!("{v:.4e}")).unwrap_or_else(|| "-".into());
+            let eff = r.error_or_estimate().map(|e| format!("{:.3}", r.estimator / e)).unwrap_or_default();
+            say!(
+                "{:>5} {:>9} {:>11.4e} {:>11} {:>11} {:>6}",
+                r.level,
+                r.unknowns,
+                r.estimator,
+                f(r.vs_next),
+                f(r.vs_reference),
+                eff
+            );
+        }
+    }
+    if let Some(path) = csv {
+        std::fs::write(&path, csv_text(&outcome.rows, exact))
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(match outcome.stopped {
+        Some(why) => {
+            note!("refused: {why}");
+            3
+        }
+        None => 0,
+    })
+}
