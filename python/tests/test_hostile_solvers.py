@@ -172,8 +172,7 @@ class TestOutputErrors:
         refused(*solve(script, case("elastic_rect"), out, prefix=prefix)[::2])
 
 
-RUST_PENDING = {"three mesh cells": "issue 34 section 3: the Rust scene reader cuts arrays that are too long; "
-                                    "pending that fix"}
+RUST_PENDING: dict[str, str] = {}  # scenes the Rust solver still accepts (none since issue 34 section 3)
 
 
 @pytest.mark.parametrize("name,text,args,rust,files", [

@@ -75,9 +75,6 @@ def test_the_system_shall_refuse_arrays_longer_than_the_schema(label, tmp_path):
         load_scene(scene(tmp_path, **LONG[label]))
 
 
-@pytest.mark.xfail(strict=True, reason="finding: the Rust reader (serde fixed-size arrays through the toml crate) "
-                   "accepts arrays longer than the schema; when it refuses them this test passes "
-                   "and the marker must go")
 @pytest.mark.parametrize("label", sorted(LONG))
 def test_the_rust_reader_shall_refuse_arrays_longer_than_the_schema(label, tmp_path, rust_bin):
     assert run([rust_bin, "check", scene(tmp_path, **LONG[label])]).returncode != 0
