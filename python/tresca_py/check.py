@@ -20,7 +20,7 @@ import sys
 
 import numpy as np
 
-from . import fields, paths, results
+from . import audit, fields, paths, results
 
 BODY_CELLS = ["strain", "stress", "von_mises"]
 CONTACT_CELLS = ["sigma_t", "slip", "slip_increment", "stick_slip"]
@@ -205,6 +205,11 @@ def main(argv=None):
     print(f"{args.h5}: {r.completed} steps, {len(run.frames)} frames (every {run.every}), {run.T} triangles, "
           f"{run.E} edges, {run.C} contact edges, status {r.status!r}")
     check_tresca(c, run)
+    budget = audit.read(r.path, r.completed)
+    if budget is not None:
+        print(audit.summary(budget))
+        for m in audit.problems(budget):
+            c.check(False, m)
     for name, step, path in (("VTKHDF (vtkHDFReader)", check_vtkhdf, r.path),
                              ("XDMF (meshio)", check_meshio, os.path.abspath(xdmf)),
                              ("XDMF (vtkXdmfReader)", check_vtkxdmf, os.path.abspath(xdmf))):

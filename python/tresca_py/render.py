@@ -26,7 +26,7 @@ import numpy as np
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
 
-from . import fields, paths, results
+from . import audit, fields, paths, results
 
 
 def units(scene_text):
@@ -49,6 +49,7 @@ def load(path):
     if r.contact is not None:
         for k in ("edges", "tangent", "g", "slip", "sigma_t", "state"):
             d["c_" + k] = getattr(r.contact, k)
+    d["audit"] = audit.read(path, r.completed)
     return d
 
 
@@ -146,6 +147,29 @@ def contact(d, n, out):
     fig.savefig(out, dpi=120, bbox_inches="tight")
 
 
+def energy(d, out):
+    """The energy budget over time (``tresca_py.audit``): stored energy, cumulative external and boundary work,
+    cumulative frictional and backward-Euler dissipation, and the balance residual on a second axis."""
+    a, t = d["audit"], d["times"]
+    fig = Figure(figsize=(7, 5.6))
+    a1, a2 = fig.subplots(2, 1, sharex=True)
+    a1.plot(t, a["stored_energy"], label="stored ½a_h(uⁿ,uⁿ)")
+    a1.plot(t, np.cumsum(a["external_work"]), label="Σ external work (lⁿ,δuⁿ)")
+    if np.any(a["boundary_work"]):
+        a1.plot(t, np.cumsum(a["boundary_work"]), label="Σ work on imposed data")
+    a1.plot(t, np.cumsum(a["friction_dissipation"]), label="Σ friction j_h(δuⁿ)")
+    a1.plot(t, np.cumsum(a["euler_dissipation"]), label="Σ backward Euler ½a_h(δuⁿ,δuⁿ)")
+    a1.set_ylabel("energy [force·length]")
+    a1.legend(fontsize=8)
+    a1.grid(alpha=0.3)
+    a2.semilogy(t[1:], np.maximum(np.abs(a["balance_residual"][1:]), 1e-300), ".", color="tab:red")
+    a2.set_ylabel("|balance residual|")
+    a2.set_xlabel(f"time [{d['units']['T'].strip() or 'time'}]")
+    a2.grid(alpha=0.3)
+    a1.set_title(title(d, "energy budget: a_h(uⁿ,δuⁿ) + j_h(δuⁿ) = (lⁿ,δuⁿ) + W_Γⁿ per step"), fontsize=9)
+    fig.savefig(out, dpi=120, bbox_inches="tight")
+
+
 def positive_or_auto(text):
     """--scale: a finite number ≥ 0 (0: automatic)."""
     v = float(text)
@@ -188,4 +212,8 @@ def main(argv=None):
             p = os.path.join(out, f"contact_{n:06d}.png")
             contact(d, n, p)
             print(p)
+    if d["audit"] is not None and len(t) > 1:
+        p = os.path.join(out, "energy.png")
+        energy(d, p)
+        print(p)
     return 0

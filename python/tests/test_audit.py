@@ -1,0 +1,52 @@
+"""The energy audit of a results file (tresca_py.audit, run by scripts/check_results.py)."""
+import shutil
+import subprocess
+import sys
+
+import h5py
+import pytest
+
+from tresca_py import audit
+from tresca_py.common import CASES, ROOT
+
+
+@pytest.fixture(scope="module")
+def front(tmp_path_factory, rust_bin):
+    out = tmp_path_factory.mktemp("audit") / "front.h5"
+    subprocess.run([rust_bin, "run", f"{CASES}/mms_front.toml", "--refine", "1", "--steps", "16", "-q",
+                    "-o", str(out)], check=True, capture_output=True)
+    return out
+
+
+def check_results(path):
+    return subprocess.run([sys.executable, f"{ROOT}/scripts/check_results.py", str(path)], capture_output=True,
+                          text=True)
+
+
+def test_the_system_shall_find_the_energy_balance_of_a_rust_run(front):
+    with h5py.File(front) as f:
+        completed = int(f["tresca/steps"].attrs["completed"])
+    a = audit.read(front, completed)
+    assert a is not None and audit.problems(a) == []
+    assert a["friction_dissipation"].max() > 0, "mms_front slips: the audit must see dissipation"
+    r = check_results(front)
+    assert r.returncode == 0 and "energy balance" in r.stdout, r.stdout + r.stderr
+
+
+@pytest.mark.parametrize("damage", ["wrong friction sign", "residual hidden"])
+def test_the_system_shall_refuse_a_run_whose_energy_does_not_balance(front, tmp_path, damage):
+    bad = tmp_path / "bad.h5"
+    shutil.copy(front, bad)
+    shutil.copy(front.with_suffix(".xdmf"), tmp_path / "bad.xdmf")
+    with h5py.File(bad, "r+") as f:
+        g = f["tresca/steps"]
+        if damage == "wrong friction sign":
+            # a friction force of the wrong sign does work instead of dissipating it
+            g["friction_dissipation"][...] = -g["friction_dissipation"][()]
+            g["balance_residual"][...] = g["balance_residual"][()] - 2 * g["friction_dissipation"][()]
+        else:
+            g["balance_residual"][...] = 0.0 * g["balance_residual"][()]
+            g["stored_energy"][-1] = 1.01 * g["stored_energy"][-1]
+    with h5py.File(bad) as f:
+        a = audit.read(bad, int(f["tresca/steps"].attrs["completed"]))
+    assert audit.problems(a), damage
