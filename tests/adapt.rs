@@ -77,7 +77,7 @@ fn indicator_vanishes_on_an_exact_discrete_solution() {
     let p = Problem::new(Scene::from_str(AFFINE, "affine.toml").unwrap()).unwrap();
     let est = Estimator::new(&p).unwrap();
     let mut steps = Vec::new();
-    p.run(|r| {
+    p.run(tresca_cr::RunOptions::all(), |r: &tresca_cr::StepResult| {
         steps.push(r.clone());
         Ok(())
     })

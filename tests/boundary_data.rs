@@ -88,10 +88,10 @@ fn inconsistent_data_are_refused() {
 #[test]
 fn data_keys_on_the_wrong_kind_are_refused() {
     let text = affine("", "0").replace("kind = \"contact\"\ng_a = \"0\"", "kind = \"neumann\"");
-    let e = Scene::from_str(&text, "k").err().expect("refused").to_string();
+    let e = Scene::from_str(&text, "k").map(|_| ()).expect_err("refused").to_string();
     assert!(e.contains("only contact parts take"), "{e}");
     let text = affine("", "0").replace("name = \"left\"\nkind = \"dirichlet\"", "name = \"left\"\nkind = \"neumann\"");
-    let e = Scene::from_str(&text, "k").err().expect("refused").to_string();
+    let e = Scene::from_str(&text, "k").map(|_| ()).expect_err("refused").to_string();
     assert!(e.contains("only dirichlet parts take"), "{e}");
 }
 

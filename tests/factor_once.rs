@@ -40,7 +40,7 @@ fn a_shared_set_up_gives_the_results_of_a_fresh_run() {
     assert!(p.reused.is_none());
     let (mut max_energy, mut u_last) = (0.0f64, vec![]);
     let mut iterations = 0;
-    p.run(|r| {
+    p.run(tresca_cr::RunOptions::all(), |r: &tresca_cr::StepResult| {
         iterations += r.iterations;
         max_energy = max_energy.max(r.errors.unwrap().energy);
         u_last = r.u.clone();

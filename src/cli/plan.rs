@@ -27,7 +27,7 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool, 
         super::summary::write(j, &s)
     };
     if let Some(path) = &csv {
-        super::run::not_an_input(&[path.clone()], &scene, "--csv")?;
+        super::run::not_an_input(std::slice::from_ref(path), &scene, "--csv")?;
     }
     say!("Planning {} for the {} ≤ {:e}", scene.file, options.quantity.describe(), options.target);
     let p = plan(&scene, &options)?;

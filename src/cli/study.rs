@@ -81,7 +81,7 @@ pub fn study(
     use tresca_cr::study::run_study;
     check_levels(levels, reference)?;
     if let Some(p) = &csv {
-        super::run::not_an_input(&[p.clone()], &scene, "--csv")?;
+        super::run::not_an_input(std::slice::from_ref(p), &scene, "--csv")?;
     }
     check_memory(&scene, levels, reference, max_memory)?;
     say!(

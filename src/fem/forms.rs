@@ -20,12 +20,15 @@ use crate::mesh::Mesh;
 /// The audit's forms on one mesh. Only the stabilised edges and the data points are stored (about 8
 /// bytes an edge): the element geometry and the jump terms are recomputed at each [`FullForm::apply`],
 /// so the audit adds no mesh-sized memory to a run.
+/// A Gauss point of a Dirichlet edge with data: 2ρμ ω_q and the basis values (edge, φ) there.
+type DataPoint = (f64, [(usize, f64); 3]);
+
 pub struct FullForm {
     /// The edges carrying the jump term (interior and Dirichlet).
     stabilised: Vec<usize>,
     /// Per Dirichlet edge with data, per 3-point Gauss point: 2ρμ ω_q and the basis values of the
     /// edge's triangle there (edge, φ).
-    data_points: Vec<[(f64, [(usize, f64); 3]); 3]>,
+    data_points: Vec<[DataPoint; 3]>,
     pen: f64,
     law: Elasticity,
 }

@@ -32,6 +32,9 @@ use crate::scene::expr::sym::Sym;
 use crate::scene::expr::{factor_slot, BoundSet, Expr, ExprSet, Vec2Expr};
 use crate::scene::{PartKind, Scene};
 
+/// Per point of a load term feeding constrained components: (component, weight w·φ, vector coefficient).
+type PointWeights = Vec<(usize, f64, [f64; 2])>;
+
 /// A quadrature point of a load term: position, and the (edge, weight · φ) pairs it feeds.
 #[derive(Clone, Debug)]
 struct LoadPoint {
@@ -102,7 +105,7 @@ struct Lift {
     slot: Vec<usize>,
     /// The load terms at the points that feed a constrained component: per term its expression bound
     /// to those points and per point (component, weight w·φ, vector coefficient).
-    constrained: Vec<(BoundSet, Vec<Vec<(usize, f64, [f64; 2])>>)>,
+    constrained: Vec<(BoundSet, Vec<PointWeights>)>,
     n_constrained: usize,
 }
 

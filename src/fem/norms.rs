@@ -196,7 +196,7 @@ impl ErrorEvaluator {
         let good = failed.as_ref().map_or(nf, |((f, _), _)| *f);
         let mut failed = failed.map(|(_, e)| e);
         let mut norms = Vec::with_capacity(good);
-        for f in 0..good {
+        for (f, field) in fields.iter().enumerate().take(good) {
             let (mut en, mut h1, mut l2) = (0.0f64, 0.0f64, 0.0f64);
             for [e, h, l] in parts.iter().skip(f).step_by(nf) {
                 en += e;
@@ -204,10 +204,10 @@ impl ErrorEvaluator {
                 l2 += l;
             }
             if self.boundary.is_empty() {
-                en += self.jump_energy(fields[f].0);
+                en += self.jump_energy(field.0);
             } else {
-                match self.boundary_values(exact, fields[f].1) {
-                    Ok(v) => en += self.jump_energy_minus(fields[f].0, &v),
+                match self.boundary_values(exact, field.1) {
+                    Ok(v) => en += self.jump_energy_minus(field.0, &v),
                     Err(e) => {
                         failed = Some(e);
                         break;

@@ -56,11 +56,10 @@ impl Writer {
             .with_fapl(h5::file_access)
             .create_excl(&partial)
             .map_err(io(path, "cannot create HDF5 file"))?;
-        let opened = Writer::fill(&file, path, &partial, run, opts).map_err(|e| {
+        let opened = Writer::fill(&file, path, &partial, run, opts).inspect_err(|_| {
             // nothing of a new file is left when it cannot be made (a full disk: the series are allocated
             // for the whole run, so the partial file would be large)
             let _ = std::fs::remove_file(&partial);
-            e
         })?;
         let (fields, tresca, vtk, xdmf, frames, raw) = opened;
         let old = paths::lstat(path)?.is_some().then(|| open_old(path)).flatten();

@@ -31,7 +31,7 @@ use crate::scene::{Method, Scene};
 use crate::study::SetupCache;
 use crate::study::{Level, LevelResult, Study};
 use model::{CostModel, CostSample, ErrorModel, TimeError};
-use pilot::{fit, pilot_scene, time_pilot, Fit, Quantity, Runner};
+use pilot::{fit, pilot_scene, time_pilot, Fit, Quantity, Runner, TimeGrids};
 use search::{decide, Pilots};
 
 /// Levels of the space pilot before any extension (four: the asymptotic check needs a fourth level).
@@ -143,7 +143,14 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
     let (r0, n0) = (s.mesh_level(), s.times.len() - 1);
     let q = &options.quantity;
     let nt = time_base(n0);
-    let time_pilot_run = time_pilot(&s, r0 + 2, nt, n0, q, TIME_BOUND_SHARE * target, options.pilot_budget, cache)?;
+    let time_pilot_run = time_pilot(
+        &s,
+        TimeGrids { refine: r0 + 2, first: nt, steps: n0 },
+        q,
+        TIME_BOUND_SHARE * target,
+        options.pilot_budget,
+        cache,
+    )?;
     let (time, _, spent) = &time_pilot_run;
     let time_fit = fit(time, q)?;
     let mesh = time.levels[0].refine;

@@ -233,6 +233,14 @@ impl Fit {
 }
 
 /// The time pilot on mesh level `refine`: grids doubling from `first` steps up to twice the scene's
+/// The time pilot's mesh and grids: the refinement, the first number of steps N and the steps of the
+/// runs whose time error is to be bounded.
+pub struct TimeGrids {
+    pub refine: u32,
+    pub first: usize,
+    pub steps: usize,
+}
+
 /// `steps` (at least four), then N, 4N, 16N, 64N from `first` if the doubling sequence is not in the
 /// asymptotic range (module doc) and its distances do not already bound the time error of grids of
 /// `steps` steps or more by `enough` ([`Fit::time_bound`]). Returns the study, the ratio used and the
@@ -240,14 +248,13 @@ impl Fit {
 /// fewer, larger edges — so the bound would be looser and the space pilot could not sample time coarsely.)
 pub fn time_pilot(
     scene: &Scene,
-    refine: u32,
-    first: usize,
-    steps: usize,
+    grids: TimeGrids,
     q: &Quantity,
     enough: f64,
     budget: f64,
     cache: &SetupCache,
 ) -> Result<(Study, usize, f64)> {
+    let TimeGrids { refine, first, steps } = grids;
     let mut spent = 0.0;
     let mut last = None;
     for ratio in [2usize, 4] {

@@ -44,7 +44,7 @@ pub(super) fn representable(file: &str, e: f64, nu: f64, rho: f64) -> Result<()>
     let mu = e / (2.0 * (1.0 + nu));
     let stiff = e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)); // λ + 2μ
     let largest = stiff.max(rho * mu) * GEOMETRY;
-    if !(largest <= top) {
+    if largest.is_nan() || largest > top {
         return Err(Error::scene(
             file,
             "material.E, discretisation.rho",
@@ -56,7 +56,8 @@ pub(super) fn representable(file: &str, e: f64, nu: f64, rho: f64) -> Result<()>
             ),
         ));
     }
-    if !(mu.min(rho * mu) / GEOMETRY >= bottom) {
+    let smallest = mu.min(rho * mu) / GEOMETRY;
+    if smallest.is_nan() || smallest < bottom {
         return Err(Error::scene(
             file,
             "material.E, discretisation.rho",
