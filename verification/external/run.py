@@ -30,6 +30,7 @@ def main(argv=None):
     ap.add_argument("--reference", default=str(ROOT / "reference"))
     ap.add_argument("--binary", default=str(ROOT / "target" / "release" / "tresca-cr"))
     ap.add_argument("--from-rows", help="re-analyse a previous run's rows.json instead of running")
+    ap.add_argument("--requirements-json", help="also write the requirement list there (for make verify's harness)")
     args = ap.parse_args(argv)
     scenes = [s for s in suite.SCENES if not args.scene or s.name in args.scene]
     codes = tuple(args.code or suite.CODES)
@@ -54,6 +55,11 @@ def main(argv=None):
         (out / "rows.json").write_text(json.dumps({"rows": rows, "notes": notes, "elapsed_s": elapsed}))
     reqs = requirements.evaluate(rows, scenes)
     report.write_all(rows, scenes, notes, reqs, elapsed, Path(args.reference), out)
+    if args.requirements_json:
+        Path(args.requirements_json).write_text(json.dumps(
+            [{"id": rid, "statement": f"The solvers shall: {text}", "passed": bool(ok), "measured": detail,
+              "command": cmd, "reference": "reference/external.md"} for rid, text, ok, detail, cmd in reqs],
+            indent=1, ensure_ascii=False))
     for rid, text, ok, detail, _ in reqs:
         print(f"{'PASS' if ok else 'FAIL'}  {rid}: {text} — {detail}")
     print(f"{sum(r[2] for r in reqs)}/{len(reqs)} requirements pass; suite {elapsed:.0f} s")

@@ -26,6 +26,15 @@ def fuzz(hs, quick):
         f"TRESCA_FUZZ_CASES={cases} " + " ".join(cmd), "reference/fuzz.md")
 
 
+def external(hs, quick):
+    """XA/XO: the external codes (GetFEM, a scikit-fem Nitsche solver) against tresca-cr on five scenes
+    (verification/external/run.py), its report staged with the others (make reference publishes it)."""
+    path = os.path.join(hs.out, "external_requirements.json")
+    cmd = [PY, "verification/external/run.py", "--out", os.path.join(hs.out, "external"), "--reference", hs.staged,
+           "--requirements-json", path]
+    hs.run_script(cmd, path, "external")
+
+
 def last_line(p):
     return (p.stdout.strip().splitlines() or ["(no output)"])[-1][:200]
 

@@ -61,10 +61,28 @@ REQUIREMENTS = (
         'reference/h_mms_rotated.md',
     ),
     Requirement(
+        'C3-data-front',
+        'converge with order 1 ± 0.1 in the energy norm when Dirichlet data u_D ≠ 0 and an imposed normal displacement g_n ≠ 0 are given and a stick–slip front moves (`mms_data_front`, 5 levels, N = 64)',
+        'tresca-cr study verification/cases/mms_data_front.toml --levels 0:64,…,4:64',
+        'reference/h_mms_data_front.md',
+    ),
+    Requirement(
+        'C4-data-cep',
+        'converge with order 1 ± 0.1 (energy) and 2 ± 0.15 (L²), free of locking, on the near-incompressible Tresca solution of Chouly, Ern & Pignet (λ = 2·10⁴, μ = 2, Dirichlet data on three sides, `mms_data_cep`, 6 levels)',
+        'tresca-cr study verification/cases/mms_data_cep.toml --levels 0:1,…,5:1',
+        'reference/h_mms_data_cep.md',
+    ),
+    Requirement(
         'K1-mms_stop',
         'converge with order 1 ± 0.1 in k when slip stops abruptly inside a step (`mms_stop`, t* = 1/3, N = 4^j; time error against the N = 4096 solution on the same mesh)',
         'tresca-cr study verification/cases/mms_stop.toml --levels 3:4,3:16,3:64,3:256 --reference 3:4096',
         'reference/k_study_mms_stop.md',
+    ),
+    Requirement(
+        'K3-data-stop',
+        '… the same in k with Dirichlet data and an imposed normal displacement (`mms_data_stop`, N = 4^j against N = 4096 on the same mesh)',
+        'tresca-cr study verification/cases/mms_data_stop.toml --levels 3:4,3:16,3:64,3:256 --reference 3:4096',
+        'reference/k_study_mms_data_stop.md',
     ),
     Requirement(
         'K2-stick-to-slip',
@@ -175,6 +193,20 @@ REQUIREMENTS = (
         'not panic on 20 000 fuzzed inputs each for the scene parser (+ set-up and run), expressions and the Gmsh reader',
         'TRESCA_FUZZ_CASES=20000 cargo test --release --test fuzz -- --nocapture',
         'reference/fuzz.md',
+    ),
+    Requirement(
+        'XA…',
+        'reach the same continuous solution as established external codes: on five scenes (Example 5.1, `mms_front`, the near-incompressible Chouly–Ern–Pignet case, an imposed normal displacement, `mms_rotated`) the Richardson limits of GetFEM P1/P2/Taylor–Hood, an independent scikit-fem P2 Nitsche solver and tresca-cr (‖u‖_H1, ½a(u,u), u·τ at three points, ∫σ_τ, stick-zone ends, max slip) agree pairwise within the sum of their GCI bands (about 5 min)',
+        'verification/external/run.py',
+        'reference/external.md',
+        pattern='XA-.+',
+    ),
+    Requirement(
+        'XO…',
+        'see each external code converge at its theoretical order where the solution is exact: true H1 errors of P1/CR at order 1 and P2/Taylor–Hood at order 2 ± 0.15 (fit over the finest four of five levels and the last two successive orders; locking displacement-only codes on the near-incompressible scene are stated as a finding, verification/external/README.md)',
+        'verification/external/run.py',
+        'reference/external.md',
+        pattern='XO-.+',
     ),
 )
 

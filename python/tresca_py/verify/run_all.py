@@ -39,6 +39,16 @@ def study_table(quick):
                                               "with contact on a non-axis-aligned edge the solver shall converge in h",
                                               l2_required=False),
         "k": lambda hs: studies.k_study(hs, quick),
+        "data": lambda hs: (
+            studies.h_study(hs, "C3-data-front", "verification/cases/mms_data_front.toml", "h_mms_data_front",
+                            [(k, 64) for k in range(n)], 1, 2,
+                            "with nonzero Dirichlet data, an imposed normal displacement and a moving stick–slip "
+                            "front the solver shall converge in h", l2_required=False),
+            studies.h_study(hs, "C4-data-cep", "verification/cases/mms_data_cep.toml", "h_mms_data_cep",
+                            [(k, 1) for k in range(n + 1)], 1, 2,
+                            "on the near-incompressible Tresca solution of Chouly, Ern & Pignet (λ/μ = 10⁴, "
+                            "Dirichlet data on three sides) the solver shall converge in h without locking"),
+            studies.k_study(hs, quick, "mms_data_stop", "K3-data-stop")),
         "be_exact": studies.be_exact_study,
         "joint": lambda hs: studies.joint_study(hs, quick),
         "paper": lambda hs: paper.paper_tables(hs, quick),
@@ -50,6 +60,7 @@ def study_table(quick):
         "cross": lambda hs: checks.cross_check(hs, quick),
         "distributed": lambda hs: checks.distributed(hs, quick),
         "fuzz": lambda hs: checks.fuzz(hs, quick),
+        "external": lambda hs: checks.external(hs, quick),
     }
 
 
