@@ -17,7 +17,7 @@ pub use parts::{FrictionBound, Part, PartKind};
 pub use tables::MAX_REFINE;
 use tables::{check_refine, exact, loads, material, mesh_spec, parts, quantities, solver_settings, time_grid};
 pub use values::MAX_EXPR_CHARS;
-use values::{line_of, positive_finite, uniform_times};
+use values::{at_line, line_of, positive_finite, uniform_times};
 
 use raw::*;
 use std::path::{Path, PathBuf};
@@ -134,7 +134,7 @@ impl Scene {
     /// Parse and validate scene text; `file` is used in messages.
     pub fn from_str(text: &str, file: &str) -> Result<Self> {
         let raw: RawScene = toml::from_str(text).map_err(|e| {
-            let span = e.span().map(|s| line_of(text, s.start)).map(|l| format!("line {l}")).unwrap_or_default();
+            let span = e.span().map(|s| line_of(text, s.start)).map(|l| at_line(text, l)).unwrap_or_default();
             Error::scene(file, span, e.message().to_string())
         })?;
         let mesh = mesh_spec(file, &raw.mesh)?;

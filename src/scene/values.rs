@@ -120,6 +120,15 @@ pub(super) fn uniform_times(file: &str, t: f64, n: usize) -> Result<Vec<f64>> {
     Ok(times)
 }
 
+/// "line L: key": where a TOML error is, with the key the line assigns (if it assigns one).
+pub(super) fn at_line(text: &str, line: usize) -> String {
+    let key = text.lines().nth(line.saturating_sub(1)).and_then(|l| l.split_once('=')).map(|(k, _)| k.trim());
+    match key {
+        Some(k) if !k.is_empty() && !k.starts_with('#') => format!("line {line}: {k}"),
+        _ => format!("line {line}"),
+    }
+}
+
 pub(super) fn line_of(text: &str, byte: usize) -> usize {
     text[..byte.min(text.len())].matches('\n').count() + 1
 }
