@@ -16,36 +16,21 @@ from pathlib import Path
 
 import numpy as np
 
+from tresca_py.expr import ExprError
+from tresca_py.expr import parse as expr_parse
+
 
 class ProblemError(ValueError):
     """A scene this reader cannot turn into a problem; the message names the key."""
 
 
-_FUNCS = ("sin", "cos", "tan", "exp", "ln", "log", "sqrt", "abs", "signum", "tanh", "sinh", "cosh",
-          "atan2", "min", "max", "floor")
-
-
 def to_sympy(text, key):
-    """exmex string -> sympy expression in x, y, t (``^`` power, PI/E constants, the functions above)."""
-    import sympy
-    from sympy.parsing.sympy_parser import parse_expr, standard_transformations
-    x, y, t = sympy.symbols("x y t", real=True)
-    names = {"x": x, "y": y, "t": t, "PI": sympy.pi, "pi": sympy.pi, "E": sympy.E, "e": sympy.E,
-             "sin": sympy.sin, "cos": sympy.cos, "tan": sympy.tan, "exp": sympy.exp, "ln": sympy.log,
-             "log": sympy.log, "sqrt": sympy.sqrt, "abs": sympy.Abs, "tanh": sympy.tanh, "sinh": sympy.sinh,
-             "cosh": sympy.cosh, "atan2": sympy.atan2, "min": sympy.Min, "max": sympy.Max,
-             "floor": sympy.floor, "signum": lambda a: sympy.Piecewise((-1, a < 0), (1, True))}
-    gdict = {"Integer": sympy.Integer, "Float": sympy.Float, "Rational": sympy.Rational,
-             "Symbol": sympy.Symbol, "Function": sympy.Function, "__builtins__": {}}
+    """exmex string -> sympy expression in x, y, t: the project's one reading (``tresca_py.expr``), so the
+    external codes solve exactly the expressions tresca-cr reads (signum(0) = +1, the refused readings)."""
     try:
-        expr = parse_expr(str(text).replace("^", "**"), local_dict=names, global_dict=gdict,
-                          transformations=standard_transformations)
-    except Exception as err:  # sympy raises many types
-        raise ProblemError(f"{key}: cannot parse {text!r}: {err}") from None
-    extra = {str(s) for s in expr.free_symbols} - {"x", "y", "t"}
-    if extra:
-        raise ProblemError(f"{key}: unknown names {sorted(extra)} in {text!r}")
-    return expr
+        return expr_parse(text, key)
+    except ExprError as err:
+        raise ProblemError(str(err)) from None
 
 
 def numpy_code(expr):
