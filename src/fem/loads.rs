@@ -31,9 +31,12 @@ use crate::scene::expr::program::Program;
 use crate::scene::expr::sym::Sym;
 use crate::scene::expr::{factor_slot, BoundSet, Expr, ExprSet, Vec2Expr};
 use crate::scene::{PartKind, Scene};
+use constrained::constrained_terms;
+
+mod constrained;
 
 /// Per point of a load term feeding constrained components: (component, weight w·φ, vector coefficient).
-type PointWeights = Vec<(usize, f64, [f64; 2])>;
+pub(super) type PointWeights = Vec<(usize, f64, [f64; 2])>;
 
 /// A quadrature point of a load term: position, and the (edge, weight · φ) pairs it feeds.
 #[derive(Clone, Debug)]
@@ -266,25 +269,6 @@ impl Loads {
         Ok(())
     }
 
-    /// (lⁿ, ψ_k) of the loads f and g alone (without the lifting's part) on the constrained components
-    /// of `fem::lifting::BoundaryData::constrained`, in that order; empty without boundary data.
-    pub fn constrained(&self, t: f64) -> Result<Vec<f64>> {
-        let Some(lift) = &self.lift else {
-            return Ok(Vec::new());
-        };
-        let mut out = vec![0.0; lift.n_constrained];
-        let mut values = Vec::new();
-        for (expr, points) in &lift.constrained {
-            expr.eval(t, &mut values)?;
-            for (v, feeds) in values.chunks_exact(2).zip(points) {
-                for &(c, w, a) in feeds {
-                    out[c] += w * (a[0] * v[0] + a[1] * v[1]);
-                }
-            }
-        }
-        Ok(out)
-    }
-
     /// (lⁿ, ψ_k) of the loads f and g alone on every unknown (with boundary data, l(t) without the
     /// lifting's part; otherwise [`Loads::assemble`]).
     pub fn assemble_loads(&self, t: f64, out: &mut Vec<f64>) -> Result<()> {
@@ -393,35 +377,4 @@ fn separated(e: &Vec2Expr, factors: &mut Vec<(String, Sym)>, separate: bool) -> 
     *factors = known;
     out.sort_by_key(|(j, _)| *j);
     Some(out)
-}
-
-/// The load terms at their points that feed a constrained component of `data` (both axes of a
-/// Dirichlet edge with data, the normal of a Γ_C edge with a gap), and the number of such components.
-#[allow(clippy::type_complexity)]
-fn constrained_terms(
-    raw: &[(&Vec2Expr, Vec<LoadPoint>)],
-    data: &BoundaryData,
-    space: &CrSpace,
-) -> (Vec<(BoundSet, Vec<Vec<(usize, f64, [f64; 2])>>)>, usize) {
-    let comps = data.constrained(&space.contact);
-    let mut of_edge: Vec<Vec<(usize, [f64; 2])>> = vec![Vec::new(); space.edge_dof.len()];
-    for (c, &(e, a)) in comps.iter().enumerate() {
-        of_edge[e].push((c, a));
-    }
-    let mut out = Vec::new();
-    for (e, pts) in raw {
-        let (mut points, mut feeds) = (Vec::new(), Vec::new());
-        for p in pts {
-            let f: Vec<(usize, f64, [f64; 2])> =
-                p.edges.iter().flat_map(|&(edge, w)| of_edge[edge].iter().map(move |&(c, a)| (c, w, a))).collect();
-            if !f.is_empty() {
-                points.push(p.x);
-                feeds.push(f);
-            }
-        }
-        if !points.is_empty() {
-            out.push((ExprSet::new(&[&e.0[0], &e.0[1]]).bind(points), feeds));
-        }
-    }
-    (out, comps.len())
 }
