@@ -38,6 +38,11 @@ def read(path, completed):
         return {k: np.asarray(g[k][:completed], dtype=float) for k in SERIES}
 
 
+def largest_work(a):
+    """The largest work of a step, |(lⁿ,δuⁿ)| + |W_Γⁿ| + j_h(δuⁿ): the scale of the balance."""
+    return float(np.max(np.abs(a["external_work"]) + np.abs(a["boundary_work"]) + a["friction_dissipation"]))
+
+
 def problems(a):
     """The audit's violations as messages (empty when the balance holds)."""
     out = []
@@ -45,8 +50,7 @@ def problems(a):
         return ["energy audit: a series holds NaN or Inf"]
     if len(a["stored_energy"]) < 2:
         return out
-    work = np.abs(a["external_work"]) + np.abs(a["boundary_work"]) + a["friction_dissipation"]
-    scale = float(np.max(work))
+    scale = largest_work(a)
     terms = max(scale, float(np.max(np.abs(a["stored_energy"]))))
     ident = (np.diff(a["stored_energy"]) + a["euler_dissipation"][1:] + a["friction_dissipation"][1:]
              - a["external_work"][1:] - a["boundary_work"][1:])
@@ -70,7 +74,6 @@ def problems(a):
 
 def summary(a):
     """One line: the largest |residual| against the largest work of a step."""
-    work = np.abs(a["external_work"]) + np.abs(a["boundary_work"]) + a["friction_dissipation"]
-    res, scale = float(np.max(np.abs(a["balance_residual"]))), float(np.max(work))
+    res, scale = float(np.max(np.abs(a["balance_residual"]))), largest_work(a)
     rel = res / scale if scale > 0 else 0.0
     return f"energy balance: max |residual| {res:.2e} ({rel:.1e} of the largest work of a step)"

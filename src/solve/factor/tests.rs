@@ -1,0 +1,115 @@
+use super::super::ordering::nested_dissection;
+use super::*;
+use crate::sparse::{csc_from_triplets, matvec};
+
+/// Plane-elasticity-like test matrix: a 2D grid (m × m nodes) Laplacian, two coupled unknowns per node
+/// (numbered consecutively), shifted to be SPD.
+fn grid(m: usize) -> SparseColMat<usize, f64> {
+    let node = |i: usize, j: usize| i * m + j;
+    let mut t = Vec::new();
+    for i in 0..m {
+        for j in 0..m {
+            let a = node(i, j);
+            for c in 0..2 {
+                t.push((2 * a + c, 2 * a + c, 4.5));
+            }
+            t.push((2 * a, 2 * a + 1, 0.25));
+            t.push((2 * a + 1, 2 * a, 0.25));
+            for (di, dj) in [(0, 1), (1, 0)] {
+                if i + di < m && j + dj < m {
+                    let b = node(i + di, j + dj);
+                    for c in 0..2 {
+                        t.push((2 * a + c, 2 * b + c, -1.0));
+                        t.push((2 * b + c, 2 * a + c, -1.0));
+                    }
+                }
+            }
+        }
+    }
+    csc_from_triplets(2 * m * m, &t)
+}
+
+fn residual(k: &SparseColMat<usize, f64>, f: &Factor) -> f64 {
+    let n = k.nrows();
+    let b: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+    let mut x = b.clone();
+    f.solve_in_place(&mut x);
+    let mut r = vec![0.0; n];
+    matvec(k, &x, &mut r);
+    r.iter().zip(&b).map(|(r, b)| (r - b).abs()).fold(0.0, f64::max)
+}
+
+/// The blocked steps (`solve::free::Block`) rely on this: in a solve with B columns each column's
+/// result depends neither on the other columns nor on its position.
+#[test]
+fn block_columns_are_independent_of_neighbours_and_position() {
+    let k = grid(70);
+    let n = k.nrows();
+    let f = Factor::with_last(&k, &[0, 2, 4, 6]).unwrap();
+    let b: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+    let cols = 16;
+    let mut y: Vec<f64> =
+        (0..n * cols).map(|i| if (i / n).is_multiple_of(2) { b[i % n] } else { ((i * 13) % 7) as f64 }).collect();
+    f.forward_block(&mut y, cols).unwrap();
+    f.backward_block(&mut y, cols).unwrap();
+    let bits = |c: usize| y[c * n..(c + 1) * n].iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    for c in (2..cols).step_by(2) {
+        assert_eq!(bits(0), bits(c), "column {c}");
+    }
+}
+
+/// The factor with the ordering of `fill_order` on the groups `first`.
+fn ordered(k: &SparseColMat<usize, f64>, nested: bool, first: &[usize]) -> Result<Factor> {
+    Factor::with_order(k, &[], fill_order(&Graph::of_matrix(k, first), nested)?)
+}
+
+/// Groups of the two unknowns of a grid node.
+fn pairs(n: usize) -> Vec<usize> {
+    (0..=n).step_by(2).collect()
+}
+
+fn singles(n: usize) -> Vec<usize> {
+    (0..=n).collect()
+}
+
+#[test]
+fn nested_dissection_orders_and_solves() {
+    let k = grid(40);
+    let (fwd, inv) = nested_dissection(&Graph::of_matrix(&k, &pairs(k.nrows()))).expect("METIS ordering");
+    assert!(fwd.iter().enumerate().all(|(new, &old)| inv[old] == new));
+    let nd = ordered(&k, true, &pairs(k.nrows())).unwrap();
+    let amd = ordered(&k, false, &pairs(k.nrows())).unwrap();
+    assert!(residual(&k, &nd) < 1e-12 && residual(&k, &amd) < 1e-12);
+}
+
+#[test]
+fn nested_dissection_is_deterministic_across_threads() {
+    let k = grid(30);
+    let reference = nested_dissection(&Graph::of_matrix(&k, &pairs(k.nrows()))).unwrap();
+    let runs: Vec<_> = std::thread::scope(|s| {
+        let h: Vec<_> =
+            (0..4).map(|_| s.spawn(|| nested_dissection(&Graph::of_matrix(&k, &pairs(k.nrows()))).unwrap())).collect();
+        h.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    assert!(runs.iter().all(|r| *r == reference));
+}
+
+#[test]
+fn degenerate_graphs_fall_back_to_amd() {
+    let diag = |n: usize| csc_from_triplets(n, &(0..n).map(|i| (i, i, 2.0)).collect::<Vec<_>>());
+    for n in [0, 1, 2, 5] {
+        assert!(nested_dissection(&Graph::of_matrix(&diag(n), &singles(n))).is_none());
+        let f = ordered(&diag(n), true, &singles(n)).unwrap();
+        assert!(residual(&diag(n), &f) < 1e-15);
+    }
+    // One coupled pair: a single METIS vertex, no edges.
+    let pair = csc_from_triplets(2, &[(0, 0, 2.0), (1, 1, 2.0), (0, 1, 1.0), (1, 0, 1.0)]);
+    assert!(nested_dissection(&Graph::of_matrix(&pair, &[0, 2])).is_none());
+    assert!(residual(&pair, &ordered(&pair, true, &[0, 2]).unwrap()) < 1e-15);
+    // Three unknowns: METIS on a 2-vertex graph.
+    let three = csc_from_triplets(
+        3,
+        &[(0, 0, 4.0), (1, 1, 4.0), (2, 2, 4.0), (1, 2, 1.0), (2, 1, 1.0), (0, 2, 1.0), (2, 0, 1.0)],
+    );
+    assert!(residual(&three, &ordered(&three, true, &[0, 1, 3]).unwrap()) < 1e-14);
+}
