@@ -63,3 +63,20 @@ def test_publish_copies_the_staged_files(tmp_path):
     names = publish(out=hs.out, reference=str(ref))
     assert names == ["h_mms_front.md", "summary.md"]
     assert (ref / "h_mms_front.md").read_text() == "table\n"
+
+
+def test_publish_copies_a_staged_folder(tmp_path):
+    """`make reference` shall copy a study's staged folder (reference/adaptive/) into reference/, replacing the
+    files of the same name and keeping the others."""
+    hs = Harness(out=str(tmp_path / "out"), echo=False)
+    os.makedirs(hs.path("adaptive/lshape"))
+    hs.write("adaptive/study.md", "new\n")
+    hs.write("adaptive/lshape/mesh_0.png", "png\n")
+    ref = tmp_path / "reference"
+    (ref / "adaptive").mkdir(parents=True)
+    (ref / "adaptive" / "study.md").write_text("old\n")
+    (ref / "adaptive" / "kept.csv").write_text("kept\n")
+    assert publish(out=hs.out, reference=str(ref)) == ["adaptive"]
+    assert (ref / "adaptive" / "study.md").read_text() == "new\n"
+    assert (ref / "adaptive" / "lshape" / "mesh_0.png").read_text() == "png\n"
+    assert (ref / "adaptive" / "kept.csv").read_text() == "kept\n"

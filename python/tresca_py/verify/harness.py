@@ -135,14 +135,18 @@ class Harness:
 
 
 def publish(out=None, reference=None):
-    """``make reference``: copy the staged files of ``out/verify/reference/`` (and the summary) into the
-    tracked ``reference/``; returns the names copied."""
+    """``make reference``: copy the staged files and folders of ``out/verify/reference/`` (and the summary)
+    into the tracked ``reference/``; returns the names copied."""
     out = out or out_dir()
     reference = reference or os.path.join(ROOT, "reference")
     staged = os.path.join(out, "reference")
     names = sorted(os.listdir(staged)) if os.path.isdir(staged) else []
     for n in names:
-        shutil.copy2(os.path.join(staged, n), os.path.join(reference, n))
+        src, dst = os.path.join(staged, n), os.path.join(reference, n)
+        if os.path.isdir(src):   # a study's folder (reference/adaptive/): its files replace those of the same name
+            shutil.copytree(src, dst, dirs_exist_ok=True)
+        else:
+            shutil.copy2(src, dst)
     if os.path.exists(os.path.join(out, "summary.md")):
         shutil.copy2(os.path.join(out, "summary.md"), os.path.join(reference, "summary.md"))
         names.append("summary.md")

@@ -134,6 +134,42 @@ REQUIREMENTS = (
         'reference/paper_tables.md',
     ),
     Requirement(
+        'A1-effectivity',
+        'keep the adaptive indicator\'s effectivity η/|||u − u_h||| ≥ 1 and its max/min ≤ 1.05²·(DOF_last/DOF_0)^0.05 over 17 adapted levels (θ = 0.5) of `mms_elastic` and `mms_stick_to_slip`: reliability and efficiency make it mesh-independent; allowed are a rate difference of 0.05 between η and the error (the fit band of A2) and Dörfler\'s ±5 % scatter per level at both ends',
+        'tresca-cr adapt verification/cases/mms_elastic.toml --levels 17 --theta 0.5 --csv …',
+        'reference/adaptive/study.md',
+    ),
+    Requirement(
+        'A2-rate',
+        '… and converge there at the optimal rate: true error ∝ DOF^(−1/2), fitted over levels 9–16 within 0.05, the last two rates over 3-level windows (levels 4, 7, …, 16) within 0.12 (±5 % Dörfler scatter at both ends of a ×2.3 window)',
+        'as A1',
+        'reference/adaptive/study.md',
+    ),
+    Requirement(
+        'A3-example-5-1',
+        'on Example 5.1, against a generation-12 reference and in the same study, converge adaptively like DOF^(−1/2) ± 0.05 (3-level windows ± 0.12) where uniform refinement gives DOF^(−0.43) ± 0.05 (the issue\'s order 0.85–0.87 in h; pairs of levels), the adaptive rate the larger; only levels with ≤ the DOF of uniform generation 8 (the reference\'s error ≤ 0.3 of theirs)',
+        'tresca-cr adapt verification/cases/paper_example_5_1.toml --levels 16 --theta 0.5 --reference 12; … --levels 9 --theta 1 --reference 12',
+        'reference/adaptive/study.md',
+    ),
+    Requirement(
+        'A4-lshape-dof',
+        'on the L-shape (`lshape_adapt`, Gmsh, re-entrant corner) reach the uniform route\'s finest accuracy (uniform level 6, 24,640 unknowns, against a generation-10 reference) with at most a tenth of its unknowns (issue 33\'s bar; log-log interpolation between adaptive levels)',
+        'tresca-cr adapt verification/cases/lshape_adapt.toml --levels 13 --theta 0.5 --reference 10; … --levels 7 --theta 1 --reference 10',
+        'reference/adaptive/study.md',
+    ),
+    Requirement(
+        'A5-min-angle',
+        'keep every adapted level\'s minimum angle at or above newest-vertex bisection\'s bound, the smallest angle over six generations of bisecting each initial triangle (computed in Python, `tresca_py/bisection.py`), on the structured meshes (`mms_elastic`, `mms_stick_to_slip`, Example 5.1) and the Gmsh L-shape, adaptive and uniform routes',
+        'verification/run_all.py --only adaptive',
+        'reference/adaptive/study.md',
+    ),
+    Requirement(
+        'A6-adapted-mesh',
+        'write each adapted level\'s mesh as Gmsh (`adapt --out DIR --gmsh`: the same points and triangles as `level_<k>.h5`), on which the scikit-fem and dolfinx re-implementations agree with the Rust solver to ≤ 1e-8 (DOF vectors, energies, σ_τ; no differing stick/slip flag), as does the adapt run\'s own level file',
+        'verification/run_all.py --only adaptive',
+        'reference/adaptive/study.md',
+    ),
+    Requirement(
         'O1-clients',
         "write results that VTK's `vtkHDFReader`, meshio (XDMF) and h5py open, with the solver's values",
         'scripts/check_results.py out/verify_ex51.h5',

@@ -15,7 +15,7 @@ import subprocess
 import time
 
 from tresca_py.common import BIN, PY
-from tresca_py.verify import checks, estimates, paper, studies
+from tresca_py.verify import adaptive, checks, estimates, paper, studies
 from tresca_py.verify.harness import Harness, out_dir
 
 
@@ -53,6 +53,7 @@ def study_table(quick):
         "joint": lambda hs: studies.joint_study(hs, quick),
         "paper": lambda hs: paper.paper_tables(hs, quick),
         "estimates": lambda hs: estimates.run(hs, quick),
+        "adaptive": adaptive.study,
         "planner": lambda hs: checks.planner(hs, quick),
         "clients": checks.results_clients,
         "paraview": checks.paraview,
