@@ -14,7 +14,9 @@ Errors without an exact solution are distances to the reference of ``--reference
 mesh refined to bisection generation ≥ G; src/adapt/reference.rs). Only levels with at most the DOF of the
 uniform generation G − 4 enter a rate: the reference then has ≥ 16 times their DOF, its own error is ≤
 16^(−0.43) ≈ 0.3 of theirs, and |||u − u_l|||² ≈ |||u_ref − u_l|||² + |||u − u_ref|||² makes the distance
-low by ≤ 5 %, a rate bias ≤ 0.01 over the ranges used.
+low by ≤ 5 % at the finest level used and less at the coarser ones: a rate bias ≤ ln(1/0.95)/ln 50 ≈ 0.013
+over the ranges used (DOF ×50 and more). On Example 5.1 the fit starts at level 3: levels 0–2 (8–19
+triangles) are left out as too coarse to be asymptotic; the window check then tests the range.
 """
 import csv
 import math
@@ -29,6 +31,7 @@ from tresca_py.verify import adapted_reimpl
 from tresca_py.verify.studytools import req
 
 SUB = "adaptive"   # the study's files: out/verify/reference/adaptive/ → reference/adaptive/
+STUDY_MD = "reference/adaptive/study.md"
 FIT_BAND, WINDOW_BAND, PAIR_BAND = 0.05, 0.12, 0.05
 # an effectivity that drifts means η and the error converge at different rates: allowed, the fit band
 # over the levels' DOF range, times the ±5 % per-level scatter at both ends
@@ -114,11 +117,11 @@ def manufactured(hs, name, levels):
     uni, _ = adapt(hs, case(name), f"{name}_uniform", 8, 1)
     ok, text = effectivity_check(rows)
     req(hs, f"A1-effectivity-{name}", f"on `{name}` the indicator's effectivity η/|||u − u_h||| shall stay ≥ 1 "
-        f"and within a bounded range over {levels} adapted levels", ok, text, cmd, "reference/adaptive.md")
+        f"and within a bounded range over {levels} adapted levels", ok, text, cmd, STUDY_MD)
     ok, _, _, text = rate_check(rows, "error", list(range(9, levels)), list(range(4, levels, 3)), 0.5,
                                 WINDOW_BAND)
     req(hs, f"A2-rate-{name}", f"on `{name}` the adaptive true error shall decay like DOF^(−1/2) (± {FIT_BAND} "
-        f"fit, ± {WINDOW_BAND} over 3-level windows)", ok, text, cmd, "reference/adaptive.md")
+        f"fit, ± {WINDOW_BAND} over 3-level windows)", ok, text, cmd, STUDY_MD)
     return rows, uni
 
 
@@ -143,7 +146,7 @@ def example_5_1(hs, levels, reference, out):
     req(hs, "A3-example-5-1", f"on Example 5.1 (errors against the generation-{reference} reference) the adaptive "
         f"error shall decay like DOF^(−1/2) ± {FIT_BAND} (windows ± {WINDOW_BAND}) where uniform refinement "
         f"gives DOF^(−0.43) ± {PAIR_BAND}, measured in the same study, adaptive faster",
-        ok, f"adaptive {text_a}; uniform {text_u}", f"{cmd}; {cmd_u}", "reference/adaptive.md")
+        ok, f"adaptive {text_a}; uniform {text_u}", f"{cmd}; {cmd_u}", STUDY_MD)
     return rows, uni
 
 
@@ -156,10 +159,14 @@ def lshape(hs, levels, uniform_levels, reference, out):
     d_u, d_a = uni[-1]["unknowns"], dof_for(rows, "vs_reference", target)
     ok = d_a is not None and d_a <= d_u / 10
     got = "not reached" if d_a is None else f"≈ {d_a:.0f} unknowns, ratio {d_u / d_a:.1f}"
+    # the ratio at the coarser uniform levels too (reported): how it grows with the accuracy asked
+    trend = [(k, uni[k]["unknowns"] / d) for k in range(1, len(uni) - 1)
+             if (d := dof_for(rows, "vs_reference", uni[k]["vs_reference"])) is not None]
     req(hs, "A4-lshape-dof", "on the L-shape the adaptive route shall reach the uniform route's finest accuracy "
         "with at most a tenth of its unknowns (issue 33's bar)", ok,
-        f"uniform level {len(uni) - 1}: {target:.3e} with {d_u:.0f} unknowns; adaptive: {got}",
-        f"{cmd}; {cmd_u}", "reference/adaptive.md")
+        f"uniform level {len(uni) - 1}: {target:.3e} with {d_u:.0f} unknowns; adaptive: {got} (ratio at uniform "
+        f"levels {', '.join(f'{k}: {r:.1f}' for k, r in trend)})",
+        f"{cmd}; {cmd_u}", STUDY_MD)
     return rows, uni
 
 
@@ -178,7 +185,7 @@ def min_angle(hs, routes):
         req(hs, f"A5-min-angle-{name}", f"on `{name}` ({kind} mesh) every adapted level's minimum angle shall stay at "
             "or above newest-vertex bisection's bound for the initial mesh (its descendants' similarity classes)",
             ok, f"bound {bound:.4f}°; " + "; ".join(parts), "verification/run_all.py --only adaptive",
-            "reference/adaptive.md")
+            STUDY_MD)
 
 
 def reimplementations(hs, out, k):
@@ -195,7 +202,7 @@ def reimplementations(hs, out, k):
     req(hs, "A6-adapted-mesh", "on an adapted L-shape mesh written by `adapt --gmsh`, the scikit-fem and dolfinx "
         "re-implementations shall agree with the Rust solver to ≤ 1e-8 (DOF vectors, energies, σ_τ, stick/slip)",
         ok, text, f"tresca-cr adapt verification/cases/lshape_adapt.toml … --out DIR --gmsh; scripts/"
-        f"{{skfem,dolfinx}}_solve.py DIR/level_{k}.toml; scripts/compare.py --tol 1e-8", "reference/adaptive.md")
+        f"{{skfem,dolfinx}}_solve.py DIR/level_{k}.toml; scripts/compare.py --tol 1e-8", STUDY_MD)
 
 
 def figures(hs, pairs, mesh_dirs):
