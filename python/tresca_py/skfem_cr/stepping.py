@@ -11,7 +11,7 @@ from tresca_py.skfem_cr.cr import Discretisation
 from tresca_py.skfem_cr.friction import StepSolver, classify
 
 
-def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True, step_solver=StepSolver):
+def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True, step_solver=StepSolver, lifting=None):
     """Backward Euler over ``scene.times``; ``step_solver(disc, K)`` solves the steps (its ``step(l, u_prev)``
     as ``friction.StepSolver``'s; the dolfinx re-implementation passes its own).
 
@@ -20,6 +20,8 @@ def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True, step
     ``errors(t, u)``: collective, ``u`` canonical on every rank; returns (energy error^2, h1^2, l2^2)
     on rank 0, the energy error including the jump terms (2 rho mu/h_e) int_e |[u_h]|^2 computed by the
     framework as an integral of squares (u^T J u would lose sqrt(eps) accuracy when the jumps vanish).
+    ``lifting``: the boundary data's ``SkfemLifting`` (None without data): u = w + u_L, w solving the step with
+    the load lⁿ + b_D(tₙ) − K u_Lⁿ (``tresca_py.skfem_cr.lifting``).
     Returns the results dict on rank 0, None elsewhere.
     """
     rank = 0 if comm is None else comm.rank
@@ -42,6 +44,8 @@ def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True, step
         if scene.exact_u is not None:
             res["errors"] = {k: np.zeros(N + 1) for k in ("energy", "h1", "l2")}
         u = disc.interpolate(scene.u0, times[0])
+        if lifting is not None:
+            u = u + lifting.lift(times[0])
     else:
         u = None
     for n, t in enumerate(times):
@@ -53,7 +57,12 @@ def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True, step
                 raise InputError(f"step {n} (t = {t:.6g}): {err}") from None
             if root:
                 u_prev = u
-                u, info = stepper.step(load_t, u_prev)
+                if lifting is None:
+                    u, info = stepper.step(load_t, u_prev)
+                else:
+                    u_l = lifting.lift(t)
+                    w, info = stepper.step(load_t + lifting.rhs(t) - K @ u_l, u_prev)
+                    u = w + u_l
                 mu = info["mu"]
                 slip = classify(mu, info["ds"], info["d"], disc.weight)
                 res["sigma_t"][n] = -mu / disc.lengths[disc.contact]
@@ -69,7 +78,7 @@ def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True, step
                 res["dof"][n] = res["slip"][n]          # u^0 = I_CR u0 holds s_e tau_e on contact edges
             res["n_slip"][n] = int(res["state"][n].sum())
             res["n_stick"][n] = C - res["n_slip"][n]
-            res["energy"][n] = float(u @ (K @ u))
+            res["energy"][n] = float(u @ (K @ u)) if lifting is None else lifting.energy(K, u, t)
         if scene.exact_u is not None and errors is not None:
             ub = u if comm is None else comm.bcast(u, root=0)
             e = errors(t, ub)
