@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import PY, SCRIPTS, run
-from tresca_py.common import CASES
+from tresca_py.common import CASES, MPIRUN
 from tresca_py.compare import compare_files
 from tresca_py.mesh import build_mesh
 from tresca_py.scene import SceneError, load_scene
@@ -159,3 +159,29 @@ def test_the_system_shall_read_zero_data_as_no_data_and_refuse_data_on_the_wrong
     path.write_text(PATCH.replace('traction = ["0.024*t", "0"]', 'traction = ["0.024*t", "0"]\nu = ["0", "1"]'))
     with pytest.raises(SceneError, match="'u' is only allowed"):
         load_scene(str(path))
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_the_system_shall_check_the_python_solvers_results_files(solver, patch, tmp_path, capsys):
+    """scripts/check_results.py accepts a file of the /tresca group alone (no views, no sidecar: the Python
+    solvers' files) and still refuses one whose /tresca group is damaged."""
+    from tresca_py import check
+    out = tmp_path / "patch.h5"
+    assert solve(solver, patch, out).returncode == 0
+    assert check.main([str(out)]) == 0
+    assert "the tresca group alone is checked" in capsys.readouterr().out
+    with h5py.File(out, "r+") as fh:
+        fh["tresca/u"][1, 0, 0] = np.nan
+    assert check.main([str(out)]) == 2
+
+
+@pytest.mark.mpi
+def test_the_system_shall_apply_boundary_data_alike_in_dolfinx_serial_and_on_two_ranks(patch, tmp_path):
+    """The data's load b_D and norm c(t) are assembled distributed and gathered: two ranks give the serial run
+    to the cross-check's 1e-8 (the two differ by the summation order of the gathered entries)."""
+    serial, par = tmp_path / "s.h5", tmp_path / "p.h5"
+    assert solve("dolfinx", patch, serial).returncode == 0
+    p = run([MPIRUN, "-n", "2", PY, os.path.join(SCRIPTS, "dolfinx_solve.py"), patch, "-o", str(par), "-q"])
+    assert p.returncode == 0, p.stderr
+    r = compare_files(str(serial), str(par))
+    assert max(r["du"], r["dE"], r["dsig"], r["derr"]) <= 1e-8 and r["flags"] == 0

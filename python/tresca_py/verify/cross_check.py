@@ -65,7 +65,7 @@ QUICK = {
     "expr_functions": ((0,), 4),
 }
 # dolfinx mpirun -n 2 versus serial (case, refine)
-MPI_FULL = [("paper_example_5_1", 2), ("mms_front", 1)]
+MPI_FULL = [("paper_example_5_1", 2), ("mms_front", 1), ("mms_data_stop", 1)]
 MPI_QUICK = [("pdas_cycle", 0)]
 
 PAIRS = (("rust", "skfem"), ("rust", "dolfinx"), ("skfem", "dolfinx"))
