@@ -18,7 +18,7 @@ def main(argv=None):
         t_asm = time.perf_counter() - t0
         errors = prob.errors if scene.exact_u is not None else None
         lifting = SkfemLifting(prob) if scene.has_boundary_data else None
-        res = run(disc, prob.K, prob.J, prob.load, errors, log=not args.quiet, lifting=lifting)
+        res = run(disc, prob.K, prob.load, errors, log=not args.quiet, lifting=lifting)
         wall = time.perf_counter() - t0
         write_results(out, disc, res, "skfem", {"assembly_time": t_asm, "total_time": wall})
     print(f"skfem: {len(disc.edges)} edges, {len(disc.contact)} contact edges, {len(scene.times) - 1} steps; "
