@@ -185,3 +185,16 @@ def test_the_system_shall_apply_boundary_data_alike_in_dolfinx_serial_and_on_two
     assert p.returncode == 0, p.stderr
     r = compare_files(str(serial), str(par))
     assert max(r["du"], r["dE"], r["dsig"], r["derr"]) <= 1e-8 and r["flags"] == 0
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_the_system_shall_name_boundary_data_that_are_not_finite_at_a_step(solver, patch, tmp_path):
+    """A gap consistent at t0 (exactly 0 there) but NaN from t = 1/2 on (sqrt of a negative number) stops the
+    run at step 2 (t = 2/3) with one error line naming the expression, no traceback and no results file."""
+    scene = tmp_path / "nan.toml"
+    scene.write_text(PATCH.replace('gap = "0.02*t*x"', 'gap = "0.02*t*x + sqrt(0.25 - t*t) - 0.5"'))
+    out = tmp_path / "nan.h5"
+    p = solve(solver, str(scene), out)
+    assert p.returncode == 2, p.stderr
+    assert "gap" in p.stderr and "step 2" in p.stderr and "Traceback" not in p.stderr
+    assert not out.exists()

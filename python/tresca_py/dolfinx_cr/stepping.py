@@ -84,11 +84,11 @@ def backward_euler(edges, prob, stepper_class, comm, log):
         try:
             load = prob.load(t) if n else None
             b_d = prob.data_vector(t) if data else None
+            u_l = edges.lifting(t) if data else None      # on every rank: a bad `gap` stops them all
         except InputError as err:
             raise InputError(f"step {n} (t = {t:.6g}): {err}") from None
         c_d = prob.data_norm(t) if data else 0.0
         if root:
-            u_l = edges.lifting(t) if data else None
             if n == 0:
                 u, info = edges.interpolate(scene.u0, t), None
             else:

@@ -40,11 +40,10 @@ def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
     for n, t in enumerate(times):
         tic = time.perf_counter()
         if n > 0:
-            try:
-                load_t = load(t)
+            try:                                    # a load or data expression not finite at step n
+                u = _step(stepper, disc, K, load(t), u, lifting, t, res, n)
             except InputError as err:
                 raise InputError(f"step {n} (t = {t:.6g}): {err}") from None
-            u = _step(stepper, disc, K, load_t, u, lifting, t, res, n)
         res["u"][n] = u.reshape(-1, 2)
         res["slip"][n] = np.sum(u.reshape(-1, 2)[disc.contact] * disc.tangent, axis=1)
         if n == 0:
