@@ -3,6 +3,7 @@ the Gmsh reader with red refinement."""
 import os
 
 import numpy as np
+import pytest
 
 from tresca_py.common import CASES
 from tresca_py.mesh import build_mesh, match_points, structured_mesh
@@ -48,3 +49,24 @@ def test_the_system_shall_match_points_between_numberings_and_refuse_strangers()
         assert "no partner" in str(err)
     else:
         raise AssertionError("a point without partner was matched")
+
+
+@pytest.mark.parametrize("case", ["trapezoid", "mms_rotated", "mms_data_front"])
+def test_the_system_shall_build_the_same_edge_data_in_both_python_re_implementations(case):
+    """skfem_cr.cr.Discretisation and dolfinx_cr.edges.CrEdges are written independently: the same edges (by
+    midpoint), boundary parts, Γ_C normals, tangents and ḡ_e, and the same CR interpolant and lifting."""
+    from tresca_py.dolfinx_cr.edges import CrEdges
+    sc = load_scene(os.path.join(CASES, f"{case}.toml"))
+    a, b = Discretisation(sc), CrEdges(sc)
+    k = match_points(a.midpoints, b.midpoints)             # b's edge i is a's edge k[i]
+    assert np.array_equal(np.sort(a.edges[k], axis=1), np.sort(b.edges, axis=1))
+    assert np.array_equal(a.part_of_edge[k], b.part_of_edge)
+    assert np.array_equal(np.sort(k[b.contact]), np.sort(a.contact))
+    kc = match_points(a.midpoints[a.contact], b.midpoints[b.contact])
+    for name in ("normal", "tangent", "gbar", "weight"):
+        assert np.allclose(getattr(a, name)[kc], getattr(b, name), rtol=0, atol=1e-14), name
+    ua, ub = a.interpolate(sc.u0, 0.0).reshape(-1, 2), b.interpolate(sc.u0, 0.0).reshape(-1, 2)
+    assert np.allclose(ua[k], ub, rtol=0, atol=1e-14)
+    Pa, _ = a.reduction()
+    Pb, _ = b.reduction()
+    assert Pa.shape == Pb.shape

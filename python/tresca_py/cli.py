@@ -53,11 +53,11 @@ def output_path(args, scene):
     return paths.output_file(out, "results file")
 
 
-def open_scene(args, report=True):
-    """Scene, its discretisation and the checked output path; bad input exits with one error line."""
-    from tresca_py.skfem_cr.cr import Discretisation
+def open_scene(args, discretise, report=True):
+    """Scene, the solver's own discretisation ``discretise(scene)`` and the checked output path; bad input exits
+    with one error line."""
     with exit_on_failure(report):
         scene = load_scene(args.scene, refine=args.refine, steps=args.steps)
         out = output_path(args, scene)
-        disc = Discretisation(scene)
+        disc = discretise(scene)
     return scene, disc, out

@@ -25,7 +25,7 @@ _SCHEMA = {
     "title": None,
     "mesh": {"corners", "cells", "diagonal", "refine", "file"},
     "material": {"E", "nu"},
-    "boundary": {"name", "kind", "traction", "g_a"},
+    "boundary": {"name", "kind", "traction", "g_a", "u", "gap"},
     "loads": {"f"},
     "initial": {"u0"},
     "time": {"T", "steps", "times"},
@@ -44,6 +44,13 @@ class Boundary:
     kind: str                    # "dirichlet" | "neumann" | "contact"
     traction: VecExpr | None = None
     g_a: Expr | None = None
+    u: VecExpr | None = None     # Dirichlet data u_D(x, y, t); None: clamped (absent or the constant 0)
+    gap: Expr | None = None      # imposed normal displacement g_n(x, y, t) on Γ_C; None: g_n = 0
+
+    @property
+    def has_data(self):
+        """True if the part imposes nonzero boundary data (u_D or g_n)."""
+        return self.u is not None or self.gap is not None
 
 
 @dataclass
@@ -63,6 +70,11 @@ class Scene:
     exact_u: VecExpr | None = None
     exact_grad: list | None = None       # [[Expr, Expr], [Expr, Expr]]
     output: str | None = None
+
+    @property
+    def has_boundary_data(self):
+        """True if a part imposes nonzero boundary data (docs/scene.md: `u`, `gap`)."""
+        return any(b.has_data for b in self.boundaries)
 
     @property
     def lam(self):
@@ -180,7 +192,19 @@ def _read_boundaries(doc):
             raise SceneError(f"[{where}] ('{name}') 'traction' is only allowed for kind = \"neumann\"")
         if "g_a" in b and kind != "contact":
             raise SceneError(f"[{where}] ('{name}') 'g_a' is only allowed for kind = \"contact\"")
+        if "u" in b and kind != "dirichlet":
+            raise SceneError(f"[{where}] ('{name}') 'u' is only allowed for kind = \"dirichlet\"")
+        if "gap" in b and kind != "contact":
+            raise SceneError(f"[{where}] ('{name}') 'gap' is only allowed for kind = \"contact\"")
         bd = Boundary(name, kind)
+        if kind == "dirichlet" and "u" in b:
+            u = VecExpr(b["u"], f"boundary '{name}' u")
+            bd.u = None if u.is_zero else u
+        if kind == "contact" and "gap" in b:
+            if not isinstance(b["gap"], str):
+                raise SceneError(f"[{where}] ('{name}') 'gap' must be one expression string, got {b['gap']!r}")
+            gap = Expr(b["gap"], f"boundary '{name}' gap")
+            bd.gap = None if gap.is_zero else gap
         if kind == "neumann":
             bd.traction = VecExpr(b.get("traction", ["0", "0"]), f"boundary '{name}' traction")
         if kind == "contact":

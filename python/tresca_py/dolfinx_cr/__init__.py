@@ -1,15 +1,16 @@
 """The DOLFINx 0.11 re-implementation of tresca-cr's discrete problem.
 
-Independent of the Rust crate and of the scikit-fem re-implementation's assembly and solvers. Modules:
-``forms`` (sympy -> UFL, the load and error forms), ``assemble`` (distributed assembly gathered to rank 0),
-``friction`` (K_r by MUMPS Cholesky, each step's dual friction problem by PETSc TAO TRON), ``main``
+Independent of the Rust crate and of the scikit-fem re-implementation (it imports nothing from it). Modules:
+``edges`` (its own edge table, boundary parts, Γ_C data, CR interpolant, lifting of the boundary data and the
+reduction u = P r), ``forms`` (sympy -> UFL, the load, data and error forms), ``assemble`` (distributed assembly
+gathered to rank 0), ``friction`` (K_r by MUMPS Cholesky, each step's dual friction problem by PETSc TAO TRON),
+``stepping`` (backward Euler with the boundary data, the stick/slip rule, the results file), ``main``
 (scripts/dolfinx_solve.py), ``distributed`` (scripts/dolfinx_distributed.py).
 
-What it still shares with the scikit-fem re-implementation: the scene reading (``tresca_py.scene``/``expr``),
-the meshes (``tresca_py.mesh``), the canonical edge numbering with the boundary and contact data, the CR
-interpolant of u0 and the reduction u = P r (``tresca_py.skfem_cr.cr.Discretisation``), the backward-Euler
-loop with the stick/slip rule and the results writer (``tresca_py.skfem_cr.stepping``). It shares nothing
-with the Rust solver but the scene format.  The discrete problem (README, Problem 2 of
+What it shares with the scikit-fem re-implementation is the scene format and its reading
+(``tresca_py.scene``/``expr``/``scene_data``), the meshes (``tresca_py.mesh``), the quadrature constants, the
+results schema (``tresca_py.results``) and the command line (``tresca_py.cli``); verification/README.md lists it.
+It shares nothing with the Rust solver but the scene format.  The discrete problem (README, Problem 2 of
 Porwal & Wadhawan), written in UFL with the vector CR element ("CR", 1, (2,)):
 
     a_h(u, v) = int sigma(u):eps(v) dx

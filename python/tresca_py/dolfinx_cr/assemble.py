@@ -1,5 +1,5 @@
-"""Distributed assembly of a_h, its jump part, loads and true errors with DOLFINx, gathered to rank 0 in
-the canonical edge ordering of ``tresca_py.skfem_cr.cr.Discretisation`` (edges matched by midpoints)."""
+"""Distributed assembly of a_h, its jump part, loads, the boundary data's forms and true errors with DOLFINx,
+gathered to rank 0 in the edge ordering of ``tresca_py.dolfinx_cr.edges.CrEdges`` (edges matched by midpoints)."""
 import dolfinx_solver  # noqa: F401  (loads libmpi for the wheel; must precede dolfinx)
 import basix.ufl
 import numpy as np
@@ -9,17 +9,17 @@ from dolfinx import fem
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
-from tresca_py.dolfinx_cr.forms import error_forms, load_form
+from tresca_py.dolfinx_cr.edges import CrEdges
+from tresca_py.dolfinx_cr.forms import data_forms, error_forms, load_form
 from tresca_py.errors import InputError
 from tresca_py.mesh import match_points
 from tresca_py.scene import check_loads
-from tresca_py.skfem_cr.cr import Discretisation
 
 
 class DolfinxProblem:
     """Distributed assembly of a_h, its jump part, loads and true errors (canonical ordering on rank 0)."""
 
-    def __init__(self, disc: Discretisation, comm):
+    def __init__(self, disc: CrEdges, comm):
         self.disc, self.comm = disc, comm
         scene = disc.scene
         rank = comm.rank
@@ -77,11 +77,16 @@ class DolfinxProblem:
         self.t = fem.Constant(msh, 0.0)
         self.L = load_form(scene, msh, v, ds, self.t)
 
+        # boundary data: b_D(t; v) and c(t) on the Dirichlet parts with `u` (tresca_py.dolfinx_cr.stepping)
+        with_u = tuple(i + 1 for i, b in enumerate(scene.boundaries) if b.kind == "dirichlet" and b.u is not None)
+        self.b_d, self.c_d = data_forms(scene, msh, v, ds, self.t, pen, with_u) if with_u else (None, None)
+
         # true errors
         self.err_forms = None
         if scene.exact_u is not None:
             self.uh = fem.Function(V)
-            self.err_forms = error_forms(scene, self.uh, self.t, (lam, mu, rho, pen), h, dS2, ds, ids["dirichlet"])
+            self.err_forms = error_forms(scene, self.uh, self.t, (lam, mu, rho, pen), h, dS2, ds, ids["dirichlet"],
+                                         data=scene.has_boundary_data)
 
     def _gather_matrix(self, form):
         A = fem.assemble_matrix(form)             # not finalised: ghost rows hold partial sums
@@ -100,12 +105,27 @@ class DolfinxProblem:
         return sp.csr_matrix((d, (r, c)), shape=(n, n))
 
     def load(self, t):
+        """(l(t), ·) on rank 0 (collective)."""
+        return self._gather_vector(self.L, t)
+
+    def data_vector(self, t):
+        """b_D(t; ·) on rank 0 (collective; zero without Dirichlet data)."""
+        return self._gather_vector(self.b_d, t)
+
+    def data_norm(self, t):
+        """c(t) = Σ_{Γ_D} (2ρμ/h_e) ∫_e |u_D(t)|² (collective)."""
+        if self.c_d is None:
+            return 0.0
         self.t.value = t
-        if self.L is None:
+        return float(self.comm.allreduce(fem.assemble_scalar(self.c_d), op=MPI.SUM))
+
+    def _gather_vector(self, form, t):
+        self.t.value = t
+        if form is None:
             vals = np.zeros(0)
             idx = np.zeros(0, dtype=np.int64)
         else:
-            b = fem.assemble_vector(self.L)       # owned + ghost entries, ghosts not accumulated
+            b = fem.assemble_vector(form)         # owned + ghost entries, ghosts not accumulated
             vals, idx = b.array.copy(), self.canon
         if self.comm.allreduce(not np.all(np.isfinite(vals)), op=MPI.LOR):
             self._name_nonfinite_load(t)
@@ -123,6 +143,7 @@ class DolfinxProblem:
         disc = self.disc
         p = disc.points
         check_loads(disc.scene, t, p[disc.triangles], {name: p[disc.edges[e]] for name, e in disc.neumann.items()})
+        disc.lifting(t)                       # names a `u` data expression that is not finite
         raise InputError(f"the load vector at t = {t:.6g} is not finite (NaN or Inf)")
 
     def errors(self, t, u_canon):

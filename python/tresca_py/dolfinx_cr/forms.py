@@ -71,10 +71,11 @@ def dunavant_dx(msh):
         "quadrature_weights": DUNAVANT_REF_W.copy()})
 
 
-def error_forms(scene, uh, t, params, h, dS2, ds, dirichlet):
+def error_forms(scene, uh, t, params, h, dS2, ds, dirichlet, data=False):
     """Compiled forms of the squared true errors of uh against the scene's exact solution: energy (with
-    the jump terms on interior edges and on the Dirichlet part `dirichlet`, 2-point Gauss), H1 seminorm
-    and L2, by the Dunavant rule. params = (lambda, mu, rho, 2 rho mu / h penalty on Gamma_D)."""
+    the jump terms on interior edges and on the Dirichlet part `dirichlet`, 2-point Gauss; with boundary
+    data, `data`, the jump of the error on Γ_D is uh − u), H1 seminorm and L2, by the Dunavant rule.
+    params = (lambda, mu, rho, 2 rho mu / h penalty on Gamma_D)."""
     lam, mu, rho, pen = params
     msh = uh.function_space.mesh
     X, dx4 = ufl.SpatialCoordinate(msh), dunavant_dx(msh)
@@ -86,7 +87,8 @@ def error_forms(scene, uh, t, params, h, dS2, ds, dirichlet):
     # jump part of the energy error as an integral of squares (no cancellation)
     el = el + 2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(uh), ufl.jump(uh)) * dS2
     if dirichlet:
-        el = el + pen * ufl.inner(uh, uh) * ds(dirichlet, metadata={"quadrature_degree": 3})
+        jd = uh - ue if data else uh
+        el = el + pen * ufl.inner(jd, jd) * ds(dirichlet, metadata={"quadrature_degree": 3})
     return [fem.form(el), fem.form(ufl.inner(G, G) * dx4), fem.form(ufl.inner(ue - uh, ue - uh) * dx4)]
 
 
@@ -103,3 +105,16 @@ def load_form(scene, msh, v, ds, t):
             term = ufl.inner(vec_to_ufl(b.traction, X, t), v) * ds(i + 1, metadata={"quadrature_degree": 5})
             L = term if L is None else L + term
     return None if L is None else fem.form(L)
+
+
+def data_forms(scene, msh, v, ds, t, pen, parts):
+    """The boundary data's forms on the Dirichlet parts ``parts`` (measure ids) with `u`, by 3-point Gauss
+    (degree 5): b_D(t; v) = Σ (2ρμ/h_e) ∫_e u_D·v and c(t) = Σ (2ρμ/h_e) ∫_e |u_D|², ``pen`` = 2ρμ/h_e."""
+    X = ufl.SpatialCoordinate(msh)
+    b = c = None
+    for i in parts:
+        ud = vec_to_ufl(scene.boundaries[i - 1].u, X, t)
+        dsi = ds(i, metadata={"quadrature_degree": 5})
+        b = pen * ufl.inner(ud, v) * dsi if b is None else b + pen * ufl.inner(ud, v) * dsi
+        c = pen * ufl.inner(ud, ud) * dsi if c is None else c + pen * ufl.inner(ud, ud) * dsi
+    return fem.form(b), fem.form(c)

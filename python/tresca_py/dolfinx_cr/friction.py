@@ -1,7 +1,7 @@
 """The dolfinx re-implementation's own step solver, with PETSc throughout (independent of the scikit-fem one's
 SuperLU factorisation and primal active-set method).
 
-With u = P r (``Discretisation.reduction``: two unknowns per free edge, one tangential unknown s_e per contact
+With u = P r (``CrEdges.reduction``: two unknowns per free edge, one tangential unknown s_e per contact
 edge) and K_r = P^T K P, backward-Euler step n is the dual problem
 
     min_mu  1/2 mu^T C mu - mu^T d   subject to  |mu_e| <= w_e,

@@ -1,14 +1,16 @@
 """The scikit-fem re-implementation of tresca-cr's discrete problem (independent of the Rust crate).
 
 Modules: ``cr`` (edges, boundary parts, contact data, CR interpolant, reduction), ``assemble`` (a_h, its
-jump part, loads and true errors with scikit-fem), ``friction`` (the exact per-step friction solver),
-``stepping`` (backward Euler and the results file), ``main`` (the command line, scripts/skfem_solve.py).
+jump part, loads and true errors with scikit-fem), ``lifting`` (boundary data u_D and g_n: u = w + u_L),
+``friction`` (the exact per-step friction solver), ``stepping`` (backward Euler and the results file), ``main``
+(the command line, scripts/skfem_solve.py). It imports nothing from the dolfinx re-implementation.
 
 The mathematics
 ---------------
 Unknowns are CR vector fields, one 2-vector per edge midpoint m_e, stored in the *canonical*
 ordering ``2*e + c`` (edge e of ``Discretisation.edges``, component c). Dirichlet edges carry zero.
 A contact edge e with outward normal n_e and tangent tau_e = (-n_y, n_x) carries u(m_e) = s_e tau_e.
+(With boundary data these describe w; the displacement written is u = w + u_L, ``lifting``.)
 The reduced space is parametrised by ``u = P r`` where r holds two numbers per free edge and one
 number s_e per contact edge (listed last).  A framework script assembles, in the canonical ordering,
 

@@ -117,10 +117,12 @@ class SkfemProblem:
         d = scene.exact_u(X, Y, t) - uh.value
         l2 = d[0] ** 2 + d[1] ** 2
         dx = self.basis.dx                                  # quadrature weights * |det DF|
-        return float(np.sum(el * dx)) + self.jump_energy(u_canon), float(np.sum(h1 * dx)), float(np.sum(l2 * dx))
+        jump = self.jump_energy(u_canon, t if scene.has_boundary_data else None)
+        return float(np.sum(el * dx)) + jump, float(np.sum(h1 * dx)), float(np.sum(l2 * dx))
 
-    def jump_energy(self, u_canon):
-        """sum_{e interior or Dirichlet} (2 rho mu / h_e) int_e |[u_h]|^2 as a sum of squares (no cancellation)."""
+    def jump_energy(self, u_canon, t=None):
+        """sum_{e interior or Dirichlet} (2 rho mu / h_e) int_e |[u_h]|^2 as a sum of squares (no cancellation);
+        with a time t (a scene with boundary data) the jump of the error on a Dirichlet edge is u_h - u(t)."""
         scene = self.disc.scene
         usk = u_canon[self.canon]
         pen = lambda fb: 2.0 * scene.rho * self.mu / self.disc.lengths[self.edge_of_facet[fb.find]][:, None]  # noqa: E731
@@ -128,5 +130,8 @@ class SkfemProblem:
         out = np.sum(np.sum(d ** 2, axis=0) * pen(self.fbs[0]) * self.fbs[0].dx)
         if self.fb_d is not None:
             d = self.fb_d.interpolate(usk).value
+            if t is not None:
+                xd = self.fb_d.global_coordinates()
+                d = d - scene.exact_u(xd[0], xd[1], t)
             out += np.sum(np.sum(d ** 2, axis=0) * pen(self.fb_d) * self.fb_d.dx)
         return float(out)

@@ -10,6 +10,7 @@ from tresca_py.expr import VecExpr
 from tresca_py.mesh import Mesh, build_mesh
 from tresca_py.quadrature import GAUSS3_S, GAUSS3_W
 from tresca_py.scene import Scene, SceneError
+from tresca_py.scene_data import check_boundary_data
 
 
 class Discretisation:
@@ -28,6 +29,8 @@ class Discretisation:
         self._edges()
         self._parts(mesh)
         self._contact_data()
+        b = np.flatnonzero(self.is_boundary)
+        check_boundary_data(scene, self.points, self.edges[b], self.part_of_edge[b])
 
     def _edges(self):
         """Edges (boundary ones counter-clockwise), their triangles, midpoints and lengths."""

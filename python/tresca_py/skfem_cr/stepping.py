@@ -11,80 +11,73 @@ from tresca_py.skfem_cr.cr import Discretisation
 from tresca_py.skfem_cr.friction import StepSolver, classify
 
 
-def run(disc: Discretisation, K, J, load, errors=None, comm=None, log=True, step_solver=StepSolver):
-    """Backward Euler over ``scene.times``; ``step_solver(disc, K)`` solves the steps (its ``step(l, u_prev)``
-    as ``friction.StepSolver``'s; the dolfinx re-implementation passes its own).
+def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
+    """Backward Euler over ``scene.times`` with the exact friction step (``friction.StepSolver``); returns the
+    results dict.
 
-    ``K``: canonical sparse a_h (only needed on rank 0); ``J`` (its jump part) is unused here.
-    ``load(t)``: collective; canonical load vector on rank 0 (anything elsewhere).
-    ``errors(t, u)``: collective, ``u`` canonical on every rank; returns (energy error^2, h1^2, l2^2)
-    on rank 0, the energy error including the jump terms (2 rho mu/h_e) int_e |[u_h]|^2 computed by the
+    ``K``: canonical sparse a_h. ``load(t)``: the canonical load vector. ``errors(t, u)``: (energy error^2,
+    h1^2, l2^2), the energy error including the jump terms (2 rho mu/h_e) int_e |[u_h]|^2 computed by the
     framework as an integral of squares (u^T J u would lose sqrt(eps) accuracy when the jumps vanish).
-    Returns the results dict on rank 0, None elsewhere.
+    ``lifting``: the boundary data's ``SkfemLifting`` (None without data): u = w + u_L, w solving the step with
+    the load lⁿ + b_D(tₙ) − K u_Lⁿ (``tresca_py.skfem_cr.lifting``).
     """
-    rank = 0 if comm is None else comm.rank
     scene = disc.scene
     times = scene.times
     N = len(times) - 1
     C = len(disc.contact)
-    root = rank == 0
-    if root:
-        t0 = time.perf_counter()
-        stepper = step_solver(disc, K)
-        t_fact = time.perf_counter() - t0
-        E2 = disc.n_dofs
-        res = dict(u=np.zeros((N + 1, E2 // 2, 2)), slip=np.zeros((N + 1, C)), mu=np.zeros((N + 1, C)),
-                   dof=np.zeros((N + 1, C)),
-                   sigma_t=np.zeros((N + 1, C)), state=np.zeros((N + 1, C), dtype=np.int8),
-                   iterations=np.zeros(N + 1, dtype=np.int64), residual=np.zeros(N + 1),
-                   n_stick=np.zeros(N + 1, dtype=np.int64), n_slip=np.zeros(N + 1, dtype=np.int64),
-                   wall_time=np.zeros(N + 1), energy=np.zeros(N + 1), factor_time=t_fact)
-        if scene.exact_u is not None:
-            res["errors"] = {k: np.zeros(N + 1) for k in ("energy", "h1", "l2")}
-        u = disc.interpolate(scene.u0, times[0])
-    else:
-        u = None
+    t0 = time.perf_counter()
+    stepper = StepSolver(disc, K)
+    res = dict(u=np.zeros((N + 1, len(disc.edges), 2)), slip=np.zeros((N + 1, C)), mu=np.zeros((N + 1, C)),
+               dof=np.zeros((N + 1, C)), sigma_t=np.zeros((N + 1, C)), state=np.zeros((N + 1, C), dtype=np.int8),
+               iterations=np.zeros(N + 1, dtype=np.int64), residual=np.zeros(N + 1),
+               n_stick=np.zeros(N + 1, dtype=np.int64), n_slip=np.zeros(N + 1, dtype=np.int64),
+               wall_time=np.zeros(N + 1), energy=np.zeros(N + 1), factor_time=time.perf_counter() - t0)
+    if errors is not None:
+        res["errors"] = {k: np.zeros(N + 1) for k in ("energy", "h1", "l2")}
+    u = disc.interpolate(scene.u0, times[0])
+    if lifting is not None:
+        u = u + lifting.lift(times[0])
     for n, t in enumerate(times):
         tic = time.perf_counter()
         if n > 0:
-            try:
-                load_t = load(t)
+            try:                                    # a load or data expression not finite at step n
+                u = _step(stepper, disc, K, load(t), u, lifting, t, res, n)
             except InputError as err:
                 raise InputError(f"step {n} (t = {t:.6g}): {err}") from None
-            if root:
-                u_prev = u
-                u, info = stepper.step(load_t, u_prev)
-                mu = info["mu"]
-                slip = classify(mu, info["ds"], info["d"], disc.weight)
-                res["sigma_t"][n] = -mu / disc.lengths[disc.contact]
-                res["mu"][n] = mu
-                res["dof"][n] = info["dof"]
-                res["state"][n] = slip
-                res["iterations"][n] = info["iterations"]
-                res["residual"][n] = info["residual"]
-        if root:
-            res["u"][n] = u.reshape(-1, 2)
-            res["slip"][n] = np.sum(u.reshape(-1, 2)[disc.contact] * disc.tangent, axis=1)
-            if n == 0:
-                res["dof"][n] = res["slip"][n]          # u^0 = I_CR u0 holds s_e tau_e on contact edges
-            res["n_slip"][n] = int(res["state"][n].sum())
-            res["n_stick"][n] = C - res["n_slip"][n]
-            res["energy"][n] = float(u @ (K @ u))
-        if scene.exact_u is not None and errors is not None:
-            ub = u if comm is None else comm.bcast(u, root=0)
-            e = errors(t, ub)
-            if root:
-                el, h1, l2 = e
-                res["errors"]["energy"][n] = math.sqrt(max(el, 0.0))
-                res["errors"]["h1"][n] = math.sqrt(max(h1, 0.0))
-                res["errors"]["l2"][n] = math.sqrt(max(l2, 0.0))
-        if root:
-            res["wall_time"][n] = time.perf_counter() - tic
-            if log and (n == N or (N >= 10 and n % max(1, N // 10) == 0)):
-                extra = f" err_E={res['errors']['energy'][n]:.4e}" if "errors" in res else ""
-                print(f"step {n:5d}/{N} t={t:.6g} iters={res['iterations'][n]} "
-                      f"slip={res['n_slip'][n]}/{C} a_h(u,u)={res['energy'][n]:.6e}{extra}", flush=True)
-    return res if root else None
+        res["u"][n] = u.reshape(-1, 2)
+        res["slip"][n] = np.sum(u.reshape(-1, 2)[disc.contact] * disc.tangent, axis=1)
+        if n == 0:
+            res["dof"][n] = res["slip"][n]          # u^0 = I_CR u0 holds s_e tau_e on contact edges
+        res["n_slip"][n] = int(res["state"][n].sum())
+        res["n_stick"][n] = C - res["n_slip"][n]
+        res["energy"][n] = float(u @ (K @ u)) if lifting is None else lifting.energy(K, u, t)
+        if errors is not None:
+            for key, e2 in zip(("energy", "h1", "l2"), errors(t, u), strict=True):
+                res["errors"][key][n] = math.sqrt(max(e2, 0.0))
+        res["wall_time"][n] = time.perf_counter() - tic
+        if log and (n == N or (N >= 10 and n % max(1, N // 10) == 0)):
+            extra = f" err_E={res['errors']['energy'][n]:.4e}" if "errors" in res else ""
+            print(f"step {n:5d}/{N} t={t:.6g} iters={res['iterations'][n]} "
+                  f"slip={res['n_slip'][n]}/{C} a_h(u,u)={res['energy'][n]:.6e}{extra}", flush=True)
+    return res
+
+
+def _step(stepper, disc, K, load_t, u_prev, lifting, t, res, n):
+    """Step n: the friction step (on w = u − u_L with data), its contact data stored in ``res``; returns uⁿ."""
+    if lifting is None:
+        u, info = stepper.step(load_t, u_prev)
+    else:
+        u_l = lifting.lift(t)
+        w, info = stepper.step(load_t + lifting.rhs(t) - K @ u_l, u_prev)
+        u = w + u_l
+    mu = info["mu"]
+    res["sigma_t"][n] = -mu / disc.lengths[disc.contact]
+    res["mu"][n] = mu
+    res["dof"][n] = info["dof"]
+    res["state"][n] = classify(mu, info["ds"], info["d"], disc.weight)
+    res["iterations"][n] = info["iterations"]
+    res["residual"][n] = info["residual"]
+    return u
 
 
 # ----------------------------------------------------------------------------------------------

@@ -184,8 +184,9 @@ def cond_K(st, scene_path, refine):
     """Condition number of the reduced stabilised CR stiffness (scikit-fem assembly of the same a_h)."""
     from tresca_py import cli as ts
     from tresca_py.skfem_cr.assemble import SkfemProblem
+    from tresca_py.skfem_cr.cr import Discretisation
     args = ts.cli("cond", [scene_path, "-o", os.path.join(st.tmp, "c.h5"), "--refine", str(refine), "-q"])
-    scene, disc, _ = ts.open_scene(args)
+    scene, disc, _ = ts.open_scene(args, Discretisation)
     K = SkfemProblem(disc).K
     free = np.ones(len(disc.edges), bool)
     free[disc.dirichlet] = False

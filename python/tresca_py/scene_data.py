@@ -1,0 +1,107 @@
+"""Boundary data that do not fit together are refused before anything is solved (as the Rust solver's
+``src/fem/lifting/consistency.rs``; docs/scene.md, keys ``u`` and ``gap``):
+
+* u₀ must equal u_D(·, t₀) on every Dirichlet edge (u_D = 0 where a part gives none),
+* u₀·n must equal g_n(·, t₀) on every Γ_C edge (g_n = 0 where a part gives none),
+* at a vertex shared by two Dirichlet parts their data must agree, and at a vertex shared by a Dirichlet
+  and a contact part u_D·n_e = g_n (n_e the contact edge's outward normal), at every time node.
+
+Values are compared at the 3-point Gauss points of the edges and at the shared vertices. Tolerance: 1e-9 of
+the size of the data (the largest |u₀| at a mesh vertex or value compared): consistent data differ only by
+the rounding of their expressions (a few ulps), a real mismatch below 1e-9 of the data is far below what the
+discretisation resolves. Scenes without boundary data are not checked (u₀ is projected onto V_h there).
+
+Each solver calls ``check_boundary_data`` with its own boundary edges; this module only reads the scene.
+"""
+import numpy as np
+
+from tresca_py.quadrature import GAUSS3_S
+from tresca_py.scene import SceneError
+
+#: relative tolerance of the comparisons (module docstring)
+REL_TOL = 1e-9
+
+
+def _vec(u, x, y, t):
+    """u_D (or zero without data) at points x, y: shape (2, ...)."""
+    return np.zeros((2,) + np.shape(x)) if u is None else u(x, y, t)
+
+
+def _scal(g, x, y, t):
+    return np.zeros(np.shape(x)) if g is None else g(x, y, t)
+
+
+def _edge_rows(scene, a, b, part):
+    """(what, points (k, 2), first values, second values) of the u₀ comparisons on the boundary edges."""
+    t0 = scene.times[0]
+    rows = []
+    q = a[:, None, :] + GAUSS3_S[None, :, None] * (b - a)[:, None, :]          # (k, 3, 2)
+    d = (b - a) / np.hypot(*(b - a).T)[:, None]
+    normal = np.stack([d[:, 1], -d[:, 0]], 1)                                # outward: edges counter-clockwise
+    for ip, bd in enumerate(scene.boundaries):
+        sel = part == ip
+        if not np.any(sel) or bd.kind == "neumann" or (not bd.has_data and scene.u0.is_zero):
+            continue
+        x, y = q[sel, :, 0], q[sel, :, 1]
+        u0 = scene.u0(x, y, t0)
+        if bd.kind == "dirichlet":
+            ud = _vec(bd.u, x, y, t0)
+            for c in range(2):
+                rows.append((f"initial.u0[{c}] and part `{bd.name}`'s u[{c}] at t0 = {t0}", q[sel], u0[c], ud[c]))
+        else:
+            un = u0[0] * normal[sel, None, 0] + u0[1] * normal[sel, None, 1]
+            rows.append((f"initial.u0·n and part `{bd.name}`'s gap at t0 = {t0}", q[sel], un, _scal(bd.gap, x, y, t0)))
+    return rows, normal
+
+
+def _vertex_rows(scene, a_idx, b_idx, points, part, normal):
+    """The comparisons at vertices shared by two parts, one of them with data, at every time node."""
+    rows = []
+    at = {}
+    for e, (va, vb) in enumerate(zip(a_idx, b_idx, strict=True)):
+        for v in (int(va), int(vb)):
+            at.setdefault(v, []).append(e)
+    for v, edges in sorted(at.items()):
+        for i, ea in enumerate(edges):
+            for eb in edges[i + 1:]:
+                pa, pb = scene.boundaries[part[ea]], scene.boundaries[part[eb]]
+                if part[ea] == part[eb] or not (pa.has_data or pb.has_data):
+                    continue
+                if pa.kind == "contact" and pb.kind == "dirichlet":
+                    pa, pb, ea, eb = pb, pa, eb, ea
+                x = points[v]
+                what = f"parts `{pa.name}` and `{pb.name}` at their common vertex"
+                for t in scene.times:
+                    if pa.kind == pb.kind == "dirichlet":
+                        va, vb = _vec(pa.u, x[0], x[1], t), _vec(pb.u, x[0], x[1], t)
+                        rows += [(f"{what} (u[{c}], t = {t})", x[None, :], va[c], vb[c]) for c in range(2)]
+                    elif pa.kind == "dirichlet" and pb.kind == "contact":
+                        un = _vec(pa.u, x[0], x[1], t) @ normal[eb]
+                        rows.append((f"{what} (u·n against gap, t = {t})", x[None, :], un,
+                                     _scal(pb.gap, x[0], x[1], t)))
+    return rows
+
+
+def check_boundary_data(scene, points, boundary_edges, part):
+    """Raise ``SceneError`` naming the parts, the point and the two values where the boundary data of
+    ``scene`` do not fit together (module docstring). ``boundary_edges`` (k, 2): the vertex indices of every
+    boundary edge, counter-clockwise (the body on the left); ``part`` (k,): the index of its boundary part."""
+    if not scene.has_boundary_data:
+        return
+    points = np.asarray(points, dtype=float)
+    boundary_edges, part = np.asarray(boundary_edges), np.asarray(part)
+    a, b = points[boundary_edges[:, 0]], points[boundary_edges[:, 1]]
+    rows, normal = _edge_rows(scene, a, b, part)
+    rows += _vertex_rows(scene, boundary_edges[:, 0], boundary_edges[:, 1], points, part, normal)
+    u0 = scene.u0(points[:, 0], points[:, 1], scene.times[0])
+    scale = max([float(np.max(np.abs(u0), initial=0.0))]
+                + [max(float(np.max(np.abs(r[2]), initial=0.0)), float(np.max(np.abs(r[3]), initial=0.0)))
+                   for r in rows])
+    tol = REL_TOL * scale
+    for what, xy, va, vb in rows:
+        diff = np.abs(np.asarray(va) - np.asarray(vb)).reshape(-1)
+        if diff.size and np.max(diff) > tol:
+            k = int(np.argmax(diff > tol))
+            x = np.asarray(xy).reshape(-1, 2)[k]
+            raise SceneError(f"inconsistent boundary data: {what} differ at ({x[0]:.6f}, {x[1]:.6f}): "
+                             f"{np.ravel(va)[k]:e} against {np.ravel(vb)[k]:e} (tolerance {tol:.1e})")
