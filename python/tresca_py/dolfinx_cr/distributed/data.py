@@ -90,8 +90,9 @@ def _load_doc(path, text, doc, refine, steps):
 
 
 def boundary_data(scene):
-    """Per boundary part (scene order): (u_D as VecExpr or None, g_n as Expr or None); None when no part
-    gives data. InputError for a key on the wrong kind of part."""
+    """Per boundary part (scene order): (u_D as VecExpr or None, g_n as Expr or None; None when absent or the
+    constant 0, as src/scene/parts.rs); None when no part gives data. InputError for a key on the wrong kind
+    of part."""
     out, any_data = [], False
     for b, tab in zip(scene.boundaries, _tables(scene.text), strict=True):
         u = g = None
@@ -99,10 +100,14 @@ def boundary_data(scene):
             if b.kind != "dirichlet":
                 raise InputError(f"[boundary] ('{b.name}') 'u' is only allowed for kind = \"dirichlet\"")
             u = VecExpr(tab["u"], f"boundary '{b.name}' u")
+            u = None if u.is_zero else u                      # the constant 0 is no data (src/scene/parts.rs)
         if "gap" in tab:
             if b.kind != "contact":
                 raise InputError(f"[boundary] ('{b.name}') 'gap' is only allowed for kind = \"contact\"")
+            if not isinstance(tab["gap"], str):
+                raise InputError(f"[boundary] ('{b.name}') 'gap' must be one expression string, got {tab['gap']!r}")
             g = Expr(tab["gap"], f"boundary '{b.name}' gap")
+            g = None if g.is_zero else g
         any_data = any_data or u is not None or g is not None
         out.append((u, g))
     return out if any_data else None
