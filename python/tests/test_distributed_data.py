@@ -121,17 +121,20 @@ def scene_with(tmp_path, name, old, new):
 
 
 @pytest.mark.parametrize("ranks", [1, 2])
-@pytest.mark.parametrize("name, key, message", [
+@pytest.mark.parametrize("name, key, shift, message", [
     # u0's first component shifted by 0.01: contradicts u_D(t0) on the top side (u0·n on Γ_C is -u0[1]: unchanged)
-    ("mms_data_front", 'u0 = ["', "initial.u0[0] and part `top`'s u[0] at t0 = 0"),
+    ("mms_data_front", 'u0 = ["', "(1/100)+", "initial.u0[0] and part `top`'s u[0] at t0 = 0"),
     # the gap shifted by 0.01, u0 unchanged: u0·n contradicts it at t0
-    ("mms_data_stop", 'gap = "', "initial.u0·n and part `bottom`'s gap at t0 = 0"),
+    ("mms_data_stop", 'gap = "', "(1/100)+", "initial.u0·n and part `bottom`'s gap at t0 = 0"),
+    # the right side's u[0] shifted by t/100: fits u0 at t0 = 0, but not the top side's u[0] at their common
+    # vertex (1, 1) at the first step t = 0.5 (at (1, 0) only u[1] = -u·n meets the gap: unchanged)
+    ("mms_data_cep", 'name = "right"\nkind = "dirichlet"\nu = ["', "(t/100)+", "at their common vertex (u[0], t = 0.5)"),
 ])
-def test_refuses_inconsistent_data(tmp_path, ranks, name, key, message):
-    """The system shall refuse, on every rank, boundary data that contradict the initial value (u0 against u_D(t0)
-    on Γ_D, u0·n against the gap at t0 on Γ_C) with one error line naming them, exit status 2 and no results
-    file."""
-    scene = scene_with(tmp_path, name, key, key + "(1/100)+")
+def test_refuses_inconsistent_data(tmp_path, ranks, name, key, shift, message):
+    """The system shall refuse, on every rank, boundary data that do not fit together (u0 against u_D(t0) on Γ_D,
+    u0·n against the gap at t0 on Γ_C, two parts' data at their common vertex) with one error line naming them,
+    exit status 2 and no results file."""
+    scene = scene_with(tmp_path, name, key, key + shift)
     out = str(tmp_path / "out.h5")
     p = distributed(scene, out, ranks=ranks, steps=2)
     assert p.returncode == 2, p.stdout[-1000:] + p.stderr[-1000:]
@@ -146,3 +149,16 @@ def test_refuses_data_on_the_wrong_part(tmp_path):
     p = distributed(scene, str(tmp_path / "out.h5"), ranks=1)
     assert p.returncode == 2 and "Traceback" not in p.stderr, p.stderr
     assert "('top') 'gap' is only allowed for kind = \"contact\"" in p.stderr
+
+
+def test_names_data_that_cannot_be_evaluated(tmp_path):
+    """The system shall stop, on every rank, with one error line naming the step and the Dirichlet data expression
+    that cannot be evaluated there (1/(t - 0.5) at t = 0.5, consistent with u0 at t0 = 0), leaving no files."""
+    key = 'kind = "dirichlet"\nu = ["'
+    scene = scene_with(tmp_path, "mms_data_stop", key, key + "(1/(t-0.5)+2)+")
+    out = str(tmp_path / "out.h5")
+    p = distributed(scene, out)
+    assert p.returncode == 2 and "Traceback" not in p.stderr, p.stderr[-2000:]
+    lines = [ln for ln in p.stderr.splitlines() if ln.startswith("error:")]
+    assert len(lines) == 1 and lines[0].startswith("error: step 2 (t = 0.5): boundary 'top' u[0]: expression"), lines
+    assert sorted(os.listdir(tmp_path)) == ["mms_data_stop_edited.toml"]

@@ -9,8 +9,7 @@ the Rust solver applies them (src/fem/lifting.rs):
   (3-point Gauss): the jump stabilisation on Dirichlet edges is measured against u_D;
 * the energy written is Σ_T ∫σ(u):ε(u) + Σ_int (2ρμ/h_e)∫|[u]|² + Σ_D (2ρμ/h_e)∫|u − u_D|² (Rust's 2Eⁿ), and
   the energy error's jump on Γ_D is u_h − u (src/fem/norms.rs);
-* u₀ that contradicts u_D(t₀) on Γ_D, or whose normal part contradicts g_n(t₀) on Γ_C, is refused
-  (src/fem/lifting/consistency.rs: 3-point Gauss points, tolerance 1e-9 of the data's size).
+* data that do not fit together are refused (``consistency``).
 
 The keys are read from the scene's text here (``boundary_data``), so this module does not depend on how
 ``tresca_py.scene`` stores them; ``load`` reads a scene whose keys ``tresca_py.scene`` does not know yet
@@ -31,14 +30,12 @@ from tresca_py.errors import InputError
 from tresca_py.expr import Expr, VecExpr
 from tresca_py.quadrature import GAUSS3_S, GAUSS3_W
 
-# Consistency tolerance, relative to the size of the data (src/fem/lifting/consistency.rs): consistent data
-# differ by the rounding of their expressions only, a real mismatch below 1e-9 is far below the discretisation.
-CONSISTENCY_RTOL = 1e-9
 DATA_KEYS = ("u", "gap")
 
 
 def _tables(text):
-    return tomllib.loads(text).get("boundary", [])
+    tables = tomllib.loads(text).get("boundary", [])
+    return [b for b in tables if isinstance(b, dict)] if isinstance(tables, list) else []
 
 
 def load(path, refine=None, steps=None):
@@ -52,8 +49,7 @@ def load(path, refine=None, steps=None):
         tables = _tables(text)
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
         return scene_mod.load_scene(path, refine=refine, steps=steps)     # its error names the problem
-    if all(k in known for k in DATA_KEYS) or not any(k in b for b in tables if isinstance(b, dict)
-                                                     for k in DATA_KEYS):
+    if all(k in known for k in DATA_KEYS) or not any(k in b for b in tables for k in DATA_KEYS):
         return scene_mod.load_scene(path, refine=refine, steps=steps)
     doc = tomllib.loads(text)
     for b in doc.get("boundary", []):
@@ -66,12 +62,18 @@ def load(path, refine=None, steps=None):
 def _load_doc(path, text, doc, refine, steps):
     """``tresca_py.scene.load_scene`` on an already parsed document (its steps, in its order)."""
     sm = scene_mod
-    for key, val in doc.items():
-        allowed = sm._SCHEMA.get(key, set())
+    for key, val in doc.items():                 # the checks of tresca_py.scene._read_doc
         if key not in sm._SCHEMA:
             raise sm.SceneError(f"{path}: unknown top-level key '{key}' (allowed: {sorted(sm._SCHEMA)})")
-        for tab in (val if isinstance(val, list) else [val]):
-            bad = [k for k in tab if allowed is not None and k not in allowed] if isinstance(tab, dict) else []
+        allowed = sm._SCHEMA[key]
+        if allowed is None:
+            continue
+        if key == "boundary" and not isinstance(val, list):
+            raise sm.SceneError(f"{path}: 'boundary' must be an array of tables ([[boundary]])")
+        for tab in (val if key == "boundary" else [val]):
+            if not isinstance(tab, dict):
+                raise sm.SceneError(f"{path}: [{key}] must be a table")
+            bad = [k for k in tab if k not in allowed]
             if bad:
                 raise sm.SceneError(f"{path}: unknown key '{bad[0]}' in [{key}] (allowed: {sorted(allowed)})")
     mesh = sm._read_mesh(path, doc, refine)
@@ -79,7 +81,7 @@ def _load_doc(path, text, doc, refine, steps):
     bnds = sm._read_boundaries(doc)
     rho = sm._num(doc.get("discretisation", {}), "rho", "discretisation", default=10.0)
     if rho <= 0:
-        raise sm.SceneError("[discretisation] rho must be positive")
+        raise sm.SceneError("[discretisation] rho must be positive (without the jump term CR elasticity is singular)")
     solver = {"method": "ssn", "tol": 1e-12, "max_iter": 500, "uzawa_step": 0.0, **doc.get("solver", {})}
     exact_u, exact_grad = sm._read_exact(doc)
     return sm.Scene(path=str(path), text=text, title=str(doc.get("title", "")), mesh=mesh, E=float(E),
@@ -111,6 +113,19 @@ def boundary_data(scene):
         any_data = any_data or u is not None or g is not None
         out.append((u, g))
     return out if any_data else None
+
+
+def evaluate(expr, x, y, t):
+    """expr(x, y, t) (Expr, or VecExpr: leading axis 2); InputError naming the expression where it is not
+    finite, also where Python's float arithmetic raises instead (t enters as a float: 1/(t - 0.5) at 0.5)."""
+    comps = getattr(expr, "comps", None)
+    vals = []
+    for c in comps or [expr]:
+        try:
+            vals.append(c(x, y, t))
+        except ArithmeticError as e:
+            raise InputError(f"{c.key}: expression {c.text!r} cannot be evaluated at t = {float(t):.6g}: {e}") from None
+    return np.stack(vals) if comps is not None else vals[0]
 
 
 def gauss_points(a, b):
@@ -148,10 +163,10 @@ class Lifting:
         msg = None
         try:
             for blocks, q, u in zip(self.d_blocks, self.d_points, self.d_expr, strict=True):
-                m = u(q[..., 0], q[..., 1], t) @ GAUSS3_W                      # (2, k)
+                m = evaluate(u, q[..., 0], q[..., 1], t) @ GAUSS3_W            # (2, k)
                 arr[2 * blocks], arr[2 * blocks + 1] = m[0], m[1]
             for pos, q, g in zip(self.g_pos, self.g_points, self.g_expr, strict=True):
-                m = g(q[..., 0], q[..., 1], t) @ GAUSS3_W
+                m = evaluate(g, q[..., 0], q[..., 1], t) @ GAUSS3_W
                 blocks, n = self.prob.con_lb[pos], self.prob.normal[pos]
                 arr[2 * blocks], arr[2 * blocks + 1] = m * n[:, 0], m * n[:, 1]
         except InputError as e:
@@ -188,43 +203,3 @@ class Lifting:
     def energy(self):
         """Collective: the energy of u_h (prob.uh, the real displacement)."""
         return self.prob.comm.allreduce(fem.assemble_scalar(self.energy_form), op=MPI.SUM)
-
-    def check_initial(self, A, B, pb):
-        """Collective: Fail unless u₀ agrees with u_D(t₀) on every Dirichlet edge and u₀·n with g_n(t₀) on
-        every Γ_C edge (zero data where a part gives none), at the 3-point Gauss points."""
-        prob, scene = self.prob, self.prob.scene
-        t0 = float(scene.times[0])
-        cmp = []               # (what, points (k, 3, 2), values a (k, 3), values b (k, 3))
-        msg = None
-        try:
-            for ip, (b, (u, g)) in enumerate(zip(scene.boundaries, self.data, strict=True)):
-                if b.kind == "dirichlet":
-                    sel = prob.dir_lb[pb[prob.dir_lb] == ip]
-                    q = gauss_points(A[sel], B[sel])
-                    a = scene.u0(q[..., 0], q[..., 1], t0)
-                    d = u(q[..., 0], q[..., 1], t0) if u is not None else np.zeros_like(a)
-                    cmp += [(f"initial.u0[{c}] and part `{b.name}`'s u[{c}] at t0 = {t0}", q, a[c], d[c])
-                            for c in range(2)]
-                elif b.kind == "contact":
-                    pos = np.flatnonzero(pb[prob.con_lb] == ip)
-                    q = gauss_points(A[prob.con_lb[pos]], B[prob.con_lb[pos]])
-                    a = scene.u0(q[..., 0], q[..., 1], t0)
-                    an = a[0] * prob.normal[pos, 0, None] + a[1] * prob.normal[pos, 1, None]
-                    gv = g(q[..., 0], q[..., 1], t0) if g is not None else np.zeros_like(an)
-                    cmp.append((f"initial.u0·n and part `{b.name}`'s gap at t0 = {t0}", q, an, gv))
-            pts = prob.points
-            scale = float(np.max(np.abs(scene.u0(pts[:, 0], pts[:, 1], t0)), initial=0.0))
-        except InputError as e:
-            msg, scale = str(e), 0.0
-        agree(prob.comm, msg)
-        for _, _, a, d in cmp:
-            scale = max(scale, float(np.max(np.abs(a), initial=0.0)), float(np.max(np.abs(d), initial=0.0)))
-        tol = CONSISTENCY_RTOL * prob.comm.allreduce(scale, op=MPI.MAX)
-        for what, q, a, d in cmp:
-            bad = np.argwhere(np.abs(a - d) > tol)
-            if len(bad):
-                k, j = bad[0]
-                msg = (f"inconsistent boundary data: {what} differ at ({q[k, j, 0]:.6f}, {q[k, j, 1]:.6f}): "
-                       f"{a[k, j]:e} against {d[k, j]:e} (tolerance {tol:.1e})")
-                break
-        agree(prob.comm, msg)

@@ -17,6 +17,7 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from tresca_py.dolfinx_cr.distributed import consistency
 from tresca_py.dolfinx_cr.distributed.data import Lifting, boundary_data
 from tresca_py.dolfinx_cr.distributed.linear import condense, factorise_relaxed, petsc_lib
 from tresca_py.dolfinx_cr.distributed.mesh import Fail, agree, gmsh_mesh, structured_mesh
@@ -79,7 +80,7 @@ class Problem:
         data = boundary_data(scene)
         self.lift = Lifting(self, data, A, B, pb) if data is not None else None
         if self.lift is not None:
-            self.lift.check_initial(A, B, pb)
+            consistency.check(self, data, A, B, pb)
         self._initial_value(A, B)
         del A, B
         self.times_setup["mesh"] = time.perf_counter() - tic
