@@ -154,10 +154,13 @@ class Lifting:
                 self.g_points.append(gauss_points(A[prob.con_lb[pos]], B[prob.con_lb[pos]]))
                 self.g_expr.append(g)
         self.uL = fem.Function(prob.V)
+        self.t_set = None
 
     def set(self, t):
         """Collective: u_L at time t (edge means of the data; a value that is not finite stops every rank)."""
         self.prob.t.value = t
+        if self.t_set == t:                    # set already at this time (the step's load)
+            return
         arr = self.uL.x.array
         arr[:] = 0.0
         msg = None
@@ -173,6 +176,7 @@ class Lifting:
             msg = str(e)
         agree(self.prob.comm, msg)
         self.uL.x.scatter_forward()
+        self.t_set = t
 
     def compile(self, a_int, a_h, pen, ds):
         """The forms: rhs b_D − a_h(u_L, ·), the energy of u_h (module doc) and the Dirichlet jump of the energy
