@@ -3,7 +3,7 @@
     .venv/bin/python verification/distributed.py [--memory] [--bin target/release/tresca-cr]
                                                  [--json out/distributed.json] [--md reference/distributed.md]
 
-D1 (quick, < 3 min): every cross-check scene (verification/cases/*.toml and the generated expression
+D1 (quick, about 8 min on 2 cores): every cross-check scene (verification/cases/*.toml and the generated expression
 scenes of verification/cross_check.py) at its quick level, plus a Gmsh scene (verification/cases/lshape.msh,
 refine 1, contact on its floor), is solved by the Rust binary and by
 scripts/dolfinx_distributed.py under `mpirun -n 1`, `-n 2` and `-n 3` (3 is oversubscribed on 2 cores);
