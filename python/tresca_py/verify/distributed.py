@@ -5,7 +5,7 @@
 
 D1 (quick, about 8 min on 2 cores): every cross-check scene (verification/cases/*.toml and the generated expression
 scenes of verification/cross_check.py) at its quick level, plus a Gmsh scene (verification/cases/lshape.msh,
-refine 1, contact on its floor), is solved by the Rust binary and by
+refine 1, contact on its floor; once more with boundary data), is solved by the Rust binary and by
 scripts/dolfinx_distributed.py under `mpirun -n 1`, `-n 2` and `-n 3` (3 is oversubscribed on 2 cores);
 each distributed run is compared with the Rust run by scripts/compare.py: DOF vectors, energies, σ_τ and
 true errors within 1e-8 relative at every time node, identical stick/slip sets. The boundary-data scenes
@@ -84,6 +84,16 @@ steps = 8
 """
 
 
+def gmsh_data_scene(text):
+    """GMSH_SCENE with Dirichlet data on the clamp and an imposed normal displacement on the floor, consistent
+    at their common vertex (0, 0) (u·n = -u_y = gap) and with u0 = 0 at t0 = 0."""
+    out = text.replace('kind = "dirichlet"\n', 'kind = "dirichlet"\nu = ["0.001*t*y", "0.002*t*(1+x)"]\n')
+    out = out.replace('g_a = "0.001*(1+x)"', 'g_a = "0.001*(1+x)"\ngap = "-0.002*t*(1+x)"')
+    out = out.replace('on its floor (verification/distributed.py)', 'on its floor, boundary data (verification/distributed.py)')
+    assert out.count("gap =") == 1 and out.count("u = [") == 1, "GMSH_SCENE changed: update gmsh_data_scene"
+    return out
+
+
 def run(cmd, timeout=600):
     """tresca_py.common.run without raising: a hang (e.g. one rank waiting for a dead one) becomes a failed
     process after `timeout` s."""
@@ -120,6 +130,11 @@ def agreement(binary, work):
     with open(scenes["gmsh_lshape"], "w") as f:
         f.write(GMSH_SCENE.format(msh=case("lshape")[:-5] + ".msh"))
     plan["gmsh_lshape"] = ((1,), None)
+    # and the same Gmsh scene with boundary data (each rank lifts its owned edges of a distributed Gmsh mesh)
+    scenes["gmsh_lshape_data"] = os.path.join(work, "gmsh_lshape_data.toml")
+    with open(scenes["gmsh_lshape_data"], "w") as f:
+        f.write(gmsh_data_scene(GMSH_SCENE.format(msh=case("lshape")[:-5] + ".msh")))
+    plan["gmsh_lshape_data"] = ((1,), None)
     rows, commands = [], []
     for name, (levels, steps) in plan.items():
         k = levels[0]
