@@ -8,8 +8,8 @@ lets it run beyond one machine's memory). So rank 0 writes the layout itself, wi
 dtypes of ``tresca_py.results.SPEC`` and the attributes ``read`` requires (``status``, ``steps``,
 ``tresca/steps`` ``completed``, ``n_edges``, ``n_contact``), and the tests read its files with
 ``tresca_py.results.read``. Left out: ``tresca/steps/checksum`` (optional in the layout), which hashes
-whole steps of u that no rank holds, and the visualisation views (``/VTKHDF``, ``OUT.xdmf``) of the Rust
-solver; the displacement for ParaView is ``OUT_vtk/displacement.pvd`` (dolfinx's parallel VTKFile).
+whole steps of u that no rank holds, the energy audit and the visualisation views (``/VTKHDF``,
+``OUT.xdmf``) of the Rust solver; the displacement for ParaView is ``OUT_vtk/displacement.pvd`` (dolfinx's parallel VTKFile).
 """
 import os
 
