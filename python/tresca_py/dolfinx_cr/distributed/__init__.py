@@ -1,6 +1,7 @@
 """The distributed DOLFINx 0.11 + PETSc/MUMPS re-implementation (scripts/dolfinx_distributed.py).
 
-Modules: ``mesh`` (distributed meshes and boundary parts), ``problem`` (space, constraints, assembly,
+Modules: ``mesh`` (distributed meshes and boundary parts), ``problem`` (space, constraints, assembly),
+``data`` (boundary data ``u``/``gap``: the lifting), ``consistency`` (data that do not fit together refused),
 ``linear`` (factorisation and contact condensation), ``output`` (per-rank parts + virtual datasets), ``main``
 (the command line and the time loop).
 
@@ -28,14 +29,15 @@ Wadhawan), but nothing of size O(mesh) is held by one rank:
   n x n_c block exists.  (``--condense matsolve``: blocked multi-right-hand-side MatMatSolve instead,
   ``--rhs-block`` columns at a time; at 1.57M unknowns on 1 rank, blocks of 32: 76 s and +0.95 GB for C,
   against 10 s and no extra memory for the selected entries.)
-  Per step: u_f = K_r^{-1} l^n (distributed), d = E^T u_f - s^{n-1} gathered to rank 0 (n_c numbers),
+  Per step: u_f = K_r^{-1} l^n (distributed; with boundary data l^n + b_D - a_h(u_L, .), module ``data``), d = E^T u_f - s^{n-1} gathered to rank 0 (n_c numbers),
   the friction problem solved there by PETSc TAO TRON (``tresca_py.dolfinx_cr.friction.TaoBoxQP``),
-  mu broadcast, u^n = u_f - K_r^{-1} E mu (distributed).
+  mu broadcast, u^n = u_f - K_r^{-1} E mu (distributed); the displacement written is R u^n + u_L(t_n).
 * True errors are assembled distributed (the UFL forms of ``tresca_py.dolfinx_cr.forms``).
 * Output, without gathering the field: each rank writes its owned edges (points, triangles, edges,
   midpoints, u at every step) to ``OUT.h5.parts/rank<r>.h5`` with serial h5py; rank 0 writes ``OUT.h5``
   with the contact data, statistics and attributes and HDF5 *virtual datasets* that concatenate the
-  parts, so ``OUT.h5`` has the README ``/tresca`` layout (h5py, any HDF5 >= 1.10 reader, and
+  parts, so ``OUT.h5`` has the ``/tresca`` layout of ``tresca_py.results`` (``read`` accepts it; why not
+  ``results.write``: module ``output``) (h5py, any HDF5 >= 1.10 reader, and
   scripts/compare.py open it as one file; the parts must stay beside it).  The displacement as
   discontinuous P1 goes to ``OUT_vtk/displacement.pvd`` through dolfinx's parallel VTKFile
   (one .vtu piece per rank and frame + .pvtu/.pvd sidecars; read by ParaView and VTK's

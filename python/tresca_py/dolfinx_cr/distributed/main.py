@@ -12,12 +12,12 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
+from tresca_py.dolfinx_cr.distributed.data import load as load_scene
 from tresca_py.dolfinx_cr.distributed.mesh import Fail
 from tresca_py.dolfinx_cr.distributed.output import PartWriter, setup_time_attrs, write_main
 from tresca_py.dolfinx_cr.distributed.problem import Problem, peak_mb
 from tresca_py.cli import FAILURES, message, output_path
 from tresca_py.errors import InputError
-from tresca_py.scene import load_scene
 from tresca_py.dolfinx_cr.friction import TaoBoxQP, natural_residual
 from tresca_py.skfem_cr.friction import classify
 
@@ -189,8 +189,8 @@ def time_loop(prob, args, out, log):
             res["slip"][n] = friction.s_prev
             res["n_slip"][n] = int(res["state"][n].sum())
             res["n_stick"][n] = nc - res["n_slip"][n]
+        prob.to_function(prob.ur, t)
         en = prob.energy(prob.ur)
-        prob.to_function(prob.ur)
         writer.write(n, prob.uh.x.array[:2 * prob.nb_own])
         if prob.err_forms is not None:
             e = prob.errors(t)

@@ -1,10 +1,21 @@
 """Output of the distributed solver without gathering the field: each rank writes its owned edges to
-``OUT.h5.parts/rank<r>.h5``; rank 0 writes ``OUT.h5`` with the README /tresca layout, the big arrays as HDF5
-virtual datasets over the parts."""
+``OUT.h5.parts/rank<r>.h5``; rank 0 writes ``OUT.h5`` with the one ``/tresca`` layout of
+``tresca_py.results`` (docs/results.md), the big arrays as HDF5 virtual datasets over the parts.
+
+Why not ``tresca_py.results.write``: it takes the whole run in one process (mesh and u of every step as
+arrays) and writes them serially, and this route never gathers the mesh or u onto one rank (that is what
+lets it run beyond one machine's memory). So rank 0 writes the layout itself, with the dataset names and
+dtypes of ``tresca_py.results.SPEC`` and the attributes ``read`` requires (``status``, ``steps``,
+``tresca/steps`` ``completed``, ``n_edges``, ``n_contact``), and the tests read its files with
+``tresca_py.results.read``. Left out: ``tresca/steps/checksum`` (optional in the layout), which hashes
+whole steps of u that no rank holds, the energy audit and the visualisation views (``/VTKHDF``,
+``OUT.xdmf``) of the Rust solver; the displacement for ParaView is ``OUT_vtk/displacement.pvd`` (dolfinx's parallel VTKFile).
+"""
 import os
 
 import numpy as np
 
+from tresca_py.results import SPEC
 from tresca_py.skfem_cr.stepping import git_commit
 
 
@@ -78,28 +89,32 @@ def write_main(out, prob, res, writer_dirname, sizes, attrs):
             g.create_virtual_dataset(f"mesh/{name}" if name != "u" else "u", lay,
                                      fillvalue=np.nan if dtype == "f8" else -1)
 
-        vds("points", "points", (2,), "f8")
-        vds("triangles", "triangles", (3,), "i8")
-        vds("edges", "edges", (2,), "i8")
-        vds("midpoints", "edges", (2,), "f8")
-        vds("u", "edges", (2,), "f8", lead=(N1,))
-        g.create_dataset("times", data=scene.times)
-        g.create_dataset("energy", data=res["energy"])
-        g.create_dataset("contact/edges", data=prob.C_edges)
-        g.create_dataset("contact/normal", data=prob.C_normal.reshape(-1, 2))
-        g.create_dataset("contact/tangent", data=prob.C_tangent.reshape(-1, 2))
-        g.create_dataset("contact/g", data=prob.C_g)
-        for k in ("slip", "sigma_t", "mu", "state"):
-            g.create_dataset(f"contact/{k}", data=res[k])
-        g.create_dataset("contact/dof", data=res["slip"])
+        vds("points", "points", (2,), SPEC["mesh/points"][0])
+        vds("triangles", "triangles", (3,), SPEC["mesh/triangles"][0])
+        vds("edges", "edges", (2,), SPEC["mesh/edges"][0])
+        vds("midpoints", "edges", (2,), SPEC["mesh/midpoints"][0])
+        vds("u", "edges", (2,), SPEC["u"][0], lead=(N1,))
+
+        def put(name, a):
+            g.create_dataset(name, data=np.asarray(a, SPEC[name][0]))
+
+        put("times", scene.times)
+        put("energy", res["energy"])
         for k in ("iterations", "residual", "n_stick", "n_slip", "wall_time"):
-            g.create_dataset(f"steps/{k}", data=res[k])
+            put(f"steps/{k}", res[k])
+        g["steps"].attrs["completed"] = np.int64(N1)
+        if prob.n_c:                     # the layout has a contact group only when Γ_C has edges
+            for k, v in (("edges", prob.C_edges), ("normal", prob.C_normal.reshape(-1, 2)),
+                         ("tangent", prob.C_tangent.reshape(-1, 2)), ("g", prob.C_g), ("dof", res["slip"])):
+                put(f"contact/{k}", v)
+            for k in ("slip", "sigma_t", "mu", "state"):
+                put(f"contact/{k}", res[k])
         if "errors" in res:
             for k, v in res["errors"].items():
-                g.create_dataset(f"errors/{k}", data=v)
-        a = {"scene": scene.text, "scene_path": os.path.abspath(scene.path), "version": "python-distributed-1",
-             "git_commit": git_commit(), "solver": "dolfinx-distributed",
-             "method": "TAO TRON on the condensed dual (PETSc), rank 0",
+                put(f"errors/{k}", v)
+        a = {"scene": scene.text, "scene_path": os.path.abspath(scene.path), "title": scene.title,
+             "version": "python-distributed-1", "git_commit": git_commit(), "solver": "dolfinx-distributed",
+             "method": "TAO TRON on the condensed dual (PETSc), rank 0", "status": "completed",
              "tol": float(scene.solver.get("tol", 1e-12)), "rho": scene.rho, "E": scene.E, "nu": scene.nu,
              "refine": int(scene.mesh["refine"]), "steps": N1 - 1, "n_edges": prob.nb_glob,
              "n_contact": prob.n_c, "n_dofs": 2 * prob.nb_glob, "parts": rel}

@@ -17,6 +17,8 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from tresca_py.dolfinx_cr.distributed import consistency
+from tresca_py.dolfinx_cr.distributed.data import Lifting, boundary_data
 from tresca_py.dolfinx_cr.distributed.linear import condense, factorise_relaxed, petsc_lib
 from tresca_py.dolfinx_cr.distributed.mesh import Fail, agree, gmsh_mesh, structured_mesh
 from tresca_py.dolfinx_cr.forms import error_forms, load_form
@@ -75,6 +77,10 @@ class Problem:
         pb = part_of_facet[own]
         self._kinds(pb)
         self._contact(own, A, B, vx, f2v, c2v, pb)
+        data = boundary_data(scene)
+        self.lift = Lifting(self, data, A, B, pb) if data is not None else None
+        if self.lift is not None:
+            consistency.check(self, data, A, B, pb)
         self._initial_value(A, B)
         del A, B
         self.times_setup["mesh"] = time.perf_counter() - tic
@@ -228,9 +234,11 @@ class Problem:
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.ft)
         h = ufl.FacetArea(msh)
         pen = 2.0 * rho * mu / h
-        a_h = ufl.inner(sigma(u), eps(v)) * dx0 + 2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(u), ufl.jump(v)) * dS2
+        a_int = ufl.inner(sigma(u), eps(v)) * dx0 + 2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(u), ufl.jump(v)) * dS2
+        a_h = a_int
         if ids["dirichlet"]:
             a_h = a_h + pen * ufl.inner(u, v) * ds(ids["dirichlet"], metadata={"quadrature_degree": 3})
+        self.a_int, self.a_ufl = a_int, a_h
         a_form = fem.form(a_h)
         memlog("a_h compiled")
         K = dolfinx.fem.petsc.assemble_matrix(a_form)
@@ -285,8 +293,12 @@ class Problem:
         self.lvec = dolfinx.fem.petsc.create_vector(V)     # ghosted, layout of V
         self.uh = fem.Function(V)
         self.err_forms = None
+        if self.lift is not None:
+            self.lift.compile(self.a_int, self.a_ufl, pen, ds)
         if scene.exact_u is not None:
-            self.err_forms = error_forms(scene, self.uh, self.t, (lam, mu, rho, pen), h, dS2, ds, ids["dirichlet"])
+            # with boundary data the error's jump on Γ_D is u_h − u: the lifting's form, not u_h alone
+            dirichlet = ids["dirichlet"] if self.lift is None else ()
+            self.err_forms = error_forms(scene, self.uh, self.t, (lam, mu, rho, pen), h, dS2, ds, dirichlet)
 
     def solve(self, b, x):
         self.ksp.solve(b, x)
@@ -307,9 +319,13 @@ class Problem:
         b = self.lvec
         with b.localForm() as bl:
             bl.set(0.0)
+        if self.lift is not None:
+            self.lift.set(t)                               # u_L(t) and the time of the forms
+            dolfinx.fem.petsc.assemble_vector(b, self.lift.rhs_form)
         if self.L is not None:
             self.t.value = t
             dolfinx.fem.petsc.assemble_vector(b, self.L)
+        if self.L is not None or self.lift is not None:
             b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         if not np.isfinite(b.norm()):                      # collective
             self._name_nonfinite_load(t)
@@ -335,15 +351,24 @@ class Problem:
         agree(self.comm, msg)
         raise Fail(f"the load vector at t = {t:.6g} is not finite (NaN or Inf)")
 
-    def to_function(self, ur):
+    def to_function(self, ur, t):
+        """u_h = R ur (+ u_L(t) with boundary data): the real displacement."""
         self.R.mult(ur, self.uh.x.petsc_vec)
         self.uh.x.scatter_forward()
+        if self.lift is not None:
+            self.lift.set(t)
+            self.uh.x.array[:] += self.lift.uL.x.array
 
     def energy(self, ur):
+        """a_h(u, u) (with boundary data: of u_h, the Dirichlet jump against u_D; after ``to_function``)."""
+        if self.lift is not None:
+            return self.lift.energy()
         self.Kr.mult(ur, self.tmp)
         return ur.dot(self.tmp)
 
     def errors(self, t):
         self.t.value = t
         loc = np.array([fem.assemble_scalar(f) for f in self.err_forms])
+        if self.lift is not None and self.lift.err_form is not None:
+            loc[0] += fem.assemble_scalar(self.lift.err_form)
         return self.comm.allreduce(loc, op=MPI.SUM)
