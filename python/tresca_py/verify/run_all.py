@@ -61,6 +61,7 @@ def study_table(quick):
         "distributed": lambda hs: checks.distributed(hs, quick),
         "fuzz": lambda hs: checks.fuzz(hs, quick),
         "external": lambda hs: checks.external(hs, quick),
+        "audit": lambda hs: audits.run_cases(hs, quick),
     }
 
 
