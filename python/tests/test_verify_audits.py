@@ -2,7 +2,6 @@
 (tresca_py.verify.audits), and a damaged file fails it."""
 import shutil
 import subprocess
-import time
 
 import h5py
 import pytest
@@ -14,24 +13,23 @@ from tresca_py.verify.harness import Harness
 
 @pytest.fixture(scope="module")
 def front(tmp_path_factory, rust_bin):
-    """A tresca-cr run of mms_front (slips: friction dissipation > 0) and the time before it was written."""
-    d = tmp_path_factory.mktemp("a1")
-    since = time.time() - 1.0
-    out = d / "front.h5"
+    """A tresca-cr run of mms_front (slips: friction dissipation > 0)."""
+    out = tmp_path_factory.mktemp("a1") / "front.h5"
     subprocess.run([rust_bin, "run", f"{CASES}/mms_front.toml", "--refine", "1", "--steps", "8", "-q",
                     "-o", str(out)], check=True, capture_output=True)
-    return out, since
+    return out
 
 
 def test_the_system_shall_audit_every_tresca_file_a_study_writes(front, tmp_path):
-    out, since = front
     study = tmp_path / "study"
     study.mkdir()
-    shutil.copy(out, study / "a.h5")
+    shutil.copy(front, study / "old.h5")
+    before = audits.snapshot(str(study))  # an earlier study's file: not this study's
+    shutil.copy(front, study / "a.h5")
     with h5py.File(study / "python.h5", "w") as f:  # a file without the audit series: listed as skipped
         f.create_group("tresca/steps")
     hs = Harness(out=str(tmp_path / "hs"), echo=False)
-    checked = audits.audit_study(hs, "clients", since, root=str(study))
+    checked = audits.audit_study(hs, "clients", before, root=str(study))
     assert len(checked) == 1 and "a.h5" in checked[0], checked
     r = hs.results[-1]
     assert r.id == "A1-clients" and r.passed, r.measured
@@ -40,18 +38,17 @@ def test_the_system_shall_audit_every_tresca_file_a_study_writes(front, tmp_path
 
 def test_the_system_shall_record_nothing_for_a_study_without_results_files(tmp_path):
     hs = Harness(out=str(tmp_path / "hs"), echo=False)
-    assert audits.audit_study(hs, "elastic", time.time(), root=str(tmp_path)) == []
+    assert audits.audit_study(hs, "elastic", {}, root=str(tmp_path)) == []
     assert hs.results == []
 
 
 @pytest.mark.parametrize("damage", ["wrong friction sign", "residual hidden", "unreadable"])
 def test_the_system_shall_fail_the_study_when_one_file_does_not_balance(front, tmp_path, damage):
-    out, since = front
     study = tmp_path / "study"
     study.mkdir()
-    shutil.copy(out, study / "good.h5")
+    shutil.copy(front, study / "good.h5")
     bad = study / "bad.h5"
-    shutil.copy(out, bad)
+    shutil.copy(front, bad)
     with h5py.File(bad, "r+") as f:
         g = f["tresca/steps"]
         if damage == "wrong friction sign":
@@ -64,7 +61,7 @@ def test_the_system_shall_fail_the_study_when_one_file_does_not_balance(front, t
         else:
             del f["tresca/u"]
     hs = Harness(out=str(tmp_path / "hs"), echo=False)
-    checked = audits.audit_study(hs, "external", since, root=str(study))
+    checked = audits.audit_study(hs, "external", {}, root=str(study))
     assert len(checked) == 2
     r = hs.results[-1]
     assert r.id == "A1-external" and not r.passed, r.measured

@@ -3,7 +3,7 @@ that tresca-cr writes during ``make verify`` (issue 30 §4: "check the residual 
 on every case").
 
 After each study of :mod:`tresca_py.verify.run_all` the harness looks for the HDF5 files that study wrote
-under the output directory (modified since the study started) and checks each one that carries the audit
+under the output directory (new or modified against a :func:`snapshot` taken before it) and checks each one that carries the audit
 series (tresca-cr's files; the Python re-implementations and older versions write none, they are listed as
 skipped): the stored residual is the residual of the stored terms, |ΔE + D + j − W − W_Γ| ≤
 (``audit.BALANCE_REL`` + ``audit.rounding``) × the largest work of a step (the bound and its reason:
@@ -28,15 +28,20 @@ from tresca_py.common import BIN, ROOT
 CASE_DIRS = ("verification/cases", "verification/external/scenes")
 
 
-def written_since(root, since):
-    """The ``.h5`` files under ``root`` modified at or after ``since`` (a time.time() value), sorted."""
-    found = []
+def snapshot(root):
+    """{path: modification time (ns)} of the ``.h5`` files under ``root``."""
+    found = {}
     for d, _, names in os.walk(root):
         for n in names:
-            p = os.path.join(d, n)
-            if n.endswith(".h5") and os.path.getmtime(p) >= since:
-                found.append(p)
-    return sorted(found)
+            if n.endswith(".h5"):
+                p = os.path.join(d, n)
+                found[p] = os.stat(p).st_mtime_ns
+    return found
+
+
+def written_after(root, before):
+    """The ``.h5`` files under ``root`` that are new or modified against the :func:`snapshot` ``before``."""
+    return sorted(p for p, t in snapshot(root).items() if before.get(p) != t)
 
 
 def check_file(path):
@@ -62,12 +67,13 @@ def check_file(path):
                                                      f"{audit.BALANCE_REL + allowance:.1e})")
 
 
-def audit_study(hs, name, since, root=None):
+def audit_study(hs, name, before, root=None):
     """Record ``A1-<name>`` for the tresca-cr results files the study wrote under ``root`` (default: the
-    harness's output directory) since ``since``; returns the per-file lines (empty: nothing recorded)."""
+    harness's output directory): those new or modified against the :func:`snapshot` ``before``; returns the
+    per-file lines (empty: nothing recorded)."""
     root = root or hs.out
     checked, skipped, failed, worst = [], [], [], 0.0
-    for path in written_since(root, since):
+    for path in written_after(root, before):
         name_rel = os.path.relpath(path, ROOT)
         audited, problems, rel, detail = check_file(path)
         if not audited:

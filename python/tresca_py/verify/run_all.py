@@ -88,12 +88,12 @@ def main(argv=None):
     for name, fn in table.items():
         if args.only and name not in args.only:
             continue
-        started = time.time() - 1.0  # file times may be rounded down to the second
+        before = audits.snapshot(hs.out)  # A1 audits the results files the study writes
         try:
             fn(hs)
         except Exception as e:  # a study that cannot run is a failed requirement, not a crash
             hs.not_run(name, str(e).splitlines()[0][:300] if str(e) else repr(e))
-        audits.audit_study(hs, name, started)  # A1: the energy audit of every results file it wrote
+        audits.audit_study(hs, name, before)
     header = (f"Machine: {os.uname().nodename}, {os.cpu_count()} cores; total {time.time() - t0:.0f} s. "
               f"Versions: {versions()}.")
     return hs.report(header, partial=bool(args.only))
