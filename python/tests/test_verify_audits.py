@@ -66,3 +66,20 @@ def test_the_system_shall_fail_the_study_when_one_file_does_not_balance(front, t
     r = hs.results[-1]
     assert r.id == "A1-external" and not r.passed, r.measured
     assert "bad.h5" in r.measured.split("problems")[1].split(";")[0], r.measured
+
+
+def test_the_system_shall_run_every_scene_once_for_its_audit(tmp_path, monkeypatch, rust_bin):
+    """The study `audit` runs each scene of its directories with a results file; a scene that does not run is
+    a failed A1-audit-run-<name>, and the files it wrote are audited as A1-audit."""
+    cases = tmp_path / "cases"
+    cases.mkdir()
+    shutil.copy(f"{CASES}/elastic_rect.toml", cases / "good.toml")
+    (cases / "broken.toml").write_text("[mesh]\ncells = [1]\n")
+    monkeypatch.setattr(audits, "CASE_DIRS", (str(cases),))
+    hs = Harness(out=str(tmp_path / "hs"), echo=False)
+    before = audits.snapshot(hs.out)
+    audits.run_cases(hs, quick=True)
+    checked = audits.audit_study(hs, "audit", before)
+    assert [r.id for r in hs.results] == ["A1-audit-run-broken", "A1-audit"]
+    assert not hs.results[0].passed and hs.results[1].passed
+    assert len(checked) == 1 and "good.h5" in checked[0]
