@@ -208,7 +208,7 @@ def main(argv=None):
     budget = audit.read(r.path, r.completed)
     if budget is not None:
         print(audit.summary(budget))
-        for m in audit.problems(budget, audit.rounding(r.path)):
+        for m in audit.problems(budget, audit.rounding(r.path, audit.largest_work(budget))):
             c.check(False, m)
     for name, step, path in (("VTKHDF (vtkHDFReader)", check_vtkhdf, r.path),
                              ("XDMF (meshio)", check_meshio, os.path.abspath(xdmf)),

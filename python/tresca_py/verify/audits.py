@@ -3,17 +3,18 @@ that tresca-cr writes during ``make verify`` (issue 30 §4: "check the residual 
 on every case").
 
 After each study of :mod:`tresca_py.verify.run_all` the harness looks for the HDF5 files that study wrote
-under the output directory (new or modified against a :func:`snapshot` taken before it) and checks each one that carries the audit
-series (tresca-cr's files; the Python re-implementations and older versions write none, they are listed as
-skipped): the stored residual is the residual of the stored terms, |ΔE + D + j − W − W_Γ| ≤
+under the output directory (new or modified against a :func:`snapshot` taken before it) and checks each one
+that carries the audit series (tresca-cr's files; the Python re-implementations and older versions write none,
+they are listed as skipped): the stored residual is the residual of the stored terms, |ΔE + D + j − W − W_Γ| ≤
 (``audit.BALANCE_REL`` + ``audit.rounding``) × the largest work of a step (the bound and its reason:
-:mod:`tresca_py.audit`), the dissipations are non-negative. One result per study, ``A1-<study>``, lists
-every file checked with its largest relative residual and the solver tolerance it ran with; a study that
-wrote no tresca-cr file records nothing (its cases are ``tresca-cr study`` runs, which keep no results
-file). So that those cases are audited too, the study ``audit`` (:func:`run_cases`) runs every scene of
-``verification/cases/`` and ``verification/external/scenes/`` once with a results file (refine 1, the
-scene's own steps; refine 0 for the Gmsh scenes, whose files are already fine) and is audited like the
-others (``A1-audit``: 19 files in 11 s).
+:mod:`tresca_py.audit`), the dissipations are non-negative. One result per study, ``A1-<study>``, lists every
+file checked with its largest relative residual and the solver tolerance it ran with; a study that wrote no
+tresca-cr file records nothing (its cases are ``tresca-cr study`` runs, which keep no results file). So that
+those cases are audited too, the study ``audit`` (:func:`run_cases`) runs every scene of
+``verification/cases/`` and ``verification/external/scenes/`` once with a results file (refine 1, the scene's
+own steps; refine 0 for the Gmsh scenes, whose files are already fine) and is audited like the others
+(``A1-audit``: 19 files in 11 s). ``verification/stability.py`` audits the files of its cases, which live in
+a temporary directory, itself (``A1-stability``, :func:`record`).
 """
 import glob
 import os
@@ -62,7 +63,7 @@ def check_file(path):
     res = float(abs(a["balance_residual"]).max()) if len(a["balance_residual"]) else 0.0
     rel = res / scale if scale > 0 else 0.0
     tol_txt = f", solver tol {float(tol):.0e}" if tol is not None else ""
-    allowance = audit.rounding(r.path)
+    allowance = audit.rounding(r.path, audit.largest_work(a))
     return True, audit.problems(a, allowance), rel, (f"{rel:.1e} ({r.completed} steps{tol_txt}, bound "
                                                      f"{audit.BALANCE_REL + allowance:.1e})")
 
@@ -71,9 +72,14 @@ def audit_study(hs, name, before, root=None):
     """Record ``A1-<name>`` for the tresca-cr results files the study wrote under ``root`` (default: the
     harness's output directory): those new or modified against the :func:`snapshot` ``before``; returns the
     per-file lines (empty: nothing recorded)."""
-    root = root or hs.out
+    return record(hs, name, written_after(root or hs.out, before))
+
+
+def record(hs, name, paths):
+    """Record ``A1-<name>`` for the tresca-cr results files among ``paths`` (nothing when there is none);
+    returns the per-file lines."""
     checked, skipped, failed, worst = [], [], [], 0.0
-    for path in written_after(root, before):
+    for path in paths:
         name_rel = os.path.relpath(path, ROOT)
         audited, problems, rel, detail = check_file(path)
         if not audited:
@@ -89,7 +95,7 @@ def audit_study(hs, name, before, root=None):
                 + (f"; skipped {len(skipped)} without the audit" if skipped else ""))
     hs.require(f"A1-{name}", not failed, measured,
                statement=f"The solver shall balance the energy of every step, a_h(uⁿ,δuⁿ) + j_h(δuⁿ) = (lⁿ,δuⁿ) "
-                         f"+ W_Γⁿ, to ({audit.BALANCE_REL:g} + γ_N (λ+2μ)/μ) × the largest work of a step in every "
+                         f"+ W_Γⁿ, to {audit.BALANCE_REL:g} of the largest work of a step plus the rounding allowance in every "
                          f"results file that the study `{name}` writes with tresca-cr")
     return checked
 

@@ -210,7 +210,7 @@ REQUIREMENTS = (
     ),
     Requirement(
         'A1…',
-        'balance the energy of every step, a_h(uⁿ,δuⁿ) + j_h(δuⁿ) = (lⁿ,δuⁿ) + W_Γⁿ (the reactions\' work on imposed data), to (1e-9 + γ_N (λ+2μ)/μ) × the largest work of a step (the solver tolerance and the rounding of N unknowns, `tresca_py.audit`), with non-negative dissipations, in every results file that tresca-cr writes during `make verify`: after each study the harness audits the files it wrote (`tresca_py.audit`, as `scripts/check_results.py`), one result `A1-<study>` listing every file with its relative residual; the study `audit` runs every scene of verification/cases/ and verification/external/scenes/ once with a results file (the `tresca-cr study` cases keep none)',
+        'balance the energy of every step, a_h(uⁿ,δuⁿ) + j_h(δuⁿ) = (lⁿ,δuⁿ) + W_Γⁿ (the reactions\' work on imposed data), to 1e-9 of the largest work of a step plus the rounding allowance of `tresca_py.audit.rounding` (γ_N (λ+2μ)/μ for the solve of N unknowns, 4ε max|u| ∫g_a for the friction term), with non-negative dissipations, in every results file that tresca-cr writes during `make verify`: after each study the harness audits the files it wrote (`tresca_py.audit`, as `scripts/check_results.py`), one result `A1-<study>` listing every file with its relative residual; the study `audit` runs every scene of verification/cases/ and verification/external/scenes/ once with a results file (the `tresca-cr study` cases keep none)',
         'verification/run_all.py (after each study; tresca_py/verify/audits.py)',
         None,
         pattern='A1-.+',
