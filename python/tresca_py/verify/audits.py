@@ -94,9 +94,9 @@ def record(hs, name, paths):
                 + f"; largest |residual| / largest work of a step {worst:.1e}; per file: " + "; ".join(checked)
                 + (f"; skipped {len(skipped)} without the audit" if skipped else ""))
     hs.require(f"A1-{name}", not failed, measured,
-               statement=f"The solver shall balance the energy of every step, a_h(uⁿ,δuⁿ) + j_h(δuⁿ) = (lⁿ,δuⁿ) "
-                         f"+ W_Γⁿ, to {audit.BALANCE_REL:g} of the largest work of a step plus the rounding allowance in every "
-                         f"results file that the study `{name}` writes with tresca-cr")
+               statement=f"The solver shall balance the energy of every step, a_h(uⁿ,δuⁿ) + j_h(δuⁿ) = "
+                         f"(lⁿ,δuⁿ) + W_Γⁿ, to {audit.BALANCE_REL:g} of the largest work of a step plus the "
+                         f"rounding allowance in every results file that the study `{name}` writes with tresca-cr")
     return checked
 
 
