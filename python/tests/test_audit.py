@@ -49,4 +49,22 @@ def test_the_system_shall_refuse_a_run_whose_energy_does_not_balance(front, tmp_
             g["stored_energy"][-1] = 1.01 * g["stored_energy"][-1]
     with h5py.File(bad) as f:
         a = audit.read(bad, int(f["tresca/steps"].attrs["completed"]))
-    assert audit.problems(a), damage
+    assert audit.problems(a, audit.rounding(bad, audit.largest_work(a))), damage
+
+
+def test_the_system_shall_allow_rounding_that_grows_with_unknowns_stiffness_and_bound(front, tmp_path):
+    """The balance's rounding allowance is γ_N (λ+2μ)/μ + 4ε max|u| Σ ḡ_e|e| / scale: N ε/(1 − N ε) ·
+    2(1−ν)/(1−2ν) and the friction bound's, 0 without attributes."""
+    with h5py.File(front) as f:
+        g = f["tresca"]
+        n, nu = int(g.attrs["n_dofs"]), float(g.attrs["nu"])
+        umax = float(abs(g["u"][:]).max())
+        ends = g["mesh/points"][:][g["mesh/edges"][:][g["contact/edges"][:]]]
+        bound = float((abs(g["contact/g"][:]) * ((ends[:, 1] - ends[:, 0]) ** 2).sum(axis=1) ** 0.5).sum())
+    solve = n * audit.EPS / (1 - n * audit.EPS) * 2 * (1 - nu) / (1 - 2 * nu)
+    assert audit.rounding(front, 2.0) == pytest.approx(solve + 4 * audit.EPS * umax * bound / 2.0, rel=1e-12)
+    assert bound > 0 and 0 < audit.rounding(front, 2.0) < 1e-12
+    bare = tmp_path / "bare.h5"
+    with h5py.File(bare, "w") as f:
+        f.create_group("tresca")
+    assert audit.rounding(bare, 1.0) == 0.0

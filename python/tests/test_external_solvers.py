@@ -143,3 +143,34 @@ def test_stick_ends_skip_dirichlet_junction():
     probes["dirichlet_ends"] = [False, False]  # a Neumann end: the same data is a stick zone at the end
     row = quantities.summarise(raw, probes)
     assert row["stick_a"] == pytest.approx(0.85 + 0.1 * (0.01 - 1.0) / (0.01 - 1.0 - (0.01 - 1e-6)))
+
+
+def gmsh_patch(tmp_path):
+    """PATCH on the Gmsh pentagon of the suite (verification/external/scenes/gmsh_pentagon.msh, Γ_C = [0,1]×{0})."""
+    from tresca_py.common import ROOT
+    msh = f"{ROOT}/verification/external/scenes/gmsh_pentagon.msh"
+    text = PATCH.replace('corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]\ncells = [2, 2]',
+                         f'file = "{msh}"').replace('name = "bottom"', 'name = "contact"')
+    p = tmp_path / "gmsh_patch.toml"
+    p.write_text(text)
+    return p
+
+
+def test_gmsh_scene_is_read_and_red_refined(tmp_path):
+    """The scene reader shall read a Gmsh scene (mesh.file) as tresca-cr does: 12·4^r triangles at level r,
+    the contact part's segments oriented and chained from (0, 0) to (1, 0), a clear error for r < 0."""
+    scene = problem.load(gmsh_patch(tmp_path))
+    for r in (0, 2):
+        prob = problem.at_level(scene, r, degree=1)
+        assert len(prob["triangles"]) == 12 * 4 ** r
+        segs = next(p["segments"] for p in prob["parts"] if p["kind"] == "contact")
+        assert len(segs) == 2 * 2 ** r and all(a[1] == b[0] for a, b in zip(segs[:-1], segs[1:], strict=True))
+        assert prob["probes"]["start"] == [0.0, 0.0] and prob["probes"]["tangent"] == pytest.approx([1.0, 0.0])
+        assert prob["probes"]["length"] == pytest.approx(1.0)
+    with pytest.raises(problem.ProblemError, match="coarsened"):
+        problem.at_level(scene, -1)
+
+
+def test_skfem_nitsche_patch_on_gmsh_mesh(tmp_path):
+    """The system shall reproduce the affine slipping field on the red-refined Gmsh pentagon (scikit-fem P2)."""
+    _check_patch(skfem_nitsche.solve(problem.build(gmsh_patch(tmp_path), 1, degree=2)))

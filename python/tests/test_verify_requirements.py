@@ -14,7 +14,8 @@ RECORDED = ["E1-rect-energy", "E1-rect-L2", "E2-rotated-energy", "E2-rotated-L2"
             "C2-rotated-energy", "K1-mms_stop", "K2-stick-to-slip", "J1-joint", "P1-paper-orders", "P2-paper-runs",
             "P3-paper-estimate", "R1-estimate-effectivity", "R2-estimate-refuses", "R3-differences", "O1-clients",
             "O2-interrupted", "V1-paraview", "X-mms_front-r1", "X-mpi-mms_stop-r0", "D1-distributed-agree",
-            "D2-distributed-memory", "PL1-mms_front", "PL2-mms_stop", "S1-stability", "S12-stability", "F1-fuzz"]
+            "D2-distributed-memory", "PL1-mms_front", "PL2-mms_stop", "S1-stability", "S12-stability", "F1-fuzz",
+            "EB1-external", "EB1-clients", "EB1-audit", "EB1-audit-run-trapezoid"]
 
 
 def test_ids_are_unique():

@@ -213,7 +213,7 @@ def main(argv=None):
     budget = audit.read(r.path, r.completed)
     if budget is not None:
         print(audit.summary(budget))
-        for m in audit.problems(budget):
+        for m in audit.problems(budget, audit.rounding(r.path, audit.largest_work(budget))):
             c.check(False, m)
     readers = (("VTKHDF (vtkHDFReader)", check_vtkhdf, r.path), ("XDMF (meshio)", check_meshio, os.path.abspath(xdmf)),
                ("XDMF (vtkXdmfReader)", check_vtkxdmf, os.path.abspath(xdmf)))

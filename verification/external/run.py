@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """External codes on the continuous problem (issue 30 §3): GetFEM P1/P2, the scikit-fem P2 Nitsche solver and
-tresca-cr on five scenes, each at five uniform refinements; Richardson limits with GCI bands, pairwise agreement,
-true-error orders; writes reference/external.{md,csv} and reference/external_{dof,wall}.png.
+tresca-cr on six scenes (one a Gmsh mesh), each at five uniform refinements; Richardson limits with GCI bands,
+pairwise agreement, true-error orders; writes reference/external.{md,csv} and reference/external_{dof,wall}.png.
 
     verification/external/run.py [--scene NAME ...] [--code CODE ...] [--from-rows out/external/rows.json]
 """

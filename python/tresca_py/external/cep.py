@@ -1,10 +1,17 @@
 """The Chouly–Ern–Pignet Tresca manufactured solution (HHO + Nitsche for Tresca friction, SIAM J. Sci. Comput.
-2020) as a tresca-cr scene, derived with sympy, with the friction law checked on Γ_C = {y = 0}.
+2020) as tresca-cr scenes, derived with sympy, with the friction law checked on Γ_C = {y = 0}.
 
-Ω = (0,1)², u = (x e^{xy}(1 + 1/(1+λ)), y e^{xy}(−1 + 1/(1+λ)))/6, μ = 2, λ = 2·10⁴, Tresca bound
-s(x) = μ x² (λ/2 + 1)/(3λ + 3); top, left and right sides Dirichlet with u. The scene is static: one
-backward-Euler step from u⁰ = 0 at t = 0 to t = 1 with data t·u_D and t·f (compatible at t = 0), so that the
-step's friction acts on u¹ − 0 = u¹: the static Tresca problem, whose solution at t = 1 is u.
+u = (x e^{xy}(1 + 1/(1+λ)), y e^{xy}(−1 + 1/(1+λ)))/6, Tresca bound s(x) = μ x² (λ/2 + 1)/(3λ + 3), attained
+everywhere on y = 0 for every λ (σ_τ = −μx²(1 + 1/(1+λ))/6 there). Two scenes:
+
+* ``cep`` (:func:`scene_toml`): Ω = (0,1)², μ = 2, λ = 2·10⁴; top, left and right sides Dirichlet with u;
+* ``pentagon`` (:func:`pentagon_toml`): the Gmsh pentagon ``gmsh_pentagon.msh`` (Γ_C = [0,1] × {0}), μ = 2,
+  λ = 3 (ν = 0.3, no locking), Dirichlet with u on ``right`` and ``left``, Neumann σ(u)n on ``top`` (unit
+  outward normal (0.6, 0.8)).
+
+Both are static: one backward-Euler step from u⁰ = 0 at t = 0 to t = 1 with data t·u_D, t·σ(u)n and t·f
+(compatible at t = 0), so that the step's friction acts on u¹ − 0 = u¹: the static Tresca problem, whose
+solution at t = 1 is u.
 """
 from __future__ import annotations
 
@@ -13,23 +20,30 @@ import sympy as sp
 from tresca_py.mms.exmex import ex as exmex
 
 MU, LAM = sp.Integer(2), sp.Integer(20000)
+#: the pentagon's Lamé λ (ν = 0.3) and its Neumann side's unit outward normal
+PENTAGON_LAM, TOP_NORMAL = sp.Integer(3), sp.Matrix([sp.Rational(3, 5), sp.Rational(4, 5)])
 
 
-def exact():
+def exact(lam=LAM):
     x, y = sp.symbols("x y", real=True)
-    k = 1 / (1 + LAM)
+    k = 1 / (1 + lam)
     u = sp.Matrix([x * sp.exp(x * y) * (1 + k), y * sp.exp(x * y) * (-1 + k)]) / 6
     return x, y, u
 
 
-def derive():
-    """(f, s, checks): the body force −div σ(u), the bound s(x) and the friction-law checks on y = 0."""
-    x, y, u = exact()
+def stress(lam=LAM):
+    """(x, y, u, σ(u)) with σ = λ tr ε I + 2μ ε."""
+    x, y, u = exact(lam)
     G = u.jacobian([x, y])
     eps = (G + G.T) / 2
-    sig = LAM * eps.trace() * sp.eye(2) + 2 * MU * eps
+    return x, y, u, lam * eps.trace() * sp.eye(2) + 2 * MU * eps
+
+
+def derive(lam=LAM):
+    """(f, s, checks): the body force −div σ(u), the bound s(x) and the friction-law checks on y = 0."""
+    x, y, u, sig = stress(lam)
     f = -sp.Matrix([sp.diff(sig[0, 0], x) + sp.diff(sig[0, 1], y), sp.diff(sig[1, 0], x) + sp.diff(sig[1, 1], y)])
-    s = MU * x**2 * (LAM / 2 + 1) / (3 * LAM + 3)
+    s = MU * x**2 * (lam / 2 + 1) / (3 * lam + 3)
     n, tau = sp.Matrix([0, -1]), sp.Matrix([1, 0])  # outward normal on y = 0 and τ = (−n_y, n_x)
     sig_n = sig.subs(y, 0) * n
     u0 = u.subs(y, 0)
@@ -44,19 +58,48 @@ def derive():
     return [sp.simplify(c) for c in f], s, checks
 
 
-def scene_toml():
-    """The scene text (exmex syntax: ^ for powers)."""
-    x, y, u = exact()
-    f, s, checks = derive()
+def ex(e, scale="t*"):
+    """The project's one exmex printer (unambiguous unary minus and powers, exact rationals), time-scaled."""
+    return scale + "(" + exmex(sp.nsimplify(e)) + ")"
+
+
+def _checked(lam):
+    """:func:`derive` with its checks asserted (u_τ = x(1+1/(1+λ))/6 ≥ 0 on x ≥ 0, zero only at x = 0)."""
+    x, _, _ = exact(lam)
+    f, s, checks = derive(lam)
     assert checks["u_n"] == 0, checks
     assert checks["sigma_tau_plus_s"] == 0, checks
-    ut = checks["u_tau"]
-    assert sp.simplify(ut - x * (1 + 1 / (1 + LAM)) / 6) == 0, ut  # ≥ 0 on [0, 1], zero only at x = 0 (s = 0)
-    G = u.jacobian([x, y])
+    assert sp.simplify(checks["u_tau"] - x * (1 + 1 / (1 + lam)) / 6) == 0, checks["u_tau"]
+    return f, s
 
-    def ex(e, scale="t*"):
-        # the project's one exmex printer (unambiguous unary minus and powers, exact rationals)
-        return scale + "(" + exmex(sp.nsimplify(e)) + ")"
+
+def _tail(lam, s, f, ud, G):
+    """The contact part, loads, time, solver and exact sections shared by both scenes."""
+    return ["[[boundary]]", 'name = "{}"', 'kind = "contact"', f'g_a = "{ex(s, "")}"', 'gap = "0"', "",
+            "[loads]", f'f = ["{ex(f[0])}", "{ex(f[1])}"]', "",
+            "[time]", "T = 1.0", "steps = 1", "", "[discretisation]", "rho = 10.0", "",
+            "[solver]", 'method = "ssn"', "tol = 1e-12", "",
+            "[exact]", f'u = ["{ud[0]}", "{ud[1]}"]',
+            f'grad = [["{ex(G[0, 0])}", "{ex(G[0, 1])}"], ["{ex(G[1, 0])}", "{ex(G[1, 1])}"]]', ""]
+
+
+def _material(lam):
+    return ["[material]", f"E = {float(MU * (3 * lam + 2 * MU) / (lam + MU))!r}",
+            f"nu = {float(lam / (2 * (lam + MU)))!r}", ""]
+
+
+def _dirichlet(sides, ud):
+    out = []
+    for side in sides:
+        out += ["[[boundary]]", f'name = "{side}"', 'kind = "dirichlet"', f'u = ["{ud[0]}", "{ud[1]}"]', ""]
+    return out
+
+
+def scene_toml():
+    """The cep scene text (exmex syntax: ^ for powers)."""
+    x, y, u = exact(LAM)
+    f, s = _checked(LAM)
+    ud = [ex(c) for c in u]
     lines = [
         "# Chouly-Ern-Pignet Tresca manufactured solution (near-incompressible), GENERATED by",
         "# verification/external/scenes/make_cep.py (tresca_py.external.cep), do not edit by hand.",
@@ -66,17 +109,28 @@ def scene_toml():
         'title = "Chouly-Ern-Pignet Tresca MMS, mu = 2, lambda = 2e4"', "",
         "[mesh]", "corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]", "cells = [2, 2]",
         'diagonal = "first"', "refine = 0", "",
-        "[material]",
-        f"E = {float(MU * (3 * LAM + 2 * MU) / (LAM + MU))!r}",
-        f"nu = {float(LAM / (2 * (LAM + MU)))!r}", "",
-    ]
+        *_material(LAM), *_dirichlet(("right", "top", "left"), ud)]
+    tail = _tail(LAM, s, f, ud, u.jacobian([x, y]))
+    tail[1] = tail[1].format("bottom")
+    return "\n".join(lines + tail)
+
+
+def pentagon_toml():
+    """The Gmsh pentagon scene text: the same solution at λ = 3 with a Neumann side (σ(u)n on ``top``)."""
+    x, y, u, sig = stress(PENTAGON_LAM)
+    f, s = _checked(PENTAGON_LAM)
     ud = [ex(c) for c in u]
-    for side in ("right", "top", "left"):
-        lines += ["[[boundary]]", f'name = "{side}"', 'kind = "dirichlet"', f'u = ["{ud[0]}", "{ud[1]}"]', ""]
-    lines += ["[[boundary]]", 'name = "bottom"', 'kind = "contact"', f'g_a = "{ex(s, "")}"', 'gap = "0"', "",
-              "[loads]", f'f = ["{ex(f[0])}", "{ex(f[1])}"]', "",
-              "[time]", "T = 1.0", "steps = 1", "", "[discretisation]", "rho = 10.0", "",
-              "[solver]", 'method = "ssn"', "tol = 1e-12", "",
-              "[exact]", f'u = ["{ud[0]}", "{ud[1]}"]',
-              f'grad = [["{ex(G[0, 0])}", "{ex(G[0, 1])}"], ["{ex(G[1, 0])}", "{ex(G[1, 1])}"]]', ""]
-    return "\n".join(lines)
+    trac = [ex(c) for c in sig * TOP_NORMAL]
+    lines = [
+        "# The Chouly-Ern-Pignet Tresca solution at lambda = 3 (nu = 0.3) on a Gmsh pentagon, GENERATED by",
+        "# verification/external/scenes/make_cep.py (tresca_py.external.cep), do not edit by hand.",
+        "# Mesh: gmsh_pentagon.msh (gmsh_pentagon_gen.py, Gmsh 4.15.2, 12 triangles), refined by red refinement.",
+        "# Static: one step t = 0 -> 1 from u0 = 0 with t*u_D, t*sigma(u)n, t*f; the exact solution at t = 1 is u.",
+        "# Checked with sympy on y = 0: u.n = 0, sigma_tau = -s(x), u_tau = x(1+1/(1+lambda))/6 >= 0.",
+        'title = "Chouly-Ern-Pignet Tresca MMS on a Gmsh pentagon, mu = 2, lambda = 3"', "",
+        "[mesh]", 'file = "gmsh_pentagon.msh"', "refine = 0", "",
+        *_material(PENTAGON_LAM), *_dirichlet(("right", "left"), ud),
+        "[[boundary]]", 'name = "top"', 'kind = "neumann"', f'traction = ["{trac[0]}", "{trac[1]}"]', ""]
+    tail = _tail(PENTAGON_LAM, s, f, ud, u.jacobian([x, y]))
+    tail[1] = tail[1].format("contact")
+    return "\n".join(lines + tail)

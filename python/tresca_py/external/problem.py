@@ -6,7 +6,9 @@ E, nu, ``[[boundary]]`` parts (dirichlet with optional ``u``, neumann with ``tra
 and optional ``gap``), ``[loads] f``, ``[initial] u0``, ``[time] T, steps``, ``[exact] u, grad``.
 Expressions are exmex strings in x, y, t; they are parsed with sympy and printed as numpy code, so that a
 solver running under another interpreter (GetFEM under /usr/bin/python3) evaluates them with numpy alone
-(:func:`evaluate`).  Gmsh scenes (``mesh.file``) are not read here.
+(:func:`evaluate`).  Gmsh scenes (``mesh.file``, Gmsh 4.1 relative to the scene file, 1D physical groups
+naming the parts) are read with the project's mesh reader (``tresca_py.mesh``: meshio, red refinement), as
+tresca-cr reads them: level ``refine`` is the file's mesh refined ``refine`` times.
 """
 from __future__ import annotations
 
@@ -93,6 +95,36 @@ def structured_mesh(corners, n, m, diagonal="first"):
     return pts, tri.reshape(-1, 3), sides
 
 
+def file_mesh(path, refine):
+    """Points, counter-clockwise triangles and {part: segments} of a Gmsh file refined ``refine`` times; each
+    part's segments oriented counter-clockwise (as the triangle owning them) and chained from its start."""
+    from tresca_py.mesh import gmsh_mesh, red_refine
+    from tresca_py.scene import SceneError
+    if refine < 0:
+        raise ProblemError(f"{path}: refine {refine}: a Gmsh mesh cannot be coarsened")
+    try:
+        mesh = gmsh_mesh(path)
+    except SceneError as err:
+        raise ProblemError(str(err)) from None
+    for _ in range(refine):
+        mesh = red_refine(mesh)
+    tri = mesh.triangles
+    ccw = {(int(a), int(b)) for t in tri for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
+    sides = {}
+    for name, seg in mesh.boundary_segments.items():
+        seg = np.array([(a, b) if (a, b) in ccw else (b, a) for a, b in seg.tolist()], dtype=np.int64)
+        nxt = {a: k for k, (a, _) in enumerate(seg.tolist())}
+        heads = set(seg[:, 0].tolist()) - set(seg[:, 1].tolist())
+        k, order = nxt[min(heads)] if heads else 0, []
+        while k is not None and len(order) < len(seg):
+            order.append(k)
+            k = nxt.get(int(seg[k, 1]))
+        if len(order) != len(seg):   # several chains (a part in pieces): keep them, unchained
+            order += [i for i in range(len(seg)) if i not in set(order)]
+        sides[name] = seg[order]
+    return mesh.points, tri, sides
+
+
 def _num(tab, key, where, default=None):
     val = tab.get(key, default)
     if not isinstance(val, (int, float)) or isinstance(val, bool) or not math.isfinite(val):
@@ -120,18 +152,21 @@ def read_scene(path):
 def load(path):
     """Parse scene ``path`` once (expressions to numpy code): the level-independent part of a problem."""
     sc = read_scene(path)
-    mesh = sc.get("mesh", {})
+    mesh = dict(sc.get("mesh", {}))
     if "file" in mesh:
-        raise ProblemError(f"{path}: mesh.file (Gmsh) scenes are not read by the external codes")
-    if "corners" not in mesh or "cells" not in mesh:
-        raise ProblemError(f"{path}: mesh.corners and mesh.cells are required")
+        mesh["file"] = str(Path(path).parent / mesh["file"])
+        sides = file_mesh(mesh["file"], 0)[2]
+    elif "corners" not in mesh or "cells" not in mesh:
+        raise ProblemError(f"{path}: mesh.corners and mesh.cells (or mesh.file) are required")
+    else:
+        sides = ("bottom", "right", "top", "left")
     mat = sc.get("material", {})
     E, nu = _num(mat, "E", "material"), _num(mat, "nu", "material")
     parts, n_contact = [], 0
     for k, b in enumerate(sc.get("boundary", [])):
         name, kind = b.get("name"), b.get("kind")
-        if name not in ("bottom", "right", "top", "left"):
-            raise ProblemError(f"boundary[{k}].name: unknown side {name!r} (bottom, right, top, left)")
+        if name not in sides:
+            raise ProblemError(f"boundary[{k}].name: unknown part {name!r} ({', '.join(sides)})")
         part = {"name": name, "kind": kind}
         if kind == "dirichlet":
             part["u"] = _vec(b.get("u", ["0", "0"]), f"boundary[{k}].u")
@@ -163,10 +198,13 @@ def at_level(scene, refine, steps=None, degree=2, gamma_n=10.0):
     parameter, p = γ_N (λ + 2μ)/h (λ + 2μ, not E: the trace inequality for σ(v)n carries λ, and with E the
     symmetric Nitsche term lost coercivity on the λ/μ = 10⁴ case: a spurious level in both P2 codes)."""
     mesh = scene["mesh"]
-    n, m = (c * 2.0 ** refine for c in mesh["cells"])  # refine < 0 coarsens cells that halve evenly
-    if n != int(n) or m != int(m) or n < 1 or m < 1:
-        raise ProblemError(f"{scene['scene']}: refine {refine} does not give whole cells from {mesh['cells']}")
-    pts, tri, sides = structured_mesh(mesh["corners"], int(n), int(m), mesh.get("diagonal", "first"))
+    if "file" in mesh:
+        pts, tri, sides = file_mesh(mesh["file"], refine)
+    else:
+        n, m = (c * 2.0 ** refine for c in mesh["cells"])  # refine < 0 coarsens cells that halve evenly
+        if n != int(n) or m != int(m) or n < 1 or m < 1:
+            raise ProblemError(f"{scene['scene']}: refine {refine} does not give whole cells from {mesh['cells']}")
+        pts, tri, sides = structured_mesh(mesh["corners"], int(n), int(m), mesh.get("diagonal", "first"))
     parts = [dict(p, segments=sides[p["name"]].tolist()) for p in scene["parts"]]
     contact = next(p for p in parts if p["kind"] == "contact")
     n_steps = int(steps or scene["steps"])

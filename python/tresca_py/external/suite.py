@@ -66,6 +66,9 @@ SCENES = (
           "static, imposed normal displacement -0.1 on Gamma_C"),
     Scene("mms_rotated", "verification/cases/mms_rotated.toml", (0, 1, 2, 3, 4), 4,
           "manufactured, rotated square (contact side not axis-aligned)", cubic_front=True),
+    Scene("pentagon", "verification/external/scenes/pentagon_tresca.toml", (1, 2, 3, 4, 5), 1,
+          "Chouly-Ern-Pignet solution at lambda = 3 on a Gmsh pentagon (12 triangles, red-refined), "
+          "Dirichlet data on two sides, Neumann on one"),
 )
 
 

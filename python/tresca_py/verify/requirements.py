@@ -232,7 +232,7 @@ REQUIREMENTS = (
     ),
     Requirement(
         'XA…',
-        'reach the same continuous solution as established external codes: on five scenes (Example 5.1, `mms_front`, the near-incompressible Chouly–Ern–Pignet case, an imposed normal displacement, `mms_rotated`) the Richardson limits of GetFEM P1/P2/Taylor–Hood, an independent scikit-fem P2 Nitsche solver and tresca-cr (‖u‖_H1, ½a(u,u), u·τ at three points, ∫σ_τ, stick-zone ends, max slip) agree pairwise within the sum of their GCI bands (about 5 min)',
+        'reach the same continuous solution as established external codes: on six scenes (Example 5.1, `mms_front`, the near-incompressible Chouly–Ern–Pignet case, an imposed normal displacement, `mms_rotated`, the Chouly–Ern–Pignet solution at λ = 3 on a Gmsh pentagon) the Richardson limits of GetFEM P1/P2/Taylor–Hood, an independent scikit-fem P2 Nitsche solver and tresca-cr (‖u‖_H1, ½a(u,u), u·τ at three points, ∫σ_τ, stick-zone ends, max slip) agree pairwise within the sum of their GCI bands (about 6 min)',
         'verification/external/run.py',
         'reference/external.md',
         pattern='XA-.+',
@@ -243,6 +243,13 @@ REQUIREMENTS = (
         'verification/external/run.py',
         'reference/external.md',
         pattern='XO-.+',
+    ),
+    Requirement(
+        'EB1…',
+        'balance the energy of every step, a_h(uⁿ,δuⁿ) + j_h(δuⁿ) = (lⁿ,δuⁿ) + W_Γⁿ (the reactions\' work on imposed data), to 1e-9 of the largest work of a step plus the rounding allowance of `tresca_py.audit.rounding` (γ_N (λ+2μ)/μ for the solve of N unknowns, 4ε max|u| ∫g_a for the friction term), with non-negative dissipations, in every results file that tresca-cr writes during `make verify`: after each study the harness audits the files it wrote (`tresca_py.audit`, as `scripts/check_results.py`), one result `EB1-<study>` listing every file with its relative residual; the study `audit` runs every scene of verification/cases/ and verification/external/scenes/ once with a results file (the `tresca-cr study` cases keep none)',
+        'verification/run_all.py (after each study; tresca_py/verify/audits.py)',
+        None,
+        pattern='EB1-.+',
     ),
 )
 

@@ -15,7 +15,7 @@ import subprocess
 import time
 
 from tresca_py.common import BIN, PY
-from tresca_py.verify import adaptive, checks, estimates, paper, studies
+from tresca_py.verify import adaptive, audits, checks, estimates, paper, studies
 from tresca_py.verify.harness import Harness, out_dir
 
 
@@ -62,6 +62,7 @@ def study_table(quick):
         "distributed": lambda hs: checks.distributed(hs, quick),
         "fuzz": lambda hs: checks.fuzz(hs, quick),
         "external": lambda hs: checks.external(hs, quick),
+        "audit": lambda hs: audits.run_cases(hs, quick),
     }
 
 
@@ -88,10 +89,12 @@ def main(argv=None):
     for name, fn in table.items():
         if args.only and name not in args.only:
             continue
+        before = audits.snapshot(hs.out)  # A1 audits the results files the study writes
         try:
             fn(hs)
         except Exception as e:  # a study that cannot run is a failed requirement, not a crash
             hs.not_run(name, str(e).splitlines()[0][:300] if str(e) else repr(e))
+        audits.audit_study(hs, name, before)
     header = (f"Machine: {os.uname().nodename}, {os.cpu_count()} cores; total {time.time() - t0:.0f} s. "
               f"Versions: {versions()}.")
     return hs.report(header, partial=bool(args.only))

@@ -24,6 +24,7 @@ import numpy as np
 
 from tresca_py.common import BIN, REF, ROOT, short_path
 from tresca_py.verify import summary as cli_summary
+from tresca_py.verify import audits
 from tresca_py.verify.harness import Harness, out_dir
 from tresca_py.common import rel_to as rel
 NEAR = os.path.join(ROOT, "verification", "cases", "near_incompressible.toml")
@@ -455,6 +456,8 @@ def main(argv=None):
             c(st)
         except Exception as e:  # noqa: BLE001
             st.check(c.__name__, "runs", f"script error: {e!r}"[:300], False)
+    # A1: the energy audit of every results file the cases kept (the refused runs' files are not kept)
+    audits.record(hs, "stability", [p for p in st.h5_files if p and os.path.exists(p)])
     if args.json:
         hs.dump(args.json)
     nfail = len(hs.failed)
