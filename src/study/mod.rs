@@ -128,7 +128,7 @@ fn run_level(
     s.set_steps(level.steps)?;
     let start = Instant::now();
     let problem = cache.problem(s, level.refine)?;
-    let mut u = Vec::new();
+    let (mut u, mut kept_t) = (Vec::new(), Vec::new());
     let (mut max_err, mut common_err, mut final_err) = (None::<ErrorNorms>, None::<ErrorNorms>, None);
     let (mut iterations, mut norm_max) = (0, 0.0f64);
     let times = &problem.scene.times;
@@ -153,6 +153,7 @@ fn run_level(
         if is_common[r.n] {
             norm_max = norm_max.max(r.energy.max(0.0).sqrt());
             u.push(r.u.clone());
+            kept_t.push(r.t);
         }
         if r.n == last_n {
             values = outputs::values(&names, &problem, r);
@@ -187,7 +188,7 @@ fn run_level(
         outputs: values,
         ..LevelResult::default()
     };
-    Ok(Kept { problem, u })
+    Ok(Kept { problem, u, t: kept_t })
 }
 
 /// A study under way: levels are added one at a time ([`Sequence::push`]), each compared with the two
@@ -269,7 +270,7 @@ impl<'a> Sequence<'a> {
     pub fn push(&mut self, level: Level) -> Result<&LevelResult> {
         let mut r = LevelResult::default();
         let kept = run_level(self.scene, &self.cache, level, &self.common, true, &mut r)?;
-        r.jumps = measure::jumps(&kept);
+        r.jumps = measure::jumps(&kept)?;
         if let Some(p) = &self.prev {
             if self.consecutive {
                 r.consecutive = Some(max_last(&measure::consecutive(&kept, p)?));
