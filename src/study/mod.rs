@@ -26,6 +26,7 @@ use crate::stepping::{RunOptions, StepResult};
 pub use cache::SetupCache;
 use measure::{max_last, Kept};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 crate::named_enum! {
@@ -79,6 +80,9 @@ pub struct LevelResult {
     /// Seconds of set-up shared from that earlier level (0 when factorised): `setup` plus this is the
     /// set-up of a run of the level alone.
     pub reused_setup: f64,
+    /// Whether the level was handed from an earlier sequence's run of it ([`SetupCache`], a plan's
+    /// pilots): not run again, its times are that run's.
+    pub shared_run: bool,
     pub iterations: usize,
     /// True errors, max over the level's own time nodes ("max over n").
     pub max_err: Option<ErrorNorms>,
@@ -161,7 +165,8 @@ fn run_level(
         Ok(())
     };
     on_step(&first)?;
-    problem.run(RunOptions { after: Some(first), want: |n| all || is_common[n] }, &mut on_step)?;
+    // no energy audit: a study reports none (with boundary data it runs anyway, for the steps' energy)
+    problem.run(RunOptions { after: Some(first), want: |n| all || is_common[n], audit: false }, &mut on_step)?;
     if u.len() != common.len() {
         return Err(Error::scene(
             &scene.file,
@@ -203,8 +208,10 @@ pub struct Sequence<'a> {
     differences: Option<&'a Path>,
     difference_files: Vec<PathBuf>,
     results: Vec<LevelResult>,
-    prev: Option<Kept>,
-    prev2: Option<Kept>,
+    prev: Option<Arc<Kept>>,
+    prev2: Option<Arc<Kept>>,
+    /// Take levels from, and keep them in, the cache's runs ([`Sequence::sharing_runs`]).
+    share_runs: bool,
     /// Measure the paper's consecutive-level error |||u_l − P u_{l−1}||| (reported by studies; the
     /// planner does not use it).
     consecutive: bool,
@@ -255,8 +262,16 @@ impl<'a> Sequence<'a> {
             results: vec![],
             prev: None,
             prev2: None,
+            share_runs: false,
             consecutive: true,
         })
+    }
+
+    /// The sequence taking a level from the cache when an earlier sequence with the same common time
+    /// nodes ran it, and keeping its levels there for later ones ([`SetupCache`]: the planner's pilots).
+    pub fn sharing_runs(mut self) -> Self {
+        self.share_runs = true;
+        self
     }
 
     /// The sequence without the paper's consecutive-level error (a prolongation and an energy norm at
@@ -268,9 +283,20 @@ impl<'a> Sequence<'a> {
 
     /// Run one more level and compare it with the previous two (and the reference run).
     pub fn push(&mut self, level: Level) -> Result<&LevelResult> {
-        let mut r = LevelResult::default();
-        let kept = run_level(self.scene, &self.cache, level, &self.common, true, &mut r)?;
-        r.jumps = measure::jumps(&kept)?;
+        let common = self.common.len() - 1;
+        let (mut r, kept) = match self.cache.kept_run(level, common).filter(|_| self.share_runs) {
+            Some((r, kept)) => (LevelResult { shared_run: true, ..r }, kept),
+            None => {
+                let mut r = LevelResult::default();
+                let kept = Arc::new(run_level(self.scene, &self.cache, level, &self.common, true, &mut r)?);
+                self.cache.count_run(level, common);
+                r.jumps = measure::jumps(&kept)?;
+                if self.share_runs {
+                    self.cache.keep_run(level, common, &r, &kept);
+                }
+                (r, kept)
+            }
+        };
         if let Some(p) = &self.prev {
             if self.consecutive {
                 r.consecutive = Some(max_last(&measure::consecutive(&kept, p)?));
