@@ -288,6 +288,9 @@ impl<'a> Sequence<'a> {
             Some((r, kept)) => (LevelResult { shared_run: true, ..r }, kept),
             None => {
                 let mut r = LevelResult::default();
+                // the pilots of a plan run one after the other on one thread: the Arc is for the cache's
+                // Mutex, never sent to another thread
+                #[allow(clippy::arc_with_non_send_sync)]
                 let kept = Arc::new(run_level(self.scene, &self.cache, level, &self.common, true, &mut r)?);
                 self.cache.count_run(level, common);
                 r.jumps = measure::jumps(&kept)?;
