@@ -71,3 +71,25 @@ fn a_plan_factorises_each_pilot_mesh_once() {
     assert!(p.time.levels.iter().skip(1).all(|l| !l.factorised), "the time pilot shares its mesh");
     assert!(cache.problems() > made.len() + 2, "{} levels on {} set-ups", cache.problems(), made.len());
 }
+
+/// Requirement: the system shall solve each pilot level of a plan once: a level (mesh, steps, common
+/// time nodes) an earlier pilot ran is taken from that run. On mms_stop (N = 4) the time pilot's doubling
+/// grids 4, 8, 16, 32 are not in the asymptotic range, so its ×4 grids 4, 16, 64, 256 follow: 4 and 16
+/// were run by the doubling grids and are not solved again; no level is solved twice in the whole plan.
+#[test]
+fn a_plan_solves_each_pilot_level_once() {
+    let s = scene("verification/cases/mms_stop.toml");
+    let options =
+        Options { target: 5.6e-3, quantity: Quantity::Energy, budget: 600.0, pilot_budget: 60.0, max_memory: None };
+    let cache = tresca_cr::study::SetupCache::default();
+    let p = plan_with_cache(&s, &options, &cache).unwrap();
+    assert!(p.refused.is_none(), "{:?}", p.refused);
+    let solved = cache.solved();
+    let mut unique = solved.clone();
+    unique.sort_unstable();
+    unique.dedup();
+    assert_eq!(solved.len(), unique.len(), "a pilot level was solved twice: {solved:?}");
+    assert_eq!(p.time_ratio, 4);
+    let shared: Vec<usize> = p.time.levels.iter().filter(|l| l.shared_run).map(|l| l.steps).collect();
+    assert_eq!(shared, [4, 16], "the ×4 grids the doubling grids ran");
+}

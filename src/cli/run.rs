@@ -75,7 +75,7 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool, json: Opti
     // Without a results file and without true errors, u is formed only at the last step: every step still
     // solves the friction problem (slip, μ, stick/slip), but reconstructing u costs O(n·n_c) per step.
     let want = |k: usize| all || k == n;
-    let result = problem.run(RunOptions { after: first, want }, on_step);
+    let result = problem.run(RunOptions { after: first, want, audit: true }, on_step);
     if let Some(z) = problem.friction.as_ref().map(|f| f.zeroed_steps()).filter(|&z| z > 0) {
         note!(
             "note: at {z} steps the friction bound g_a was below the rounding of the load (its effect on the slip \

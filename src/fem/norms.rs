@@ -79,9 +79,10 @@ pub struct ErrorEvaluator {
     bound: Option<ExactAt>,
     /// Per stabilised edge and Gauss point: weight · 2ρμ and the jump terms.
     jumps: Jumps,
-    /// With boundary data: the Gauss points on Γ_D (index into `jumps`, point), where the exact u is
-    /// subtracted from the jump; empty without data.
-    boundary: Vec<(usize, [f64; 2])>,
+    /// With boundary data: the Gauss points on Γ_D (index into `jumps`, edge, point), where the exact u
+    /// (or the data u_D, [`ErrorEvaluator::jump_energy_against`]) is subtracted from the jump; empty
+    /// without data.
+    boundary: Vec<(usize, usize, [f64; 2])>,
     law: Elasticity,
 }
 
@@ -109,7 +110,7 @@ impl ErrorEvaluator {
                 for (s, w) in GAUSS2 {
                     if space.data.is_some() && mesh.edge_tris[e].1.is_none() {
                         let [a, b] = mesh.edges[e].map(|v| mesh.points[v]);
-                        boundary.push((jumps.weight.len(), super::quadrature::edge_point(a, b, s)));
+                        boundary.push((jumps.weight.len(), e, super::quadrature::edge_point(a, b, s)));
                     }
                     jumps.weight.push(pen * w);
                     for (k, p) in jump_terms(mesh, e, s) {
@@ -293,7 +294,21 @@ impl ErrorEvaluator {
 
     /// The exact u at the Γ_D points of `boundary` at time t.
     fn boundary_values(&self, exact: &Exact, t: f64) -> Result<Vec<(usize, [f64; 2])>> {
-        self.boundary.iter().map(|&(q, x)| Ok((q, exact.u.eval(x[0], x[1], t)?))).collect()
+        self.boundary.iter().map(|&(q, _, x)| Ok((q, exact.u.eval(x[0], x[1], t)?))).collect()
+    }
+
+    /// The stabilisation part with the jump on Γ_D measured against data: Σ_{e interior} (2ρμ/h_e) ∫_e
+    /// |[u_h]|² + Σ_{e ⊂ Γ_D} (2ρμ/h_e) ∫_e |u_h − u_D|², `u_d(e, x)` giving u_D at point x of Dirichlet
+    /// edge e (the jump part of the true error, [`ErrorEvaluator::errors`], without the exact u). Without
+    /// data, [`ErrorEvaluator::jump_energy`].
+    pub fn jump_energy_against(
+        &self,
+        mid: &[[f64; 2]],
+        u_d: impl Fn(usize, [f64; 2]) -> Result<[f64; 2]>,
+    ) -> Result<f64> {
+        let sub: Vec<(usize, [f64; 2])> =
+            self.boundary.iter().map(|&(q, e, x)| Ok((q, u_d(e, x)?))).collect::<Result<_>>()?;
+        Ok(self.jump_energy_minus(mid, &sub))
     }
 
     /// [`ErrorEvaluator::jump_energy`] with `sub` (jump point, value; increasing points) subtracted

@@ -96,8 +96,7 @@ pub fn prolong_with(parent: &[usize], coarse: (&Mesh, &CrSpace), u_c: &[f64], fi
     Prolongation::new(parent, coarse.0, fine).apply(coarse.1, u_c, fine.1)
 }
 
-/// P as an operator, for prolonging many fields between the same two meshes: for every fine edge with
-/// unknowns, the values φ_i(m) of the CR basis functions of its (one or two) fine triangles' coarse
+/// P as an operator, for prolonging many fields between the same two meshes: for every fine edge, the values φ_i(m) of the CR basis functions of its (one or two) fine triangles' coarse
 /// parents at its midpoint m, with their coarse edges. Each field then costs a gather; the values are
 /// the same, bit for bit, as computing the geometry anew for it.
 pub struct Prolongation {
@@ -114,15 +113,13 @@ impl Prolongation {
         let mut start = Vec::with_capacity(fs.edge_dof.len() + 1);
         let mut terms = Vec::with_capacity(6 * fs.edge_dof.len());
         start.push(0);
-        for (e, dof) in fs.edge_dof.iter().enumerate() {
-            if dof.terms().next().is_some() {
-                let m = fm.midpoint(e);
-                let (t1, t2) = fm.edge_tris[e];
-                for t in [Some(t1), t2].into_iter().flatten() {
-                    let ct = parent[t];
-                    let phi = Element::phi(Element::new(coarse, ct).bary(m));
-                    terms.extend(phi.iter().enumerate().map(|(i, &p)| (coarse.tri_edges[ct][i], p)));
-                }
+        for e in 0..fs.edge_dof.len() {
+            let m = fm.midpoint(e);
+            let (t1, t2) = fm.edge_tris[e];
+            for t in [Some(t1), t2].into_iter().flatten() {
+                let ct = parent[t];
+                let phi = Element::phi(Element::new(coarse, ct).bary(m));
+                terms.extend(phi.iter().enumerate().map(|(i, &p)| (coarse.tri_edges[ct][i], p)));
             }
             start.push(terms.len());
         }
@@ -135,22 +132,34 @@ impl Prolongation {
         let mid = coarse.midpoint_values(u_c);
         let mut u = vec![0.0; fine.n_dofs];
         for (e, dof) in fine.edge_dof.iter().enumerate() {
-            let terms = &self.terms[self.start[e]..self.start[e + 1]];
-            if terms.is_empty() {
+            if dof.terms().next().is_none() {
                 continue;
             }
-            let mut sum = [0.0; 2];
-            for &(c, p) in terms {
-                let v = mid[c];
-                sum = [sum[0] + p * v[0], sum[1] + p * v[1]];
-            }
-            let count = (terms.len() / 3) as f64;
-            let v = [sum[0] / count, sum[1] / count];
+            let v = self.at(e, &mid);
             for (k, c) in dof.terms() {
                 u[k] = c[0] * v[0] + c[1] * v[1];
             }
         }
         u
+    }
+
+    /// P U_c on the full midpoint fields: from the coarse displacement at every coarse edge midpoint
+    /// (the lifting of boundary data included, `CrSpace::displacement`) to the value at every fine edge
+    /// midpoint, constrained edges included.
+    pub fn apply_full(&self, mid: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        (0..self.start.len() - 1).map(|e| self.at(e, mid)).collect()
+    }
+
+    /// Fine edge e's value: the mean over its parents of Σ_i φ_i(m) mid(coarse edge i).
+    fn at(&self, e: usize, mid: &[[f64; 2]]) -> [f64; 2] {
+        let terms = &self.terms[self.start[e]..self.start[e + 1]];
+        let mut sum = [0.0; 2];
+        for &(c, p) in terms {
+            let v = mid[c];
+            sum = [sum[0] + p * v[0], sum[1] + p * v[1]];
+        }
+        let count = (terms.len() / 3) as f64;
+        [sum[0] / count, sum[1] / count]
     }
 }
 

@@ -179,9 +179,11 @@ pub struct Runner<'a> {
 
 impl<'a> Runner<'a> {
     /// A pilot sequence whose levels take their set-ups from `cache` (one per mesh for all the pilots of
-    /// a plan: the time pilot's levels share one mesh, and the space pilot returns to it).
+    /// a plan: the time pilot's levels share one mesh, and the space pilot returns to it), and the levels
+    /// an earlier pilot ran with the same common nodes ([`Sequence::sharing_runs`]).
     pub fn new(scene: &'a Scene, min_steps: usize, cache: &SetupCache) -> Result<Runner<'a>> {
-        let seq = Sequence::with_cache(scene, min_steps, None, None, cache.clone())?.without_consecutive();
+        let seq =
+            Sequence::with_cache(scene, min_steps, None, None, cache.clone())?.without_consecutive().sharing_runs();
         Ok(Runner { seq, spent: 0.0 })
     }
 
@@ -208,8 +210,9 @@ impl<'a> Runner<'a> {
                 m as f64 / 1e9
             )));
         }
-        let wall = self.seq.push(level)?.wall;
-        self.spent += wall;
+        let r = self.seq.push(level)?;
+        // a level an earlier pilot ran is not run again: it costs nothing more
+        self.spent += if r.shared_run { 0.0 } else { r.wall };
         Ok(None)
     }
 

@@ -45,8 +45,8 @@ pub struct Problem {
     pub mesh: Mesh,
     pub space: CrSpace,
     pub law: Elasticity,
-    /// K, the matrix of a_h on V_h.
-    pub stiffness: SparseColMat<usize, f64>,
+    /// K, the matrix of a_h on V_h (shared by the problems on one mesh's set-up, [`MeshSetUp`]).
+    pub stiffness: Arc<SparseColMat<usize, f64>>,
     /// u_f = K⁻¹lⁿ and its contact trace; owns the factor of K.
     pub free: FreeResponse,
     /// The friction problem on Γ_C (`None` without Γ_C: plain elasticity).

@@ -157,38 +157,48 @@ impl Problem {
         options: RunOptions<impl Fn(usize) -> bool>,
         on_step: impl FnMut(&StepResult) -> Result<()>,
     ) -> Result<()> {
-        let RunOptions { after, want } = options;
+        let RunOptions { after, want, audit } = options;
+        // with boundary data the audit also gives a step's energy (2Eⁿ): always run then
+        let audit = audit || self.space.data.is_some();
         match after {
-            Some(from) => self.run_handing(from, None, want, on_step),
+            Some(from) => self.run_handing(from, None, (want, audit), on_step),
             None => {
                 let first = self.initial_unchecked().map_err(|e| self.prefer_conditioning(e))?;
-                self.run_handing(first.clone(), Some(first), want, on_step)
+                self.run_handing(first.clone(), Some(first), (want, audit), on_step)
             }
         }
     }
 
     /// Run steps from `from` to N; `first`, if given, is handed out before them. Every result is handed
-    /// out only once K's condition estimate is accepted.
+    /// out only once K's condition estimate is accepted; with `audit`, with its energy audit.
     fn run_handing(
         &self,
         from: StepResult,
         first: Option<StepResult>,
-        want: impl Fn(usize) -> bool,
+        (want, audit): (impl Fn(usize) -> bool, bool),
         mut on_step: impl FnMut(&StepResult) -> Result<()>,
     ) -> Result<()> {
         // the energy audit of every step handed out, against the state of the step before
         let (first, mut state) = match first {
-            Some(f) => {
+            Some(f) if audit => {
                 let (f, s) = self.audited(None, &f)?;
                 (Some(f), s)
             }
-            None => (None, self.audit_state(&from)?),
+            Some(f) => (Some(f), None),
+            None if audit => (None, self.audit_state(&from)?),
+            None => (None, None),
         };
         let mut held = Held { first, steps: Vec::new(), bytes: 0 };
         let mut hand = |r: &StepResult| -> Result<()> {
-            let (r, s) = self.audited(state.as_ref(), r)?;
-            state = s;
-            let r = &r;
+            let audited;
+            let r = if audit {
+                let (a, s) = self.audited(state.as_ref(), r)?;
+                state = s;
+                audited = a;
+                &audited
+            } else {
+                r
+            };
             if !self.conditioning.ready() && held.hold(r) {
                 return Ok(());
             }
@@ -231,16 +241,20 @@ pub struct RunOptions<W> {
     pub after: Option<StepResult>,
     /// The steps at which u is formed (the others carry slip, μ and stick/slip only).
     pub want: W,
+    /// Audit the energy of every step ([`super::audit`]); off where no one reads it (a study's levels:
+    /// saves a matrix-free a_h product per node). With boundary data the audit always runs: it gives
+    /// a step's energy.
+    pub audit: bool,
 }
 
 impl RunOptions<fn(usize) -> bool> {
     /// Every step from step 0, u formed at each.
     pub fn all() -> Self {
-        RunOptions { after: None, want: |_| true }
+        RunOptions { after: None, want: |_| true, audit: true }
     }
 
     /// The steps after `r`, u formed at each.
     pub fn after(r: StepResult) -> Self {
-        RunOptions { after: Some(r), want: |_| true }
+        RunOptions { after: Some(r), want: |_| true, audit: true }
     }
 }

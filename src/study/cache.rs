@@ -7,7 +7,15 @@
 //! available when a set-up is added (the newest is always kept): the planner returns to its pilot
 //! meshes, and studies usually hold one mesh at a time. Which set-ups it keeps only changes speed:
 //! a shared set-up has the values of a fresh one.
+//!
+//! It also keeps the finished levels of sequences that share runs (the planner's pilots,
+//! [`super::Sequence::sharing_runs`]): a level (mesh, steps) run by one pilot sequence with the same
+//! common time nodes is handed to the next instead of run again (the time pilot's ×4 grids after its
+//! doubling grids, the space pilot's level on the time pilot's mesh and grid). A kept run has the values
+//! of a fresh one (the same set-up and steps); its runs are dropped with its mesh's set-up.
 
+use super::measure::Kept;
+use super::{Level, LevelResult};
 use crate::error::Result;
 use crate::scene::budget::available_memory;
 use crate::scene::Scene;
@@ -31,6 +39,10 @@ struct Inner {
     made: Vec<u32>,
     /// Problems handed out.
     problems: usize,
+    /// Finished levels kept for sequences sharing runs, with their sequence's number of common steps.
+    runs: Vec<(Level, usize, LevelResult, Arc<Kept>)>,
+    /// Levels run (refinement, steps, common steps), in order: each solve of the steps.
+    solved: Vec<(u32, usize, usize)>,
 }
 
 impl SetupCache {
@@ -61,9 +73,43 @@ impl SetupCache {
         while inner.entries.len() > 1
             && inner.entries[..inner.entries.len() - 1].iter().map(|(_, m)| m.bytes() as f64).sum::<f64>() > limit
         {
-            inner.entries.remove(0);
+            let (r, _) = inner.entries.remove(0);
+            inner.runs.retain(|(l, ..)| l.refine != r);
         }
         Ok((m, true))
+    }
+
+    /// A finished level of a sequence with `common` common steps, if one was kept ([`SetupCache::keep_run`]).
+    pub(crate) fn kept_run(&self, level: Level, common: usize) -> Option<(LevelResult, Arc<Kept>)> {
+        let inner = self.lock();
+        let found = inner.runs.iter().find(|(l, c, ..)| *l == level && *c == common);
+        found.map(|(_, _, r, k)| (r.clone(), Arc::clone(k)))
+    }
+
+    /// Count a level run (refinement, steps) of a sequence with `common` common steps.
+    pub(crate) fn count_run(&self, level: Level, common: usize) {
+        self.lock().solved.push((level.refine, level.steps, common));
+    }
+
+    /// Keep a finished level for later sequences sharing runs, while its mesh's set-up is kept and the
+    /// kept unknowns hold at most [`SHARE_OF_MEMORY`] / 2 of the available memory.
+    pub(crate) fn keep_run(&self, level: Level, common: usize, result: &LevelResult, kept: &Arc<Kept>) {
+        let mut inner = self.lock();
+        if !inner.entries.iter().any(|(r, _)| *r == level.refine) {
+            return;
+        }
+        let bytes = |k: &Kept| k.u.iter().map(|u| 8 * u.len()).sum::<usize>();
+        let held: usize = inner.runs.iter().map(|(.., k)| bytes(k)).sum::<usize>() + bytes(kept);
+        let limit = available_memory().map_or(0.0, |a| a as f64 * SHARE_OF_MEMORY / 2.0);
+        if held as f64 <= limit {
+            inner.runs.push((level, common, result.clone(), Arc::clone(kept)));
+        }
+    }
+
+    /// The levels run so far (refinement, steps, common steps), in order; a level handed from a kept
+    /// run is not run again and not listed again.
+    pub fn solved(&self) -> Vec<(u32, usize, usize)> {
+        self.lock().solved.clone()
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, Inner> {

@@ -1,5 +1,5 @@
 //! `study --differences DIR`: per level l ≥ 2, the elementwise energy density σ(d):ε(d) of
-//! d = u_l − P u_{l−1} (constant per triangle of level l; ∇P u_{l−1} = ∇u_{l−1} there on nested meshes) as
+//! d = u_l − P u_{l−1} (the displacements, boundary data's lifting included; constant per triangle of level l; ∇P u_{l−1} = ∇u_{l−1} there on nested meshes) as
 //! a cell field, in one XDMF3 file per level with the data inline (XML), which ParaView and meshio
 //! open: `DIR/difference_<refine>_<steps>.xdmf`, fields `density_T` (at the final time) and `density_max`
 //! (max over the common time nodes) and `energy_T` (density × area, the element's share of
@@ -22,8 +22,8 @@ pub fn write(dir: &Path, fine: &Kept, coarse: &Kept) -> Result<std::path::PathBu
     };
     let mut dmax = vec![0.0f64; nt];
     let mut dlast = vec![0.0; nt];
-    for (uf, uc) in fine.u.iter().zip(&coarse.u) {
-        dlast = pair.density(uf, uc);
+    for i in 0..fine.u.len() {
+        dlast = pair.density(&fine.displacement(i)?, &coarse.displacement(i)?);
         for (m, d) in dmax.iter_mut().zip(&dlast) {
             *m = m.max(*d);
         }

@@ -10,18 +10,40 @@
 //!   seminorm (Σ_{T fine} ∫_T σ(u_f − u_c):ε(u_f − u_c))^{1/2} — a true inner-product norm on the finest
 //!   broken-P1 space, in which the level errors' gradient parts live, the jump part |||·|||² − that of a
 //!   level's own error being its own jumps, computed exactly — and a_h(·,·)^{1/2} on a shared mesh.
+//!
+//! With boundary data (`fem::lifting`) every distance is one of the displacements u = w + u_L(tₙ), not of
+//! the unknowns w, as the true errors are: the densities and the prolongation take the full midpoint
+//! fields ([`Kept::displacement`]), the consecutive error is A(d, d)^{1/2} with d = u_l − P u_{l−1} and A
+//! the audit's form on full fields (`fem::forms`: the jump of d on Γ_D is d), and a level's own jumps
+//! are measured against u_D on Γ_D. On a shared mesh the lifting of the common nodes is the same on both
+//! levels, so u_f − u_c = w_f − w_c there. Without data every quantity is computed as before, bit for bit.
 
 use crate::error::Result;
+use crate::fem::forms::{dot2, FullForm};
 use crate::fem::norms::ErrorEvaluator;
 use crate::fem::prolong::{parent_triangles, Prolongation};
 use crate::fem::space::Element;
+use crate::scene::PartKind;
 use crate::sparse::energy;
 use crate::stepping::Problem;
 
-/// A finished run kept for comparisons: problem and unknowns at the common time nodes.
+/// A finished run kept for comparisons: problem, and unknowns at the common time nodes `t`.
 pub struct Kept {
     pub problem: Problem,
     pub u: Vec<Vec<f64>>,
+    pub t: Vec<f64>,
+}
+
+impl Kept {
+    /// The displacement u = w + u_L(t) at every edge midpoint at common node i (the unknowns' midpoint
+    /// values without boundary data).
+    pub fn displacement(&self, i: usize) -> Result<Vec<[f64; 2]>> {
+        self.problem.space.displacement(&self.u[i], self.t[i])
+    }
+
+    fn has_data(&self) -> bool {
+        self.problem.space.data.is_some()
+    }
 }
 
 /// a_h(e, e)^{1/2} on the unknowns of `p`.
@@ -49,10 +71,10 @@ impl<'a> Pair<'a> {
         Pair { fine, coarse, parent, fine_elements: elements(fine), coarse_elements: elements(coarse) }
     }
 
-    /// Elementwise energy density σ(u_f − u_c):ε(u_f − u_c) on the fine triangles for unknowns `uf`, `uc`.
-    pub fn density(&self, uf: &[f64], uc: &[f64]) -> Vec<f64> {
+    /// Elementwise energy density σ(u_f − u_c):ε(u_f − u_c) on the fine triangles for the midpoint fields
+    /// `mf`, `mc` ([`Kept::displacement`]).
+    pub fn density(&self, mf: &[[f64; 2]], mc: &[[f64; 2]]) -> Vec<f64> {
         let (fine, coarse) = (self.fine, self.coarse);
-        let (mf, mc) = (fine.space.midpoint_values(uf), coarse.space.midpoint_values(uc));
         (0..fine.mesh.tris.len())
             .map(|t| {
                 let gf = self.fine_elements[t].gradient(fine.mesh.tri_edges[t].map(|e| mf[e]));
@@ -74,6 +96,16 @@ fn integrate(p: &Problem, dens: &[f64]) -> f64 {
 pub fn consecutive(fine: &Kept, coarse: &Kept) -> Result<Vec<f64>> {
     let (c, f) = (&coarse.problem, &fine.problem);
     let p = Prolongation::new(&parent_triangles(&c.mesh, &f.mesh)?, &c.mesh, (&f.mesh, &f.space));
+    if fine.has_data() {
+        let form = FullForm::new(&f.mesh, &f.space, &f.law, f.scene.rho);
+        return (0..fine.u.len())
+            .map(|i| {
+                let (mf, pc) = (fine.displacement(i)?, p.apply_full(&coarse.displacement(i)?));
+                let d: Vec<[f64; 2]> = mf.iter().zip(&pc).map(|(a, b)| [a[0] - b[0], a[1] - b[1]]).collect();
+                Ok(dot2(&form.apply(&f.mesh, &d), &d).max(0.0).sqrt())
+            })
+            .collect();
+    }
     Ok(fine
         .u
         .iter()
@@ -93,18 +125,33 @@ pub fn distance(fine: &Kept, coarse: &Kept) -> Result<Vec<f64>> {
         return Ok(fine.u.iter().zip(&coarse.u).map(|(a, b)| energy_norm(fp, &diff(a, b))).collect());
     }
     let pair = Pair::new(fp, cp, parent_triangles(&cp.mesh, &fp.mesh)?);
-    Ok(fine.u.iter().zip(&coarse.u).map(|(uf, uc)| integrate(fp, &pair.density(uf, uc)).max(0.0).sqrt()).collect())
+    (0..fine.u.len())
+        .map(|i| Ok(integrate(fp, &pair.density(&fine.displacement(i)?, &coarse.displacement(i)?)).max(0.0).sqrt()))
+        .collect()
 }
 
 fn diff(a: &[f64], b: &[f64]) -> Vec<f64> {
     a.iter().zip(b).map(|(x, y)| x - y).collect()
 }
 
-/// The stabilisation energy Σ_e (2ρμ/h_e) ∫_e |[u_l]|² of a level at every common node.
-pub fn jumps(lv: &Kept) -> Vec<f64> {
+/// The stabilisation energy Σ_e (2ρμ/h_e) ∫_e |[u_l]|² of a level at every common node (with boundary
+/// data the jump on Γ_D is u_l − u_D: the jump part of the level's true error).
+pub fn jumps(lv: &Kept) -> Result<Vec<f64>> {
     let p = &lv.problem;
     let ev = ErrorEvaluator::new(&p.mesh, &p.space, &p.law, p.scene.rho);
-    lv.u.iter().map(|u| ev.jump_energy(&p.space.midpoint_values(u))).collect()
+    if !lv.has_data() {
+        return Ok(lv.u.iter().map(|u| ev.jump_energy(&p.space.midpoint_values(u))).collect());
+    }
+    let parts = &p.scene.parts;
+    (0..lv.u.len())
+        .map(|i| {
+            let t = lv.t[i];
+            ev.jump_energy_against(&lv.displacement(i)?, |e, x| match p.space.edge_part[e].map(|k| &parts[k].kind) {
+                Some(PartKind::Dirichlet(Some(u))) => u.eval(x[0], x[1], t),
+                _ => Ok([0.0; 2]),
+            })
+        })
+        .collect()
 }
 
 /// |||u_ref − u_l||| at every common node (module doc).
@@ -113,7 +160,7 @@ pub fn reference_error(rf: &Kept, lv: &Kept) -> Result<Vec<f64>> {
         return distance(rf, lv);
     }
     let grad = distance(rf, lv)?;
-    Ok(grad.iter().zip(jumps(lv)).map(|(g, j)| (g * g + j).max(0.0).sqrt()).collect())
+    Ok(grad.iter().zip(jumps(lv)?).map(|(g, j)| (g * g + j).max(0.0).sqrt()).collect())
 }
 
 /// (max, last) of a series.

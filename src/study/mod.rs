@@ -26,6 +26,7 @@ use crate::stepping::{RunOptions, StepResult};
 pub use cache::SetupCache;
 use measure::{max_last, Kept};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 crate::named_enum! {
@@ -79,6 +80,9 @@ pub struct LevelResult {
     /// Seconds of set-up shared from that earlier level (0 when factorised): `setup` plus this is the
     /// set-up of a run of the level alone.
     pub reused_setup: f64,
+    /// Whether the level was handed from an earlier sequence's run of it ([`SetupCache`], a plan's
+    /// pilots): not run again, its times are that run's.
+    pub shared_run: bool,
     pub iterations: usize,
     /// True errors, max over the level's own time nodes ("max over n").
     pub max_err: Option<ErrorNorms>,
@@ -128,7 +132,7 @@ fn run_level(
     s.set_steps(level.steps)?;
     let start = Instant::now();
     let problem = cache.problem(s, level.refine)?;
-    let mut u = Vec::new();
+    let (mut u, mut kept_t) = (Vec::new(), Vec::new());
     let (mut max_err, mut common_err, mut final_err) = (None::<ErrorNorms>, None::<ErrorNorms>, None);
     let (mut iterations, mut norm_max) = (0, 0.0f64);
     let times = &problem.scene.times;
@@ -153,6 +157,7 @@ fn run_level(
         if is_common[r.n] {
             norm_max = norm_max.max(r.energy.max(0.0).sqrt());
             u.push(r.u.clone());
+            kept_t.push(r.t);
         }
         if r.n == last_n {
             values = outputs::values(&names, &problem, r);
@@ -160,7 +165,8 @@ fn run_level(
         Ok(())
     };
     on_step(&first)?;
-    problem.run(RunOptions { after: Some(first), want: |n| all || is_common[n] }, &mut on_step)?;
+    // no energy audit: a study reports none (with boundary data it runs anyway, for the steps' energy)
+    problem.run(RunOptions { after: Some(first), want: |n| all || is_common[n], audit: false }, &mut on_step)?;
     if u.len() != common.len() {
         return Err(Error::scene(
             &scene.file,
@@ -187,7 +193,7 @@ fn run_level(
         outputs: values,
         ..LevelResult::default()
     };
-    Ok(Kept { problem, u })
+    Ok(Kept { problem, u, t: kept_t })
 }
 
 /// A study under way: levels are added one at a time ([`Sequence::push`]), each compared with the two
@@ -202,8 +208,10 @@ pub struct Sequence<'a> {
     differences: Option<&'a Path>,
     difference_files: Vec<PathBuf>,
     results: Vec<LevelResult>,
-    prev: Option<Kept>,
-    prev2: Option<Kept>,
+    prev: Option<Arc<Kept>>,
+    prev2: Option<Arc<Kept>>,
+    /// Take levels from, and keep them in, the cache's runs ([`Sequence::sharing_runs`]).
+    share_runs: bool,
     /// Measure the paper's consecutive-level error |||u_l − P u_{l−1}||| (reported by studies; the
     /// planner does not use it).
     consecutive: bool,
@@ -254,8 +262,16 @@ impl<'a> Sequence<'a> {
             results: vec![],
             prev: None,
             prev2: None,
+            share_runs: false,
             consecutive: true,
         })
+    }
+
+    /// The sequence taking a level from the cache when an earlier sequence with the same common time
+    /// nodes ran it, and keeping its levels there for later ones ([`SetupCache`]: the planner's pilots).
+    pub fn sharing_runs(mut self) -> Self {
+        self.share_runs = true;
+        self
     }
 
     /// The sequence without the paper's consecutive-level error (a prolongation and an energy norm at
@@ -267,9 +283,23 @@ impl<'a> Sequence<'a> {
 
     /// Run one more level and compare it with the previous two (and the reference run).
     pub fn push(&mut self, level: Level) -> Result<&LevelResult> {
-        let mut r = LevelResult::default();
-        let kept = run_level(self.scene, &self.cache, level, &self.common, true, &mut r)?;
-        r.jumps = measure::jumps(&kept);
+        let common = self.common.len() - 1;
+        let (mut r, kept) = match self.cache.kept_run(level, common).filter(|_| self.share_runs) {
+            Some((r, kept)) => (LevelResult { shared_run: true, ..r }, kept),
+            None => {
+                let mut r = LevelResult::default();
+                // the pilots of a plan run one after the other on one thread: the Arc is for the cache's
+                // Mutex, never sent to another thread
+                #[allow(clippy::arc_with_non_send_sync)]
+                let kept = Arc::new(run_level(self.scene, &self.cache, level, &self.common, true, &mut r)?);
+                self.cache.count_run(level, common);
+                r.jumps = measure::jumps(&kept)?;
+                if self.share_runs {
+                    self.cache.keep_run(level, common, &r, &kept);
+                }
+                (r, kept)
+            }
+        };
         if let Some(p) = &self.prev {
             if self.consecutive {
                 r.consecutive = Some(max_last(&measure::consecutive(&kept, p)?));
