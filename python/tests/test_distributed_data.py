@@ -111,6 +111,17 @@ def test_results_file_is_the_tresca_layout(runs, tmp_path):
     assert r.contact is None and r.status == "completed"
 
 
+def test_check_results_accepts_the_distributed_file(runs):
+    """The system shall accept a distributed results file in ``scripts/check_results.py``: exit 0, the /tresca
+    group checked (status, steps, contact edges of the file) and said to have no visualisation views."""
+    _, dx = runs("mms_data_stop")
+    r = results.read(dx)
+    p = run([PY, os.path.join(SCRIPTS, "check_results.py"), dx])
+    assert p.returncode == 0, p.stdout[-2000:] + p.stderr[-2000:]
+    assert f"{dx}: {r.completed} steps" in p.stdout and f"{len(r.contact.edges)} contact edges" in p.stdout, p.stdout
+    assert "solver 'dolfinx-distributed'" in p.stdout and "OK: the tresca group is valid" in p.stdout, p.stdout
+
+
 def scene_with(tmp_path, name, old, new):
     """verification/cases/NAME.toml with the text ``old`` replaced by ``new`` (exactly once)."""
     text = open(case(name)).read()

@@ -90,3 +90,33 @@ def test_the_system_shall_accept_and_refuse_expressions_as_the_rust_solver_does(
         python_ok = False
     assert python_ok == (p.returncode == 0), f"{text!r}: Rust: {p.stderr.strip() or 'accepted'}"
     assert os.path.exists(path)
+
+
+# parts in t alone where Rust's f64 gives inf or NaN and Python's float would raise (ZeroDivisionError,
+# OverflowError) or turn complex; x and y are arrays, as the solvers pass them
+# (text, t where it is not finite, its value there, a t where it is finite)
+IEEE = [("1/(t-0.5)", 0.5, "inf", 0.25), ("2^(1000*t) + x", 2.0, "inf", 0.5), ("(t-1)^0.3 + y", 0.0, "nan", 2.0)]
+
+
+@pytest.mark.parametrize("text, t, value, t_ok", IEEE)
+def test_the_system_shall_name_an_expression_whose_part_in_t_is_not_finite_with_the_point(text, t, value, t_ok):
+    e = Expr(text, "[loads] f[0]")
+    x, y = np.array([0.25, 0.75]), np.array([0.5, 0.5])
+    with pytest.raises(ExprError) as err:
+        e(x, y, t)
+    assert str(err.value) == f"[loads] f[0]: expression {text!r} has the value {value} at (x, y) = (0.25, 0.5), t = {t:g}"
+    assert np.all(np.isfinite(e(x, y, t_ok)))        # the same expression where f64 has a value: no error
+
+
+def test_the_system_shall_stop_a_run_where_a_load_is_not_finite_as_the_rust_solver_does(rust_bin, tmp_path):
+    """f = 1/(t - 0.5) at the time node t = 0.5: Rust and the scikit-fem re-implementation both stop with one
+    error line naming the expression, the value inf and the time; no traceback."""
+    from tresca_py.common import PY, SCRIPTS
+    path = tmp_path / "s.toml"
+    path.write_text(SCENE.format(expr="1/(t-0.5)"))
+    p = run([rust_bin, "run", str(path), "-o", str(tmp_path / "r.h5"), "-q"])
+    assert p.returncode != 0 and '"1/(t-0.5)": value inf at t = 0.5' in p.stderr, p.stderr
+    q = run([PY, os.path.join(SCRIPTS, "skfem_solve.py"), str(path), "-o", str(tmp_path / "p.h5"), "-q"])
+    lines = [ln for ln in q.stderr.splitlines() if ln.startswith("error:")]
+    assert q.returncode == 2 and "Traceback" not in q.stderr and len(lines) == 1, q.stderr[-2000:]
+    assert "expression '1/(t-0.5)' has the value inf at (x, y) = (" in lines[0] and "t = 0.5" in lines[0], lines

@@ -45,6 +45,16 @@ def run(cmd, check=True, **kw):
     return p, time.perf_counter() - t
 
 
+def git_commit():
+    """The repository's commit (a results file's ``git_commit`` attribute), "unknown" outside a clone."""
+    try:
+        out = subprocess.run(["git", "-C", os.path.dirname(os.path.abspath(__file__)), "rev-parse", "HEAD"],
+                             capture_output=True, text=True, timeout=5)
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    return out.stdout.strip() or "unknown"
+
+
 def short_path(p):
     """``p`` relative to the repository root when it lies inside it (for printed commands)."""
     p = str(p)

@@ -244,10 +244,19 @@ class Expr:
         return self.symbols[2] in self.sym.free_symbols
 
     def __call__(self, x, y, t):
+        """The values at (x, y, t), broadcast; ``ExprError`` naming the expression, the point and the value
+        where one is not finite (Rust: ``value inf at (x=…, y=…, t=…)``, src/scene/expr/mod.rs). t enters as
+        numpy's float64, so a part in t alone has f64's IEEE values as in Rust (1/(t - 0.5) at t = 0.5 is inf,
+        (t - 1)^0.3 at t = 0 is NaN), where Python's float would raise or turn complex."""
         x = np.asarray(x, dtype=float)
         y = np.asarray(y, dtype=float)
-        with np.errstate(all="ignore"):
-            val = np.asarray(self._f(x, y, float(t)), dtype=float)
+        try:
+            with np.errstate(all="ignore"):
+                val = np.asarray(self._f(x, y, np.float64(t)), dtype=float)
+        except (ArithmeticError, ValueError, TypeError) as e:       # not expected: IEEE gives inf/NaN instead
+            at = f"(x, y) = ({float(x):.6g}, {float(y):.6g}), " if x.size == 1 == y.size else ""
+            raise ExprError(f"{self.key}: expression {self.text!r} cannot be evaluated at {at}t = {float(t):.6g}: "
+                            f"{e}") from None
         val = np.broadcast_to(val, np.broadcast(x, y).shape).copy()
         if not np.all(np.isfinite(val)):
             k = np.unravel_index(np.argmin(np.isfinite(val)), val.shape)

@@ -82,10 +82,12 @@ def _vertex_rows(scene, a_idx, b_idx, points, part, normal):
     return rows
 
 
-def check_boundary_data(scene, points, boundary_edges, part):
+def check_boundary_data(scene, points, boundary_edges, part, u0_max=None):
     """Raise ``SceneError`` naming the parts, the point and the two values where the boundary data of
     ``scene`` do not fit together (module docstring). ``boundary_edges`` (k, 2): the vertex indices of every
-    boundary edge, counter-clockwise (the body on the left); ``part`` (k,): the index of its boundary part."""
+    boundary edge, counter-clockwise (the body on the left); ``part`` (k,): the index of its boundary part.
+    ``u0_max``: the largest |u₀| at the mesh's vertices when ``points`` holds only some of them (a
+    distributed mesh); by default taken over ``points``."""
     if not scene.has_boundary_data:
         return
     points = np.asarray(points, dtype=float)
@@ -93,8 +95,9 @@ def check_boundary_data(scene, points, boundary_edges, part):
     a, b = points[boundary_edges[:, 0]], points[boundary_edges[:, 1]]
     rows, normal = _edge_rows(scene, a, b, part)
     rows += _vertex_rows(scene, boundary_edges[:, 0], boundary_edges[:, 1], points, part, normal)
-    u0 = scene.u0(points[:, 0], points[:, 1], scene.times[0])
-    scale = max([float(np.max(np.abs(u0), initial=0.0))]
+    if u0_max is None:
+        u0_max = float(np.max(np.abs(scene.u0(points[:, 0], points[:, 1], scene.times[0])), initial=0.0))
+    scale = max([u0_max]
                 + [max(float(np.max(np.abs(r[2]), initial=0.0)), float(np.max(np.abs(r[3]), initial=0.0)))
                    for r in rows])
     tol = REL_TOL * scale

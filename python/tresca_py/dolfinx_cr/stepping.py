@@ -14,12 +14,12 @@ of the three codes can be compared exactly.
 """
 import math
 import os
-import subprocess
 import time
 
 import numpy as np
 
 from tresca_py import results
+from tresca_py.common import git_commit
 from tresca_py.errors import InputError
 
 #: the two 1e-9 of the stick/slip rule (module docstring): a force within 1e-9 of the bound is at it, an
@@ -125,16 +125,6 @@ def _log(log, series, edges, n, N, t):
               flush=True)
 
 
-def commit():
-    """The repository's commit for the results file, "unknown" outside a clone."""
-    here = os.path.dirname(os.path.abspath(__file__))
-    try:
-        out = subprocess.run(["git", "-C", here, "rev-parse", "HEAD"], capture_output=True, text=True, timeout=5)
-    except (OSError, subprocess.SubprocessError):
-        return "unknown"
-    return out.stdout.strip() or "unknown"
-
-
 def save(path, edges, series, attrs):
     """The run as a results file of the ``/tresca`` layout (``tresca_py.results.write``)."""
     scene = edges.scene
@@ -145,7 +135,7 @@ def save(path, edges, series, attrs):
                                   series.state, c["mu"], c["dof"])
     mesh = results.Mesh(edges.points, edges.triangles, edges.edges, edges.midpoints)
     base = {"scene": scene.text, "scene_path": os.path.abspath(scene.path), "title": scene.title,
-            "version": "python-2", "git_commit": commit(), "solver": "dolfinx",
+            "version": "python-2", "git_commit": git_commit(), "solver": "dolfinx",
             "tol": float(scene.solver.get("tol", 1e-12)), "rho": scene.rho, "E": scene.E, "nu": scene.nu,
             "refine": int(scene.mesh["refine"]), "steps": len(scene.times) - 1,
             "factor_time": float(series.factor_time)}

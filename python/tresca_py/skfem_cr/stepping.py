@@ -1,11 +1,11 @@
 """Backward Euler over a scene's time nodes with the exact friction step, and the results file."""
 import math
 import os
-import subprocess
 import time
 
 import numpy as np
 
+from tresca_py.common import git_commit
 from tresca_py.errors import InputError
 from tresca_py.skfem_cr.cr import Discretisation
 from tresca_py.skfem_cr.friction import StepSolver, classify
@@ -83,15 +83,6 @@ def _step(stepper, disc, K, load_t, u_prev, lifting, t, res, n):
 # ----------------------------------------------------------------------------------------------
 # output
 # ----------------------------------------------------------------------------------------------
-def git_commit():
-    """The repository's commit (for the results file's attributes), "unknown" outside a clone."""
-    try:
-        return subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
-                              cwd=os.path.dirname(os.path.abspath(__file__)), timeout=5).stdout.strip() or "unknown"
-    except Exception:
-        return "unknown"
-
-
 def write_results(path, disc: Discretisation, res, solver_name, extra_attrs=None):
     """Write the run as a results file of the one ``/tresca`` layout (``tresca_py.results.write``: atomic,
     with status, completed steps and step checksums; ``contact/mu`` = the friction force mu_e and

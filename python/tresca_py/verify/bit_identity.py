@@ -9,7 +9,7 @@ Usage:
 and the paper's Example 5.1 levels of Tables 5.1/5.2 (refine k, N = 40·2^k, k = 0..4),  with the SSN, Uzawa and PDAS solvers where the scene
 has contact. `compare` reads every dataset and attribute under ``/tresca`` and ``/VTKHDF`` with h5py and requires the
 bytes to be equal, except what is not a number of the method: wall times (``steps/wall_time``,
-``setup_times``, and ``steps/checksum``, which hashes the wall time with the rest of a step), the build (``version``, ``git_commit``). It prints one line per file and exits non-zero
+``setup_times``, the Python solvers' ``*_time`` and ``*peak_rss_mb`` attributes, and ``steps/checksum``, which hashes the wall time with the rest of a step), the build (``version``, ``git_commit``). It prints one line per file and exits non-zero
 if any value differs. With ``--rel TOL`` floating-point values may differ by TOL relative to the largest
 magnitude of their dataset (max |a - b| <= TOL max |a|, for changes that move results by rounding only;
 float32 visualisation copies within max(TOL, 1e-6), the solvers' residuals within 1e-12 absolute);
@@ -30,7 +30,10 @@ from tresca_py.common import ROOT, rel_to
 # not numbers of the method: they change from run to run or build to build
 # steps/checksum hashes each step's rows including steps/wall_time, so it changes from run to run too (its
 # agreement with the rows is what --resume and scripts/check_results.py verify)
-VOLATILE = {"steps/wall_time", "steps/checksum", "setup_times", "version", "git_commit", "scene_path"}
+VOLATILE = {"steps/wall_time", "steps/checksum", "setup_times", "version", "git_commit", "scene_path",
+            # the Python solvers' timings and peak memory (attributes of /tresca)
+            "assembly_time", "factor_time", "total_time", "setup_time", "step_time_median", "peak_rss_mb",
+            "setup_peak_rss_mb"}
 # added by a later version (issue 18: per-step checksums): compared when both files have it, else skipped
 ADDED = {"tresca/steps/checksum"} | {
     # issue 30: the per-step energy audit (src/stepping/audit.rs)
@@ -70,9 +73,10 @@ def cmd_run(args):
 
 
 def items(f):
-    """{path: bytes-comparable value} of every dataset and attribute under /tresca and /VTKHDF."""
+    """{path: bytes-comparable value} of every dataset and attribute under /tresca and /VTKHDF (a Python
+    solver's file has no /VTKHDF; a group in one file only differs by its keys)."""
     out = {}
-    for group in ("tresca", "VTKHDF"):
+    for group in (g for g in ("tresca", "VTKHDF") if g in f):
         def visit(name, obj, group=group):
             if isinstance(obj, h5py.Dataset):
                 out[f"{group}/{name}"] = obj[()]

@@ -358,16 +358,6 @@ def tables(cx, mpi_rows):
     return "\n".join(lines)
 
 
-def with_boundary_data(path):
-    """True for a scene with boundary data (a dirichlet part's `u` or a contact part's `gap`). The serial
-    solvers read them (every such case is cross-checked here); only the distributed route
-    (``verify/distributed.py``) still skips these scenes, until it reads the data (helper distbdata, issue 30 §1)."""
-    import tomllib
-    with open(path, "rb") as fh:
-        doc = tomllib.load(fh)
-    return any("u" in b or "gap" in b for b in doc.get("boundary", []))
-
-
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="one mesh level per case, fewer steps (make test)")

@@ -121,8 +121,6 @@ def agreement(binary, work):
     """D1: rows (case, refine, steps, ranks, compare result or error)."""
     plan = dict(cross_check.QUICK)
     on_disk = sorted(f[:-5] for f in os.listdir(cross_check.CASES_DIR) if f.endswith(".toml"))
-    # the distributed route does not read `u`/`gap` yet (issue 30 §1): such scenes are not run here
-    on_disk = [n for n in on_disk if not cross_check.with_boundary_data(os.path.join(cross_check.CASES_DIR, f"{n}.toml"))]
     for name in on_disk:
         plan.setdefault(name, ((0,), None))
     scenes = {n: os.path.join(cross_check.CASES_DIR, f"{n}.toml") for n in on_disk}

@@ -11,121 +11,26 @@ the Rust solver applies them (src/fem/lifting.rs):
   the energy error's jump on Γ_D is u_h − u (src/fem/norms.rs);
 * data that do not fit together are refused (``consistency``).
 
-The keys are read from the scene's text here (``boundary_data``), so this module does not depend on how
-``tresca_py.scene`` stores them; ``load`` reads a scene whose keys ``tresca_py.scene`` does not know yet
-(issue 30, branch pybdata) by setting them aside for the rest of the validation.
+The data are those of ``tresca_py.scene`` (``Boundary.u``/``.gap``), read there once for every solver.
 """
-import tomllib
-
 import dolfinx_solver  # noqa: F401  (loads libmpi for the wheel; must precede dolfinx)
 import numpy as np
 import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from tresca_py import scene as scene_mod
 from tresca_py.dolfinx_cr.distributed.mesh import agree
 from tresca_py.dolfinx_cr.forms import vec_to_ufl
 from tresca_py.errors import InputError
-from tresca_py.expr import Expr, VecExpr
 from tresca_py.quadrature import GAUSS3_S, GAUSS3_W
-
-DATA_KEYS = ("u", "gap")
-
-
-def _tables(text):
-    tables = tomllib.loads(text).get("boundary", [])
-    return [b for b in tables if isinstance(b, dict)] if isinstance(tables, list) else []
-
-
-def load(path, refine=None, steps=None):
-    """The scene of ``path`` (``tresca_py.scene.load_scene``); a scene with boundary data is read with the
-    keys ``u``/``gap`` set aside while ``tresca_py.scene`` does not know them (they are read by
-    ``boundary_data``)."""
-    known = scene_mod._SCHEMA["boundary"]
-    try:
-        with open(path, "rb") as fh:
-            text = fh.read().decode("utf-8")
-        tables = _tables(text)
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
-        return scene_mod.load_scene(path, refine=refine, steps=steps)     # its error names the problem
-    if all(k in known for k in DATA_KEYS) or not any(k in b for b in tables for k in DATA_KEYS):
-        return scene_mod.load_scene(path, refine=refine, steps=steps)
-    doc = tomllib.loads(text)
-    for b in doc.get("boundary", []):
-        for k in DATA_KEYS:
-            if isinstance(b, dict):
-                b.pop(k, None)
-    return _load_doc(path, text, doc, refine, steps)
-
-
-def _load_doc(path, text, doc, refine, steps):
-    """``tresca_py.scene.load_scene`` on an already parsed document (its steps, in its order)."""
-    sm = scene_mod
-    for key, val in doc.items():                 # the checks of tresca_py.scene._read_doc
-        if key not in sm._SCHEMA:
-            raise sm.SceneError(f"{path}: unknown top-level key '{key}' (allowed: {sorted(sm._SCHEMA)})")
-        allowed = sm._SCHEMA[key]
-        if allowed is None:
-            continue
-        if key == "boundary" and not isinstance(val, list):
-            raise sm.SceneError(f"{path}: 'boundary' must be an array of tables ([[boundary]])")
-        for tab in (val if key == "boundary" else [val]):
-            if not isinstance(tab, dict):
-                raise sm.SceneError(f"{path}: [{key}] must be a table")
-            bad = [k for k in tab if k not in allowed]
-            if bad:
-                raise sm.SceneError(f"{path}: unknown key '{bad[0]}' in [{key}] (allowed: {sorted(allowed)})")
-    mesh = sm._read_mesh(path, doc, refine)
-    E, nu = sm._read_material(path, doc)
-    bnds = sm._read_boundaries(doc)
-    rho = sm._num(doc.get("discretisation", {}), "rho", "discretisation", default=10.0)
-    if rho <= 0:
-        raise sm.SceneError("[discretisation] rho must be positive (without the jump term CR elasticity is singular)")
-    solver = {"method": "ssn", "tol": 1e-12, "max_iter": 500, "uzawa_step": 0.0, **doc.get("solver", {})}
-    exact_u, exact_grad = sm._read_exact(doc)
-    return sm.Scene(path=str(path), text=text, title=str(doc.get("title", "")), mesh=mesh, E=float(E),
-                    nu=float(nu), boundaries=bnds, f=VecExpr(doc.get("loads", {}).get("f", ["0", "0"]), "[loads] f"),
-                    u0=VecExpr(doc.get("initial", {}).get("u0", ["0", "0"]), "[initial] u0"),
-                    times=sm._read_times(path, doc, steps), rho=float(rho), solver=solver, exact_u=exact_u,
-                    exact_grad=exact_grad, output=doc.get("output", {}).get("path"))
 
 
 def boundary_data(scene):
     """Per boundary part (scene order): (u_D as VecExpr or None, g_n as Expr or None; None when absent or the
-    constant 0, as src/scene/parts.rs); None when no part gives data. InputError for a key on the wrong kind
-    of part."""
-    out, any_data = [], False
-    for b, tab in zip(scene.boundaries, _tables(scene.text), strict=True):
-        u = g = None
-        if "u" in tab:
-            if b.kind != "dirichlet":
-                raise InputError(f"[boundary] ('{b.name}') 'u' is only allowed for kind = \"dirichlet\"")
-            u = VecExpr(tab["u"], f"boundary '{b.name}' u")
-            u = None if u.is_zero else u                      # the constant 0 is no data (src/scene/parts.rs)
-        if "gap" in tab:
-            if b.kind != "contact":
-                raise InputError(f"[boundary] ('{b.name}') 'gap' is only allowed for kind = \"contact\"")
-            if not isinstance(tab["gap"], str):
-                raise InputError(f"[boundary] ('{b.name}') 'gap' must be one expression string, got {tab['gap']!r}")
-            g = Expr(tab["gap"], f"boundary '{b.name}' gap")
-            g = None if g.is_zero else g
-        any_data = any_data or u is not None or g is not None
-        out.append((u, g))
-    return out if any_data else None
-
-
-def evaluate(expr, x, y, t):
-    """expr(x, y, t) (Expr, or VecExpr: leading axis 2); InputError naming the expression where it is not
-    finite, also where Python's float arithmetic raises instead (t enters as a float: 1/(t - 0.5) at 0.5)."""
-    comps = getattr(expr, "comps", None)
-    vals = []
-    for c in comps or [expr]:
-        try:
-            vals.append(c(x, y, t))
-        except ArithmeticError as e:
-            raise InputError(f"{c.key}: expression {c.text!r} cannot be evaluated at t = {float(t):.6g}: {e}") from None
-    return np.stack(vals) if comps is not None else vals[0]
+    constant 0, ``tresca_py.scene``); None when no part gives data."""
+    if not scene.has_boundary_data:
+        return None
+    return [(b.u, b.gap) for b in scene.boundaries]
 
 
 def gauss_points(a, b):
@@ -166,10 +71,10 @@ class Lifting:
         msg = None
         try:
             for blocks, q, u in zip(self.d_blocks, self.d_points, self.d_expr, strict=True):
-                m = evaluate(u, q[..., 0], q[..., 1], t) @ GAUSS3_W            # (2, k)
+                m = u(q[..., 0], q[..., 1], t) @ GAUSS3_W            # (2, k)
                 arr[2 * blocks], arr[2 * blocks + 1] = m[0], m[1]
             for pos, q, g in zip(self.g_pos, self.g_points, self.g_expr, strict=True):
-                m = evaluate(g, q[..., 0], q[..., 1], t) @ GAUSS3_W
+                m = g(q[..., 0], q[..., 1], t) @ GAUSS3_W
                 blocks, n = self.prob.con_lb[pos], self.prob.normal[pos]
                 arr[2 * blocks], arr[2 * blocks + 1] = m * n[:, 0], m * n[:, 1]
         except InputError as e:

@@ -12,14 +12,14 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
-from tresca_py.dolfinx_cr.distributed.data import load as load_scene
 from tresca_py.dolfinx_cr.distributed.mesh import Fail
 from tresca_py.dolfinx_cr.distributed.output import PartWriter, setup_time_attrs, write_main
 from tresca_py.dolfinx_cr.distributed.problem import Problem, peak_mb
 from tresca_py.cli import FAILURES, message, output_path
 from tresca_py.errors import InputError
 from tresca_py.dolfinx_cr.friction import TaoBoxQP, natural_residual
-from tresca_py.skfem_cr.friction import classify
+from tresca_py.dolfinx_cr.stepping import slipping
+from tresca_py.scene import load_scene
 
 DESCRIPTION = ("Quasi-static Tresca friction with stabilised CR elements -- distributed DOLFINx 0.11 + PETSc/MUMPS "
                "solver.")
@@ -133,7 +133,7 @@ class Friction:
         ds = d - prob.C @ mu
         res["iterations"][n] = its
         res["residual"][n] = natural_residual(prob.C, d, prob.C_w, mu)
-        res["state"][n] = classify(mu, ds, d, prob.C_w)
+        res["state"][n] = slipping(mu, ds, d, prob.C_w)
         res["sigma_t"][n] = -mu / prob.C_len
         res["mu"][n] = mu
         self.mu_prev = mu.copy()

@@ -16,7 +16,7 @@ import os
 import numpy as np
 
 from tresca_py.results import SPEC
-from tresca_py.skfem_cr.stepping import git_commit
+from tresca_py.common import git_commit
 
 
 class PartWriter:

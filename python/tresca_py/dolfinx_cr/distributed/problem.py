@@ -80,7 +80,7 @@ class Problem:
         data = boundary_data(scene)
         self.lift = Lifting(self, data, A, B, pb) if data is not None else None
         if self.lift is not None:
-            consistency.check(self, data, A, B, pb)
+            consistency.check(self, A, B, pb)
         self._initial_value(A, B)
         del A, B
         self.times_setup["mesh"] = time.perf_counter() - tic
