@@ -14,6 +14,8 @@ use super::{MeshSpec, PartKind, Scene};
 use crate::error::{human, Error, Result};
 use std::path::Path;
 
+pub use crate::machine::{available_disk, available_memory};
+
 /// Sizes and needs of a run.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Estimate {
@@ -146,30 +148,6 @@ fn sizes(scene: &Scene) -> Result<(u64, u64, u64)> {
             Ok((tris, tris.saturating_mul(3) / 2 + tris.isqrt(), contact << refine))
         }
     }
-}
-
-/// MemAvailable of `/proc/meminfo`, bytes (`None` where there is no such file).
-pub fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
-
-/// Free bytes (for unprivileged users) of the file system holding `dir` or its nearest existing ancestor.
-pub fn available_disk(dir: &Path) -> Option<u64> {
-    use std::os::unix::ffi::OsStrExt;
-    let mut d = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
-    while !d.exists() {
-        d = d.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    }
-    let c = std::ffi::CString::new(d.as_os_str().as_bytes()).ok()?;
-    let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
-    // SAFETY: `c` is a NUL-terminated path and `st` a statvfs the call fills.
-    if unsafe { libc::statvfs(c.as_ptr(), &mut st) } != 0 {
-        return None;
-    }
-    Some((st.f_bavail as u64).saturating_mul(st.f_frsize as u64))
 }
 
 /// A size such as `800M`, `16G`, `1.5T` or a number of bytes (decimal units; `k`, `M`, `G`, `T`).

@@ -94,10 +94,12 @@ impl Factor {
             return (Err(Error::Linear(e.into())), None);
         }
         let oom = || Error::Linear("out of memory for the Cholesky factorisation".into());
+        if let Err(e) = Symbolic::fits_with(&symbolic, 0) {
+            return (Err(e), None);
+        }
+        let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
         let Some(mut values) = Pages::zeroed(symbolic.len_val()) else { return (Err(oom()), None) };
-        let Ok(mut buf) =
-            MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
-        else {
+        let Ok(mut buf) = MemBuffer::try_new(scratch) else {
             return (Err(oom()), None);
         };
         // the factor's pages are mapped on a second thread while this one computes (solve::pages)
