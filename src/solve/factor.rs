@@ -39,6 +39,8 @@ pub struct Factor {
     last: Vec<usize>,
     /// The fill-reducing permutation: position → unknown.
     fwd: Vec<usize>,
+    /// How that permutation was made ([`Symbolic::ordered_by`]).
+    ordering: &'static str,
 }
 
 impl Factor {
@@ -87,7 +89,7 @@ impl Factor {
         k: &SparseColMat<usize, f64>,
         beside: impl FnOnce() -> R + Send,
     ) -> (Result<Factor>, Option<R>) {
-        let Symbolic { symbolic, fwd, last, pattern_nnz } = symbolic;
+        let Symbolic { symbolic, fwd, last, pattern_nnz, ordering } = symbolic;
         let n = k.nrows();
         if symbolic.nrows() != n || k.compute_nnz() != pattern_nnz {
             let e = "internal: the matrix does not have the pattern of its symbolic factorisation";
@@ -120,7 +122,8 @@ impl Factor {
             );
             (numeric.map(|_| ()), r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
         });
-        (Factor::finish(symbolic, values, numeric, n, last, fwd), Some(r))
+        let factor = Factor::finish(symbolic, values, numeric, n, last, fwd).map(|f| Factor { ordering, ..f });
+        (factor, Some(r))
     }
 
     fn finish(
@@ -138,7 +141,12 @@ impl Factor {
         })?;
         let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
             .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
-        Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last, fwd })
+        Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last, fwd, ordering: "given" })
+    }
+
+    /// How the fill-reducing ordering was made (AMD, nested dissection by coordinates, METIS).
+    pub fn ordering(&self) -> &'static str {
+        self.ordering
     }
 
     /// Entries of L kept (supernodal blocks included).

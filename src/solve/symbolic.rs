@@ -22,6 +22,8 @@ pub struct Symbolic {
     pub(super) last: Vec<usize>,
     /// Entries of the pattern (the matrix factorised must have the same pattern).
     pub(super) pattern_nnz: usize,
+    /// How the fill-reducing ordering was made, as a run reports it ("given" unless named).
+    pub(super) ordering: &'static str,
 }
 
 impl Symbolic {
@@ -53,12 +55,17 @@ impl Symbolic {
         let ordering = SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n));
         let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, ordering, params)
             .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))?;
-        Ok(Symbolic { symbolic, fwd, last: last.to_vec(), pattern_nnz: pattern.compute_nnz() })
+        Ok(Symbolic { symbolic, fwd, last: last.to_vec(), pattern_nnz: pattern.compute_nnz(), ordering: "given" })
     }
 
     /// Entries of L (supernodal blocks included).
     pub fn len_val(&self) -> usize {
         self.symbolic.len_val()
+    }
+
+    /// The same, its ordering named `ordering` (reported by runs: [`super::factor::Factor::ordering`]).
+    pub fn ordered_by(self, ordering: &'static str) -> Symbolic {
+        Symbolic { ordering, ..self }
     }
 
     /// Bytes the numeric factorisation allocates: L's values and its scratch.
