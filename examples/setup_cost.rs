@@ -4,7 +4,10 @@
 //! the other processes' load) with its minor page faults; ORDERING is `auto` (the run's choice: nested
 //! dissection by coordinates from `ND_MIN_SIZE` unknowns), `amd`, `nd` (by coordinates) or `metis`.
 //!
-//! `RAYON_NUM_THREADS=1 cargo run --release --example setup_cost verification/cases/mms_stop.toml 4 [PASSES] [ORDERING]`
+//! `RAYON_NUM_THREADS=1 cargo run --release --example setup_cost verification/cases/mms_stop.toml 4 [PASSES] [ORDERING] [symbolic]`
+//!
+//! A fifth argument `symbolic` stops each pass after the symbolic factorisation: the size of K and of its
+//! factor for meshes whose numeric factorisation does not fit in memory.
 //!
 //! In a real run every buffer is fresh memory, whose first touch costs about 2.4 µs a page on the
 //! project's VMs; from the second pass on the allocator reuses memory, so these are compute costs.
@@ -31,6 +34,7 @@ fn main() {
         o => panic!("ordering `{o}`: auto, amd, nd (by coordinates) or metis"),
     };
     let metis = a.get(3).is_some_and(|s| s == "metis");
+    let symbolic_only = a.get(4).is_some_and(|s| s == "symbolic");
     let mut rows: Vec<(&str, Vec<(f64, f64)>)> = Vec::new();
     let mut tm = |name: &'static str, d: (f64, f64)| match rows.iter_mut().find(|r| r.0 == name) {
         Some(r) => r.1.push(d),
@@ -64,6 +68,9 @@ fn main() {
         let sym = Symbolic::new(pat.as_ref(), &contact, order).unwrap();
         tm("symbolic", t.elapsed());
         sizes = (pat.compute_nnz(), sym.len_val());
+        if symbolic_only {
+            continue;
+        }
         let t = Clock::now();
         let val = stiffness_values(&pattern, pat.as_ref(), &mesh, &space, &law, scene.rho);
         tm("stiffness", t.elapsed());

@@ -26,6 +26,7 @@ pub mod error;
 pub mod fem;
 pub mod friction;
 pub mod input;
+pub mod machine;
 pub mod mesh;
 pub mod names;
 pub mod output;

@@ -175,7 +175,7 @@ fn adapt_command_writes_levels_and_refuses_what_does_not_fit() {
         assert!(head.contains(&col), "column {col} in {head:?}");
     }
     assert_eq!(text.lines().count(), 4);
-    let out = bin().args(["adapt", sc.to_str().unwrap(), "--target", "1e-9", "--max-memory", "3M"]).output().unwrap();
+    let out = bin().args(["adapt", sc.to_str().unwrap(), "--target", "1e-9", "--max-memory", "40M"]).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{err}");
     assert!(err.contains("does not fit") && err.contains("memory"), "{err}");

@@ -231,6 +231,7 @@ struct Facts {
     paper_dofs: usize,
     contact: usize,
     setup: tresca_cr::stepping::SetupTimes,
+    ordering: &'static str,
     method: &'static str,
     exact: bool,
 }
@@ -247,6 +248,7 @@ impl Facts {
             paper_dofs: sp.paper_dofs(),
             contact: sp.contact.len(),
             setup: problem.setup,
+            ordering: problem.free.factor().ordering(),
             method: problem.scene.solver.method.name(),
             exact: problem.scene.exact.is_some(),
         }
@@ -272,6 +274,7 @@ fn json_summary(
         solver: f.method.into(),
         tol: f.tol,
         setup: f.setup.into(),
+        ordering: f.ordering.to_string(),
         step_stats,
         iterations: t.iters,
         max_residual: t.max_res,
@@ -293,6 +296,7 @@ fn print_summary(f: &Facts, t: &Tally, n: usize, wall: f64) {
         st.condensation,
         st.superposition
     );
+    say!("fill-reducing ordering: {}", f.ordering);
     say!("solver {}: {} iterations in all, max residual {:.2e}; wall time {:.3}s", f.method, t.iters, t.max_res, wall);
     if t.work > 0.0 {
         say!(

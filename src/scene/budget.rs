@@ -3,16 +3,21 @@
 //! estimates; `check` and `run` refuse a run whose estimate exceeds what the machine has (MemAvailable of
 //! `/proc/meminfo`, free space of the output's file system) or the limits the user gives.
 //!
-//! Calibration (Example 5.1 `--steps 4 -o`, peak RSS by `/usr/bin/time`, 2026-11-26): 3.17, 3.07, 3.45
-//! and 3.51 kB per unknown at refine 5, 6, 7, 8 (24,640 to 1,573,376 unknowns). The factor's fill grows
-//! like n log n, so the estimate is n (α + β log₂ n) plus the two buffers of a block of steps
-//! (`solve::free`, 16 bytes a value, at most 16 columns and 2²⁴ values) and the dense contact parts:
-//! α and β fitted to refine 7 and 8, it gives refine 5 and 6 within −0.4 % and +7.6 %. An estimate,
-//! not a bound: the fill also depends on the ordering (AMD below 1M unknowns, nested dissection above).
+//! Calibration (Example 5.1 `--steps 4 -o`, peak RSS by `/usr/bin/time`, 2026-11-26; figures in
+//! `reference/performance.md` §8): six meshes from 24,640 to 4,817,792 unknowns (refine 5–8 of `cells =
+//! [2, 2]`, refine 8 of `[3, 3]`, refine 7 of `[7, 7]`). The factor's fill grows like n log n, so the
+//! estimate is γ + n (α + β log₂ n) plus the two buffers of a block of steps (`solve::free`, 16 bytes a
+//! value, at most 16 columns and 2²⁴ values) and the dense contact parts: γ, α, β fitted by least squares
+//! of the relative misfit to the six, which it then gives within 3.5 %. An estimate, not a bound: the fill
+//! also depends on the ordering (AMD below 1M unknowns, nested dissection above). The factorisation checks
+//! its exact size once the symbolic factorisation is known (`solve::Symbolic::fits`) and refuses a factor
+//! that would not fit, or first tries METIS's ordering, which fills less.
 
 use super::{MeshSpec, PartKind, Scene};
 use crate::error::{human, Error, Result};
 use std::path::Path;
+
+pub use crate::machine::{available_disk, available_memory};
 
 /// Sizes and needs of a run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -28,10 +33,11 @@ pub struct Estimate {
     pub disk: u64,
 }
 
-/// Peak bytes per unknown of the set-up (mesh, space, K, factor) are BYTES_PER_UNKNOWN +
-/// BYTES_PER_UNKNOWN_LOG2 · log₂(unknowns) (fitted, see the module doc).
-const BYTES_PER_UNKNOWN: f64 = 1830.0;
-const BYTES_PER_UNKNOWN_LOG2: f64 = 73.4;
+/// Peak bytes of the set-up (mesh, space, K, factor) are BYTES_FIXED + unknowns · (BYTES_PER_UNKNOWN +
+/// BYTES_PER_UNKNOWN_LOG2 · log₂(unknowns)) (fitted, see the module doc).
+const BYTES_FIXED: f64 = 1.54e7;
+const BYTES_PER_UNKNOWN: f64 = -500.3;
+const BYTES_PER_UNKNOWN_LOG2: f64 = 196.15;
 /// The values of the block of steps' buffers (`solve::free`): at most 16 columns and 2²⁴ values each.
 const BLOCK_COLUMNS: u64 = 16;
 const BLOCK_VALUES: u64 = 1 << 24;
@@ -54,7 +60,7 @@ impl Estimate {
         let steps = steps as u64;
         let per_unknown = BYTES_PER_UNKNOWN + BYTES_PER_UNKNOWN_LOG2 * (unknowns.max(2) as f64).log2();
         let blocks = 16 * unknowns.saturating_mul(BLOCK_COLUMNS).min(BLOCK_VALUES);
-        let memory = ((per_unknown * unknowns as f64).min(u64::MAX as f64 / 2.0) as u64)
+        let memory = ((BYTES_FIXED + per_unknown * unknowns as f64).min(u64::MAX as f64 / 2.0) as u64)
             .saturating_add(blocks)
             .saturating_add(contact.saturating_mul(contact).saturating_mul(16))
             .saturating_add(steps.saturating_mul(BYTES_PER_STEP));
@@ -146,30 +152,6 @@ fn sizes(scene: &Scene) -> Result<(u64, u64, u64)> {
             Ok((tris, tris.saturating_mul(3) / 2 + tris.isqrt(), contact << refine))
         }
     }
-}
-
-/// MemAvailable of `/proc/meminfo`, bytes (`None` where there is no such file).
-pub fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
-
-/// Free bytes (for unprivileged users) of the file system holding `dir` or its nearest existing ancestor.
-pub fn available_disk(dir: &Path) -> Option<u64> {
-    use std::os::unix::ffi::OsStrExt;
-    let mut d = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
-    while !d.exists() {
-        d = d.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    }
-    let c = std::ffi::CString::new(d.as_os_str().as_bytes()).ok()?;
-    let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
-    // SAFETY: `c` is a NUL-terminated path and `st` a statvfs the call fills.
-    if unsafe { libc::statvfs(c.as_ptr(), &mut st) } != 0 {
-        return None;
-    }
-    Some((st.f_bavail as u64).saturating_mul(st.f_frsize as u64))
 }
 
 /// A size such as `800M`, `16G`, `1.5T` or a number of bytes (decimal units; `k`, `M`, `G`, `T`).

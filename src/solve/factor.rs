@@ -39,6 +39,8 @@ pub struct Factor {
     last: Vec<usize>,
     /// The fill-reducing permutation: position → unknown.
     fwd: Vec<usize>,
+    /// How that permutation was made ([`Symbolic::ordered_by`]).
+    ordering: &'static str,
 }
 
 impl Factor {
@@ -87,17 +89,19 @@ impl Factor {
         k: &SparseColMat<usize, f64>,
         beside: impl FnOnce() -> R + Send,
     ) -> (Result<Factor>, Option<R>) {
-        let Symbolic { symbolic, fwd, last, pattern_nnz } = symbolic;
+        let Symbolic { symbolic, fwd, last, pattern_nnz, ordering } = symbolic;
         let n = k.nrows();
         if symbolic.nrows() != n || k.compute_nnz() != pattern_nnz {
             let e = "internal: the matrix does not have the pattern of its symbolic factorisation";
             return (Err(Error::Linear(e.into())), None);
         }
         let oom = || Error::Linear("out of memory for the Cholesky factorisation".into());
+        if let Err(e) = Symbolic::fits_with(&symbolic, 0) {
+            return (Err(e), None);
+        }
+        let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
         let Some(mut values) = Pages::zeroed(symbolic.len_val()) else { return (Err(oom()), None) };
-        let Ok(mut buf) =
-            MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
-        else {
+        let Ok(mut buf) = MemBuffer::try_new(scratch) else {
             return (Err(oom()), None);
         };
         // the factor's pages are mapped on a second thread while this one computes (solve::pages)
@@ -118,7 +122,8 @@ impl Factor {
             );
             (numeric.map(|_| ()), r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
         });
-        (Factor::finish(symbolic, values, numeric, n, last, fwd), Some(r))
+        let factor = Factor::finish(symbolic, values, numeric, n, last, fwd).map(|f| Factor { ordering, ..f });
+        (factor, Some(r))
     }
 
     fn finish(
@@ -136,7 +141,12 @@ impl Factor {
         })?;
         let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
             .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
-        Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last, fwd })
+        Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last, fwd, ordering: "given" })
+    }
+
+    /// How the fill-reducing ordering was made (AMD, nested dissection by coordinates, METIS).
+    pub fn ordering(&self) -> &'static str {
+        self.ordering
     }
 
     /// Entries of L kept (supernodal blocks included).

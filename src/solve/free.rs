@@ -45,6 +45,8 @@ const BLOCK_VALUES: usize = 1 << 24;
 /// Steps in a block at most (at 196,608 unknowns a solve pair costs 61 ms for one column, 13 ms a
 /// column for 8, 9 ms for 16 and 7.6 ms for 32).
 const MAX_BLOCK: usize = 16;
+/// Bytes of a block's two buffers (right-hand sides and solutions) at most.
+pub const BLOCK_BYTES: u64 = 2 * 8 * BLOCK_VALUES as u64;
 
 /// u_f and s_f of one step at any time node.
 pub struct FreeResponse {

@@ -20,7 +20,7 @@ use crate::scene::Scene;
 use crate::solve::condense::{condense, Condensation};
 use crate::solve::condition;
 use crate::solve::factor::{fill_order_at, Factor, Symbolic};
-use crate::solve::free::FreeResponse;
+use crate::solve::free::{FreeResponse, BLOCK_BYTES};
 use crate::solve::ordering::{Graph, ND_MIN_SIZE};
 use crate::solve::superpose::LoadBasis;
 use crate::sparse::{dot, energy};

@@ -60,6 +60,7 @@ fn summary_round_trips_through_json() {
         solver: "ssn".into(),
         tol: 1e-12,
         setup,
+        ordering: "AMD".into(),
         step_stats: vec![step.clone(), Step { errors: None, ..step }],
         iterations: 6,
         max_residual: 1e-13,
