@@ -175,13 +175,56 @@ fn adapt_command_writes_levels_and_refuses_what_does_not_fit() {
         assert!(head.contains(&col), "column {col} in {head:?}");
     }
     assert_eq!(text.lines().count(), 4);
-    let out = bin().args(["adapt", sc.to_str().unwrap(), "--target", "1e-9", "--max-memory", "3M"]).output().unwrap();
+    let json = dir.as_path().join("a.json");
+    let out = bin()
+        .args(["adapt", sc.to_str().unwrap(), "--target", "1e-9", "--max-memory", "3M", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{err}");
     assert!(err.contains("does not fit") && err.contains("memory"), "{err}");
-    let out = bin().args(["adapt", sc.to_str().unwrap(), "--levels", "2", "--theta", "1.5"]).output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(err.contains("theta") && !err.contains("panicked"), "{err}");
+    // the summary of a refused loop: the levels that ran, and why it stopped
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["command"], "adapt");
+    assert!(v["status"].as_str().unwrap().starts_with("refused: level"), "{v}");
+    let levels = v["adapt"]["levels"].as_array().unwrap();
+    assert!(!levels.is_empty() && levels[0]["unknowns"].as_u64().unwrap() > 0, "{v}");
+    assert!(levels.iter().all(|l| l["estimator"].as_f64().unwrap() > 1e-9), "stopped before the target");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The system shall refuse each bad value of `adapt`'s flags with one error naming the flag and what it
+/// takes, and a non-zero exit, before any level is solved (no panic, nothing written).
+#[test]
+fn adapt_refuses_bad_flags_naming_them() {
+    let sc = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/cases/lshape_adapt.toml");
+    let bad: [(&[&str], &str); 12] = [
+        (&["--levels", "2", "--theta", "1.5"], "(0, 1]"),
+        (&["--levels", "2", "--theta", "0"], "(0, 1]"),
+        (&["--levels", "2", "--theta", "-0.5"], "(0, 1]"),
+        (&["--levels", "0"], "≥ 1"),
+        (&["--levels", "-3"], "≥ 1"),
+        (&["--target", "0"], "> 0"),
+        (&["--target", "-1e-3"], "> 0"),
+        (&["--target", "nan"], "> 0"),
+        (&["--levels", "2", "--refine", "-1"], "refinements"),
+        (&["--levels", "2", "--steps", "-4"], "whole number"),
+        (&["--levels", "2", "--reference", "99"], "at most 24"),
+        (&["--levels", "2", "--budget", "-5s"], "positive duration"),
+    ];
+    let flag = |args: &[&str]| args.iter().rev().nth(1).unwrap().to_string();
+    for (args, what) in bad {
+        let out = bin().arg("adapt").arg(&sc).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_ne!(out.status.code(), Some(0), "{args:?} accepted");
+        assert!(err.contains(&flag(args)) && err.contains(what), "{args:?}: {err}");
+        assert!(!err.contains("panicked") && out.stdout.is_empty(), "{args:?}: {err}");
+    }
+    for args in [&["--levels", "2", "--max-memory", "-1G"][..], &["--levels", "2", "--steps", "0"]] {
+        let out = bin().arg("adapt").arg(&sc).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(matches!(out.status.code(), Some(1 | 2)), "{args:?}: {err}");
+        assert!(!err.contains("panicked") && err.lines().count() <= 3, "{args:?}: {err}");
+    }
 }

@@ -82,6 +82,19 @@ impl Row {
     pub fn error_or_estimate(&self) -> Option<f64> {
         self.error.or(self.vs_reference).or(self.vs_next)
     }
+
+    /// What [`Row::error_or_estimate`] is: `true` (`exact`: the scene has `[exact]`), `vs_reference` or
+    /// `vs_next`; `None` when no error is known.
+    pub fn error_kind(&self, exact: bool) -> Option<&'static str> {
+        self.error_or_estimate()?;
+        Some(if exact {
+            "true"
+        } else if self.vs_reference.is_some() {
+            "vs_reference"
+        } else {
+            "vs_next"
+        })
+    }
 }
 
 /// A solved level: its fields at every node, the accumulated indicator, the true error.

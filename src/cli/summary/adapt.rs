@@ -1,0 +1,77 @@
+//! The `adapt` part of the summary (fields in the parent module's doc).
+
+use serde::{Deserialize, Serialize};
+use tresca_cr::adapt::estimator::TERMS;
+use tresca_cr::adapt::{Options, Row};
+
+/// One level of the adaptive loop.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct AdaptLevel {
+    pub level: usize,
+    pub triangles: usize,
+    pub unknowns: usize,
+    pub paper_dofs: usize,
+    pub generation: u32,
+    pub estimator: f64,
+    pub error: Option<f64>,
+    pub error_kind: Option<String>,
+    pub effectivity: Option<f64>,
+    pub vs_next: Option<f64>,
+    pub vs_reference: Option<f64>,
+    pub min_angle: f64,
+    pub marked: usize,
+    pub wall: f64,
+    pub worst_step: usize,
+    /// The terms of η at its worst node, by name (`estimator::TERMS`), not squared.
+    pub terms: std::collections::BTreeMap<String, f64>,
+}
+
+impl AdaptLevel {
+    /// The level of `r`; `exact`: the scene has `[exact]` (its errors are true ones).
+    pub fn of(r: &Row, exact: bool) -> AdaptLevel {
+        let error = r.error_or_estimate();
+        AdaptLevel {
+            level: r.level,
+            triangles: r.triangles,
+            unknowns: r.unknowns,
+            paper_dofs: r.paper_dofs,
+            generation: r.generation,
+            estimator: r.estimator,
+            error,
+            error_kind: r.error_kind(exact).map(String::from),
+            effectivity: error.map(|e| r.estimator / e),
+            vs_next: r.vs_next,
+            vs_reference: r.vs_reference,
+            min_angle: r.min_angle,
+            marked: r.marked,
+            wall: r.wall,
+            worst_step: r.worst_step,
+            terms: TERMS.iter().zip(r.terms).map(|(n, v)| (n.to_string(), v.max(0.0).sqrt())).collect(),
+        }
+    }
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct AdaptSummary {
+    pub theta: f64,
+    pub levels_asked: Option<usize>,
+    pub target: Option<f64>,
+    pub reference_generation: Option<u32>,
+    pub exact: bool,
+    pub levels: Vec<AdaptLevel>,
+    pub stopped: Option<String>,
+}
+
+impl AdaptSummary {
+    pub fn of(o: &Options, exact: bool, rows: &[Row], stopped: Option<String>) -> AdaptSummary {
+        AdaptSummary {
+            theta: o.theta,
+            levels_asked: o.levels,
+            target: o.target,
+            reference_generation: o.reference,
+            exact,
+            levels: rows.iter().map(|r| AdaptLevel::of(r, exact)).collect(),
+            stopped,
+        }
+    }
+}
