@@ -228,3 +228,61 @@ fn adapt_refuses_bad_flags_naming_them() {
         assert!(!err.contains("panicked") && err.lines().count() <= 3, "{args:?}: {err}");
     }
 }
+
+/// The system shall report a time indicator η_k (src/adapt/time.rs) that exceeds the space indicator
+/// where the error is the time stepping's — mms_stop, slip stopping abruptly inside a step, whose true
+/// error levels off at its O(k) time error while η falls — and stays below it where it is not: zero on
+/// mms_elastic (no friction, loads affine in t: backward Euler is exact), below η on mms_stick_to_slip
+/// (measured η_k/η ≤ 0.44 over these levels). η + η_k bounds the true error on mms_stop (the two bounds
+/// add: total error ≤ space error + time error).
+#[test]
+fn time_indicator_exceeds_the_space_one_only_where_the_time_error_dominates() {
+    let stop = rows(&scene("verification/cases/mms_stop.toml"), &options(10, 0.5, None));
+    for r in &stop {
+        println!(
+            "mms_stop level {}: η {:.3e} η_k {:.3e} error {:.3e}",
+            r.level,
+            r.estimator,
+            r.time_estimator,
+            r.error.unwrap()
+        );
+        assert!(
+            r.time_estimator > r.estimator,
+            "mms_stop level {}: η_k {} ≤ η {}",
+            r.level,
+            r.time_estimator,
+            r.estimator
+        );
+        assert!(r.estimator + r.time_estimator >= r.error.unwrap(), "level {}", r.level);
+    }
+    // the true error levels off (the time error) while η keeps falling: the case is time-dominated
+    let (first, last) = (&stop[0], stop.last().unwrap());
+    assert!(last.estimator < 0.5 * first.estimator && last.error.unwrap() > 0.5 * first.error.unwrap());
+    for r in rows(&scene("verification/cases/mms_elastic.toml"), &options(8, 0.5, None)) {
+        assert_eq!(r.time_estimator, 0.0, "mms_elastic level {}", r.level);
+    }
+    for r in rows(&scene("verification/cases/mms_stick_to_slip.toml"), &options(10, 0.5, None)) {
+        println!("mms_stick_to_slip level {}: η {:.3e} η_k {:.3e}", r.level, r.estimator, r.time_estimator);
+        assert!(r.time_estimator > 0.0 && r.time_estimator < r.estimator, "level {}", r.level);
+    }
+}
+
+/// The system shall accumulate a dissipation mismatch D = Σ Δμⁿ·Δsⁿ whose every step is ≥ 0 (the
+/// monotonicity of the friction law's subdifferential, src/adapt/time.rs), up to the friction solver's
+/// tolerance on μ and s.
+#[test]
+fn dissipation_mismatch_is_non_negative_step_by_step() {
+    let p = Problem::new(scene("verification/cases/mms_stick_to_slip.toml")).unwrap();
+    let mut ti = tresca_cr::adapt::time::TimeIndicator::default();
+    let (mut last, mut steps) = (0.0, 0);
+    p.run(tresca_cr::RunOptions::all(), |r: &tresca_cr::StepResult| {
+        ti.push(&p, r).unwrap();
+        let scale: f64 = r.mu.iter().zip(&r.slip).map(|(m, s)| (m * s).abs()).sum();
+        assert!(ti.dissipation - last >= -1e-10 * scale.max(1e-300), "step {}: {}", r.n, ti.dissipation - last);
+        last = ti.dissipation;
+        steps += 1;
+        Ok(())
+    })
+    .unwrap();
+    assert!(steps > 2 && ti.dissipation > 0.0, "the front moves: D = {}", ti.dissipation);
+}

@@ -11,10 +11,13 @@
 //! and the wall time. Before a level is set up its memory (and results file) are estimated from the
 //! built mesh and refused when they do not fit, as `run` does; with a wall-time budget a level is
 //! refused when the time so far plus the last level's time scaled by the growth in unknowns exceeds it.
+//! Beside η each level reports the time indicator η_k ([`time`]), a bound on the error of the time
+//! stepping (the steps are the scene's; the loop refines space only).
 
 pub mod estimator;
 pub mod export;
 pub mod reference;
+pub mod time;
 
 use crate::error::{Error, Result};
 use crate::mesh::bisect::{bisect, dorfler, label_longest_edge};
@@ -27,6 +30,7 @@ use estimator::{Accumulated, Estimator};
 use reference::{distance, overlay, Kept};
 use std::path::PathBuf;
 use std::time::Instant;
+use time::TimeIndicator;
 
 /// What the adaptive loop is asked to do.
 #[derive(Clone, Debug)]
@@ -74,6 +78,10 @@ pub struct Row {
     pub min_angle: f64,
     pub marked: usize,
     pub wall: f64,
+    /// The time indicator η_k = D^{1/2} + 3L ([`time`]) and its two parts D^{1/2} and L.
+    pub time_estimator: f64,
+    pub time_dissipation: f64,
+    pub time_load: f64,
 }
 
 impl Row {
@@ -102,6 +110,7 @@ struct Solved {
     kept: Kept,
     acc: Accumulated,
     error: Option<f64>,
+    time: TimeIndicator,
     unknowns: usize,
     paper_dofs: usize,
 }
@@ -119,8 +128,9 @@ pub fn initial_mesh(scene: &Scene) -> Result<Mesh> {
     Mesh::build(raw)
 }
 
-/// Solve every step of `scene` on `mesh`, with the indicator at every node; write the results file.
-fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool) -> Result<Solved> {
+/// Solve every step of `scene` on `mesh`, with the indicator at every node (and the time indicator
+/// with `timed`); write the results file.
+fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool, timed: bool) -> Result<Solved> {
     let problem = Problem::with_mesh(scene.clone(), mesh)?;
     let est = Estimator::new(&problem)?;
     let mut writer = match &out {
@@ -128,8 +138,12 @@ fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool) -> Result
         None => None,
     };
     let (mut acc, mut u, mut error) = (Accumulated::default(), Vec::new(), None::<f64>);
+    let mut time = TimeIndicator::default();
     let mut on_step = |r: &StepResult| -> Result<()> {
         acc.push(r.n, &est.at(&problem, r)?);
+        if timed {
+            time.push(&problem, r)?;
+        }
         if let Some(e) = r.errors {
             error = Some(error.map_or(e.energy, |m| m.max(e.energy)));
         }
@@ -147,7 +161,7 @@ fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool) -> Result
     result?;
     let (unknowns, paper_dofs) = (problem.space.n_dofs, problem.space.paper_dofs());
     let kept = Kept { mesh: problem.mesh.clone(), space: problem.space.clone(), u };
-    Ok(Solved { kept, acc, error, unknowns, paper_dofs })
+    Ok(Solved { kept, acc, error, time, unknowns, paper_dofs })
 }
 
 /// Number of contact edges of `mesh` under `scene`'s parts.
@@ -187,7 +201,7 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
         if let (Some(dir), true) = (&opts.out, opts.gmsh) {
             export::write_gmsh(&mesh, &dir.join(format!("level_{level}.msh")))?;
         }
-        let solved = solve(scene, mesh, out, opts.force)?;
+        let solved = solve(scene, mesh, out, opts.force, true)?;
         let marked = dorfler(&solved.acc.eta2, opts.theta);
         let mut row = Row {
             level,
@@ -201,6 +215,9 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
             min_angle,
             generation,
             marked: marked.iter().filter(|&&m| m).count(),
+            time_estimator: solved.time.value(),
+            time_dissipation: solved.time.dissipation.max(0.0).sqrt(),
+            time_load: solved.time.load,
             ..Row::default()
         };
         let law = crate::fem::elasticity::Elasticity::new(&scene.material);
@@ -225,7 +242,7 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
     }
     if let (Some(g), Some(finest)) = (opts.reference, levels.last()) {
         let (ref_mesh, _) = overlay(finest.mesh.clone(), last_root, g)?;
-        let rf = solve(scene, ref_mesh, None, false)?;
+        let rf = solve(scene, ref_mesh, None, false, false)?;
         let law = crate::fem::elasticity::Elasticity::new(&scene.material);
         for (row, kept) in rows.iter_mut().zip(&levels) {
             row.vs_reference = Some(distance(&rf.kept, kept, &law, scene.rho)?);

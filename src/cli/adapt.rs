@@ -17,7 +17,7 @@ pub fn csv_text(rows: &[Row], exact: bool) -> String {
     for t in TERMS {
         let _ = write!(s, ",eta_{t}");
     }
-    s.push('\n');
+    s.push_str(",time_estimator,time_dissipation,time_load\n");
     for r in rows {
         let e = r.error_or_estimate();
         let f = |x: Option<f64>| x.map(|v| format!("{v:.6e}")).unwrap_or_default();
@@ -43,7 +43,7 @@ pub fn csv_text(rows: &[Row], exact: bool) -> String {
         for v in r.terms {
             let _ = write!(s, ",{:.6e}", v.max(0.0).sqrt());
         }
-        s.push('\n');
+        let _ = writeln!(s, ",{:.6e},{:.6e},{:.6e}", r.time_estimator, r.time_dissipation, r.time_load);
     }
     s
 }
@@ -56,11 +56,12 @@ pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<PathB
     }
     let exact = scene.exact.is_some();
     say!(
-        "{:>5} {:>9} {:>9} {:>11} {:>11} {:>6} {:>8} {:>7} {:>8}",
+        "{:>5} {:>9} {:>9} {:>11} {:>11} {:>11} {:>6} {:>8} {:>7} {:>8}",
         "level",
         "triangles",
         "unknowns",
         "estimator",
+        "time est",
         if exact { "error" } else { "vs next" },
         "eff",
         "min ang",
@@ -71,11 +72,12 @@ pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<PathB
         let e = r.error.map(|e| format!("{e:.4e}")).unwrap_or_else(|| "-".into());
         let eff = r.error.map(|e| format!("{:.3}", r.estimator / e)).unwrap_or_default();
         say!(
-            "{:>5} {:>9} {:>9} {:>11.4e} {:>11} {:>6} {:>8.3} {:>7} {:>8.3}",
+            "{:>5} {:>9} {:>9} {:>11.4e} {:>11.4e} {:>11} {:>6} {:>8.3} {:>7} {:>8.3}",
             r.level,
             r.triangles,
             r.unknowns,
             r.estimator,
+            r.time_estimator,
             e,
             eff,
             r.min_angle,

@@ -64,7 +64,8 @@
 //! `error` (the true error, else the distance to the reference, else to the next level; `null` when none
 //! is known) with `error_kind` (`true`, `vs_reference`, `vs_next`) and `effectivity` (η / error),
 //! `vs_next`, `vs_reference`, `min_angle` (degrees), `marked` (triangles marked for bisection), `wall`,
-//! `worst_step` (the node of the largest η) and `terms` (η's terms at that node, by name).
+//! `worst_step` (the node of the largest η), `terms` (η's terms at that node, by name), `time_estimator`
+//! (the time indicator η_k = D^{1/2} + 3L, `src/adapt/time.rs`), `time_dissipation` (D^{1/2}), `time_load` (L).
 
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};

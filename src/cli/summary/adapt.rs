@@ -24,6 +24,10 @@ pub struct AdaptLevel {
     pub worst_step: usize,
     /// The terms of η at its worst node, by name (`estimator::TERMS`), not squared.
     pub terms: std::collections::BTreeMap<String, f64>,
+    /// The time indicator η_k = D^{1/2} + 3L and its parts (`adapt::time`).
+    pub time_estimator: f64,
+    pub time_dissipation: f64,
+    pub time_load: f64,
 }
 
 impl AdaptLevel {
@@ -47,6 +51,9 @@ impl AdaptLevel {
             wall: r.wall,
             worst_step: r.worst_step,
             terms: TERMS.iter().zip(r.terms).map(|(n, v)| (n.to_string(), v.max(0.0).sqrt())).collect(),
+            time_estimator: r.time_estimator,
+            time_dissipation: r.time_dissipation,
+            time_load: r.time_load,
         }
     }
 }

@@ -120,6 +120,9 @@ fn adapt_summary_round_trips_and_old_summaries_still_read() {
         min_angle: 29.7,
         marked: 17,
         wall: 0.25,
+        time_estimator: 3e-3,
+        time_dissipation: 1e-3,
+        time_load: 2e-3 / 3.0,
     };
     let opts = tresca_cr::adapt::Options {
         levels: Some(4),
