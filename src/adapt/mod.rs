@@ -62,6 +62,8 @@ pub struct Row {
     pub triangles: usize,
     pub unknowns: usize,
     pub paper_dofs: usize,
+    /// Edges on the contact parts.
+    pub contact_edges: u64,
     /// η = max over the nodes of (Σ_T η_T²)^{1/2}.
     pub estimator: f64,
     /// The squared terms of η at its worst node (`estimator::TERMS`) and that node.
@@ -208,6 +210,7 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
             triangles: solved.kept.mesh.tris.len(),
             unknowns: solved.unknowns,
             paper_dofs: solved.paper_dofs,
+            contact_edges: contact_edges(scene, &solved.kept.mesh),
             estimator: solved.acc.global,
             terms: solved.acc.terms,
             worst_step: solved.acc.step,

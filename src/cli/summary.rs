@@ -55,7 +55,12 @@
 //! plus N · step · n ln n); `plan` and `runners_up` ([`Candidate`]: `refine`, `steps`, `unknowns`, `h`, `k`,
 //! `error`, `space_error`, `time_error`, `wall`, `memory`), `over_budget`; `solver`, `tol`; `notes`;
 //! `refused`; `achieved` (with `--run`, [`Achieved`]: `estimate`, `space`, `time`, `true_error`, `met`,
-//! `levels`).
+//! `levels`); `adaptive` ([`AdaptiveRoute`], energy-norm targets only; absent in older summaries): the
+//! adaptive route weighed against the uniform plan (`src/plan/adaptive.rs`): `choice` (`uniform`,
+//! `adaptive`, `neither`), `reason`, `refused` (why not weighed), `eta` (the indicator value to reach),
+//! `adaptive_rate`, `uniform_rate` (r in η = c N^(−r)), `uniform_unknowns`, `uniform_wall`, `uniform_memory`,
+//! `adaptive_unknowns`, `adaptive_levels`, `adaptive_wall` (the whole sequence), `adaptive_memory` (its last
+//! level), `pilot_wall`, `adaptive_pilot`, `uniform_pilot` (their levels, as `adapt`'s).
 //!
 //! `adapt` ([`AdaptSummary`]): `theta`, `levels_asked`, `target`, `reference_generation` (the flags;
 //! `null` when not given), `exact` (the errors are true ones), `stopped` (why the loop stopped before its
@@ -384,7 +389,7 @@ impl StudySummary {
 
 mod adapt;
 mod plan;
-pub use adapt::AdaptSummary;
+pub use adapt::{AdaptSummary, AdaptiveRoute};
 pub use plan::{Achieved, PlanSummary};
 
 #[cfg(test)]

@@ -82,3 +82,74 @@ impl AdaptSummary {
         }
     }
 }
+
+/// `plan`'s weighing of the adaptive route against the uniform one (`plan::adaptive`).
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct AdaptiveRoute {
+    /// `uniform`, `adaptive` or `neither`; `null` when the routes were not weighed (`refused` says why).
+    pub choice: Option<String>,
+    pub reason: Option<String>,
+    pub refused: Option<String>,
+    /// η_u(N_u), the indicator value both routes must reach.
+    pub eta: Option<f64>,
+    /// The laws' orders r in η = c N^(−r).
+    pub adaptive_rate: Option<f64>,
+    pub uniform_rate: Option<f64>,
+    pub uniform_unknowns: Option<f64>,
+    pub uniform_wall: Option<f64>,
+    pub uniform_memory: Option<u64>,
+    pub adaptive_unknowns: Option<f64>,
+    pub adaptive_levels: Option<usize>,
+    pub adaptive_wall: Option<f64>,
+    pub adaptive_memory: Option<u64>,
+    pub pilot_wall: Option<f64>,
+    pub adaptive_pilot: Vec<AdaptLevel>,
+    pub uniform_pilot: Vec<AdaptLevel>,
+}
+
+impl AdaptiveRoute {
+    /// The weighing `w`, or why there is none; `exact`: the scene has `[exact]`.
+    pub fn of(w: &std::result::Result<tresca_cr::plan::adaptive::AdaptivePlan, String>, exact: bool) -> AdaptiveRoute {
+        let none = AdaptiveRoute {
+            choice: None,
+            reason: None,
+            refused: None,
+            eta: None,
+            adaptive_rate: None,
+            uniform_rate: None,
+            uniform_unknowns: None,
+            uniform_wall: None,
+            uniform_memory: None,
+            adaptive_unknowns: None,
+            adaptive_levels: None,
+            adaptive_wall: None,
+            adaptive_memory: None,
+            pilot_wall: None,
+            adaptive_pilot: vec![],
+            uniform_pilot: vec![],
+        };
+        let w = match w {
+            Ok(w) => w,
+            Err(why) => return AdaptiveRoute { refused: Some(why.clone()), ..none },
+        };
+        let rows = |rs: &[Row]| rs.iter().map(|r| AdaptLevel::of(r, exact)).collect();
+        AdaptiveRoute {
+            choice: Some(w.choice.name().into()),
+            reason: Some(w.reason.clone()),
+            eta: Some(w.eta),
+            adaptive_rate: Some(-w.adaptive_law.p),
+            uniform_rate: Some(-w.uniform_law.p),
+            uniform_unknowns: Some(w.uniform_unknowns),
+            uniform_wall: Some(w.uniform_wall),
+            uniform_memory: Some(w.uniform_memory),
+            adaptive_unknowns: Some(w.unknowns),
+            adaptive_levels: Some(w.levels),
+            adaptive_wall: Some(w.wall),
+            adaptive_memory: Some(w.memory),
+            pilot_wall: Some(w.pilot_wall),
+            adaptive_pilot: rows(&w.adaptive_pilot),
+            uniform_pilot: rows(&w.uniform_pilot),
+            ..none
+        }
+    }
+}

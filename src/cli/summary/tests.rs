@@ -110,6 +110,7 @@ fn adapt_summary_round_trips_and_old_summaries_still_read() {
         triangles: 120,
         unknowns: 340,
         paper_dofs: 320,
+        contact_edges: 8,
         estimator: 2e-2,
         terms: [1e-6, 2e-4, 3e-6, 4e-8, 5e-5],
         worst_step: 4,
