@@ -162,6 +162,9 @@ enum Cmd {
         /// Refuse configurations whose estimated peak memory exceeds this (default: available memory).
         #[arg(long, allow_hyphen_values = true, value_parser = cli::args::size)]
         max_memory: Option<u64>,
+        /// Plan uniform refinement only: do not pilot and weigh the adaptive route (`adapt`).
+        #[arg(long)]
+        uniform_only: bool,
         #[command(flatten)]
         json: cli::summary::JsonArg,
     },
@@ -335,7 +338,7 @@ fn main() {
                 }
                 Ok(())
             }),
-        Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory, json } => {
+        Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory, uniform_only, json } => {
             let no_limits = Limits { max_memory: None, max_disk: None };
             if let Some(d) = tresca_cr::plan::pilot::Quantity::deprecation(&quantity) {
                 note!("warning: {d}");
@@ -350,7 +353,7 @@ fn main() {
             cli::summary::check_path(json.json.as_deref())
                 .and_then(|()| load(&scene, None, None, no_limits, |_| None, false))
                 .and_then(|(s, _)| {
-                    let code = cli::plan::run(s, options, csv, run, json.json)?;
+                    let code = cli::plan::run(s, options, csv, run, !uniform_only, json.json)?;
                     if code != 0 {
                         std::process::exit(code);
                     }

@@ -37,6 +37,9 @@ use crate::stepping::{Problem, StepResult};
 /// Sub-intervals per step for L.
 pub const SUBSTEPS: usize = 4;
 
+/// A time node as the indicator keeps it: t, ℓ(t), μ, s.
+type Node = (f64, Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// The time indicator accumulated over the steps of a run.
 #[derive(Clone, Debug, Default)]
 pub struct TimeIndicator {
@@ -45,7 +48,7 @@ pub struct TimeIndicator {
     /// L = Σ_m ∫ ‖ℓ̇ − ℓ̄̇‖_* over step m.
     pub load: f64,
     /// The previous node: t, ℓ, μ, s.
-    prev: Option<(f64, Vec<f64>, Vec<f64>, Vec<f64>)>,
+    prev: Option<Node>,
 }
 
 impl TimeIndicator {

@@ -22,7 +22,15 @@ fn adaptive_chosen(w: &Option<Weighed>) -> bool {
 /// Exit code of a refusal (no plan; errors exit with 1, command-line usage errors with 2 as clap does).
 pub const REFUSED: i32 = 3;
 
-pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool, json: Option<PathBuf>) -> Result<i32> {
+/// Plan (and with `weigh_adaptive` weigh the adaptive route beside it); returns the exit code.
+pub fn run(
+    scene: Scene,
+    options: Options,
+    csv: Option<PathBuf>,
+    execute: bool,
+    weigh_adaptive: bool,
+    json: Option<PathBuf>,
+) -> Result<i32> {
     let start = std::time::Instant::now();
     let summarise = |p: &Plan, achieved, adaptive: &Option<Weighed>| -> Result<()> {
         let Some(j) = &json else { return Ok(()) };
@@ -49,7 +57,7 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool, 
     for n in &p.notes {
         say!("note: {n}");
     }
-    let adaptive = super::plan_adaptive::weigh(&scene, &p)?;
+    let adaptive = if weigh_adaptive { super::plan_adaptive::weigh(&scene, &p)? } else { None };
     if let Some(why) = &p.refused {
         let chosen = adaptive_chosen(&adaptive);
         say!("\n{}: {why}", if chosen { "No uniform plan (the adaptive route above is)" } else { "No plan" });
