@@ -1,4 +1,6 @@
 //! `plan` weighs an adaptive sequence (`adapt`, Dörfler θ = [`THETA`]) against the uniform plan.
+//! Each of its two pilots takes at most a tenth of the uniform run's predicted wall time (at least ¼ s,
+//! at most half the pilot budget), so weighing adds at most about a fifth of the run to the planner.
 //!
 //! Both routes are compared through the same error indicator η (`adapt::estimator`, an upper bound of
 //! the energy-norm error up to a constant): a few levels of each — adaptive, and uniform as the θ = 1
@@ -122,7 +124,9 @@ pub fn weigh(scene: &Scene, p: &Plan) -> Result<std::result::Result<AdaptivePlan
     };
     let Some(cost) = p.cost else { return Ok(Err("no cost model".into())) };
     let start = std::time::Instant::now();
-    let share = (p.options.pilot_budget / 2.0).max(1.0);
+    // each pilot may take a tenth of the uniform run (as a pilot extension may), at least ¼ s, at most
+    // half the pilot budget
+    let share = (super::EXTENSION_SHARE * u.wall).max(0.25).min((p.options.pilot_budget / 2.0).max(0.25));
     let adaptive_pilot = pilot(scene, THETA, ADAPTIVE_LEVELS, share)?;
     let uniform_pilot = pilot(scene, 1.0, UNIFORM_LEVELS, share)?;
     let pilot_wall = start.elapsed().as_secs_f64();
