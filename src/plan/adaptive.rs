@@ -168,23 +168,7 @@ pub fn weigh(scene: &Scene, p: &Plan) -> Result<std::result::Result<AdaptivePlan
     let limit = p.options.max_memory.or_else(available_memory);
     let fits = |wall: f64, memory: u64| wall <= p.options.budget && limit.is_none_or(|m| memory <= m);
     let (fa, fu) = (fits(wall, memory), fits(u.wall, u.memory));
-    let choice = match (fa, fu) {
-        (true, true) if wall < u.wall => Route::Adaptive,
-        (true, false) => Route::Adaptive,
-        (_, true) => Route::Uniform,
-        (false, false) => Route::Neither,
-    };
-    let reason = match choice {
-        Route::Adaptive if fu => {
-            format!("the adaptive route is predicted cheaper: {wall:.3e} s against {:.3e} s", u.wall)
-        }
-        Route::Adaptive => "only the adaptive route fits the budget and memory".to_string(),
-        Route::Uniform if fa => {
-            format!("the uniform route is predicted cheaper: {:.3e} s against {wall:.3e} s", u.wall)
-        }
-        Route::Uniform => "only the uniform route fits the budget and memory".to_string(),
-        Route::Neither => "neither route fits the budget and memory".to_string(),
-    };
+    let (choice, reason) = choose(fa, fu, wall, u.wall);
     Ok(Ok(AdaptivePlan {
         adaptive_pilot,
         uniform_pilot,
@@ -202,4 +186,25 @@ pub fn weigh(scene: &Scene, p: &Plan) -> Result<std::result::Result<AdaptivePlan
         choice,
         reason,
     }))
+}
+
+/// The route recommended, and why: the cheaper of those that fit (`fa`, `fu`: the adaptive and the
+/// uniform route fit the budget and memory; `wall`, `uniform`: their predicted wall times).
+fn choose(fa: bool, fu: bool, wall: f64, uniform: f64) -> (Route, String) {
+    let choice = match (fa, fu) {
+        (true, true) if wall < uniform => Route::Adaptive,
+        (true, false) => Route::Adaptive,
+        (_, true) => Route::Uniform,
+        (false, false) => Route::Neither,
+    };
+    let reason = match choice {
+        Route::Adaptive if fu => {
+            format!("the adaptive route is predicted cheaper: {wall:.3e} s against {uniform:.3e} s")
+        }
+        Route::Adaptive => "only the adaptive route fits the budget and memory".to_string(),
+        Route::Uniform if fa => format!("the uniform route is predicted cheaper: {uniform:.3e} s against {wall:.3e} s"),
+        Route::Uniform => "only the uniform route fits the budget and memory".to_string(),
+        Route::Neither => "neither route fits the budget and memory".to_string(),
+    };
+    (choice, reason)
 }
