@@ -92,25 +92,25 @@ enum Cmd {
     Adapt {
         scene: PathBuf,
         /// Stop once the estimator is at most this (energy norm, max over the time nodes).
-        #[arg(long, required_unless_present = "levels")]
+        #[arg(long, required_unless_present = "levels", allow_hyphen_values = true, value_parser = cli::args::positive)]
         target: Option<f64>,
         /// Number of levels (solves), the starting mesh included.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::at_least_one)]
         levels: Option<usize>,
         /// Dörfler's parameter: mark the fewest triangles carrying this share of η².
-        #[arg(long, default_value_t = 0.5)]
+        #[arg(long, default_value_t = 0.5, allow_hyphen_values = true, value_parser = cli::args::theta)]
         theta: f64,
         /// Starting mesh: uniform refinements (overrides mesh.refine).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::refine)]
         refine: Option<u32>,
         /// Uniform time steps (overrides time.steps).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::count)]
         steps: Option<usize>,
         /// Per-step solver (overrides solver.method).
         #[arg(long)]
         solver: Option<Method>,
         /// Solver tolerance (overrides solver.tol).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         tol: Option<f64>,
         /// Write DIR/level_<k>.h5, each level's results file with its mesh.
         #[arg(long, value_name = "DIR")]
@@ -125,14 +125,16 @@ enum Cmd {
         #[arg(long)]
         csv: Option<PathBuf>,
         /// Wall time the whole loop may take (e.g. 90s, 10m).
-        #[arg(long, value_parser = cli::plan::parse_duration)]
+        #[arg(long, allow_hyphen_values = true, value_parser = cli::plan::parse_duration)]
         budget: Option<f64>,
         /// Measure every level against a reference solution on the finest mesh refined until every
         /// triangle has at least this bisection generation (a uniform mesh of that generation nests in it).
-        #[arg(long, value_name = "GENERATION")]
+        #[arg(long, value_name = "GENERATION", allow_negative_numbers = true, value_parser = cli::args::generation)]
         reference: Option<u32>,
         #[command(flatten)]
         limits: Limits,
+        #[command(flatten)]
+        json: cli::summary::JsonArg,
     },
     /// Plan the cheapest run that meets a target accuracy: pilot runs, error and cost models, the
     /// cheapest (refine, steps, solver, tolerance) and two runners-up, or a refusal (exit code 3).
@@ -160,6 +162,9 @@ enum Cmd {
         /// Refuse configurations whose estimated peak memory exceeds this (default: available memory).
         #[arg(long, allow_hyphen_values = true, value_parser = cli::args::size)]
         max_memory: Option<u64>,
+        /// Plan uniform refinement only: do not pilot and weigh the adaptive route (`adapt`).
+        #[arg(long)]
+        uniform_only: bool,
         #[command(flatten)]
         json: cli::summary::JsonArg,
     },
@@ -309,32 +314,31 @@ fn main() {
             budget,
             reference,
             limits,
-        } => load(&scene, refine, steps, limits, |_| None, false).and_then(|(mut s, _)| {
-            solver_overrides(&mut s, solver, tol)?;
-            if let Some(t) = target {
-                anyhow::ensure!(t.is_finite() && t > 0.0, "--target {t}: must be a positive number");
-            }
-            anyhow::ensure!(levels != Some(0), "--levels must be at least 1");
-            let (max_memory, max_disk) = (limits.max_memory, limits.max_disk);
-            let opts = tresca_cr::adapt::Options {
-                levels,
-                target,
-                theta,
-                out,
-                gmsh,
-                force,
-                max_memory,
-                max_disk,
-                budget,
-                reference,
-            };
-            let code = cli::adapt::run(s, opts, csv)?;
-            if code != 0 {
-                std::process::exit(code);
-            }
-            Ok(())
-        }),
-        Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory, json } => {
+            json,
+        } => cli::summary::check_path(json.json.as_deref())
+            .and_then(|()| load(&scene, refine, steps, limits, |_| None, false))
+            .and_then(|(mut s, _)| {
+                solver_overrides(&mut s, solver, tol)?;
+                let (max_memory, max_disk) = (limits.max_memory, limits.max_disk);
+                let opts = tresca_cr::adapt::Options {
+                    levels,
+                    target,
+                    theta,
+                    out,
+                    gmsh,
+                    force,
+                    max_memory,
+                    max_disk,
+                    budget,
+                    reference,
+                };
+                let code = cli::adapt::run(s, opts, csv, json.json)?;
+                if code != 0 {
+                    std::process::exit(code);
+                }
+                Ok(())
+            }),
+        Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory, uniform_only, json } => {
             let no_limits = Limits { max_memory: None, max_disk: None };
             if let Some(d) = tresca_cr::plan::pilot::Quantity::deprecation(&quantity) {
                 note!("warning: {d}");
@@ -349,7 +353,7 @@ fn main() {
             cli::summary::check_path(json.json.as_deref())
                 .and_then(|()| load(&scene, None, None, no_limits, |_| None, false))
                 .and_then(|(s, _)| {
-                    let code = cli::plan::run(s, options, csv, run, json.json)?;
+                    let code = cli::plan::run(s, options, csv, run, !uniform_only, json.json)?;
                     if code != 0 {
                         std::process::exit(code);
                     }

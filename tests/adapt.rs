@@ -175,13 +175,114 @@ fn adapt_command_writes_levels_and_refuses_what_does_not_fit() {
         assert!(head.contains(&col), "column {col} in {head:?}");
     }
     assert_eq!(text.lines().count(), 4);
-    let out = bin().args(["adapt", sc.to_str().unwrap(), "--target", "1e-9", "--max-memory", "40M"]).output().unwrap();
+    let json = dir.as_path().join("a.json");
+    let out = bin()
+        .args(["adapt", sc.to_str().unwrap(), "--target", "1e-9", "--max-memory", "40M", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{err}");
     assert!(err.contains("does not fit") && err.contains("memory"), "{err}");
-    let out = bin().args(["adapt", sc.to_str().unwrap(), "--levels", "2", "--theta", "1.5"]).output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(err.contains("theta") && !err.contains("panicked"), "{err}");
+    // the summary of a refused loop: the levels that ran, and why it stopped
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["command"], "adapt");
+    assert!(v["status"].as_str().unwrap().starts_with("refused: level"), "{v}");
+    let levels = v["adapt"]["levels"].as_array().unwrap();
+    assert!(!levels.is_empty() && levels[0]["unknowns"].as_u64().unwrap() > 0, "{v}");
+    assert!(levels.iter().all(|l| l["estimator"].as_f64().unwrap() > 1e-9), "stopped before the target");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The system shall refuse each bad value of `adapt`'s flags with one error naming the flag and what it
+/// takes, and a non-zero exit, before any level is solved (no panic, nothing written).
+#[test]
+fn adapt_refuses_bad_flags_naming_them() {
+    let sc = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/cases/lshape_adapt.toml");
+    let bad: [(&[&str], &str); 12] = [
+        (&["--levels", "2", "--theta", "1.5"], "(0, 1]"),
+        (&["--levels", "2", "--theta", "0"], "(0, 1]"),
+        (&["--levels", "2", "--theta", "-0.5"], "(0, 1]"),
+        (&["--levels", "0"], "≥ 1"),
+        (&["--levels", "-3"], "≥ 1"),
+        (&["--target", "0"], "> 0"),
+        (&["--target", "-1e-3"], "> 0"),
+        (&["--target", "nan"], "> 0"),
+        (&["--levels", "2", "--refine", "-1"], "refinements"),
+        (&["--levels", "2", "--steps", "-4"], "whole number"),
+        (&["--levels", "2", "--reference", "99"], "at most 24"),
+        (&["--levels", "2", "--budget", "-5s"], "positive duration"),
+    ];
+    let flag = |args: &[&str]| args.iter().rev().nth(1).unwrap().to_string();
+    for (args, what) in bad {
+        let out = bin().arg("adapt").arg(&sc).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_ne!(out.status.code(), Some(0), "{args:?} accepted");
+        assert!(err.contains(&flag(args)) && err.contains(what), "{args:?}: {err}");
+        assert!(!err.contains("panicked") && out.stdout.is_empty(), "{args:?}: {err}");
+    }
+    for args in [&["--levels", "2", "--max-memory", "-1G"][..], &["--levels", "2", "--steps", "0"]] {
+        let out = bin().arg("adapt").arg(&sc).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(matches!(out.status.code(), Some(1 | 2)), "{args:?}: {err}");
+        assert!(!err.contains("panicked") && err.lines().count() <= 3, "{args:?}: {err}");
+    }
+}
+
+/// The system shall report a time indicator η_k (src/adapt/time.rs) that exceeds the space indicator
+/// where the error is the time stepping's — mms_stop, slip stopping abruptly inside a step, whose true
+/// error levels off at its O(k) time error while η falls — and stays below it where it is not: zero on
+/// mms_elastic (no friction, loads affine in t: backward Euler is exact), below η on mms_stick_to_slip
+/// (measured η_k/η ≤ 0.44 over these levels). η + η_k bounds the true error on mms_stop (the two bounds
+/// add: total error ≤ space error + time error).
+#[test]
+fn time_indicator_exceeds_the_space_one_only_where_the_time_error_dominates() {
+    let stop = rows(&scene("verification/cases/mms_stop.toml"), &options(10, 0.5, None));
+    for r in &stop {
+        println!(
+            "mms_stop level {}: η {:.3e} η_k {:.3e} error {:.3e}",
+            r.level,
+            r.estimator,
+            r.time_estimator,
+            r.error.unwrap()
+        );
+        assert!(
+            r.time_estimator > r.estimator,
+            "mms_stop level {}: η_k {} ≤ η {}",
+            r.level,
+            r.time_estimator,
+            r.estimator
+        );
+        assert!(r.estimator + r.time_estimator >= r.error.unwrap(), "level {}", r.level);
+    }
+    // the true error levels off (the time error) while η keeps falling: the case is time-dominated
+    let (first, last) = (&stop[0], stop.last().unwrap());
+    assert!(last.estimator < 0.5 * first.estimator && last.error.unwrap() > 0.5 * first.error.unwrap());
+    for r in rows(&scene("verification/cases/mms_elastic.toml"), &options(8, 0.5, None)) {
+        assert_eq!(r.time_estimator, 0.0, "mms_elastic level {}", r.level);
+    }
+    for r in rows(&scene("verification/cases/mms_stick_to_slip.toml"), &options(10, 0.5, None)) {
+        println!("mms_stick_to_slip level {}: η {:.3e} η_k {:.3e}", r.level, r.estimator, r.time_estimator);
+        assert!(r.time_estimator > 0.0 && r.time_estimator < r.estimator, "level {}", r.level);
+    }
+}
+
+/// The system shall accumulate a dissipation mismatch D = Σ Δμⁿ·Δsⁿ whose every step is ≥ 0 (the
+/// monotonicity of the friction law's subdifferential, src/adapt/time.rs), up to the friction solver's
+/// tolerance on μ and s.
+#[test]
+fn dissipation_mismatch_is_non_negative_step_by_step() {
+    let p = Problem::new(scene("verification/cases/mms_stick_to_slip.toml")).unwrap();
+    let mut ti = tresca_cr::adapt::time::TimeIndicator::default();
+    let (mut last, mut steps) = (0.0, 0);
+    p.run(tresca_cr::RunOptions::all(), |r: &tresca_cr::StepResult| {
+        ti.push(&p, r).unwrap();
+        let scale: f64 = r.mu.iter().zip(&r.slip).map(|(m, s)| (m * s).abs()).sum();
+        assert!(ti.dissipation - last >= -1e-10 * scale.max(1e-300), "step {}: {}", r.n, ti.dissipation - last);
+        last = ti.dissipation;
+        steps += 1;
+        Ok(())
+    })
+    .unwrap();
+    assert!(steps > 2 && ti.dissipation > 0.0, "the front moves: D = {}", ti.dissipation);
 }

@@ -11,10 +11,13 @@
 //! and the wall time. Before a level is set up its memory (and results file) are estimated from the
 //! built mesh and refused when they do not fit, as `run` does; with a wall-time budget a level is
 //! refused when the time so far plus the last level's time scaled by the growth in unknowns exceeds it.
+//! Beside η each level reports the time indicator η_k ([`time`]), a bound on the error of the time
+//! stepping (the steps are the scene's; the loop refines space only).
 
 pub mod estimator;
 pub mod export;
 pub mod reference;
+pub mod time;
 
 use crate::error::{Error, Result};
 use crate::mesh::bisect::{bisect, dorfler, label_longest_edge};
@@ -27,6 +30,7 @@ use estimator::{Accumulated, Estimator};
 use reference::{distance, overlay, Kept};
 use std::path::PathBuf;
 use std::time::Instant;
+use time::TimeIndicator;
 
 /// What the adaptive loop is asked to do.
 #[derive(Clone, Debug)]
@@ -58,6 +62,8 @@ pub struct Row {
     pub triangles: usize,
     pub unknowns: usize,
     pub paper_dofs: usize,
+    /// Edges on the contact parts.
+    pub contact_edges: u64,
     /// η = max over the nodes of (Σ_T η_T²)^{1/2}.
     pub estimator: f64,
     /// The squared terms of η at its worst node (`estimator::TERMS`) and that node.
@@ -74,6 +80,10 @@ pub struct Row {
     pub min_angle: f64,
     pub marked: usize,
     pub wall: f64,
+    /// The time indicator η_k = D^{1/2} + 3L ([`time`]) and its two parts D^{1/2} and L.
+    pub time_estimator: f64,
+    pub time_dissipation: f64,
+    pub time_load: f64,
 }
 
 impl Row {
@@ -82,6 +92,19 @@ impl Row {
     pub fn error_or_estimate(&self) -> Option<f64> {
         self.error.or(self.vs_reference).or(self.vs_next)
     }
+
+    /// What [`Row::error_or_estimate`] is: `true` (`exact`: the scene has `[exact]`), `vs_reference` or
+    /// `vs_next`; `None` when no error is known.
+    pub fn error_kind(&self, exact: bool) -> Option<&'static str> {
+        self.error_or_estimate()?;
+        Some(if exact {
+            "true"
+        } else if self.vs_reference.is_some() {
+            "vs_reference"
+        } else {
+            "vs_next"
+        })
+    }
 }
 
 /// A solved level: its fields at every node, the accumulated indicator, the true error.
@@ -89,6 +112,7 @@ struct Solved {
     kept: Kept,
     acc: Accumulated,
     error: Option<f64>,
+    time: TimeIndicator,
     unknowns: usize,
     paper_dofs: usize,
 }
@@ -106,8 +130,9 @@ pub fn initial_mesh(scene: &Scene) -> Result<Mesh> {
     Mesh::build(raw)
 }
 
-/// Solve every step of `scene` on `mesh`, with the indicator at every node; write the results file.
-fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool) -> Result<Solved> {
+/// Solve every step of `scene` on `mesh`, with the indicator at every node (and the time indicator
+/// with `timed`); write the results file.
+fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool, timed: bool) -> Result<Solved> {
     let problem = Problem::with_mesh(scene.clone(), mesh)?;
     let est = Estimator::new(&problem)?;
     let mut writer = match &out {
@@ -115,8 +140,12 @@ fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool) -> Result
         None => None,
     };
     let (mut acc, mut u, mut error) = (Accumulated::default(), Vec::new(), None::<f64>);
+    let mut time = TimeIndicator::default();
     let mut on_step = |r: &StepResult| -> Result<()> {
         acc.push(r.n, &est.at(&problem, r)?);
+        if timed {
+            time.push(&problem, r)?;
+        }
         if let Some(e) = r.errors {
             error = Some(error.map_or(e.energy, |m| m.max(e.energy)));
         }
@@ -134,7 +163,7 @@ fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool) -> Result
     result?;
     let (unknowns, paper_dofs) = (problem.space.n_dofs, problem.space.paper_dofs());
     let kept = Kept { mesh: problem.mesh.clone(), space: problem.space.clone(), u };
-    Ok(Solved { kept, acc, error, unknowns, paper_dofs })
+    Ok(Solved { kept, acc, error, time, unknowns, paper_dofs })
 }
 
 /// Number of contact edges of `mesh` under `scene`'s parts.
@@ -174,13 +203,14 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
         if let (Some(dir), true) = (&opts.out, opts.gmsh) {
             export::write_gmsh(&mesh, &dir.join(format!("level_{level}.msh")))?;
         }
-        let solved = solve(scene, mesh, out, opts.force)?;
+        let solved = solve(scene, mesh, out, opts.force, true)?;
         let marked = dorfler(&solved.acc.eta2, opts.theta);
         let mut row = Row {
             level,
             triangles: solved.kept.mesh.tris.len(),
             unknowns: solved.unknowns,
             paper_dofs: solved.paper_dofs,
+            contact_edges: contact_edges(scene, &solved.kept.mesh),
             estimator: solved.acc.global,
             terms: solved.acc.terms,
             worst_step: solved.acc.step,
@@ -188,6 +218,9 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
             min_angle,
             generation,
             marked: marked.iter().filter(|&&m| m).count(),
+            time_estimator: solved.time.value(),
+            time_dissipation: solved.time.dissipation.max(0.0).sqrt(),
+            time_load: solved.time.load,
             ..Row::default()
         };
         let law = crate::fem::elasticity::Elasticity::new(&scene.material);
@@ -212,7 +245,7 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
     }
     if let (Some(g), Some(finest)) = (opts.reference, levels.last()) {
         let (ref_mesh, _) = overlay(finest.mesh.clone(), last_root, g)?;
-        let rf = solve(scene, ref_mesh, None, false)?;
+        let rf = solve(scene, ref_mesh, None, false, false)?;
         let law = crate::fem::elasticity::Elasticity::new(&scene.material);
         for (row, kept) in rows.iter_mut().zip(&levels) {
             row.vs_reference = Some(distance(&rf.kept, kept, &law, scene.rho)?);

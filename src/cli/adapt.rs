@@ -1,5 +1,5 @@
 //! `tresca-cr adapt`: the adaptive loop (solve → estimate → mark → refine over whole runs) printed as a
-//! table per level and written as CSV; each level's results file in `--out DIR`.
+//! table per level and written as CSV and (`--json`) in the summary; each level's results file in `--out DIR`.
 
 use super::out::{note, say};
 use anyhow::{Context, Result};
@@ -17,15 +17,8 @@ pub fn csv_text(rows: &[Row], exact: bool) -> String {
     for t in TERMS {
         let _ = write!(s, ",eta_{t}");
     }
-    s.push('\n');
+    s.push_str(",time_estimator,time_dissipation,time_load\n");
     for r in rows {
-        let kind = if exact {
-            "true"
-        } else if r.vs_reference.is_some() {
-            "vs_reference"
-        } else {
-            "vs_next"
-        };
         let e = r.error_or_estimate();
         let f = |x: Option<f64>| x.map(|v| format!("{v:.6e}")).unwrap_or_default();
         let _ = write!(
@@ -38,7 +31,7 @@ pub fn csv_text(rows: &[Row], exact: bool) -> String {
             r.generation,
             r.estimator,
             f(e),
-            if e.is_some() { kind } else { "" },
+            r.error_kind(exact).unwrap_or_default(),
             f(e.map(|e| r.estimator / e)),
             f(r.vs_next),
             f(r.vs_reference),
@@ -50,23 +43,25 @@ pub fn csv_text(rows: &[Row], exact: bool) -> String {
         for v in r.terms {
             let _ = write!(s, ",{:.6e}", v.max(0.0).sqrt());
         }
-        s.push('\n');
+        let _ = writeln!(s, ",{:.6e},{:.6e},{:.6e}", r.time_estimator, r.time_dissipation, r.time_load);
     }
     s
 }
 
 /// Run the loop and report; returns the exit code (3: stopped before the goal, with the reason).
-pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>) -> Result<i32> {
+pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<PathBuf>) -> Result<i32> {
+    let start = std::time::Instant::now();
     if let Some(dir) = &opts.out {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     let exact = scene.exact.is_some();
     say!(
-        "{:>5} {:>9} {:>9} {:>11} {:>11} {:>6} {:>8} {:>7} {:>8}",
+        "{:>5} {:>9} {:>9} {:>11} {:>11} {:>11} {:>6} {:>8} {:>7} {:>8}",
         "level",
         "triangles",
         "unknowns",
         "estimator",
+        "time est",
         if exact { "error" } else { "vs next" },
         "eff",
         "min ang",
@@ -77,11 +72,12 @@ pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>) -> Result<i32> {
         let e = r.error.map(|e| format!("{e:.4e}")).unwrap_or_else(|| "-".into());
         let eff = r.error.map(|e| format!("{:.3}", r.estimator / e)).unwrap_or_default();
         say!(
-            "{:>5} {:>9} {:>9} {:>11.4e} {:>11} {:>6} {:>8.3} {:>7} {:>8.3}",
+            "{:>5} {:>9} {:>9} {:>11.4e} {:>11.4e} {:>11} {:>6} {:>8.3} {:>7} {:>8.3}",
             r.level,
             r.triangles,
             r.unknowns,
             r.estimator,
+            r.time_estimator,
             e,
             eff,
             r.min_angle,
@@ -109,6 +105,14 @@ pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>) -> Result<i32> {
     if let Some(path) = csv {
         std::fs::write(&path, csv_text(&outcome.rows, exact))
             .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(j) = &json {
+        let mut summary = super::summary::Summary::new("adapt", &scene.file, start.elapsed().as_secs_f64());
+        if let Some(why) = &outcome.stopped {
+            summary.status = format!("refused: {why}");
+        }
+        summary.adapt = Some(super::summary::AdaptSummary::of(&opts, exact, &outcome.rows, outcome.stopped.clone()));
+        super::summary::write(j, &summary)?;
     }
     Ok(match outcome.stopped {
         Some(why) => {

@@ -43,3 +43,36 @@ pub fn level(text: &str) -> Result<Level, String> {
     refine(&l.refine.to_string())?;
     Ok(l)
 }
+
+/// Dörfler's θ, a number in (0, 1] (`adapt --theta`).
+pub fn theta(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= 1.0 => Ok(v),
+        _ => Err(format!("`{text}`: expected Dörfler's θ, a number in (0, 1] (the share of η² marked)")),
+    }
+}
+
+/// A whole number ≥ 1 (`adapt --levels`: the starting mesh is level 0, so one level is the least).
+pub fn at_least_one(text: &str) -> Result<usize, String> {
+    match text.trim().parse::<usize>() {
+        Ok(k) if k >= 1 => Ok(k),
+        _ => Err(format!("`{text}`: expected a whole number ≥ 1")),
+    }
+}
+
+/// A finite number > 0 (`adapt --target`, an energy-norm error).
+pub fn positive(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("`{text}`: expected a finite number > 0")),
+    }
+}
+
+/// A bisection generation, 0 to 24 (`adapt --reference`: two bisections halve h, so 24 is `refine` 12).
+pub fn generation(text: &str) -> Result<u32, String> {
+    match text.trim().parse::<u32>() {
+        Ok(g) if g <= 24 => Ok(g),
+        Ok(g) => Err(format!("generation {g} is beyond any machine (at most 24, as 12 uniform refinements)")),
+        Err(_) => Err(format!("`{text}`: expected a whole number of bisection generations from 0 to 24")),
+    }
+}

@@ -5,6 +5,7 @@ pub mod args;
 pub mod check;
 pub mod out;
 pub mod plan;
+pub mod plan_adaptive;
 pub mod run;
 pub mod study;
 pub mod summary;

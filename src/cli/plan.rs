@@ -12,17 +12,36 @@ use tresca_cr::study::orders::successive_orders;
 use tresca_cr::study::{run_study, Level, Study};
 use tresca_cr::Scene;
 
+type Weighed = std::result::Result<tresca_cr::plan::adaptive::AdaptivePlan, String>;
+
+/// The adaptive route was weighed and recommended.
+fn adaptive_chosen(w: &Option<Weighed>) -> bool {
+    matches!(w, Some(Ok(a)) if a.choice == tresca_cr::plan::adaptive::Route::Adaptive)
+}
+
 /// Exit code of a refusal (no plan; errors exit with 1, command-line usage errors with 2 as clap does).
 pub const REFUSED: i32 = 3;
 
-pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool, json: Option<PathBuf>) -> Result<i32> {
+/// Plan (and with `weigh_adaptive` weigh the adaptive route beside it); returns the exit code.
+pub fn run(
+    scene: Scene,
+    options: Options,
+    csv: Option<PathBuf>,
+    execute: bool,
+    weigh_adaptive: bool,
+    json: Option<PathBuf>,
+) -> Result<i32> {
     let start = std::time::Instant::now();
-    let summarise = |p: &Plan, achieved| -> Result<()> {
+    let summarise = |p: &Plan, achieved, adaptive: &Option<Weighed>| -> Result<()> {
         let Some(j) = &json else { return Ok(()) };
         let mut s = super::summary::Summary::new("plan", &scene.file, start.elapsed().as_secs_f64());
-        s.plan = Some(super::summary::PlanSummary::of(p, &p.options.quantity.describe(), achieved));
+        let mut ps = super::summary::PlanSummary::of(p, &p.options.quantity.describe(), achieved);
+        ps.adaptive = adaptive.as_ref().map(|w| super::summary::AdaptiveRoute::of(w, scene.exact.is_some()));
+        s.plan = Some(ps);
         if let Some(why) = &p.refused {
-            s.status = format!("refused: {why}");
+            if !adaptive_chosen(adaptive) {
+                s.status = format!("refused: {why}");
+            }
         }
         super::summary::write(j, &s)
     };
@@ -38,11 +57,13 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool, 
     for n in &p.notes {
         say!("note: {n}");
     }
+    let adaptive = if weigh_adaptive { super::plan_adaptive::weigh(&scene, &p)? } else { None };
     if let Some(why) = &p.refused {
-        say!("\nNo plan: {why}");
-        summarise(&p, None)?;
+        let chosen = adaptive_chosen(&adaptive);
+        say!("\n{}: {why}", if chosen { "No uniform plan (the adaptive route above is)" } else { "No plan" });
+        summarise(&p, None, &adaptive)?;
         super::out::report_written(csv.as_deref())?;
-        return Ok(REFUSED);
+        return Ok(if chosen { 0 } else { REFUSED });
     }
     say!(
         "\n{:>8} {:>6} {:>7} {:>10} {:>6} {:>8} {:>11} {:>11} {:>11} {:>11} {:>9}",
@@ -84,7 +105,7 @@ pub fn run(scene: Scene, options: Options, csv: Option<PathBuf>, execute: bool, 
         p.tol
     );
     let achieved = if execute { Some(execute_plan(&scene, &p, b)?) } else { None };
-    summarise(&p, achieved)?;
+    summarise(&p, achieved, &adaptive)?;
     super::out::report_written(csv.as_deref())?;
     Ok(0)
 }

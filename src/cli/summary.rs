@@ -1,4 +1,4 @@
-//! `--json FILE`: the machine-readable summary of `check`, `run`, `study` and `plan`, written (atomically:
+//! `--json FILE`: the machine-readable summary of `check`, `run`, `study`, `plan` and `adapt`, written (atomically:
 //! a temporary file renamed) when the subcommand ends, also when a run stops on a solver failure. The
 //! verification scripts read it instead of the human messages, which may be reworded at any time. Its
 //! structs mirror library types (`LevelResult`, `plan::Candidate`, …) on purpose: the schema is a contract
@@ -10,12 +10,12 @@
 //! | field | meaning |
 //! |---|---|
 //! | `schema` | the schema version, [`SCHEMA`] |
-//! | `command` | `check`, `run`, `study` or `plan` |
+//! | `command` | `check`, `run`, `study`, `plan` or `adapt` |
 //! | `version`, `commit` | the crate version and the git commit of the build (`-dirty` when it had changes) |
 //! | `scene` | the scene file as given |
-//! | `status` | `completed`, `stopped: <why>` (a run's solver failure) or `refused: <why>` (a plan's refusal) |
+//! | `status` | `completed`, `stopped: <why>` (a run's solver failure) or `refused: <why>` (a plan's refusal, an adaptive loop stopped before its goal) |
 //! | `wall` | wall time of the whole subcommand |
-//! | `check`, `run`, `study`, `plan` | the part of the subcommand that ran (the others `null`) |
+//! | `check`, `run`, `study`, `plan`, `adapt` | the part of the subcommand that ran (the others `null`) |
 //!
 //! `check` ([`CheckSummary`]): `vertices`, `triangles`, `edges`, `h` (largest edge) of the mesh; `unknowns`,
 //! `paper_dofs` (the paper's count 2(edges − Dirichlet edges)), `contact_unknowns`; `steps`; `solver`, `tol`,
@@ -57,7 +57,22 @@
 //! plus N · step · n ln n); `plan` and `runners_up` ([`Candidate`]: `refine`, `steps`, `unknowns`, `h`, `k`,
 //! `error`, `space_error`, `time_error`, `wall`, `memory`), `over_budget`; `solver`, `tol`; `notes`;
 //! `refused`; `achieved` (with `--run`, [`Achieved`]: `estimate`, `space`, `time`, `true_error`, `met`,
-//! `levels`).
+//! `levels`); `adaptive` ([`AdaptiveRoute`], energy-norm targets only; absent in older summaries): the
+//! adaptive route weighed against the uniform plan (`src/plan/adaptive.rs`): `choice` (`uniform`,
+//! `adaptive`, `neither`), `reason`, `refused` (why not weighed), `eta` (the indicator value to reach),
+//! `adaptive_rate`, `uniform_rate` (r in η = c N^(−r)), `uniform_unknowns`, `uniform_wall`, `uniform_memory`,
+//! `adaptive_unknowns`, `adaptive_levels`, `adaptive_wall` (the whole sequence), `adaptive_memory` (its last
+//! level), `pilot_wall`, `adaptive_pilot`, `uniform_pilot` (their levels, as `adapt`'s).
+//!
+//! `adapt` ([`AdaptSummary`]): `theta`, `levels_asked`, `target`, `reference_generation` (the flags;
+//! `null` when not given), `exact` (the errors are true ones), `stopped` (why the loop stopped before its
+//! goal, else `null`); `levels`, one [`AdaptLevel`] per level: `level`, `triangles`, `unknowns`,
+//! `paper_dofs`, `generation` (largest bisection generation), `estimator` (η, max over the time nodes),
+//! `error` (the true error, else the distance to the reference, else to the next level; `null` when none
+//! is known) with `error_kind` (`true`, `vs_reference`, `vs_next`) and `effectivity` (η / error),
+//! `vs_next`, `vs_reference`, `min_angle` (degrees), `marked` (triangles marked for bisection), `wall`,
+//! `worst_step` (the node of the largest η), `terms` (η's terms at that node, by name), `time_estimator`
+//! (the time indicator η_k = D^{1/2} + 3L, `src/adapt/time.rs`), `time_dissipation` (D^{1/2}), `time_load` (L).
 
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
@@ -91,6 +106,9 @@ pub struct Summary {
     pub run: Option<RunSummary>,
     pub study: Option<StudySummary>,
     pub plan: Option<PlanSummary>,
+    /// Absent in summaries written before `adapt --json` existed (read as `null`).
+    #[serde(default)]
+    pub adapt: Option<AdaptSummary>,
 }
 
 impl Summary {
@@ -108,6 +126,7 @@ impl Summary {
             run: None,
             study: None,
             plan: None,
+            adapt: None,
         }
     }
 }
@@ -373,7 +392,9 @@ impl StudySummary {
     }
 }
 
+mod adapt;
 mod plan;
+pub use adapt::{AdaptSummary, AdaptiveRoute};
 pub use plan::{Achieved, PlanSummary};
 
 #[cfg(test)]

@@ -21,6 +21,7 @@
 //! target/‖u‖)⌋ keeps the solver's share of the error under 1 % of the target, within [1e-12, 1e-6] (a
 //! tighter one buys nothing, a looser one saves no Newton iteration worth having).
 
+pub mod adaptive;
 pub mod model;
 pub mod pilot;
 mod search;

@@ -115,6 +115,9 @@ pub struct PlanSummary {
     pub notes: Vec<String>,
     pub refused: Option<String>,
     pub achieved: Option<Achieved>,
+    /// The adaptive route weighed against this plan (absent in summaries written before it existed).
+    #[serde(default)]
+    pub adaptive: Option<super::AdaptiveRoute>,
 }
 
 impl PlanSummary {
@@ -150,6 +153,7 @@ impl PlanSummary {
             notes: p.notes.clone(),
             refused: p.refused.clone(),
             achieved,
+            adaptive: None,
         }
     }
 }
@@ -216,6 +220,7 @@ pub(super) mod tests {
                 met: true,
                 levels: vec![level],
             }),
+            adaptive: Some(super::super::AdaptiveRoute::of(&Err("not weighed".into()), false)),
         }
     }
 }

@@ -101,3 +101,58 @@ fn json_path_in_a_missing_directory_is_refused() {
     assert!(check_path(Some(Path::new("s.json"))).is_ok());
     assert!(check_path(None).is_ok());
 }
+
+/// The system shall write an `adapt` summary that reads back to the same values, and read a summary
+/// written before `adapt` existed (no `adapt` field) as one without it.
+#[test]
+fn adapt_summary_round_trips_and_old_summaries_still_read() {
+    let row = tresca_cr::adapt::Row {
+        level: 3,
+        triangles: 120,
+        unknowns: 340,
+        paper_dofs: 320,
+        contact_edges: 8,
+        estimator: 2e-2,
+        terms: [1e-6, 2e-4, 3e-6, 4e-8, 5e-5],
+        worst_step: 4,
+        error: None,
+        vs_next: Some(4e-3),
+        vs_reference: Some(5e-3),
+        generation: 5,
+        min_angle: 29.7,
+        marked: 17,
+        wall: 0.25,
+        time_estimator: 3e-3,
+        time_dissipation: 1e-3,
+        time_load: 2e-3 / 3.0,
+    };
+    let opts = tresca_cr::adapt::Options {
+        levels: Some(4),
+        target: None,
+        theta: 0.5,
+        out: None,
+        gmsh: false,
+        force: false,
+        max_memory: None,
+        max_disk: None,
+        budget: None,
+        reference: Some(12),
+    };
+    let mut s = Summary::new("adapt", "verification/cases/lshape_adapt.toml", 2.0);
+    s.adapt =
+        Some(AdaptSummary::of(&opts, false, &[row.clone(), tresca_cr::adapt::Row { vs_reference: None, ..row }], None));
+    let text = serde_json::to_string(&s).unwrap();
+    let back: Summary = serde_json::from_str(&text).unwrap();
+    assert_eq!(back, s);
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let l = &v["adapt"]["levels"];
+    assert_eq!(l[0]["error"], 5e-3);
+    assert_eq!(l[0]["error_kind"], "vs_reference");
+    assert_eq!(l[1]["error_kind"], "vs_next");
+    assert_eq!(l[0]["effectivity"], 2e-2 / 5e-3);
+    assert_eq!(l[0]["terms"]["stress_jump"], 2e-4f64.sqrt());
+    let mut old = v.clone();
+    old.as_object_mut().unwrap().remove("adapt");
+    let back: Summary = serde_json::from_value(old).unwrap();
+    assert_eq!(back.adapt, None);
+}

@@ -1,0 +1,210 @@
+//! `plan` weighs an adaptive sequence (`adapt`, Dörfler θ = [`THETA`]) against the uniform plan.
+//! Each of its two pilots takes at most a tenth of the uniform run's predicted wall time (at least ¼ s,
+//! at most half the pilot budget), so weighing adds at most about a fifth of the run to the planner.
+//!
+//! Both routes are compared through the same error indicator η (`adapt::estimator`, an upper bound of
+//! the energy-norm error up to a constant): a few levels of each — adaptive, and uniform as the θ = 1
+//! sequence (every triangle bisected once per level) — give the laws η_a = C_a N^{−r_a} and
+//! η_u = C_u N^{−r_u} in the unknowns N (least squares over the pilots' finer halves). The uniform plan
+//! meets the target with N_u unknowns (its best candidate, else the cheapest over the budget), with the
+//! predicted error e_u ≤ target (whole refinements overshoot); the adaptive route, which can stop at
+//! any level, needs the N_a at which η_a equals η_u(N_u)·target/e_u — the indicator value of the target
+//! on the uniform route, hence about the same error: the indicator's effectivity is about the same on both routes
+//! (Example 5.1: 2.0–3.2 adaptive, 2.1–2.7 uniform, `reference/adaptive.md`), which is this comparison's
+//! assumption. Its cost: every level of the sequence is a whole run, so the route costs the pilot's
+//! levels plus the predicted ones, N growing by the pilot's mean factor q per level up to N_a, each
+//! priced by the plan's cost model at the plan's steps and scaled by the pilot's measured ratio of
+//! adaptive level wall to the model (the median over its finer half, at least 1: estimation, marking and
+//! bisection included). Its memory: the
+//! pre-run estimate of the last level. The cheaper route that fits the budget and memory is
+//! recommended.
+
+use super::model::PowerLaw;
+use super::{Candidate, Plan};
+use crate::adapt::{adapt, Options, Row};
+use crate::error::Result;
+use crate::scene::budget::{available_memory, Estimate};
+use crate::scene::Scene;
+
+/// Dörfler's θ of the adaptive route.
+pub const THETA: f64 = 0.5;
+/// Most adaptive pilot levels (with θ = ½ the unknowns grow by about 1.3 per level).
+pub const ADAPTIVE_LEVELS: usize = 20;
+/// Most uniform pilot levels (bisection generations: two are one uniform refinement).
+pub const UNIFORM_LEVELS: usize = 9;
+/// Fewest levels a law is fitted to.
+pub const FIT_LEVELS: usize = 4;
+
+/// Which route the planner recommends.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Route {
+    Uniform,
+    Adaptive,
+    /// Neither fits the budget and memory.
+    Neither,
+}
+
+impl Route {
+    pub fn name(self) -> &'static str {
+        match self {
+            Route::Uniform => "uniform",
+            Route::Adaptive => "adaptive",
+            Route::Neither => "neither",
+        }
+    }
+}
+
+/// The adaptive route's prediction beside the uniform plan.
+#[derive(Clone, Debug)]
+pub struct AdaptivePlan {
+    /// The pilot sequences (adaptive θ = ½, uniform θ = 1) and their laws η = c N^p (p < 0).
+    pub adaptive_pilot: Vec<Row>,
+    pub uniform_pilot: Vec<Row>,
+    pub adaptive_law: PowerLaw,
+    pub uniform_law: PowerLaw,
+    /// Seconds the two pilots took.
+    pub pilot_wall: f64,
+    /// The uniform route: unknowns, steps, predicted wall and memory (from the plan).
+    pub uniform_unknowns: f64,
+    pub uniform_wall: f64,
+    pub uniform_memory: u64,
+    /// η_u(N_u): the indicator value both routes must reach.
+    pub eta: f64,
+    /// The adaptive route: unknowns of its last level, levels in all, wall (the whole sequence), memory.
+    pub unknowns: f64,
+    pub levels: usize,
+    pub wall: f64,
+    pub memory: u64,
+    pub choice: Route,
+    pub reason: String,
+}
+
+/// Least-squares power law η = c N^p over `rows` (at least [`FIT_LEVELS`]).
+fn law(rows: &[Row]) -> Option<PowerLaw> {
+    let pts: Vec<(f64, f64)> =
+        rows.iter().filter(|r| r.estimator > 0.0).map(|r| ((r.unknowns as f64).ln(), r.estimator.ln())).collect();
+    if pts.len() < FIT_LEVELS {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let (mx, my) = pts.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let sxx: f64 = pts.iter().map(|(x, _)| (x - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+    let p = sxy / sxx;
+    (p < 0.0).then(|| PowerLaw { c: (my - p * mx).exp(), p })
+}
+
+/// The pilot: `levels` levels of `adapt` with θ, each stopped by the share `budget` of seconds.
+fn pilot(scene: &Scene, theta: f64, levels: usize, budget: f64) -> Result<Vec<Row>> {
+    let opts = Options {
+        levels: Some(levels),
+        target: None,
+        theta,
+        out: None,
+        gmsh: false,
+        force: false,
+        max_memory: None,
+        max_disk: None,
+        budget: Some(budget),
+        reference: None,
+    };
+    Ok(adapt(scene, &opts, |_| {})?.rows)
+}
+
+/// The uniform route the plan offers: its best candidate, else the cheapest over the budget.
+fn uniform_route(p: &Plan) -> Option<&Candidate> {
+    p.best.first().or(p.over_budget.as_ref())
+}
+
+/// Weigh the adaptive route against the plan `p` of `scene` (energy-norm target); `None` with the reason
+/// when it cannot be weighed (no uniform route, a pilot too short or not converging).
+pub fn weigh(scene: &Scene, p: &Plan) -> Result<std::result::Result<AdaptivePlan, String>> {
+    let Some(u) = uniform_route(p) else {
+        return Ok(Err("the uniform plan offers no configuration to compare with".into()));
+    };
+    let Some(cost) = p.cost else { return Ok(Err("no cost model".into())) };
+    let start = std::time::Instant::now();
+    // each pilot may take a tenth of the uniform run (as a pilot extension may), at least ¼ s, at most
+    // half the pilot budget
+    let share = (super::EXTENSION_SHARE * u.wall).max(0.25).min((p.options.pilot_budget / 2.0).max(0.25));
+    let adaptive_pilot = pilot(scene, THETA, ADAPTIVE_LEVELS, share)?;
+    let uniform_pilot = pilot(scene, 1.0, UNIFORM_LEVELS, share)?;
+    let pilot_wall = start.elapsed().as_secs_f64();
+    let half = |rows: &[Row]| rows.len().saturating_sub((rows.len() / 2).max(FIT_LEVELS)).min(rows.len());
+    let (Some(a), Some(un)) =
+        (law(&adaptive_pilot[half(&adaptive_pilot)..]), law(&uniform_pilot[half(&uniform_pilot)..]))
+    else {
+        return Ok(Err(format!(
+            "the pilots ({} adaptive, {} uniform levels) are too short or their indicator does not decrease",
+            adaptive_pilot.len(),
+            uniform_pilot.len()
+        )));
+    };
+    // the uniform candidate overshoots the target (whole refinements); the adaptive route stops at it
+    let eta = un.at(u.unknowns as f64) * (p.options.target / u.error).max(1.0);
+    let unknowns = a.solve(eta).max(1.0);
+    let last = adaptive_pilot.last().expect("levels");
+    let first = &adaptive_pilot[half(&adaptive_pilot)];
+    let span = (last.level - first.level).max(1) as f64;
+    let q = (last.unknowns as f64 / first.unknowns as f64).powf(1.0 / span).max(1.05);
+    // the measured walls of the pilot's finer half against the cost model at the scene's steps (median)
+    let steps = scene.times.len() - 1;
+    let mut ratios: Vec<f64> = adaptive_pilot[half(&adaptive_pilot)..]
+        .iter()
+        .map(|r| r.wall / cost.predict(r.unknowns as f64, steps))
+        .collect();
+    ratios.sort_by(f64::total_cmp);
+    let kappa = ratios[ratios.len() / 2].max(1.0);
+    let (mut n, mut wall, mut levels) = (last.unknowns as f64, pilot_wall, adaptive_pilot.len());
+    while n < unknowns {
+        n = (n * q).min(unknowns);
+        wall += kappa * cost.predict(n, u.steps);
+        levels += 1;
+    }
+    let growth = (unknowns / last.unknowns as f64).max(1.0);
+    let contact = (last.contact_edges as f64 * growth.sqrt()).ceil() as u64;
+    let sizes = ((unknowns / 3.0) as u64, (unknowns / 2.0) as u64, contact);
+    let memory = Estimate::of_sizes(sizes, u.steps, false).memory;
+    let limit = p.options.max_memory.or_else(available_memory);
+    let fits = |wall: f64, memory: u64| wall <= p.options.budget && limit.is_none_or(|m| memory <= m);
+    let (fa, fu) = (fits(wall, memory), fits(u.wall, u.memory));
+    let (choice, reason) = choose(fa, fu, wall, u.wall);
+    Ok(Ok(AdaptivePlan {
+        adaptive_pilot,
+        uniform_pilot,
+        adaptive_law: a,
+        uniform_law: un,
+        pilot_wall,
+        uniform_unknowns: u.unknowns as f64,
+        uniform_wall: u.wall,
+        uniform_memory: u.memory,
+        eta,
+        unknowns,
+        levels,
+        wall,
+        memory,
+        choice,
+        reason,
+    }))
+}
+
+/// The route recommended, and why: the cheaper of those that fit (`fa`, `fu`: the adaptive and the
+/// uniform route fit the budget and memory; `wall`, `uniform`: their predicted wall times).
+fn choose(fa: bool, fu: bool, wall: f64, uniform: f64) -> (Route, String) {
+    let choice = match (fa, fu) {
+        (true, true) if wall < uniform => Route::Adaptive,
+        (true, false) => Route::Adaptive,
+        (_, true) => Route::Uniform,
+        (false, false) => Route::Neither,
+    };
+    let reason = match choice {
+        Route::Adaptive if fu => {
+            format!("the adaptive route is predicted cheaper: {wall:.3e} s against {uniform:.3e} s")
+        }
+        Route::Adaptive => "only the adaptive route fits the budget and memory".to_string(),
+        Route::Uniform if fa => format!("the uniform route is predicted cheaper: {uniform:.3e} s against {wall:.3e} s"),
+        Route::Uniform => "only the uniform route fits the budget and memory".to_string(),
+        Route::Neither => "neither route fits the budget and memory".to_string(),
+    };
+    (choice, reason)
+}
