@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn plan(case: &str, target: &str, extra: &[&str], name: &str) -> (Option<i32>, serde_json::Value) {
+fn plan(case: &str, target: &str, extra: &[&str], name: &str) -> (Option<i32>, serde_json::Value, String) {
     let json: PathBuf = std::env::temp_dir().join(format!("tresca_adapt_plan_{}_{name}.json", std::process::id()));
     let sc = Path::new(env!("CARGO_MANIFEST_DIR")).join(case);
     let out = Command::new(env!("CARGO_BIN_EXE_tresca-cr"))
@@ -16,11 +16,15 @@ fn plan(case: &str, target: &str, extra: &[&str], name: &str) -> (Option<i32>, s
         .arg(&json)
         .output()
         .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("recommended:"), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        text.contains("recommended") || text.contains("not weighed"),
+        "{text}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let _ = std::fs::remove_file(&json);
-    (out.status.code(), v["plan"]["adaptive"].clone())
+    (out.status.code(), v["plan"]["adaptive"].clone(), text)
 }
 
 fn f(v: &serde_json::Value, key: &str) -> f64 {
@@ -38,28 +42,26 @@ fn f(v: &serde_json::Value, key: &str) -> f64 {
 /// (refine 9) and 9.4 (refine 10), at 1e-4 3.7–3.9: asked ≥ 3 and ≥ 2.
 #[test]
 fn example_5_1_plan_prefers_the_adaptive_route_where_uniform_does_not_fit() {
-    let (code, a) = plan("verification/cases/paper_example_5_1.toml", "5e-5", &["--max-memory", "4G"], "a");
+    let (code, a, _) = plan("verification/cases/paper_example_5_1.toml", "5e-5", &["--max-memory", "4G"], "a");
     assert_eq!(code, Some(0), "{a}");
     assert_eq!(a["choice"], "adaptive", "{a}");
     assert!((f(&a, "adaptive_rate") - 0.5).abs() <= 0.05, "{a}");
     assert!((f(&a, "uniform_rate") - 0.43).abs() <= 0.05, "{a}");
     assert!(f(&a, "uniform_unknowns") >= 3.0 * f(&a, "adaptive_unknowns"), "{a}");
     assert!(f(&a, "adaptive_memory") <= 4.0 * f64::from(1u32 << 30), "{a}");
-    let (code, a) = plan("verification/cases/paper_example_5_1.toml", "1e-4", &[], "b");
+    let (code, a, _) = plan("verification/cases/paper_example_5_1.toml", "1e-4", &[], "b");
     assert_eq!(code, Some(0));
     assert!(f(&a, "uniform_unknowns") >= 2.0 * f(&a, "adaptive_unknowns"), "{a}");
     assert!(a["adaptive_pilot"].as_array().unwrap().len() >= 8, "{a}");
 }
 
-/// The system shall, on mms_elastic (a smooth solution: both routes converge like N^(−1/2)), find no
-/// gain in unknowns worth the adaptive sequence's extra levels and recommend the uniform route (rates
-/// within 0.05 of each other, measured 0.498 and 0.494; unknowns within a factor 2, measured 0.91).
+/// The system shall, on mms_elastic (a smooth solution: the uniform space order is CR's optimal 1), not
+/// pilot the adaptive route — it can gain nothing but its overhead, and its pilots would add to the
+/// planner's own cost (issue 32: ≤ 5 % of the plan) — and say so; the uniform plan stands alone.
 #[test]
-fn mms_elastic_plan_keeps_the_uniform_route() {
-    let (code, a) = plan("verification/cases/mms_elastic.toml", "1e-2", &[], "c");
-    assert_eq!(code, Some(0));
-    assert_eq!(a["choice"], "uniform", "{a}");
-    assert!((f(&a, "adaptive_rate") - f(&a, "uniform_rate")).abs() <= 0.05, "{a}");
-    assert!(f(&a, "adaptive_unknowns") >= 0.5 * f(&a, "uniform_unknowns"), "{a}");
-    assert!(f(&a, "adaptive_wall") > f(&a, "uniform_wall"), "{a}");
+fn mms_elastic_plan_does_not_weigh_the_adaptive_route() {
+    let (code, a, text) = plan("verification/cases/mms_elastic.toml", "1e-2", &[], "c");
+    assert_eq!(code, Some(0), "{text}");
+    assert!(a.is_null(), "{a}");
+    assert!(text.contains("Adaptive route not weighed: the uniform space order"), "{text}");
 }

@@ -8,10 +8,26 @@ use tresca_cr::plan::pilot::Quantity;
 use tresca_cr::plan::Plan;
 use tresca_cr::Scene;
 
-/// Weigh and print; `None` for targets the indicator does not bound (outputs other than the energy norm)
-/// or when the uniform plan has no error model.
+/// The energy-norm order in h of the lowest-order CR element on a smooth solution. A uniform space fit at or
+/// above it less the pilots' scatter leaves the adaptive route nothing to gain but its overhead.
+const OPTIMAL_ORDER: f64 = 1.0;
+/// The scatter of a fitted space order over the pilots' few levels (the planner's in-range band).
+const ORDER_SCATTER: f64 = 0.05;
+
+/// Weigh and print; `None` for targets the indicator does not bound (outputs other than the energy norm),
+/// when the uniform plan has no error model, or when its space order is already optimal (then the
+/// adaptive pilots would only add to the planner's cost: issue 32 bounds it by 5 % of the plan).
 pub fn weigh(scene: &Scene, p: &Plan) -> Result<Option<std::result::Result<AdaptivePlan, String>>> {
-    if p.options.quantity != Quantity::Energy || p.error.is_none() {
+    let Some(model) = p.error.as_ref().filter(|_| p.options.quantity == Quantity::Energy) else {
+        return Ok(None);
+    };
+    if model.space.p >= OPTIMAL_ORDER - ORDER_SCATTER {
+        say!(
+            "\nAdaptive route not weighed: the uniform space order {:.3} is optimal for CR (≥ {}), so adaptive \
+             refinement cannot reach the target with fewer unknowns by more than its overhead",
+            model.space.p,
+            OPTIMAL_ORDER - ORDER_SCATTER
+        );
         return Ok(None);
     }
     say!("\nAdaptive route (θ = {}), weighed through the error indicator η:", tresca_cr::plan::adaptive::THETA);
