@@ -399,8 +399,8 @@ def unit_load_limits(path):
 def load_scale_limit(f, lim):
     """Why loads × f (f > 0) cannot be written, by the unit-load limits `lim` of :func:`unit_load_limits`:
     "underflow" (a view's u below f32's normal range), "overflow" (a view above f32's range, or the
-    energy, ~ f², above f64's), "border" (within VIEW_MARGIN or ENERGY_MARGIN of a limit: either outcome is right), or None
-    (representable: the run must succeed and scale exactly)."""
+    energy, ~ f², above f64's), "border" (within VIEW_MARGIN or ENERGY_MARGIN of a limit: either outcome is
+    right), or None (representable: the run must succeed and scale exactly)."""
     lo, hi, e_hi = F32_TINY / lim["u_min"], F32_MAX / lim["views"], np.sqrt(F64_MAX / lim["energy"])
     near = [(lo, VIEW_MARGIN), (hi, VIEW_MARGIN), (e_hi, ENERGY_MARGIN)]
     if any(x / m < f < x * m for x, m in near):
@@ -436,8 +436,9 @@ def case_load(st):
                      "overflow": "exceeds the single-precision range" in msg or "overflows f64" in msg}
             ok &= limit == "border" and any(named.values()) or named.get(limit, False)
             refused.append(f"{f:g}")
-            out.append(f"{f:g}: refused ({limit or 'REPRESENTABLE'}, {'named' if any(named.values()) else 'UNNAMED'}: "
-                       f"…{(re.search(r'step \d+: [^;]*', msg) or re.search('.*', msg))[0][:90]})")
+            said = (re.search(r"step \d+: [^;]*", msg) or re.search(".*", msg))[0][:90]
+            out.append(f"{f:g}: refused ({limit or 'REPRESENTABLE'}, "
+                       f"{'named' if any(named.values()) else 'UNNAMED'}: …{said})")
             if r["h5"] and os.path.exists(r["h5"]):
                 with h5py.File(r["h5"], "r") as h:
                     ok &= h["tresca"].attrs["status"] != "completed"
