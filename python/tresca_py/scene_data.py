@@ -17,6 +17,7 @@ Each solver calls ``check_boundary_data`` with its own boundary edges; this modu
 import numpy as np
 
 from tresca_py.quadrature import GAUSS3_S
+from tresca_py.expr import ExprError
 from tresca_py.scene import SceneError
 
 #: relative tolerance of the comparisons (module docstring)
@@ -87,7 +88,8 @@ def _vertex_rows(scene, a_idx, b_idx, points, part, normal):
 
 
 def _data_size(scene, points, boundary_edges, part):
-    """The largest |u_D| component and |g_n| at the vertices of the parts with data, over every time node."""
+    """The largest |u_D| component and |g_n| at the vertices of the parts with data, over every time node
+    (a node where the data are not finite is skipped: the run names it at its step)."""
     size = 0.0
     for ip, bd in enumerate(scene.boundaries):
         v = np.unique(boundary_edges[part == ip])
@@ -95,8 +97,11 @@ def _data_size(scene, points, boundary_edges, part):
             continue
         x, y = points[v, 0], points[v, 1]
         for t in scene.times:
-            d = _vec(bd.u, x, y, t) if bd.kind == "dirichlet" else _scal(bd.gap, x, y, t)
-            size = max(size, float(np.max(np.abs(d))))
+            try:
+                d = _vec(bd.u, x, y, t) if bd.kind == "dirichlet" else _scal(bd.gap, x, y, t)
+            except (ExprError, SceneError):
+                continue
+            size = max(size, float(np.max(np.abs(d), where=np.isfinite(d), initial=0.0)))
     return size
 
 

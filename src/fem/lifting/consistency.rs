@@ -165,18 +165,20 @@ fn shared_vertices(scene: &Scene, mesh: &Mesh, space: &CrSpace, cmp: &mut Vec<Mi
     Ok(())
 }
 
-/// The largest |u_D| component and |g_n| at the vertices of the parts with data, over every time node.
+/// The largest |u_D| component and |g_n| at the vertices of the parts with data, over every time node
+/// (a value that cannot be evaluated or is not finite is skipped: the run names it at its step).
 fn data_size(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<f64> {
     let mut size = 0.0f64;
     for (e, p) in space.edge_part.iter().enumerate() {
         let Some(kind) = p.map(|p| &scene.parts[p].kind) else { continue };
         for x in mesh.edges[e].map(|v| mesh.points[v]) {
             for &t in &scene.times {
-                size = match kind {
-                    PartKind::Dirichlet(u @ Some(_)) => vec_at(u, x, t)?.iter().fold(size, |m, c| m.max(c.abs())),
-                    PartKind::Contact(_, g @ Some(_)) => size.max(gap_at(g, x, t)?.abs()),
+                let v = match kind {
+                    PartKind::Dirichlet(u @ Some(_)) => vec_at(u, x, t).unwrap_or([0.0; 2]),
+                    PartKind::Contact(_, g @ Some(_)) => [gap_at(g, x, t).unwrap_or(0.0), 0.0],
                     _ => break,
                 };
+                size = v.iter().filter(|c| c.is_finite()).fold(size, |m, c| m.max(c.abs()));
             }
         }
     }
