@@ -111,3 +111,31 @@ fn zero_data_are_the_scene_without_them() {
         assert!(x.u.iter().zip(&y.u).all(|(p, q)| p.to_bits() == q.to_bits()), "step {}", x.n);
     }
 }
+
+/// [`affine`] with the sides `left` and `right` made traction-free Neumann parts: no vertex then joins
+/// the contact part to a part with data, so only the t₀ comparisons are made.
+fn no_shared_data(gap: &str) -> String {
+    let mut text = affine("", gap);
+    for side in ["left", "right"] {
+        let from = format!("name = \"{side}\"\nkind = \"dirichlet\"\nu = ");
+        let at = text.find(&from).expect("side") + from.len();
+        let end = at + text[at..].find('\n').expect("line");
+        text.replace_range(at - from.len()..end, &format!("name = \"{side}\"\nkind = \"neumann\""));
+    }
+    text
+}
+
+/// The system shall accept data that vanish at t₀ only up to rounding (the gap's terms cancel there:
+/// (0.1 + t)² − 0.01 − 0.2t − t² = 1.7e-18 at t = 0, exactly 0 in exact arithmetic, while u₀ = 0 and
+/// u_D(t₀) = 0 make the relative tolerance 0), and still refuse a mismatch of 1e-6 on the same data.
+#[test]
+fn rounding_of_data_that_vanish_at_t0_is_accepted() {
+    let gap = "(0.1 + t)*(0.1 + t) - 0.01 - 0.2*t - t*t + 0.003*t - 0.005*t*x";
+    let s = Scene::from_str(&no_shared_data(gap), "cancel").unwrap();
+    if let Err(e) = tresca_cr::Problem::new(s) {
+        panic!("refused: {e}");
+    }
+    let wrong = Scene::from_str(&no_shared_data(&format!("{gap} + 1e-6")), "off").unwrap();
+    let e = tresca_cr::Problem::new(wrong).err().expect("refused").to_string();
+    assert!(e.contains("inconsistent boundary data"), "{e}");
+}

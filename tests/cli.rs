@@ -205,3 +205,17 @@ fn sigkill_then_resume_is_bit_identical() {
     }
     assert!(killed_mid_run >= 1, "no kill landed in the middle of the run; lengthen it");
 }
+
+/// The system shall print no NaN as a study estimate: an output that is not extrapolated shows "—" for
+/// its estimate and GCI and says why (a one-step scene whose max_slip and stick_length do not converge
+/// monotonically over three levels).
+#[test]
+fn study_prints_reasons_not_nan() {
+    let scene = root("verification/external/scenes/imposed_normal.toml");
+    let o = run(&["study", &scene, "--levels", "1:1,2:1,3:1"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!out.to_lowercase().contains("nan"), "NaN printed:\n{out}");
+    assert!(out.contains("Output max_slip at T: not extrapolated: "), "{out}");
+    assert!(out.lines().filter(|l| l.contains("est          —  GCI          —")).count() >= 3, "{out}");
+}

@@ -174,3 +174,18 @@ def test_gmsh_scene_is_read_and_red_refined(tmp_path):
 def test_skfem_nitsche_patch_on_gmsh_mesh(tmp_path):
     """The system shall reproduce the affine slipping field on the red-refined Gmsh pentagon (scikit-fem P2)."""
     _check_patch(skfem_nitsche.solve(problem.build(gmsh_patch(tmp_path), 1, degree=2)))
+
+
+def test_study_estimates_state_a_reason_instead_of_nan(tmp_path):
+    """The system shall report tresca-cr study's output estimates from its CSV columns (elastic_energy, not
+    a missing 'energy'): a limit ± GCI where extrapolated, else "not extrapolated: why", never NaN."""
+    from tresca_py.external.report import study_estimates
+    p = tmp_path / "study.csv"
+    p.write_text("refine,elastic_energy_limit,elastic_energy_gci,elastic_energy_verdict,max_slip_limit,max_slip_gci,"
+                 "max_slip_verdict\n3,5.8e-3,2.2e-6,in the asymptotic range,,,"
+                 "\"not yet: refine further (the three finest values oscillate)\"\n")
+    est = study_estimates(p)
+    assert est["elastic_energy"] == "0.0058 ± 2.2e-06 (in the asymptotic range)"
+    assert est["max_slip"] == "not extrapolated: the three finest values oscillate"
+    assert est["stick_length"] == "not in the study's CSV"
+    assert not any("nan" in v.lower() for v in est.values())

@@ -6,20 +6,25 @@
 * at a vertex shared by two Dirichlet parts their data must agree, and at a vertex shared by a Dirichlet
   and a contact part u_D·n_e = g_n (n_e the contact edge's outward normal), at every time node.
 
-Values are compared at the 3-point Gauss points of the edges and at the shared vertices. Tolerance: 1e-9 of
-the size of the data (the largest |u₀| at a mesh vertex or value compared): consistent data differ only by
-the rounding of their expressions (a few ulps), a real mismatch below 1e-9 of the data is far below what the
-discretisation resolves. Scenes without boundary data are not checked (u₀ is projected onto V_h there).
+Values are compared at the 3-point Gauss points of the edges and at the shared vertices. Tolerance: the larger
+of 1e-9 of the size of the data (the largest |u₀| at a mesh vertex or value compared: a real mismatch below
+that is far below what the discretisation resolves) and ROUNDING_ULPS ulps of the size the data reach over the
+time grid (the largest |u_D|, |g_n| at the vertices of the parts with data, at every time node): the floor for
+data that all vanish at t₀ by cancellation, whose terms are of that size and leave a few ulps of it. Scenes without boundary data are not checked (u₀ is projected onto V_h there).
 
 Each solver calls ``check_boundary_data`` with its own boundary edges; this module only reads the scene.
 """
 import numpy as np
 
 from tresca_py.quadrature import GAUSS3_S
+from tresca_py.expr import ExprError
 from tresca_py.scene import SceneError
 
 #: relative tolerance of the comparisons (module docstring)
 REL_TOL = 1e-9
+#: ulps of the data's size over time that rounding may leave where an expression's terms cancel (one per
+#: operation for expressions of a few dozen operations)
+ROUNDING_ULPS = 64.0
 
 
 def _vec(u, x, y, t):
@@ -82,6 +87,24 @@ def _vertex_rows(scene, a_idx, b_idx, points, part, normal):
     return rows
 
 
+def _data_size(scene, points, boundary_edges, part):
+    """The largest |u_D| component and |g_n| at the vertices of the parts with data, over every time node
+    (a node where the data are not finite is skipped: the run names it at its step)."""
+    size = 0.0
+    for ip, bd in enumerate(scene.boundaries):
+        v = np.unique(boundary_edges[part == ip])
+        if not bd.has_data or v.size == 0:
+            continue
+        x, y = points[v, 0], points[v, 1]
+        for t in scene.times:
+            try:
+                d = _vec(bd.u, x, y, t) if bd.kind == "dirichlet" else _scal(bd.gap, x, y, t)
+            except (ExprError, SceneError):
+                continue
+            size = max(size, float(np.max(np.abs(d), where=np.isfinite(d), initial=0.0)))
+    return size
+
+
 def check_boundary_data(scene, points, boundary_edges, part, u0_max=None):
     """Raise ``SceneError`` naming the parts, the point and the two values where the boundary data of
     ``scene`` do not fit together (module docstring). ``boundary_edges`` (k, 2): the vertex indices of every
@@ -100,7 +123,7 @@ def check_boundary_data(scene, points, boundary_edges, part, u0_max=None):
     scale = max([u0_max]
                 + [max(float(np.max(np.abs(r[2]), initial=0.0)), float(np.max(np.abs(r[3]), initial=0.0)))
                    for r in rows])
-    tol = REL_TOL * scale
+    tol = max(REL_TOL * scale, ROUNDING_ULPS * np.finfo(float).eps * _data_size(scene, points, boundary_edges, part))
     for what, xy, va, vb in rows:
         diff = np.abs(np.asarray(va) - np.asarray(vb)).reshape(-1)
         if diff.size and np.max(diff) > tol:

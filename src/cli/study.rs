@@ -5,6 +5,7 @@ use super::out::say;
 use anyhow::{Context, Result};
 use std::path::PathBuf;
 use tresca_cr::scene::budget::Estimate;
+use tresca_cr::study::richardson::Verdict;
 use tresca_cr::study::{Axis, Level, LevelResult, Study};
 use tresca_cr::Scene;
 
@@ -195,20 +196,43 @@ fn print_estimates(s: &Study) {
             );
         }
     }
+    print_outputs(s);
+}
+
+/// A number of the outputs' table, or "—" where the study has none (no extrapolation: the line's verdict
+/// says why), so that no NaN is printed as an estimate.
+fn cell(v: f64, width: usize, digits: usize) -> String {
+    if v.is_finite() {
+        format!("{v:>width$.digits$e}")
+    } else {
+        format!("{:>width$}", "—")
+    }
+}
+
+/// Every scalar output: its extrapolation (or why there is none) and per level the value, estimated error
+/// and GCI.
+fn print_outputs(s: &Study) {
     for o in &s.outputs {
         match o.model {
             Some(m) => say!("\nOutput {} at T: extrapolated {:.6e}, p = {:.3}", o.name, m.limit, m.p),
-            None => say!("\nOutput {} at T: no extrapolation", o.name),
+            None => {
+                let why = match o.levels.last().map(|l| &l.2) {
+                    Some(Verdict::NotYet(w)) => w.clone(),
+                    Some(v) => v.text(),
+                    None => "no levels".into(),
+                };
+                say!("\nOutput {} at T: not extrapolated: {why}", o.name)
+            }
         }
-        for (r, (l, q)) in s.levels.iter().zip(o.levels.iter().zip(s.levels.iter().map(|r| r.outputs.clone()))) {
-            let idx = s.outputs.iter().position(|x| x.name == o.name).unwrap_or(0);
+        let idx = s.outputs.iter().position(|x| x.name == o.name).unwrap_or(0);
+        for (r, l) in s.levels.iter().zip(&o.levels) {
             say!(
-                "{:>3} {:>6} value {:>12.5e}  est {:>10.3e}  GCI {:>10.3e}  {}",
+                "{:>3} {:>6} value {}  est {}  GCI {}  {}",
                 r.refine,
                 r.steps,
-                q.get(idx).copied().unwrap_or(f64::NAN),
-                l.0,
-                l.1,
+                cell(r.outputs.get(idx).copied().unwrap_or(f64::NAN), 12, 5),
+                cell(l.0, 10, 3),
+                cell(l.1, 10, 3),
                 l.2.text()
             );
         }

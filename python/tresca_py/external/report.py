@@ -113,16 +113,27 @@ def plots(rows, scenes, lims, out_dir):
     return paths
 
 
+STUDY_OUTPUTS = ("elastic_energy", "max_slip", "stick_length")  # `tresca-cr study`'s output columns
+
+
 def study_estimates(path):
-    """tresca-cr study's own limits (last row of its --csv): {output: (limit, gci, verdict)}."""
+    """tresca-cr study's own limits (last row of its --csv): {output: text}, the text "limit ± GCI (verdict)"
+    or, where the study did not extrapolate (its limit cell is empty), "not extrapolated: why"."""
     if not Path(path).exists():
         return {}
     with open(path) as fh:
         last = list(csv.DictReader(fh))[-1]
     out = {}
-    for q in ("energy", "max_slip", "stick_length"):
-        lim = last.get(f"{q}_limit", "")
-        out[q] = (float(lim) if lim else math.nan, float(last.get(f"{q}_gci") or "nan"), last.get(f"{q}_verdict", ""))
+    for q in STUDY_OUTPUTS:
+        if f"{q}_limit" not in last:
+            out[q] = "not in the study's CSV"
+            continue
+        lim, gci, verdict = last[f"{q}_limit"], last.get(f"{q}_gci", ""), last.get(f"{q}_verdict", "")
+        if lim and gci:
+            out[q] = f"{float(lim):.6g} ± {float(gci):.2g} ({verdict})"
+        else:
+            why = verdict.removeprefix("not yet: refine further (").removesuffix(")") if verdict else "no verdict"
+            out[q] = f"not extrapolated: {why}"
     return out
 
 
@@ -197,7 +208,7 @@ def markdown(rows, scenes, notes, reqs, elapsed, lims, ref_dir):
             out += ["", f"tresca-cr's own `study --csv` estimates (`reference/external_study_{sc.name}.csv`, "
                     f"`tresca-cr study {sc.path} --levels "
                     + ",".join(f"{r}:{sc.steps}" for r in sc.levels) + " --csv …`): "
-                    + "; ".join(f"{q} {v[0]:.6g} ± {v[1]:.2g} ({v[2]})" for q, v in est.items()) + "."]
+                    + "; ".join(f"{q} {v}" for q, v in est.items()) + "."]
         out += ["", "| code | DOF (finest) | wall s (finest) |", "|---|---|---|"]
         for code, rs in by_code(rows, sc.name).items():
             out.append(f"| {code} | {rs[-1]['dofs']} | {rs[-1]['wall_s']:.3f} |")

@@ -6,10 +6,12 @@
 //!   Dirichlet and a contact part u_D·n_e = g_n (n_e the contact edge's normal), at every time node.
 //!
 //! Values are compared at the 3-point Gauss points of the edges (u₀ and the data) and at the shared
-//! vertices. Tolerance: 1e-9 of the size of the data, the largest |u₀| at a mesh vertex or value
-//! compared. Consistent data differ there only by the rounding of their expressions (a few ulps of
-//! that size), while any real mismatch below 1e-9 of the data would be far below what the
-//! discretisation resolves.
+//! vertices. Tolerance: the larger of 1e-9 of the size of the data (the largest |u₀| at a mesh vertex
+//! or value compared: a real mismatch below that is far below what the discretisation resolves) and
+//! [`ROUNDING_ULPS`] ulps of the size the data reach over the whole time grid (the largest |u_D|, |g_n|
+//! at the vertices of the parts with data, at every time node). The second is the floor for data that
+//! all vanish at t₀ by cancellation (`gap = "(0.1 + t)^2 - 0.01 - 0.2*t - t^2"`): their constituent
+//! terms are of the data's size over time, and a few ulps of those survive the cancellation.
 //!
 //! Only scenes with boundary data are checked: without them (u_D = 0, g_n = 0) a u₀ that does not vanish
 //! on Γ_D or whose normal part does not vanish on Γ_C is projected onto V_h (those values dropped), as
@@ -21,6 +23,10 @@ use crate::fem::space::CrSpace;
 use crate::mesh::Mesh;
 use crate::scene::expr::Vec2Expr;
 use crate::scene::{PartKind, Scene};
+
+/// Ulps of the data's size over time that rounding of an expression may leave where its terms cancel
+/// (module doc): one ulp per operation for expressions of a few dozen operations.
+pub const ROUNDING_ULPS: f64 = 64.0;
 
 /// A mismatch found: (what, where, the two values).
 type Mismatch = (String, [f64; 2], f64, f64);
@@ -89,7 +95,7 @@ pub fn check(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<()> {
         let v = u0(x[0], x[1])?;
         scale = scale.max(v[0].abs()).max(v[1].abs());
     }
-    let tol = 1e-9 * scale;
+    let tol = (1e-9 * scale).max(ROUNDING_ULPS * f64::EPSILON * data_size(scene, mesh, space)?);
     match cmp.into_iter().find(|c| (c.2 - c.3).abs() > tol) {
         None => Ok(()),
         Some((what, x, a, b)) => Err(Error::scene(
@@ -157,6 +163,26 @@ fn shared_vertices(scene: &Scene, mesh: &Mesh, space: &CrSpace, cmp: &mut Vec<Mi
         }
     }
     Ok(())
+}
+
+/// The largest |u_D| component and |g_n| at the vertices of the parts with data, over every time node
+/// (a value that cannot be evaluated or is not finite is skipped: the run names it at its step).
+fn data_size(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<f64> {
+    let mut size = 0.0f64;
+    for (e, p) in space.edge_part.iter().enumerate() {
+        let Some(kind) = p.map(|p| &scene.parts[p].kind) else { continue };
+        for x in mesh.edges[e].map(|v| mesh.points[v]) {
+            for &t in &scene.times {
+                let v = match kind {
+                    PartKind::Dirichlet(u @ Some(_)) => vec_at(u, x, t).unwrap_or([0.0; 2]),
+                    PartKind::Contact(_, g @ Some(_)) => [gap_at(g, x, t).unwrap_or(0.0), 0.0],
+                    _ => break,
+                };
+                size = v.iter().filter(|c| c.is_finite()).fold(size, |m, c| m.max(c.abs()));
+            }
+        }
+    }
+    Ok(size)
 }
 
 fn vec_at(u: &Option<Vec2Expr>, x: [f64; 2], t: f64) -> Result<[f64; 2]> {
