@@ -11,18 +11,7 @@ use tresca_cr::adapt::{adapt, Options, Row};
 use tresca_cr::{Problem, Scene};
 
 fn options(levels: usize, theta: f64, reference: Option<u32>) -> Options {
-    Options {
-        levels: Some(levels),
-        target: None,
-        theta,
-        out: None,
-        gmsh: false,
-        force: false,
-        max_memory: None,
-        max_disk: None,
-        budget: None,
-        reference,
-    }
+    Options { reference, ..Options::levels(levels, theta) }
 }
 
 fn rows(s: &Scene, o: &Options) -> Vec<Row> {

@@ -55,6 +55,24 @@ pub struct Options {
     pub reference: Option<u32>,
 }
 
+impl Options {
+    /// `levels` levels with Dörfler's θ, nothing written, no limit but the machine's.
+    pub fn levels(levels: usize, theta: f64) -> Options {
+        Options {
+            levels: Some(levels),
+            target: None,
+            theta,
+            out: None,
+            gmsh: false,
+            force: false,
+            max_memory: None,
+            max_disk: None,
+            budget: None,
+            reference: None,
+        }
+    }
+}
+
 /// One level's figures.
 #[derive(Clone, Debug, Default)]
 pub struct Row {

@@ -96,18 +96,7 @@ fn law(rows: &[Row]) -> Option<PowerLaw> {
 
 /// The pilot: `levels` levels of `adapt` with θ, each stopped by the share `budget` of seconds.
 fn pilot(scene: &Scene, theta: f64, levels: usize, budget: f64) -> Result<Vec<Row>> {
-    let opts = Options {
-        levels: Some(levels),
-        target: None,
-        theta,
-        out: None,
-        gmsh: false,
-        force: false,
-        max_memory: None,
-        max_disk: None,
-        budget: Some(budget),
-        reference: None,
-    };
+    let opts = Options { budget: Some(budget), ..Options::levels(levels, theta) };
     Ok(adapt(scene, &opts, |_| {})?.rows)
 }
 
