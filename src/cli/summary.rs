@@ -41,10 +41,10 @@
 //! `dofs`, `paper_dofs`, `wall`, `setup` (its set-up wall time), `iterations`; the true errors `max_err` (max
 //! over its own nodes), `common_err` (max over the nodes common to all levels), `final_err` (at T); `norm_max`
 //! (max over the common nodes of |||u|||); `consecutive` and `reference`: [max over common nodes, at T] of
-//! |||u_l − P u_{l−1}||| and of the error against the `--reference` run; `estimate`: [`LevelEstimate`]
+//! |||u_l − P u_{l−1}||| and of the error against the `--reference` run; `estimate`: [`study::LevelEstimate`]
 //! (`error_max`, `error_t`, `gci`, `verdict`) or `null`; `outputs`: the scalar outputs at T, in the order of
 //! `output_names`. `reference`: the reference level (`refine`, `steps`) or `null`. `estimates`
-//! ([`Estimates`]): `size` (`h` or `k`), `p`, `beta` (the model of the three finest levels, `null` when
+//! ([`study::Estimates`]): `size` (`h` or `k`), `p`, `beta` (the model of the three finest levels, `null` when
 //! refused), `refused` (why no estimate). `outputs`: per scalar output `name`, `p`, `limit` (the extrapolated
 //! value, `null` without a model) and per level `estimate`, `gci`, `verdict`. `difference_files`: the files
 //! `--differences` wrote.
@@ -79,7 +79,6 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use tresca_cr::fem::norms::ErrorNorms;
 use tresca_cr::stepping::SetupTimes;
-use tresca_cr::study::LevelResult;
 
 /// The schema version written in `schema`; raised when a field changes meaning or goes away.
 pub const SCHEMA: u32 = 1;
@@ -248,154 +247,12 @@ pub struct RunSummary {
     pub output: Option<String>,
 }
 
-/// A level's estimate.
-#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
-pub struct LevelEstimate {
-    pub error_max: f64,
-    pub error_t: f64,
-    pub gci: f64,
-    pub verdict: String,
-}
-
-/// One level of a study or of a planner's pilot.
-#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
-pub struct Level {
-    pub refine: u32,
-    pub steps: usize,
-    pub h: f64,
-    pub k: f64,
-    pub dofs: usize,
-    pub paper_dofs: usize,
-    pub wall: f64,
-    pub setup: f64,
-    pub iterations: usize,
-    pub max_err: Option<Errors>,
-    pub common_err: Option<Errors>,
-    pub final_err: Option<Errors>,
-    pub norm_max: f64,
-    pub consecutive: Option<[f64; 2]>,
-    pub reference: Option<[f64; 2]>,
-    pub estimate: Option<LevelEstimate>,
-    pub outputs: Vec<f64>,
-}
-
-impl Level {
-    pub fn of(r: &LevelResult, estimate: Option<LevelEstimate>) -> Level {
-        Level {
-            refine: r.refine,
-            steps: r.steps,
-            h: r.h,
-            k: r.k,
-            dofs: r.dofs,
-            paper_dofs: r.paper_dofs,
-            wall: r.wall,
-            setup: r.setup,
-            iterations: r.iterations,
-            max_err: r.max_err.map(Errors::from),
-            common_err: r.common_err.map(Errors::from),
-            final_err: r.final_err.map(Errors::from),
-            norm_max: r.norm_max,
-            consecutive: r.consecutive,
-            reference: r.reference,
-            estimate,
-            outputs: r.outputs.clone(),
-        }
-    }
-}
-
-/// The energy-norm model of a study.
-#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
-pub struct Estimates {
-    pub size: String,
-    pub p: Option<f64>,
-    pub beta: Option<f64>,
-    pub refused: Option<String>,
-}
-
-/// A scalar output's estimate at one level.
-#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
-pub struct OutputLevel {
-    pub estimate: f64,
-    pub gci: f64,
-    pub verdict: String,
-}
-
-#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
-pub struct OutputEstimate {
-    pub name: String,
-    pub p: Option<f64>,
-    pub limit: Option<f64>,
-    pub levels: Vec<OutputLevel>,
-}
-
-/// The level spelled refine:steps.
-#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq)]
-pub struct LevelSpec {
-    pub refine: u32,
-    pub steps: usize,
-}
-
-#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
-pub struct StudySummary {
-    pub levels: Vec<Level>,
-    pub reference: Option<LevelSpec>,
-    pub estimates: Estimates,
-    pub output_names: Vec<String>,
-    pub outputs: Vec<OutputEstimate>,
-    pub difference_files: Vec<String>,
-}
-
-impl StudySummary {
-    pub fn of(s: &tresca_cr::study::Study, reference: Option<tresca_cr::study::Level>) -> StudySummary {
-        let e = &s.estimates;
-        let levels = s
-            .levels
-            .iter()
-            .enumerate()
-            .map(|(i, r)| {
-                let est = e.levels.get(i).map(|l| LevelEstimate {
-                    error_max: l.error[0],
-                    error_t: l.error[1],
-                    gci: l.gci,
-                    verdict: l.verdict.text(),
-                });
-                Level::of(r, est)
-            })
-            .collect();
-        let outputs = s
-            .outputs
-            .iter()
-            .map(|o| OutputEstimate {
-                name: o.name.clone(),
-                p: o.model.map(|m| m.p),
-                limit: o.model.map(|m| m.limit),
-                levels: o
-                    .levels
-                    .iter()
-                    .map(|(est, gci, v)| OutputLevel { estimate: *est, gci: *gci, verdict: v.text() })
-                    .collect(),
-            })
-            .collect();
-        StudySummary {
-            levels,
-            reference: reference.map(|l| LevelSpec { refine: l.refine, steps: l.steps }),
-            estimates: Estimates {
-                size: e.size.to_string(),
-                p: e.model.map(|m| m.p),
-                beta: e.model.map(|m| m.beta),
-                refused: e.refused.clone(),
-            },
-            output_names: s.output_names.clone(),
-            outputs,
-            difference_files: s.difference_files.iter().map(|f| f.display().to_string()).collect(),
-        }
-    }
-}
-
 mod adapt;
 mod plan;
+mod study;
 pub use adapt::{AdaptSummary, AdaptiveRoute};
 pub use plan::{Achieved, PlanSummary};
+pub use study::{Level, StudySummary};
 
 #[cfg(test)]
 mod tests;

@@ -1,5 +1,6 @@
 //! The summary's round trip and the --json path check.
 
+use super::study::{Estimates, LevelEstimate, LevelSpec, OutputEstimate, OutputLevel};
 use super::*;
 
 fn errors(x: f64) -> Errors {
