@@ -69,10 +69,6 @@ impl Symbolic {
     }
 
     /// Bytes the numeric factorisation allocates: L's values and its scratch.
-    pub fn need(&self) -> u64 {
-        Symbolic::need_of(&self.symbolic)
-    }
-
     fn need_of(symbolic: &SymbolicCholesky<usize>) -> u64 {
         let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
         (symbolic.len_val() as u64).saturating_mul(8).saturating_add(scratch.unaligned_bytes_required() as u64)
