@@ -81,17 +81,15 @@ pub struct AdaptivePlan {
 
 /// Least-squares power law η = c N^p over `rows` (at least [`FIT_LEVELS`]).
 fn law(rows: &[Row]) -> Option<PowerLaw> {
-    let pts: Vec<(f64, f64)> =
-        rows.iter().filter(|r| r.estimator > 0.0).map(|r| ((r.unknowns as f64).ln(), r.estimator.ln())).collect();
-    if pts.len() < FIT_LEVELS {
+    let (x, y): (Vec<f64>, Vec<f64>) =
+        rows.iter().filter(|r| r.estimator > 0.0).map(|r| (r.unknowns as f64, r.estimator)).unzip();
+    if x.len() < FIT_LEVELS {
         return None;
     }
-    let n = pts.len() as f64;
-    let (mx, my) = pts.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
-    let sxx: f64 = pts.iter().map(|(x, _)| (x - mx).powi(2)).sum();
-    let sxy: f64 = pts.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
-    let p = sxy / sxx;
-    (p < 0.0).then(|| PowerLaw { c: (my - p * mx).exp(), p })
+    let p = crate::study::orders::fitted_order(&x, &y);
+    // the least-squares line passes through the means of the logarithms
+    let log_mean = |v: &[f64]| (v.iter().map(|a| a.ln()).sum::<f64>() / v.len() as f64).exp();
+    (p < 0.0).then(|| PowerLaw::through(log_mean(&x), log_mean(&y), p))
 }
 
 /// The pilot: `levels` levels of `adapt` with θ, each stopped by the share `budget` of seconds.
