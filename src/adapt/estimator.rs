@@ -22,7 +22,8 @@
 //!        + Σ_{e ⊂ ∂T, interior (½) or Γ_D} (1 + ρ) (2μ/h_e) ‖[u_h]‖²_e   nonconformity + stabilisation
 //!
 //! The last term's ρ part is exactly the jump part of |||e|||²; its 1 part bounds the nonconformity of
-//! the broken energy. The contact term is the Tresca mismatch of Hild–Nicaise 2007 ("Residual a
+//! the broken energy. With boundary data (`fem::lifting`) u_h is the full displacement w + u_L and the
+//! jump on a Dirichlet edge is u_h − u_D, as in the norm. The contact term is the Tresca mismatch of Hild–Nicaise 2007 ("Residual a
 //! posteriori error estimators for contact problems in elasticity", the σ_τ(u_h) − λ_h term) and of
 //! Walloth 2019 (Tresca friction); on bilateral contact the normal stress σ_n is the free reaction of
 //! the constraint u_n = 0, so it has no residual. The friction law itself holds exactly at the discrete
@@ -70,6 +71,8 @@ pub struct Estimator {
     jumps: Vec<EdgeJumps>,
     /// Contact edges: (edge, index in the friction force vector).
     contact: Vec<(usize, usize)>,
+    /// u_D on the Dirichlet parts with data ([`dirichlet_data`]).
+    dirichlet: Option<DirichletData>,
     two_mu: f64,
     rho: f64,
 }
@@ -130,7 +133,9 @@ impl Estimator {
             .map(|e| (e, GAUSS2.map(|(s, _)| jump_terms(mesh, e, s))))
             .collect();
         let contact = p.space.contact.iter().enumerate().map(|(i, c)| (c.edge, i)).collect();
-        Ok(Estimator { elements, h_tri, body, neumann, jumps, contact, two_mu: 2.0 * p.law.mu, rho: p.scene.rho })
+        let dirichlet = dirichlet_data(p);
+        let (two_mu, rho) = (2.0 * p.law.mu, p.scene.rho);
+        Ok(Estimator { elements, h_tri, body, neumann, jumps, contact, dirichlet, two_mu, rho })
     }
 
     /// σ_T as [[σxx, σxy], [σxy, σyy]] for the midpoint values `mid`.
@@ -143,7 +148,7 @@ impl Estimator {
     /// The indicator of step `r` (module doc).
     pub fn at(&self, p: &Problem, r: &StepResult) -> Result<Indicator> {
         let mesh = &p.mesh;
-        let mid = p.space.midpoint_values(&r.u);
+        let mid = p.space.displacement(&r.u, r.t)?;
         let sigma: Vec<[[f64; 2]; 2]> = (0..mesh.tris.len()).map(|t| self.stress(p, t, &mid)).collect();
         let sn = |t: usize, n: [f64; 2]| {
             let s = sigma[t];
@@ -194,11 +199,24 @@ impl Estimator {
             let d = s[0] * c.tangent[0] + s[1] * c.tangent[1] - lambda;
             add(t, 3, c.length * c.length / self.two_mu * d * d, &mut eta2);
         }
+        let mut u_d = Vec::new();
+        if let Some((sets, _)) = &self.dirichlet {
+            for set in sets {
+                let mut v = Vec::new();
+                set.eval(r.t, &mut v)?;
+                u_d.push(v);
+            }
+        }
         for (e, terms_q) in &self.jumps {
             let h = mesh.edge_length(*e);
+            let slot = self.dirichlet.as_ref().and_then(|(_, s)| s[*e]);
             let mut v = 0.0;
-            for (q, (_, w)) in terms_q.iter().zip(GAUSS2) {
-                let j = q.iter().fold([0.0; 2], |j, &(k, c)| [j[0] + c * mid[k][0], j[1] + c * mid[k][1]]);
+            for (qi, (q, (_, w))) in terms_q.iter().zip(GAUSS2).enumerate() {
+                let mut j = q.iter().fold([0.0; 2], |j, &(k, c)| [j[0] + c * mid[k][0], j[1] + c * mid[k][1]]);
+                if let Some((set, pos)) = slot {
+                    let at = 4 * pos + 2 * qi;
+                    j = [j[0] - u_d[set][at], j[1] - u_d[set][at + 1]];
+                }
                 v += w * h * (j[0] * j[0] + j[1] * j[1]);
             }
             let v = (1.0 + self.rho) * self.two_mu / h * v;
@@ -212,6 +230,26 @@ impl Estimator {
         }
         Ok(Indicator { eta2, terms })
     }
+}
+
+/// u_D of each Dirichlet part with data bound to the 2-point Gauss points of its edges (two points per
+/// edge, edge by edge), and per mesh edge its (part set, position) (`None`: no data).
+type DirichletData = (Vec<BoundSet>, Vec<Option<(usize, usize)>>);
+
+fn dirichlet_data(p: &Problem) -> Option<DirichletData> {
+    let mesh = &p.mesh;
+    let (mut sets, mut slot) = (Vec::new(), vec![None; mesh.edges.len()]);
+    for (k, part) in p.scene.parts.iter().enumerate() {
+        let PartKind::Dirichlet(Some(u)) = &part.kind else { continue };
+        let mut points = Vec::new();
+        for e in (0..mesh.edges.len()).filter(|&e| p.space.edge_part[e] == Some(k)) {
+            slot[e] = Some((sets.len(), points.len() / 2));
+            let [a, b] = mesh.edges[e].map(|v| mesh.points[v]);
+            points.extend(GAUSS2.map(|(s, _)| edge_point(a, b, s)));
+        }
+        sets.push(ExprSet::new(&[&u.0[0], &u.0[1]]).bind(points));
+    }
+    (!sets.is_empty()).then_some((sets, slot))
 }
 
 /// The unit normal of edge e pointing out of triangle t.

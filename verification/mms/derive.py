@@ -52,6 +52,10 @@ from tresca_py.mms.derive import CheckFailed, derive, require  # noqa: F401
 from tresca_py.mms.elasticity import (PHI0, PHI1, SIDES, Xs, Ys, body_force, grad_of, lame,  # noqa: F401
                                       local_field, side_geometry, side_normal_exact, stress, to_global)
 from tresca_py.mms.exmex import NotPrintable, ex  # noqa: F401
+from tresca_py.mms.lshape import case_lshape
+from tresca_py.mms.lshape import check_toml as check_lshape_toml
+from tresca_py.mms.lshape import run_checks as run_lshape_checks
+from tresca_py.mms.lshape import scene_text as lshape_text
 from tresca_py.mms.scene_toml import SOLVER, check_toml, write_toml  # noqa: F401
 
 x, y, t = symbols()
@@ -78,6 +82,8 @@ def main():
             d = run_checks(case, args.exmex, log)
             log("longest printed expression: %d characters" % max(len(v) for v in d["str"].values()))
             derived.append(d)
+        print("== mms_lshape: the L-shape with the re-entrant corner's singularity (tresca_py/mms/lshape.py)")
+        lshape = run_lshape_checks(case_lshape(), lambda msg: print("   " + msg))
         if not args.no_selftest:
             print("== selftest: deliberately wrong data must be rejected")
             selftest()
@@ -93,6 +99,10 @@ def main():
         write_toml(d, path)
         check_toml(path, d)
         print("wrote %s" % path)
+    text = lshape_text(lshape)
+    check_lshape_toml(text, lshape)
+    (out / "mms_lshape.toml").write_text(text)
+    print("wrote %s" % (out / "mms_lshape.toml"))
     print("all checks passed")
 
 

@@ -109,6 +109,8 @@ def ex(e):
         raise NotPrintable("SStep derivative of order %s is discontinuous" % d)
     if isinstance(e, Step):
         raise NotPrintable("Step (discontinuous) must not appear in printed data")
+    if isinstance(e, sp.atan2):
+        return "atan2(" + ex(e.args[0]) + "," + ex(e.args[1]) + ")"
     if e.func in _FUNCS:
         return _FUNCS[e.func] + "(" + ex(e.args[0]) + ")"
     raise NotPrintable("no exmex form for %s" % e.func)
