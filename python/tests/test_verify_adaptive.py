@@ -47,3 +47,15 @@ def test_dof_for_interpolates_in_log_log_and_says_when_not_reached():
     r = rows(0.5)
     assert adaptive.dof_for(r, "error", 2000 ** -0.5) == pytest.approx(2000)
     assert adaptive.dof_for(r, "error", 1e-9) is None
+
+
+def test_ratio_trend_gives_the_dof_ratio_of_two_power_laws_at_each_uniform_level():
+    """The system shall report, per uniform level, DOF_uniform / DOF_adaptive at the same error: for
+    e_u = D^(−1/4) and e_a = D^(−1/2) that is D_u / D_u^(1/2) = D_u^(1/2), exactly (log-log interpolation
+    of a power law)."""
+    adaptive_rows = [{"level": k, "unknowns": 1.35 ** k, "error": 1.35 ** (-k / 2)} for k in range(40)]
+    uniform_rows = [{"level": k, "unknowns": 100 * 4 ** k, "error": (100 * 4 ** k) ** -0.25} for k in range(6)]
+    trend = adaptive.ratio_trend(adaptive_rows, uniform_rows, "error")
+    assert [k for k, _ in trend] == [1, 2, 3, 4, 5]
+    for k, r in trend:
+        assert r == pytest.approx((100 * 4 ** k) ** 0.5, rel=1e-9)

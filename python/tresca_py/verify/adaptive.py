@@ -1,5 +1,6 @@
-"""The adaptive study of ``make verify`` (issue 33): ``tresca-cr adapt`` on the manufactured cases, Example
-5.1 and the L-shape, each against uniform refinement (``--theta 1``) in the same study.
+"""The adaptive study of ``make verify`` (issue 33): ``tresca-cr adapt`` on the manufactured cases (the
+L-shape ``mms_lshape`` with its corner singularity among them), Example 5.1 and the physical L-shape, each
+against uniform refinement (``--theta 1``) in the same study.
 
 Rates are slopes in DOF: a level's error e ∝ DOF^(−r), r the least-squares slope of log e against log DOF
 over a stated range of levels (:func:`tresca_py.common.orders` on the DOF, negated). The project's
@@ -151,24 +152,63 @@ def example_5_1(hs, levels, reference, out):
     return rows, uni
 
 
+def ratio_trend(rows, uni, col):
+    """Per uniform level k ≥ 1: (k, DOF_uniform / DOF_adaptive at its accuracy) where the adaptive levels
+    reach it."""
+    return [(k, uni[k]["unknowns"] / d) for k in range(1, len(uni))
+            if (d := dof_for(rows, col, uni[k][col])) is not None]
+
+
+def lshape_mms(hs, levels, uniform_levels, out):
+    """A1, A2 and A4 on mms_lshape (true errors): effectivity, adaptive DOF^(−1/2), and the adaptive DOF for
+    the uniform finest level's accuracy ≤ 1/10 of its DOF. Reported beside A4: the uniform route's rates over
+    pairs of levels (λ/2 = 0.272 asymptotically) and, when the bar is missed, the uniform DOF at which the
+    ratio would reach 10 if it kept growing like DOF^(1 − r_u/r_a) (r_u the last pair's rate, r_a the
+    adaptive fit: e_u ∝ DOF^(−r_u) and DOF_a ∝ e^(−1/r_a))."""
+    scene = case("mms_lshape")
+    rows, cmd = adapt(hs, scene, "mms_lshape_adaptive", levels, 0.5, out=out)
+    uni, cmd_u = adapt(hs, scene, "mms_lshape_uniform", uniform_levels, 1)
+    ok, text = effectivity_check(rows)
+    req(hs, "A1-effectivity-mms_lshape", "on `mms_lshape` the indicator's effectivity η/|||u − u_h||| shall stay ≥ 1 "
+        f"and within a bounded range over {levels} adapted levels", ok, text, cmd, STUDY_MD)
+    ok, r_a, _, text = rate_check(rows, "error", list(range(9, levels)), list(range(4, levels, 3)), 0.5,
+                                  WINDOW_BAND)
+    req(hs, "A2-rate-mms_lshape", f"on `mms_lshape` the adaptive true error shall decay like DOF^(−1/2) (± {FIT_BAND} "
+        f"fit, ± {WINDOW_BAND} over 3-level windows)", ok, text, cmd, STUDY_MD)
+    target, d_u = uni[-1]["error"], uni[-1]["unknowns"]
+    d_a = dof_for(rows, "error", target)
+    ok = d_a is not None and d_a <= d_u / 10
+    pairs = list(range(len(uni) - 1, -1, -2))[::-1]
+    _, r_pairs = rate(uni, "error", pairs)
+    got = "not reached" if d_a is None else f"≈ {d_a:.0f} unknowns, ratio {d_u / d_a:.1f}"
+    if d_a is not None and not ok:
+        d10 = d_u * (10 * d_a / d_u) ** (1 / (1 - r_pairs[-1] / r_a))
+        got += f"; at this trend (r_u = {r_pairs[-1]:.3f}, r_a = {r_a:.3f}) 10 at ≈ {d10:.2g} uniform unknowns"
+    req(hs, "A4-lshape-dof", "on the manufactured L-shape (`mms_lshape`: the re-entrant corner's r^0.5445 "
+        "singularity, true errors) the adaptive route shall reach the uniform route's finest accuracy with at "
+        "most a tenth of its unknowns (issue 33's bar)", ok,
+        f"uniform level {len(uni) - 1}: {target:.3e} with {d_u:.0f} unknowns; adaptive: {got} (ratio at uniform "
+        f"levels {', '.join(f'{k}: {r:.1f}' for k, r in ratio_trend(rows, uni, 'error'))}; uniform rates over "
+        f"level pairs {', '.join(f'{r:.3f}' for r in r_pairs)}, λ/2 = 0.272 asymptotically)",
+        f"{cmd}; {cmd_u}", STUDY_MD)
+    return rows, uni
+
+
 def lshape(hs, levels, uniform_levels, reference, out):
-    """A4: on the L-shape, the adaptive DOF for the uniform finest level's accuracy ≤ 1/10 of its DOF."""
+    """The physical L-shape (`lshape_adapt`, errors against a reference): reported, no bar (A4 is on
+    mms_lshape, whose errors are true ones); its runs serve A5, A6 and the pictures. Returns (rows, uniform
+    rows, the ratio text)."""
     scene = case("lshape_adapt")
     rows, cmd = adapt(hs, scene, "lshape_adaptive", levels, 0.5, reference, out, gmsh=True)
     uni, cmd_u = adapt(hs, scene, "lshape_uniform", uniform_levels, 1, reference)
     target = uni[-1]["vs_reference"]
     d_u, d_a = uni[-1]["unknowns"], dof_for(rows, "vs_reference", target)
-    ok = d_a is not None and d_a <= d_u / 10
     got = "not reached" if d_a is None else f"≈ {d_a:.0f} unknowns, ratio {d_u / d_a:.1f}"
-    # the ratio at the coarser uniform levels too (reported): how it grows with the accuracy asked
-    trend = [(k, uni[k]["unknowns"] / d) for k in range(1, len(uni) - 1)
-             if (d := dof_for(rows, "vs_reference", uni[k]["vs_reference"])) is not None]
-    req(hs, "A4-lshape-dof", "on the L-shape the adaptive route shall reach the uniform route's finest accuracy "
-        "with at most a tenth of its unknowns (issue 33's bar)", ok,
-        f"uniform level {len(uni) - 1}: {target:.3e} with {d_u:.0f} unknowns; adaptive: {got} (ratio at uniform "
-        f"levels {', '.join(f'{k}: {r:.1f}' for k, r in trend)})",
-        f"{cmd}; {cmd_u}", STUDY_MD)
-    return rows, uni
+    text = (f"`lshape_adapt` (reported, no bar; against the generation-{reference} reference): uniform level "
+            f"{len(uni) - 1}: {target:.3e} with {d_u:.0f} unknowns; adaptive: {got} (ratio at uniform levels "
+            f"{', '.join(f'{k}: {r:.1f}' for k, r in ratio_trend(rows, uni, 'vs_reference')[:-1])}). "
+            f"Commands: `{cmd}`; `{cmd_u}`")
+    return rows, uni, text
 
 
 def min_angle(hs, routes):
@@ -232,11 +272,13 @@ def table(name, rows, col):
 
 
 def study(hs):
-    """The study (about 2 min on 2 cores): A1, A2 per manufactured case, A3, A4, A5 per scene, A6; its
-    tables in reference/adaptive/study.md, its figures beside them."""
+    """The study (about 3 min on 2 cores): A1, A2 per manufactured case, A3, A4 (mms_lshape; the physical
+    L-shape reported), A5 per scene, A6; its tables in reference/adaptive/study.md, its figures beside
+    them."""
     t0 = time.perf_counter()
     work = os.path.join(hs.out, SUB)
     ex51_dir, lsh_dir = os.path.join(work, "example_5_1"), os.path.join(work, "lshape")
+    mms_dir = os.path.join(work, "mms_lshape")
     routes, md = {}, []
     for name in ("mms_elastic", "mms_stick_to_slip"):
         a, u = manufactured(hs, name, 17)
@@ -246,15 +288,20 @@ def study(hs):
     routes["paper_example_5_1"] = [("adaptive", a), ("uniform", u)]
     md += [table("Example 5.1, adaptive (reference generation 12)", a, "vs_reference"),
            table("Example 5.1, uniform", u, "vs_reference")]
-    a, u = lshape(hs, 13, 7, 10, lsh_dir)
+    a, u = lshape_mms(hs, 24, 13, mms_dir)
+    routes["mms_lshape"] = [("adaptive", a), ("uniform", u)]
+    md += [table("mms_lshape, adaptive (θ = 0.5)", a, "error"), table("mms_lshape, uniform", u, "error")]
+    a, u, physical = lshape(hs, 13, 7, 10, lsh_dir)
     routes["lshape_adapt"] = [("adaptive", a), ("uniform", u)]
     md += [table("L-shape, adaptive (reference generation 10)", a, "vs_reference"),
-           table("L-shape, uniform", u, "vs_reference")]
+           table("L-shape, uniform", u, "vs_reference"), physical + "\n"]
     min_angle(hs, routes)
     reimplementations(hs, lsh_dir, 6)
     figures(hs, [("mms_elastic", "mms_elastic: true error"), ("mms_stick_to_slip", "mms_stick_to_slip: true error"),
-                 ("example_5_1", "Example 5.1: against the reference"), ("lshape", "L-shape: against the reference")],
-            {"example_5_1": (ex51_dir, (0, 5, 10, 15)), "lshape": (lsh_dir, range(13))})
+                 ("example_5_1", "Example 5.1: against the reference"), ("lshape", "L-shape: against the reference"),
+                 ("mms_lshape", "mms_lshape: true error")],
+            {"example_5_1": (ex51_dir, (0, 5, 10, 15)), "lshape": (lsh_dir, range(13)),
+             "mms_lshape": (mms_dir, (0, 8, 16, 23))})
     results = [r for r in hs.results if re.match(r"A\d-", r.id)]
     head = ["<!-- generated by verification/run_all.py --only adaptive -->", "# Adaptive study (make verify)", "",
             f"`.venv/bin/python verification/run_all.py --only adaptive`: {time.perf_counter() - t0:.0f} s on "
