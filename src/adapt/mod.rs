@@ -157,7 +157,7 @@ fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool, timed: bo
         Some(p) => Some(Writer::create(p, &Run::of(&problem), force)?),
         None => None,
     };
-    let (mut acc, mut u, mut error) = (Accumulated::default(), Vec::new(), None::<f64>);
+    let (mut acc, mut u, mut t, mut error) = (Accumulated::default(), Vec::new(), Vec::new(), None::<f64>);
     let mut time = TimeIndicator::default();
     let mut on_step = |r: &StepResult| -> Result<()> {
         acc.push(r.n, &est.at(&problem, r)?);
@@ -171,6 +171,7 @@ fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool, timed: bo
             w.write_step(r)?;
         }
         u.push(r.u.clone());
+        t.push(r.t);
         Ok(())
     };
     let result = problem.run(crate::stepping::RunOptions::all(), &mut on_step);
@@ -180,7 +181,8 @@ fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool, timed: bo
     }
     result?;
     let (unknowns, paper_dofs) = (problem.space.n_dofs, problem.space.paper_dofs());
-    let kept = Kept { mesh: problem.mesh.clone(), space: problem.space.clone(), u };
+    let parts = problem.scene.parts.clone();
+    let kept = Kept { mesh: problem.mesh.clone(), space: problem.space.clone(), u, t, parts };
     Ok(Solved { kept, acc, error, time, unknowns, paper_dofs })
 }
 

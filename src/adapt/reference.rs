@@ -9,7 +9,9 @@
 //! generation ≤ G: one reference for both routes' levels. The distance of a level to it is the
 //! `study` reference error: |||u_ref − u_l|||² = Σ_{T ∈ ref} ∫_T σ(u_ref − u_l):ε(u_ref − u_l) +
 //! Σ_{e ∈ E⁰_l} (2ρμ/h_e)‖[u_l]‖²_e (∇u_l is constant on each reference triangle of nested meshes), max
-//! over the time nodes.
+//! over the time nodes. With boundary data (`fem::lifting`) both levels are compared by their full
+//! displacements w + u_L(t), and a Dirichlet edge's jump is u_l − u_D (the jump part of the true error,
+//! as `study`'s reference error measures it).
 
 use crate::error::Result;
 use crate::fem::elasticity::Elasticity;
@@ -18,12 +20,30 @@ use crate::fem::prolong::parent_triangles;
 use crate::fem::space::{CrSpace, Element};
 use crate::mesh::bisect::bisect;
 use crate::mesh::Mesh;
+use crate::scene::{Part, PartKind};
 
-/// A level's mesh, space and unknowns at every time node, kept for comparisons.
+/// A level's mesh, space and unknowns at every time node (times `t`), kept for comparisons; `parts` are
+/// the scene's boundary parts (u_D of the Dirichlet ones with data).
 pub struct Kept {
     pub mesh: Mesh,
     pub space: CrSpace,
     pub u: Vec<Vec<f64>>,
+    pub t: Vec<f64>,
+    pub parts: Vec<Part>,
+}
+
+impl Kept {
+    /// The stabilisation energy of node `i`'s displacement `mid`: jumps on Γ_D against u_D with data.
+    fn jump_energy(&self, jumps: &ErrorEvaluator, mid: &[[f64; 2]], i: usize) -> Result<f64> {
+        if self.space.data.is_none() {
+            return Ok(jumps.jump_energy(mid));
+        }
+        let t = self.t[i];
+        jumps.jump_energy_against(mid, |e, x| match self.space.edge_part[e].map(|k| &self.parts[k].kind) {
+            Some(PartKind::Dirichlet(Some(u))) => u.eval(x[0], x[1], t),
+            _ => Ok([0.0; 2]),
+        })
+    }
 }
 
 /// Generation of every triangle given the area of its initial ancestor.
@@ -52,9 +72,10 @@ pub fn distance(fine: &Kept, coarse: &Kept, law: &Elasticity, rho: f64) -> Resul
     let ce: Vec<Element> = (0..coarse.mesh.tris.len()).map(|t| Element::new(&coarse.mesh, t)).collect();
     let jumps = ErrorEvaluator::new(&coarse.mesh, &coarse.space, law, rho);
     let mut worst = 0.0f64;
-    for (uf, uc) in fine.u.iter().zip(&coarse.u) {
-        let (mf, mc) = (fine.space.midpoint_values(uf), coarse.space.midpoint_values(uc));
-        let mut sum = jumps.jump_energy(&mc);
+    for (i, (uf, uc)) in fine.u.iter().zip(&coarse.u).enumerate() {
+        let mf = fine.space.displacement(uf, fine.t[i])?;
+        let mc = coarse.space.displacement(uc, coarse.t[i])?;
+        let mut sum = coarse.jump_energy(&jumps, &mc, i)?;
         for (t, &p) in parent.iter().enumerate() {
             let gf = fe[t].gradient(fine.mesh.tri_edges[t].map(|e| mf[e]));
             let gc = ce[p].gradient(coarse.mesh.tri_edges[p].map(|e| mc[e]));
