@@ -3,7 +3,11 @@
 //! results file there).
 
 use super::*;
+use crate::sparse::{lower_pattern, lower_values};
 use faer::sparse::SymbolicSparseColMat;
+
+/// Lanczos steps of λ_max(K) at most (`solve::condition`), one vector of n values each.
+const LAMBDA_ITERS: usize = 12;
 
 /// The problem, or the set-up's error, each with the result of the work run beside the set-up.
 type WithBeside<R> = std::result::Result<(Problem, Option<R>), (Error, Option<R>)>;
@@ -191,7 +195,7 @@ impl MeshSetUp {
         &self.factor
     }
 
-    /// K (both triangles).
+    /// K, its lower triangle (`Problem::stiffness`).
     pub fn stiffness(&self) -> &SparseColMat<usize, f64> {
         &self.stiffness
     }
@@ -254,7 +258,7 @@ impl Discretised {
         })
     }
 
-    /// Phase 1: K, the loads and the symbolic factorisation.
+    /// Phase 1: K (its lower triangle), the loads and the symbolic factorisation.
     fn assemble(&self) -> Result<(SparseColMat<usize, f64>, Loads, Symbolic)> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         let pattern = EdgePattern::new(mesh);
@@ -276,8 +280,10 @@ impl Discretised {
                 let k_pattern = rx.recv().map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
                 let name = if nested { "nested dissection by coordinates" } else { "AMD" };
                 let symbolic = Symbolic::new(k_pattern.as_ref().as_ref(), contact, order)?.ordered_by(name);
-                // K's values, allocated beside, and the blocks of the superposition come on top of the factor
-                let beside = 8 * k_pattern.compute_nnz() as u64 + BLOCK_BYTES;
+                // on top of the factor: K's values (its lower triangle, assembled meanwhile), the Lanczos
+                // vectors of λ_max(K) computed beside the numeric factorisation, the blocks of steps
+                let lanczos = 8 * (LAMBDA_ITERS as u64 + 2) * space.n_dofs as u64;
+                let beside = 8 * k_pattern.compute_nnz() as u64 + lanczos + BLOCK_BYTES;
                 if !nested || symbolic.fits(beside) {
                     return Ok(symbolic);
                 }
@@ -287,10 +293,16 @@ impl Discretised {
                 Symbolic::new(k_pattern.as_ref().as_ref(), contact, fill_order_at(&graph, None, true)?)
                     .map(|s| s.ordered_by("METIS nested dissection (the factor by coordinates did not fit in memory)"))
             });
-            let k_pattern = Arc::new(pattern.unknown_pattern(space));
+            // K is kept as its lower triangle, the one the factorisation reads (half the memory), and the
+            // symbolic factorisation is given that triangle's pattern; the values are assembled on both
+            // and compacted to it
+            let full = pattern.unknown_pattern(space);
+            let k_pattern = Arc::new(lower_pattern(full.as_ref()));
             // a thread that failed before taking it has dropped the receiver: its error is the one reported
             let _ = tx.send(Arc::clone(&k_pattern));
-            let val = stiffness_values(pattern, k_pattern.as_ref().as_ref(), mesh, space, law, scene.rho);
+            let val = stiffness_values(pattern, full.as_ref(), mesh, space, law, scene.rho);
+            let val = lower_values(full.as_ref(), val);
+            drop(full);
             let loads = Loads::new(scene, mesh, space)?;
             let symbolic = symbolic
                 .join()
@@ -324,8 +336,10 @@ impl Discretised {
     /// the condition estimate's solves are started.
     fn factor(&self, stiffness: &SparseColMat<usize, f64>, symbolic: Symbolic) -> Result<Factored> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
+        // the set-up's temporaries are freed: their pages go back before the factor's are mapped
+        crate::machine::release_freed_memory();
         let (factor, aside) = Factor::numeric_beside(symbolic, stiffness, || {
-            let top = condition::largest_eigenvalue(stiffness, 12);
+            let top = condition::largest_eigenvalue(stiffness, LAMBDA_ITERS);
             let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, law, scene.rho).with_exact(x));
             let step0 = initial_state(scene, mesh, space, stiffness, errors.as_ref()).ok();
             (top, errors, step0)
