@@ -62,12 +62,11 @@ fn main() {
         let order = fill_order_at(&graph, points.as_deref(), nested).unwrap();
         tm(if nested { "nested dissection" } else { "amd" }, t.elapsed());
         let t = Clock::now();
+        let lower = pattern.unknown_pattern_lower(&space);
+        tm("lower pattern", t.elapsed());
+        let t = Clock::now();
         let pat = pattern.unknown_pattern(&space);
         tm("unknown pattern", t.elapsed());
-        // the run keeps K's lower triangle and gives its pattern to the symbolic factorisation
-        let t = Clock::now();
-        let lower = tresca_cr::sparse::lower_pattern(pat.as_ref());
-        tm("lower pattern", t.elapsed());
         let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
         let t = Clock::now();
         let sym = Symbolic::new(lower.as_ref(), &contact, order).unwrap();

@@ -3,7 +3,7 @@
 //! results file there).
 
 use super::*;
-use crate::sparse::{lower_pattern, lower_values};
+use crate::sparse::lower_values;
 use faer::sparse::SymbolicSparseColMat;
 
 /// Lanczos steps of λ_max(K) at most (`solve::condition`), one vector of n values each.
@@ -296,10 +296,10 @@ impl Discretised {
             // K is kept as its lower triangle, the one the factorisation reads (half the memory), and the
             // symbolic factorisation is given that triangle's pattern; the values are assembled on both
             // and compacted to it
-            let full = pattern.unknown_pattern(space);
-            let k_pattern = Arc::new(lower_pattern(full.as_ref()));
+            let k_pattern = Arc::new(pattern.unknown_pattern_lower(space));
             // a thread that failed before taking it has dropped the receiver: its error is the one reported
             let _ = tx.send(Arc::clone(&k_pattern));
+            let full = pattern.unknown_pattern(space);
             let val = stiffness_values(pattern, full.as_ref(), mesh, space, law, scene.rho);
             let val = lower_values(full.as_ref(), val);
             drop(full);
