@@ -9,15 +9,17 @@ use tresca_cr::scene::budget::Estimate;
 /// the child's own `ru_maxrss` (wait4), so tests running beside it do not count.
 fn peak_of_run(path: &str, refine: u32) -> u64 {
     let out = tmp_in("budget", &format!("r{refine}.h5"));
+    // reaped below by wait4, which reports the child's own peak (std's wait does not)
     let child = bin()
         .args(["run", path, "--refine", &refine.to_string(), "--steps", "4", "-q", "--force", "-o"])
         .arg(&out)
         .spawn()
-        .unwrap();
+        .unwrap()
+        .id() as libc::pid_t;
     let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
     // SAFETY: waits for our own child, filling the status and rusage given.
-    let pid = unsafe { libc::wait4(child.id() as libc::pid_t, &mut status, 0, &mut usage) };
-    assert_eq!(pid, child.id() as libc::pid_t);
+    let pid = unsafe { libc::wait4(child, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child);
     assert!(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0, "the run failed: {status}");
     usage.ru_maxrss as u64 * 1024
 }
