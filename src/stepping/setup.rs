@@ -6,6 +6,11 @@ use super::*;
 use crate::sparse::lower_values;
 use faer::sparse::SymbolicSparseColMat;
 
+/// From this many unknowns the caller's work beside the set-up starts with phase 3 ([`Discretised::set_up`]):
+/// where phases 1 and 2 take seconds (1,000,000 unknowns, as the switch to nested dissection,
+/// `solve::ordering::ND_MIN_SIZE`).
+const DEFER_BESIDE_MIN: usize = 1_000_000;
+
 /// Lanczos steps of λ_max(K) at most (`solve::condition`), one vector of n values each.
 const LAMBDA_ITERS: usize = 12;
 
@@ -14,7 +19,8 @@ type WithBeside<R> = std::result::Result<(Problem, Option<R>), (Error, Option<R>
 
 impl Problem {
     /// As [`Problem::new`], running `beside` on a thread of its own while the rest of the set-up
-    /// (assembly, factorisation, condensation) runs: the results file is created there. `beside` sees
+    /// (assembly, factorisation, condensation; on large meshes once the factor is made, see
+    /// `Discretised::set_up`) runs: the results file is created there. `beside` sees
     /// no set-up times (they are not known yet) and its result is returned even when the set-up fails,
     /// after it (a writer then closes its file as it would have).
     pub fn new_beside<R: Send>(
@@ -241,19 +247,34 @@ impl Discretised {
     /// 1. K's pattern, values and the loads; beside them the ordering (from the graph of the edges, begun
     ///    before K's pattern is made) and the symbolic factorisation (it needs only K's pattern, which is
     ///    the mesh's; the loads stay on the main thread, so the results file's creation, beside from the
-    ///    start, keeps its share of the two cores);
+    ///    start on small meshes, keeps its share of the two cores);
     /// 2. the numeric factorisation; beside it the factor's pages are mapped, then λ_max(K) of the
     ///    condition estimate is computed, the exact solution bound to the error quadrature and step 0
     ///    (u⁰ = I_CR u₀ with its true errors) computed;
     /// 3. the load superposition and the condensation; beside them, and beside the first steps, the
     ///    solves of the condition estimate (see `conditioning`).
     ///
-    /// `beside` runs on a thread of its own from the start (on small meshes it is the longest part, for
-    /// example creating the results file); its result is returned even when the set-up fails.
+    /// `beside` runs on a thread of its own, from the start below [`DEFER_BESIDE_MIN`] unknowns (on small
+    /// meshes it is the longest part, for example creating the results file), else from phase 3: phases 1
+    /// and 2 are where the time and the memory peak are (a third thread beside phase 1's two delays it;
+    /// what it allocates beside phase 2 adds to the factor's peak: creating the results file took 0.2 s
+    /// of CPU and 0.3 GB at 1.57 M unknowns). Its result is returned even when the set-up fails.
     fn set_up<R: Send>(&self, beside: Option<impl FnOnce(&Discretised) -> R + Send>) -> (Result<Operators>, Option<R>) {
         std::thread::scope(|s| {
-            let r = beside.map(|f| s.spawn(|| f(self)));
-            let rest = self.assemble().and_then(|(k, loads, symbolic)| self.factorise(k, loads, symbolic));
+            let (early, mut late) = match self.space.n_dofs < DEFER_BESIDE_MIN {
+                true => (beside, None),
+                false => (None, beside),
+            };
+            let mut r = early.map(|f| s.spawn(|| f(self)));
+            let mut start_late = || {
+                if let Some(f) = late.take() {
+                    r = Some(s.spawn(|| f(self)));
+                }
+            };
+            let rest =
+                self.assemble().and_then(|(k, loads, symbolic)| self.factorise(k, loads, symbolic, &mut start_late));
+            // a set-up that failed before phase 3 still runs it (its result is returned)
+            start_late();
             (rest, r.map(|r| r.join().unwrap_or_else(|e| std::panic::resume_unwind(e))))
         })
     }
@@ -316,11 +337,19 @@ impl Discretised {
     }
 
     /// Phases 2 and 3: the factor, the superposition, the condensation, the condition estimate under way.
-    fn factorise(&self, stiffness: SparseColMat<usize, f64>, loads: Loads, symbolic: Symbolic) -> Result<Operators> {
+    /// `phase3` is called once the factor is made.
+    fn factorise(
+        &self,
+        stiffness: SparseColMat<usize, f64>,
+        loads: Loads,
+        symbolic: Symbolic,
+        phase3: &mut dyn FnMut(),
+    ) -> Result<Operators> {
         let (scene, space) = (&self.scene, &self.space);
         let t2 = Instant::now();
         let Factored { factor, conditioning, errors, step0 } = self.factor(&stiffness, symbolic)?;
         let t3 = Instant::now();
+        phase3();
         let mut assembled = Vec::new();
         let basis = LoadBasis::build(&loads, &scene.times, &factor, &mut assembled)?;
         let t4 = Instant::now();
