@@ -11,6 +11,11 @@ use faer::sparse::SymbolicSparseColMat;
 /// `solve::ordering::ND_MIN_SIZE`).
 const DEFER_BESIDE_MIN: usize = 1_000_000;
 
+/// Bytes an unknown that a large run allocates after the factor besides the blocks of steps (the results
+/// file's buffers, the superposition's responses, the condition estimate's vectors): measured at refine 8 of
+/// Example 5.1, 0.65 GB over the factor and K less the blocks' 0.27 GB, for 1,573,376 unknowns.
+const AFTER_FACTOR_BYTES: u64 = 242;
+
 /// Lanczos steps of λ_max(K) at most (`solve::condition`), one vector of n values each.
 const LAMBDA_ITERS: usize = 12;
 
@@ -301,10 +306,12 @@ impl Discretised {
                 let k_pattern = rx.recv().map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
                 let name = if nested { "nested dissection by coordinates" } else { "AMD" };
                 let symbolic = Symbolic::new(k_pattern.as_ref().as_ref(), contact, order)?.ordered_by(name);
-                // on top of the factor: K's values (its lower triangle, assembled meanwhile), the Lanczos
-                // vectors of λ_max(K) computed beside the numeric factorisation, the blocks of steps
-                let lanczos = 8 * (LAMBDA_ITERS as u64 + 2) * space.n_dofs as u64;
-                let beside = 8 * k_pattern.compute_nnz() as u64 + lanczos + BLOCK_BYTES;
+                // on top of the factor: K's values (its lower triangle, assembled meanwhile), the blocks of
+                // steps, and the larger of what comes beside the numeric factorisation (λ_max(K)'s Lanczos
+                // vectors) and after it ([`AFTER_FACTOR_BYTES`])
+                let n = space.n_dofs as u64;
+                let lanczos = 8 * (LAMBDA_ITERS as u64 + 2) * n;
+                let beside = 8 * k_pattern.compute_nnz() as u64 + lanczos.max(AFTER_FACTOR_BYTES * n) + BLOCK_BYTES;
                 if !nested || symbolic.fits(beside) {
                     return Ok(symbolic);
                 }
