@@ -7,7 +7,8 @@
 //!
 //! `export_matrix SCENE REFINE --time` sets the mesh up as a run does (mesh and space, assembly with the
 //! ordering and symbolic factorisation beside it, numeric factorisation; `stepping::MeshSetUp`) and
-//! prints one JSON line: the phases' wall times, nnz(L), the factorisation's flops Σ_j c_j² and the
+//! prints one JSON line: the phases' wall times, nnz_k (the entries of K's lower triangle, what a run
+//! keeps), nnz(L), the factorisation's flops Σ_j c_j² and the
 //! process's CPU time.
 use std::io::Write;
 use tresca_cr::stepping::MeshSetUp;

@@ -1,7 +1,8 @@
 //! Single-thread cost of each stage of a run's set-up (median of PASSES passes, default 7), the numbers
 //! behind the schedule of `stepping::setup` (which stages run beside which), with the sizes of K and of
 //! its factor. Each stage is timed by the thread's CPU clock (the machine is shared: wall times carry
-//! the other processes' load) with its minor page faults; ORDERING is `auto` (the run's choice: nested
+//! the other processes' load) with its minor page faults (K kept and factorised as its lower triangle, as
+//! a run does); ORDERING is `auto` (the run's choice: nested
 //! dissection by coordinates from `ND_MIN_SIZE` unknowns), `amd`, `nd` (by coordinates) or `metis`.
 //!
 //! `RAYON_NUM_THREADS=1 cargo run --release --example setup_cost verification/cases/mms_stop.toml 4 [PASSES] [ORDERING] [symbolic]`
@@ -61,20 +62,24 @@ fn main() {
         let order = fill_order_at(&graph, points.as_deref(), nested).unwrap();
         tm(if nested { "nested dissection" } else { "amd" }, t.elapsed());
         let t = Clock::now();
+        let lower = pattern.unknown_pattern_lower(&space);
+        tm("lower pattern", t.elapsed());
+        let t = Clock::now();
         let pat = pattern.unknown_pattern(&space);
         tm("unknown pattern", t.elapsed());
         let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
         let t = Clock::now();
-        let sym = Symbolic::new(pat.as_ref(), &contact, order).unwrap();
+        let sym = Symbolic::new(lower.as_ref(), &contact, order).unwrap();
         tm("symbolic", t.elapsed());
-        sizes = (pat.compute_nnz(), sym.len_val());
+        sizes = (lower.compute_nnz(), sym.len_val());
         if symbolic_only {
             continue;
         }
         let t = Clock::now();
         let val = stiffness_values(&pattern, pat.as_ref(), &mesh, &space, &law, scene.rho);
+        let val = tresca_cr::sparse::lower_values(pat.as_ref(), val);
         tm("stiffness", t.elapsed());
-        let k = faer::sparse::SparseColMat::new(pat, val);
+        let k = faer::sparse::SparseColMat::new(lower, val);
         let t = Clock::now();
         let loads = Loads::new(&scene, &mesh, &space).unwrap();
         tm("loads", t.elapsed());
@@ -92,7 +97,7 @@ fn main() {
         tm("error evaluator", t.elapsed());
         std::hint::black_box((loads, top, inv, ev));
     }
-    println!("entries of K {}, of its factor {}", sizes.0, sizes.1);
+    println!("entries of K's lower triangle {}, of its factor {}", sizes.0, sizes.1);
     println!("{:>17} {:>11} {:>12}", "stage", "CPU", "minor faults");
     for (name, mut v) in rows {
         v.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -12,6 +12,18 @@ pub fn available_memory() -> Option<u64> {
     Some(kb * 1024)
 }
 
+/// Hand the heap memory freed so far back to the system (glibc's `malloc_trim`): glibc keeps freed
+/// memory below its top chunk and in its arenas for reuse, so after the set-up's temporaries (patterns,
+/// graph, ordering, the upper triangle of K) a process holds pages nothing uses. Called before the
+/// numeric factorisation, whose factor is the run's largest allocation. Elsewhere (no glibc) nothing.
+pub fn release_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only releases free memory of the allocator; no pointer is involved.
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
+
 /// Free bytes (for unprivileged users) of the file system holding `dir` or its nearest existing ancestor.
 pub fn available_disk(dir: &Path) -> Option<u64> {
     use std::os::unix::ffi::OsStrExt;

@@ -225,7 +225,8 @@ fn manufactured_elasticity_rates_rotated_square() {
 /// edges; its pattern is the mesh's (`EdgePattern::unknown_pattern`, from which the symbolic
 /// factorisation is computed before K's values exist: every unknown of two coupled edges, the zero x–y
 /// couplings of jump-only neighbours included), with sorted columns, symmetric (the element blocks'
-/// λ g_x g_y + μ g_y g_x is not bitwise symmetric, as before; the factor reads one triangle). Tolerance: the two routes sum the
+/// λ g_x g_y + μ g_y g_x is not bitwise symmetric, as before; the factor reads one triangle, and a run
+/// keeps that lower triangle, the same bit for bit as the matrix assembled on both). Tolerance: the two routes sum the
 /// same products in a different order, so entries agree to a few ulps of the largest entry.
 #[test]
 fn compressed_assembly_equals_the_sum_of_contributions() {
@@ -280,6 +281,12 @@ fn compressed_assembly_equals_the_sum_of_contributions() {
     }
     let scale = dense.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let mut stored = vec![0.0f64; n * n];
+    // the run keeps K's lower triangle: the one of K assembled on both, bit for bit
+    let full = stiffness(mesh, space, &law, p.scene.rho);
+    let lower = tresca_cr::sparse::lower_pattern(full.symbolic());
+    assert_eq!((k.symbolic().col_ptr(), k.symbolic().row_idx()), (lower.col_ptr(), lower.row_idx()));
+    assert_eq!(k.val(), tresca_cr::sparse::lower_values(full.symbolic(), full.val().to_vec()).as_slice());
+    let k = &full;
     let (cp, ri) = (k.symbolic().col_ptr(), k.symbolic().row_idx());
     let mesh_pattern = tresca_cr::fem::assemble::EdgePattern::new(mesh).unknown_pattern(space);
     assert_eq!((cp, ri), (mesh_pattern.col_ptr(), mesh_pattern.row_idx()), "K's pattern is not the mesh's");

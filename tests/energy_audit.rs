@@ -45,8 +45,12 @@ fn bound(p: &Problem, prev: &StepResult, r: &StepResult) -> f64 {
     let k = &p.stiffness;
     let mut row = vec![0.0f64; k.nrows()];
     for j in 0..k.ncols() {
+        // K's lower triangle: an entry below the diagonal counts in its row and, mirrored, in row j
         for (i, v) in k.row_idx_of_col(j).zip(k.val_of_col(j)) {
             row[i] += v.abs();
+            if i != j {
+                row[j] += v.abs();
+            }
         }
     }
     let knorm = row.iter().fold(0.0f64, |a, v| a.max(*v));

@@ -254,17 +254,28 @@ impl EdgePattern {
     /// values. Symmetric, every column sorted (block row b read as a column gives the column's rows in
     /// increasing order, since the unknowns are numbered edge by edge).
     pub fn unknown_pattern(&self, space: &CrSpace) -> SymbolicSparseColMat<usize> {
+        self.pattern_of(space, false)
+    }
+
+    /// The lower triangle (rows ≥ columns) of [`EdgePattern::unknown_pattern`], made directly: the
+    /// pattern a run keeps K in and gives to the symbolic factorisation (`stepping::setup`).
+    pub fn unknown_pattern_lower(&self, space: &CrSpace) -> SymbolicSparseColMat<usize> {
+        self.pattern_of(space, true)
+    }
+
+    fn pattern_of(&self, space: &CrSpace, lower: bool) -> SymbolicSparseColMat<usize> {
         let n = space.n_dofs;
         let (ptr, idx) = (&self.ptr, &self.idx);
         let count: Vec<usize> = space.edge_dof.iter().map(|d| d.terms().count()).collect();
         let nnz = (0..count.len()).map(|b| count[b] * idx[ptr[b]..ptr[b + 1]].iter().map(|&a| count[a]).sum::<usize>());
-        let mut row_idx = Vec::with_capacity(nnz.sum());
+        let nnz = nnz.sum::<usize>();
+        let mut row_idx = Vec::with_capacity(if lower { (nnz + n) / 2 } else { nnz });
         let mut col_ptr = Vec::with_capacity(n + 1);
         col_ptr.push(0);
         for (b, dof_b) in space.edge_dof.iter().enumerate() {
-            for _ in dof_b.terms() {
+            for (l, _) in dof_b.terms() {
                 for &a in &idx[ptr[b]..ptr[b + 1]] {
-                    row_idx.extend(space.edge_dof[a].terms().map(|(k, _)| k));
+                    row_idx.extend(space.edge_dof[a].terms().map(|(k, _)| k).filter(|&k| !lower || k >= l));
                 }
                 col_ptr.push(row_idx.len());
             }

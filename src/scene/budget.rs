@@ -3,12 +3,12 @@
 //! estimates; `check` and `run` refuse a run whose estimate exceeds what the machine has (MemAvailable of
 //! `/proc/meminfo`, free space of the output's file system) or the limits the user gives.
 //!
-//! Calibration (Example 5.1 `--steps 4 -o`, peak RSS by `/usr/bin/time`, 2026-11-26; figures in
-//! `reference/performance.md` §8): six meshes from 24,640 to 4,817,792 unknowns (refine 5–8 of `cells =
-//! [2, 2]`, refine 8 of `[3, 3]`, refine 7 of `[7, 7]`). The factor's fill grows like n log n, so the
-//! estimate is γ + n (α + β log₂ n) plus the two buffers of a block of steps (`solve::free`, 16 bytes a
-//! value, at most 16 columns and 2²⁴ values) and the dense contact parts: γ, α, β fitted by least squares
-//! of the relative misfit to the six, which it then gives within 3.5 %. An estimate, not a bound: the fill
+//! Calibration (Example 5.1 `--steps 4 -o`, peak RSS by `/usr/bin/time` in KiB, 2026-11-26, with K kept
+//! as its lower triangle; figures in `reference/performance.md` §8): five meshes from 24,640 to 3,539,712
+//! unknowns (refine 5–8 of `cells = [2, 2]`, refine 8 of `[3, 3]`). The factor's fill grows like n log n,
+//! so the estimate is γ + n (α + β log₂ n) plus the two buffers of a block of steps (`solve::free`, 16
+//! bytes a value, at most 16 columns and 2²⁴ values) and the dense contact parts: γ, α, β fitted by least
+//! squares of the relative misfit to the five, which it then gives within 5 %. An estimate, not a bound: the fill
 //! also depends on the ordering (AMD below 1M unknowns, nested dissection above). The factorisation checks
 //! its exact size once the symbolic factorisation is known (`solve::Symbolic::fits`) and refuses a factor
 //! that would not fit, or first tries METIS's ordering, which fills less.
@@ -35,9 +35,9 @@ pub struct Estimate {
 
 /// Peak bytes of the set-up (mesh, space, K, factor) are BYTES_FIXED + unknowns · (BYTES_PER_UNKNOWN +
 /// BYTES_PER_UNKNOWN_LOG2 · log₂(unknowns)) (fitted, see the module doc).
-const BYTES_FIXED: f64 = 1.54e7;
-const BYTES_PER_UNKNOWN: f64 = -500.3;
-const BYTES_PER_UNKNOWN_LOG2: f64 = 196.15;
+const BYTES_FIXED: f64 = 1.524e7;
+const BYTES_PER_UNKNOWN: f64 = -1166.7;
+const BYTES_PER_UNKNOWN_LOG2: f64 = 219.62;
 /// The values of the block of steps' buffers (`solve::free`): at most 16 columns and 2²⁴ values each.
 const BLOCK_COLUMNS: u64 = 16;
 const BLOCK_VALUES: u64 = 1 << 24;

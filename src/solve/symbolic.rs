@@ -27,7 +27,8 @@ pub struct Symbolic {
 }
 
 impl Symbolic {
-    /// The symbolic factorisation of the symmetric `pattern` (both triangles stored) with the
+    /// The symbolic factorisation of the symmetric `pattern` (its lower triangle read: the lower
+    /// triangle alone or both triangles stored, and the matrix factorised the same) with the
     /// fill-reducing ordering `base` (position → unknown, a permutation; from [`fill_order`]) and the
     /// distinct unknowns `last` moved to its end, in the given order.
     pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>, last: &[usize], base: Vec<usize>) -> Result<Symbolic> {

@@ -23,7 +23,7 @@ use crate::solve::factor::{fill_order_at, Factor, Symbolic};
 use crate::solve::free::{FreeResponse, BLOCK_BYTES};
 use crate::solve::ordering::{Graph, ND_MIN_SIZE};
 use crate::solve::superpose::LoadBasis;
-use crate::sparse::{dot, energy};
+use crate::sparse::{dot, symmetric_energy};
 use conditioning::Pending;
 use faer::sparse::SparseColMat;
 use std::sync::Arc;
@@ -45,7 +45,9 @@ pub struct Problem {
     pub mesh: Mesh,
     pub space: CrSpace,
     pub law: Elasticity,
-    /// K, the matrix of a_h on V_h (shared by the problems on one mesh's set-up, [`MeshSetUp`]).
+    /// K, the matrix of a_h on V_h, its lower triangle (rows ≥ columns; what the factorisation reads, and
+    /// half the memory: `sparse::symmetric_matvec`); shared by the problems on one mesh's set-up
+    /// ([`MeshSetUp`]).
     pub stiffness: Arc<SparseColMat<usize, f64>>,
     /// u_f = K⁻¹lⁿ and its contact trace; owns the factor of K.
     pub free: FreeResponse,
@@ -281,7 +283,7 @@ fn initial_state(
     };
     let nc = space.contact.len();
     let slip = space.contact.iter().map(|c| u[c.dof]).collect();
-    let energy = energy(stiffness, &u);
+    let energy = symmetric_energy(stiffness, &u);
     let r = StepResult {
         n: 0,
         t,

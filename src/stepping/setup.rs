@@ -3,14 +3,29 @@
 //! results file there).
 
 use super::*;
+use crate::sparse::lower_values;
 use faer::sparse::SymbolicSparseColMat;
+
+/// From this many unknowns the caller's work beside the set-up starts with phase 3 ([`Discretised::set_up`]):
+/// where phases 1 and 2 take seconds (1,000,000 unknowns, as the switch to nested dissection,
+/// `solve::ordering::ND_MIN_SIZE`).
+const DEFER_BESIDE_MIN: usize = 1_000_000;
+
+/// Bytes an unknown that a large run allocates after the factor besides the blocks of steps (the results
+/// file's buffers, the superposition's responses, the condition estimate's vectors): measured at refine 8 of
+/// Example 5.1, 0.65 GB over the factor and K less the blocks' 0.27 GB, for 1,573,376 unknowns.
+const AFTER_FACTOR_BYTES: u64 = 242;
+
+/// Lanczos steps of λ_max(K) at most (`solve::condition`), one vector of n values each.
+const LAMBDA_ITERS: usize = 12;
 
 /// The problem, or the set-up's error, each with the result of the work run beside the set-up.
 type WithBeside<R> = std::result::Result<(Problem, Option<R>), (Error, Option<R>)>;
 
 impl Problem {
     /// As [`Problem::new`], running `beside` on a thread of its own while the rest of the set-up
-    /// (assembly, factorisation, condensation) runs: the results file is created there. `beside` sees
+    /// (assembly, factorisation, condensation; on large meshes once the factor is made, see
+    /// `Discretised::set_up`) runs: the results file is created there. `beside` sees
     /// no set-up times (they are not known yet) and its result is returned even when the set-up fails,
     /// after it (a writer then closes its file as it would have).
     pub fn new_beside<R: Send>(
@@ -191,7 +206,7 @@ impl MeshSetUp {
         &self.factor
     }
 
-    /// K (both triangles).
+    /// K, its lower triangle (`Problem::stiffness`).
     pub fn stiffness(&self) -> &SparseColMat<usize, f64> {
         &self.stiffness
     }
@@ -237,24 +252,39 @@ impl Discretised {
     /// 1. K's pattern, values and the loads; beside them the ordering (from the graph of the edges, begun
     ///    before K's pattern is made) and the symbolic factorisation (it needs only K's pattern, which is
     ///    the mesh's; the loads stay on the main thread, so the results file's creation, beside from the
-    ///    start, keeps its share of the two cores);
+    ///    start on small meshes, keeps its share of the two cores);
     /// 2. the numeric factorisation; beside it the factor's pages are mapped, then λ_max(K) of the
     ///    condition estimate is computed, the exact solution bound to the error quadrature and step 0
     ///    (u⁰ = I_CR u₀ with its true errors) computed;
     /// 3. the load superposition and the condensation; beside them, and beside the first steps, the
     ///    solves of the condition estimate (see `conditioning`).
     ///
-    /// `beside` runs on a thread of its own from the start (on small meshes it is the longest part, for
-    /// example creating the results file); its result is returned even when the set-up fails.
+    /// `beside` runs on a thread of its own, from the start below [`DEFER_BESIDE_MIN`] unknowns (on small
+    /// meshes it is the longest part, for example creating the results file), else from phase 3: phases 1
+    /// and 2 are where the time and the memory peak are (a third thread beside phase 1's two delays it;
+    /// what it allocates beside phase 2 adds to the factor's peak: creating the results file took 0.2 s
+    /// of CPU and 0.3 GB at 1.57 M unknowns). Its result is returned even when the set-up fails.
     fn set_up<R: Send>(&self, beside: Option<impl FnOnce(&Discretised) -> R + Send>) -> (Result<Operators>, Option<R>) {
         std::thread::scope(|s| {
-            let r = beside.map(|f| s.spawn(|| f(self)));
-            let rest = self.assemble().and_then(|(k, loads, symbolic)| self.factorise(k, loads, symbolic));
+            let (early, mut late) = match self.space.n_dofs < DEFER_BESIDE_MIN {
+                true => (beside, None),
+                false => (None, beside),
+            };
+            let mut r = early.map(|f| s.spawn(|| f(self)));
+            let mut start_late = || {
+                if let Some(f) = late.take() {
+                    r = Some(s.spawn(|| f(self)));
+                }
+            };
+            let rest =
+                self.assemble().and_then(|(k, loads, symbolic)| self.factorise(k, loads, symbolic, &mut start_late));
+            // a set-up that failed before phase 3 still runs it (its result is returned)
+            start_late();
             (rest, r.map(|r| r.join().unwrap_or_else(|e| std::panic::resume_unwind(e))))
         })
     }
 
-    /// Phase 1: K, the loads and the symbolic factorisation.
+    /// Phase 1: K (its lower triangle), the loads and the symbolic factorisation.
     fn assemble(&self) -> Result<(SparseColMat<usize, f64>, Loads, Symbolic)> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         let pattern = EdgePattern::new(mesh);
@@ -276,8 +306,12 @@ impl Discretised {
                 let k_pattern = rx.recv().map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
                 let name = if nested { "nested dissection by coordinates" } else { "AMD" };
                 let symbolic = Symbolic::new(k_pattern.as_ref().as_ref(), contact, order)?.ordered_by(name);
-                // K's values, allocated beside, and the blocks of the superposition come on top of the factor
-                let beside = 8 * k_pattern.compute_nnz() as u64 + BLOCK_BYTES;
+                // on top of the factor: K's values (its lower triangle, assembled meanwhile), the blocks of
+                // steps, and the larger of what comes beside the numeric factorisation (λ_max(K)'s Lanczos
+                // vectors) and after it ([`AFTER_FACTOR_BYTES`])
+                let n = space.n_dofs as u64;
+                let lanczos = 8 * (LAMBDA_ITERS as u64 + 2) * n;
+                let beside = 8 * k_pattern.compute_nnz() as u64 + lanczos.max(AFTER_FACTOR_BYTES * n) + BLOCK_BYTES;
                 if !nested || symbolic.fits(beside) {
                     return Ok(symbolic);
                 }
@@ -287,10 +321,16 @@ impl Discretised {
                 Symbolic::new(k_pattern.as_ref().as_ref(), contact, fill_order_at(&graph, None, true)?)
                     .map(|s| s.ordered_by("METIS nested dissection (the factor by coordinates did not fit in memory)"))
             });
-            let k_pattern = Arc::new(pattern.unknown_pattern(space));
+            // K is kept as its lower triangle, the one the factorisation reads (half the memory), and the
+            // symbolic factorisation is given that triangle's pattern; the values are assembled on both
+            // and compacted to it
+            let k_pattern = Arc::new(pattern.unknown_pattern_lower(space));
             // a thread that failed before taking it has dropped the receiver: its error is the one reported
             let _ = tx.send(Arc::clone(&k_pattern));
-            let val = stiffness_values(pattern, k_pattern.as_ref().as_ref(), mesh, space, law, scene.rho);
+            let full = pattern.unknown_pattern(space);
+            let val = stiffness_values(pattern, full.as_ref(), mesh, space, law, scene.rho);
+            let val = lower_values(full.as_ref(), val);
+            drop(full);
             let loads = Loads::new(scene, mesh, space)?;
             let symbolic = symbolic
                 .join()
@@ -304,11 +344,19 @@ impl Discretised {
     }
 
     /// Phases 2 and 3: the factor, the superposition, the condensation, the condition estimate under way.
-    fn factorise(&self, stiffness: SparseColMat<usize, f64>, loads: Loads, symbolic: Symbolic) -> Result<Operators> {
+    /// `phase3` is called once the factor is made.
+    fn factorise(
+        &self,
+        stiffness: SparseColMat<usize, f64>,
+        loads: Loads,
+        symbolic: Symbolic,
+        phase3: &mut dyn FnMut(),
+    ) -> Result<Operators> {
         let (scene, space) = (&self.scene, &self.space);
         let t2 = Instant::now();
         let Factored { factor, conditioning, errors, step0 } = self.factor(&stiffness, symbolic)?;
         let t3 = Instant::now();
+        phase3();
         let mut assembled = Vec::new();
         let basis = LoadBasis::build(&loads, &scene.times, &factor, &mut assembled)?;
         let t4 = Instant::now();
@@ -324,8 +372,10 @@ impl Discretised {
     /// the condition estimate's solves are started.
     fn factor(&self, stiffness: &SparseColMat<usize, f64>, symbolic: Symbolic) -> Result<Factored> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
+        // the set-up's temporaries are freed: their pages go back before the factor's are mapped
+        crate::machine::release_freed_memory();
         let (factor, aside) = Factor::numeric_beside(symbolic, stiffness, || {
-            let top = condition::largest_eigenvalue(stiffness, 12);
+            let top = condition::largest_eigenvalue(stiffness, LAMBDA_ITERS);
             let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, law, scene.rho).with_exact(x));
             let step0 = initial_state(scene, mesh, space, stiffness, errors.as_ref()).ok();
             (top, errors, step0)

@@ -24,7 +24,7 @@ use crate::fem::norms::ErrorEvaluator;
 use crate::fem::prolong::{parent_triangles, Prolongation};
 use crate::fem::space::Element;
 use crate::scene::PartKind;
-use crate::sparse::energy;
+use crate::sparse::symmetric_energy;
 use crate::stepping::Problem;
 
 /// A finished run kept for comparisons: problem, and unknowns at the common time nodes `t`.
@@ -48,7 +48,7 @@ impl Kept {
 
 /// a_h(e, e)^{1/2} on the unknowns of `p`.
 fn energy_norm(p: &Problem, e: &[f64]) -> f64 {
-    energy(&p.stiffness, e).max(0.0).sqrt()
+    symmetric_energy(&p.stiffness, e).max(0.0).sqrt()
 }
 
 fn same_mesh(a: &Kept, b: &Kept) -> bool {
