@@ -323,6 +323,7 @@ fn main() {
                 let opts = tresca_cr::adapt::Options {
                     levels,
                     target,
+                    until_unknowns: None,
                     theta,
                     out,
                     gmsh,
@@ -331,6 +332,7 @@ fn main() {
                     max_disk,
                     budget,
                     reference,
+                    lean: false,
                 };
                 let code = cli::adapt::run(s, opts, csv, json.json)?;
                 if code != 0 {

@@ -55,6 +55,26 @@ fn example_5_1_plan_prefers_the_adaptive_route_where_uniform_does_not_fit() {
     assert!(a["adaptive_pilot"].as_array().unwrap().len() >= 8, "{a}");
 }
 
+/// The system shall pilot the adaptive route cheaply (issue 32: the planner's CPU ≤ 5 % of the plan),
+/// counted, not timed: on Example 5.1 at 1e-4 both pilots run on the space pilot's 5 steps (the time
+/// pilot shows the steps do not change the answer; the scene has 40), are lean (no time indicator, no
+/// distance between levels) and stop at the first level with at least `PILOT_UNKNOWNS` (1/128) of the
+/// uniform plan's unknowns; the route is priced at the plan's 40 steps.
+#[test]
+fn example_5_1_adaptive_pilots_are_lean_and_stop_at_a_share_of_the_uniform_plan() {
+    let (code, a, _) = plan("verification/cases/paper_example_5_1.toml", "1e-4", &[], "d");
+    assert_eq!(code, Some(0), "{a}");
+    assert_eq!(a["pilot_steps"], 5, "{a}");
+    assert_eq!(a["steps"], 40, "{a}");
+    let until = f(&a, "uniform_unknowns") * tresca_cr::plan::adaptive::PILOT_UNKNOWNS;
+    for name in ["adaptive_pilot", "uniform_pilot"] {
+        let rows = a[name].as_array().unwrap();
+        let n: Vec<f64> = rows.iter().map(|r| r["unknowns"].as_f64().unwrap()).collect();
+        assert!(n[n.len() - 1] >= until && n[n.len() - 2] < until, "{name}: {n:?} against {until}");
+        assert!(rows.iter().all(|r| r["time_estimator"] == 0.0 && r["vs_next"].is_null()), "{name}: {rows:?}");
+    }
+}
+
 /// The system shall, on mms_elastic (a smooth solution: the uniform space order is CR's optimal 1), not
 /// pilot the adaptive route — it can gain nothing but its overhead, and its pilots would add to the
 /// planner's own cost (issue 32: ≤ 5 % of the plan) — and say so; the uniform plan stands alone.

@@ -39,6 +39,8 @@ pub struct Options {
     pub levels: Option<usize>,
     /// Stop once the estimator is at most this.
     pub target: Option<f64>,
+    /// Stop once a level has at least this many unknowns.
+    pub until_unknowns: Option<usize>,
     /// Dörfler's θ in (0, 1].
     pub theta: f64,
     /// Write `level_<k>.h5` here.
@@ -53,6 +55,10 @@ pub struct Options {
     /// Measure every level against a reference: the finest level's mesh refined to at least this
     /// generation ([`reference::overlay`]).
     pub reference: Option<u32>,
+    /// A planner's pilot (`plan::adaptive`): only η and the unknowns are read, so no energy audit, no
+    /// time indicator and no distance between levels are computed (those fields of the rows stay 0 and
+    /// `None`, and the levels' fields are not kept).
+    pub lean: bool,
 }
 
 impl Options {
@@ -61,6 +67,7 @@ impl Options {
         Options {
             levels: Some(levels),
             target: None,
+            until_unknowns: None,
             theta,
             out: None,
             gmsh: false,
@@ -69,6 +76,7 @@ impl Options {
             max_disk: None,
             budget: None,
             reference: None,
+            lean: false,
         }
     }
 }
@@ -149,8 +157,9 @@ pub fn initial_mesh(scene: &Scene) -> Result<Mesh> {
 }
 
 /// Solve every step of `scene` on `mesh`, with the indicator at every node (and the time indicator
-/// with `timed`); write the results file.
-fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool, timed: bool) -> Result<Solved> {
+/// with `timed`; the energy audit and the fields at every node kept unless `lean`); write the results
+/// file.
+fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool, timed: bool, lean: bool) -> Result<Solved> {
     let problem = Problem::with_mesh(scene.clone(), mesh)?;
     let est = Estimator::new(&problem)?;
     let mut writer = match &out {
@@ -170,11 +179,14 @@ fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool, timed: bo
         if let Some(w) = writer.as_mut() {
             w.write_step(r)?;
         }
-        u.push(r.u.clone());
-        t.push(r.t);
+        if !lean {
+            u.push(r.u.clone());
+            t.push(r.t);
+        }
         Ok(())
     };
-    let result = problem.run(crate::stepping::RunOptions::all(), &mut on_step);
+    let options = crate::stepping::RunOptions { audit: !lean, ..crate::stepping::RunOptions::all() };
+    let result = problem.run(options, &mut on_step);
     let status = result.as_ref().map_or_else(|e| format!("stopped: {e}"), |()| "completed".to_string());
     if let Some(w) = writer {
         w.finish(&status)?;
@@ -223,7 +235,7 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
         if let (Some(dir), true) = (&opts.out, opts.gmsh) {
             export::write_gmsh(&mesh, &dir.join(format!("level_{level}.msh")))?;
         }
-        let solved = solve(scene, mesh, out, opts.force, true)?;
+        let solved = solve(scene, mesh, out, opts.force, !opts.lean, opts.lean)?;
         let marked = dorfler(&solved.acc.eta2, opts.theta);
         let mut row = Row {
             level,
@@ -244,7 +256,7 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
             ..Row::default()
         };
         let law = crate::fem::elasticity::Elasticity::new(&scene.material);
-        if let (Some(pv), Some(last)) = (levels.last(), rows.last_mut()) {
+        if let (Some(pv), Some(last), false) = (levels.last(), rows.last_mut(), opts.lean) {
             last.vs_next = Some(distance(&solved.kept, pv, &law, scene.rho)?);
         }
         let (raw, parent) = bisect(&solved.kept.mesh, &marked);
@@ -253,7 +265,8 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
         mesh = Mesh::build(raw)?;
         row.wall = t0.elapsed().as_secs_f64();
         report(&row);
-        let done = opts.target.is_some_and(|t| row.estimator <= t);
+        let done =
+            opts.target.is_some_and(|t| row.estimator <= t) || opts.until_unknowns.is_some_and(|n| row.unknowns >= n);
         rows.push(row);
         if opts.reference.is_none() {
             levels.clear();
@@ -265,7 +278,7 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
     }
     if let (Some(g), Some(finest)) = (opts.reference, levels.last()) {
         let (ref_mesh, _) = overlay(finest.mesh.clone(), last_root, g)?;
-        let rf = solve(scene, ref_mesh, None, false, false)?;
+        let rf = solve(scene, ref_mesh, None, false, false, false)?;
         let law = crate::fem::elasticity::Elasticity::new(&scene.material);
         for (row, kept) in rows.iter_mut().zip(&levels) {
             row.vs_reference = Some(distance(&rf.kept, kept, &law, scene.rho)?);

@@ -3,7 +3,7 @@
 use super::out::say;
 use anyhow::Result;
 use tresca_cr::adapt::Row;
-use tresca_cr::plan::adaptive::{weigh as weigh_routes, AdaptivePlan};
+use tresca_cr::plan::adaptive::{weigh as weigh_routes, AdaptivePlan, Route};
 use tresca_cr::plan::pilot::Quantity;
 use tresca_cr::plan::Plan;
 use tresca_cr::Scene;
@@ -34,12 +34,12 @@ pub fn weigh(scene: &Scene, p: &Plan) -> Result<Option<std::result::Result<Adapt
     let w = weigh_routes(scene, p)?;
     match &w {
         Err(why) => say!("  not weighed: {why}"),
-        Ok(a) => print(a),
+        Ok(a) => print(a, &scene.file),
     }
     Ok(Some(w))
 }
 
-fn print(a: &AdaptivePlan) {
+fn print(a: &AdaptivePlan, file: &str) {
     let line = |name: &str, rows: &[Row]| {
         let n: Vec<String> = rows.iter().map(|r| format!("{}:{:.3e}", r.unknowns, r.estimator)).collect();
         say!("  {name} pilot (unknowns:η): {}", n.join(" "));
@@ -47,10 +47,11 @@ fn print(a: &AdaptivePlan) {
     line("adaptive", &a.adaptive_pilot);
     line("uniform", &a.uniform_pilot);
     say!(
-        "  η ∝ N^(−{:.3}) adaptive, N^(−{:.3}) uniform; pilots {:.3} s; the uniform plan's {:.0} unknowns mean η = {:.3e}",
+        "  η ∝ N^(−{:.3}) adaptive, N^(−{:.3}) uniform; pilots {:.3} s on {} steps; the uniform plan's {:.0} unknowns mean η = {:.3e}",
         -a.adaptive_law.p,
         -a.uniform_law.p,
         a.pilot_wall,
+        a.pilot_steps,
         a.uniform_unknowns,
         a.eta
     );
@@ -65,4 +66,12 @@ fn print(a: &AdaptivePlan) {
     );
     say!("  {:>9} {:>12.0} {:>7} {:>10.3e}s {:>8}M", "adaptive", a.unknowns, a.levels, a.wall, a.memory >> 20);
     say!("  recommended: {} ({})", a.choice.name(), a.reason);
+    if a.choice == Route::Adaptive {
+        say!(
+            "  run it: tresca-cr adapt {file} --target {:.3e} --theta {} --steps {}",
+            a.eta,
+            tresca_cr::plan::adaptive::THETA,
+            a.steps
+        );
+    }
 }

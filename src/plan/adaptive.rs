@@ -1,6 +1,9 @@
 //! `plan` weighs an adaptive sequence (`adapt`, Dörfler θ = [`THETA`]) against the uniform plan.
-//! Each of its two pilots takes at most a tenth of the uniform run's predicted wall time (at least ¼ s,
-//! at most half the pilot budget), so weighing adds at most about a fifth of the run to the planner.
+//! Its two pilots refine until a level has [`PILOT_UNKNOWNS`] of the uniform plan's unknowns (at most
+//! half the pilot budget), on the space pilot's time grid (where the plan's spatial error was sampled:
+//! the time pilot showed the coarser grid gives the same spatial answer), and lean: only η and the
+//! unknowns are computed (no energy audit, time indicator or distance between levels). So they cost a
+//! few per cent of the plan (issue 32).
 //!
 //! Both routes are compared through the same error indicator η (`adapt::estimator`, an upper bound of
 //! the energy-norm error up to a constant): a few levels of each — adaptive, and uniform as the θ = 1
@@ -11,13 +14,13 @@
 //! any level, needs the N_a at which η_a equals η_u(N_u)·target/e_u — the indicator value of the target
 //! on the uniform route, hence about the same error: the indicator's effectivity is about the same on both routes
 //! (Example 5.1: 2.0–3.2 adaptive, 2.1–2.7 uniform, `reference/adaptive.md`), which is this comparison's
-//! assumption. Its cost: every level of the sequence is a whole run, so the route costs the pilot's
-//! levels plus the predicted ones, N growing by the pilot's mean factor q per level up to N_a, each
-//! priced by the plan's cost model at the plan's steps and scaled by the pilot's measured ratio of
-//! adaptive level wall to the model (the median over its finer half, at least 1: estimation, marking and
-//! bisection included). Its memory: the
-//! pre-run estimate of the last level. The cheaper route that fits the budget and memory is
-//! recommended.
+//! assumption. Its cost: every level of the sequence is a whole run at the plan's steps — the pilot's
+//! levels again and the predicted ones, N growing by the pilot's mean factor q per level up to N_a —
+//! each priced by the plan's cost model at the plan's steps and scaled by κ, the pilot's measured ratio
+//! of adaptive level wall to the model at the pilot's steps (the median over its finer half, at least 1:
+//! estimation, marking and bisection included; like the uniform route's price, without the energy
+//! audit). Its memory: the pre-run estimate of the last level. The cheaper route that fits the budget
+//! and memory is recommended.
 
 use super::model::PowerLaw;
 use super::{Candidate, Plan};
@@ -32,6 +35,11 @@ pub const THETA: f64 = 0.5;
 pub const ADAPTIVE_LEVELS: usize = 20;
 /// Most uniform pilot levels (bisection generations: two are one uniform refinement).
 pub const UNIFORM_LEVELS: usize = 9;
+/// Each pilot refines until this share of the uniform plan's unknowns (three and a half uniform
+/// refinements below it): deep enough for the laws' rates (Example 5.1 at 1e-4: 0.481 adaptive to 3,885
+/// unknowns against 0.482 to 7,267 and 0.488 to 18,106; 0.421 uniform to 3,088 against 0.415 to 6,176:
+/// N_a 117,223 against 106,811 with 1/64), cheap enough for the planner's 5 % of the plan (issue 32).
+pub const PILOT_UNKNOWNS: f64 = 1.0 / 128.0;
 /// Fewest levels a law is fitted to.
 pub const FIT_LEVELS: usize = 4;
 
@@ -62,15 +70,18 @@ pub struct AdaptivePlan {
     pub uniform_pilot: Vec<Row>,
     pub adaptive_law: PowerLaw,
     pub uniform_law: PowerLaw,
-    /// Seconds the two pilots took.
+    /// Seconds the two pilots took, and the time steps they ran (the space pilot's).
     pub pilot_wall: f64,
+    pub pilot_steps: usize,
     /// The uniform route: unknowns, steps, predicted wall and memory (from the plan).
     pub uniform_unknowns: f64,
     pub uniform_wall: f64,
     pub uniform_memory: u64,
     /// η_u(N_u): the indicator value both routes must reach.
     pub eta: f64,
-    /// The adaptive route: unknowns of its last level, levels in all, wall (the whole sequence), memory.
+    /// The adaptive route: its time steps (the plan's), unknowns of its last level, levels in all, wall
+    /// (the whole sequence), memory.
+    pub steps: usize,
     pub unknowns: f64,
     pub levels: usize,
     pub wall: f64,
@@ -92,9 +103,11 @@ fn law(rows: &[Row]) -> Option<PowerLaw> {
     (p < 0.0).then(|| PowerLaw::through(log_mean(&x), log_mean(&y), p))
 }
 
-/// The pilot: `levels` levels of `adapt` with θ, each stopped by the share `budget` of seconds.
-fn pilot(scene: &Scene, theta: f64, levels: usize, budget: f64) -> Result<Vec<Row>> {
-    let opts = Options { budget: Some(budget), ..Options::levels(levels, theta) };
+/// The pilot: up to `levels` levels of `adapt` with θ, until a level has `unknowns` unknowns or the
+/// pilot would take more than `budget` seconds; lean (only η and the unknowns are read).
+fn pilot(scene: &Scene, theta: f64, levels: usize, unknowns: usize, budget: f64) -> Result<Vec<Row>> {
+    let opts =
+        Options { budget: Some(budget), until_unknowns: Some(unknowns), lean: true, ..Options::levels(levels, theta) };
     Ok(adapt(scene, &opts, |_| {})?.rows)
 }
 
@@ -111,11 +124,14 @@ pub fn weigh(scene: &Scene, p: &Plan) -> Result<std::result::Result<AdaptivePlan
     };
     let Some(cost) = p.cost else { return Ok(Err("no cost model".into())) };
     let start = std::time::Instant::now();
-    // each pilot may take a tenth of the uniform run (as a pilot extension may), at least ¼ s, at most
-    // half the pilot budget
-    let share = (super::EXTENSION_SHARE * u.wall).max(0.25).min((p.options.pilot_budget / 2.0).max(0.25));
-    let adaptive_pilot = pilot(scene, THETA, ADAPTIVE_LEVELS, share)?;
-    let uniform_pilot = pilot(scene, 1.0, UNIFORM_LEVELS, share)?;
+    // each pilot refines until PILOT_UNKNOWNS of the uniform plan's unknowns, within half the pilot budget
+    let (until, share) = ((PILOT_UNKNOWNS * u.unknowns as f64).ceil() as usize, p.options.pilot_budget / 2.0);
+    // on the space pilot's time grid, where the plan's spatial error was sampled (`super::plan`)
+    let nh = p.space.levels.first().map_or(scene.times.len() - 1, |l| l.steps);
+    let mut s = super::pilot::pilot_scene(scene, &super::pilot::Quantity::Energy)?;
+    s.set_steps(nh)?;
+    let adaptive_pilot = pilot(&s, THETA, ADAPTIVE_LEVELS, until, share)?;
+    let uniform_pilot = pilot(&s, 1.0, UNIFORM_LEVELS, until, share)?;
     let pilot_wall = start.elapsed().as_secs_f64();
     let half = |rows: &[Row]| rows.len().saturating_sub((rows.len() / 2).max(FIT_LEVELS)).min(rows.len());
     let (Some(a), Some(un)) =
@@ -134,15 +150,14 @@ pub fn weigh(scene: &Scene, p: &Plan) -> Result<std::result::Result<AdaptivePlan
     let first = &adaptive_pilot[half(&adaptive_pilot)];
     let span = (last.level - first.level).max(1) as f64;
     let q = (last.unknowns as f64 / first.unknowns as f64).powf(1.0 / span).max(1.05);
-    // the measured walls of the pilot's finer half against the cost model at the scene's steps (median)
-    let steps = scene.times.len() - 1;
-    let mut ratios: Vec<f64> = adaptive_pilot[half(&adaptive_pilot)..]
-        .iter()
-        .map(|r| r.wall / cost.predict(r.unknowns as f64, steps))
-        .collect();
+    // the measured walls of the pilot's finer half against the cost model at the pilot's steps (median)
+    let mut ratios: Vec<f64> =
+        adaptive_pilot[half(&adaptive_pilot)..].iter().map(|r| r.wall / cost.predict(r.unknowns as f64, nh)).collect();
     ratios.sort_by(f64::total_cmp);
     let kappa = ratios[ratios.len() / 2].max(1.0);
-    let (mut n, mut wall, mut levels) = (last.unknowns as f64, pilot_wall, adaptive_pilot.len());
+    // the route runs the pilot's levels again at the plan's steps, then the predicted ones
+    let mut wall: f64 = adaptive_pilot.iter().map(|r| kappa * cost.predict(r.unknowns as f64, u.steps)).sum();
+    let (mut n, mut levels) = (last.unknowns as f64, adaptive_pilot.len());
     while n < unknowns {
         n = (n * q).min(unknowns);
         wall += kappa * cost.predict(n, u.steps);
@@ -162,10 +177,12 @@ pub fn weigh(scene: &Scene, p: &Plan) -> Result<std::result::Result<AdaptivePlan
         adaptive_law: a,
         uniform_law: un,
         pilot_wall,
+        pilot_steps: nh,
         uniform_unknowns: u.unknowns as f64,
         uniform_wall: u.wall,
         uniform_memory: u.memory,
         eta,
+        steps: u.steps,
         unknowns,
         levels,
         wall,

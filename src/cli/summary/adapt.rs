@@ -103,6 +103,9 @@ pub struct AdaptiveRoute {
     pub adaptive_wall: Option<f64>,
     pub adaptive_memory: Option<u64>,
     pub pilot_wall: Option<f64>,
+    /// The time steps the pilots ran (the space pilot's), and the route's (the plan's).
+    pub pilot_steps: Option<usize>,
+    pub steps: Option<usize>,
     pub adaptive_pilot: Vec<AdaptLevel>,
     pub uniform_pilot: Vec<AdaptLevel>,
 }
@@ -125,6 +128,8 @@ impl AdaptiveRoute {
             adaptive_wall: None,
             adaptive_memory: None,
             pilot_wall: None,
+            pilot_steps: None,
+            steps: None,
             adaptive_pilot: vec![],
             uniform_pilot: vec![],
         };
@@ -147,6 +152,8 @@ impl AdaptiveRoute {
             adaptive_wall: Some(w.wall),
             adaptive_memory: Some(w.memory),
             pilot_wall: Some(w.pilot_wall),
+            pilot_steps: Some(w.pilot_steps),
+            steps: Some(w.steps),
             adaptive_pilot: rows(&w.adaptive_pilot),
             uniform_pilot: rows(&w.uniform_pilot),
             ..none

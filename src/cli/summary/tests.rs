@@ -130,6 +130,7 @@ fn adapt_summary_round_trips_and_old_summaries_still_read() {
     let opts = tresca_cr::adapt::Options {
         levels: Some(4),
         target: None,
+        until_unknowns: None,
         theta: 0.5,
         out: None,
         gmsh: false,
@@ -138,6 +139,7 @@ fn adapt_summary_round_trips_and_old_summaries_still_read() {
         max_disk: None,
         budget: None,
         reference: Some(12),
+        lean: false,
     };
     let mut s = Summary::new("adapt", "verification/cases/lshape_adapt.toml", 2.0);
     s.adapt =
