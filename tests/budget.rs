@@ -40,3 +40,20 @@ fn the_memory_estimate_is_within_15_percent_of_the_peak() {
         assert!((0.85..=1.15).contains(&ratio), "refine {refine}: estimate {estimate:e} B, peak {peak:e} B");
     }
 }
+
+/// The system shall accept a run of a nested-dissection size whose estimate fits with METIS's ordering
+/// (the set-up's fallback, whose exact factor size it then checks) but not with the coordinate one, and
+/// refuse it when neither fits; below the nested-dissection size (no fallback) only the one estimate counts.
+#[test]
+fn the_memory_check_counts_the_metis_fallback_from_the_nested_dissection_size() {
+    assert_eq!(tresca_cr::scene::budget::FALLBACK_MIN_UNKNOWNS, tresca_cr::solve::ordering::ND_MIN_SIZE as u64);
+    let big = Estimate::of_sizes((4_194_304, 3_146_240, 1024), 4, false);
+    let metis = big.memory_metis.expect("3.1 M edges: nested dissection, so a fallback");
+    assert!(metis < big.memory, "METIS fills less");
+    let between = (metis + big.memory) / 2;
+    assert!(big.check(Some(between), None, None).is_ok(), "fits with METIS's ordering");
+    assert!(big.check(Some(metis - 1), None, None).is_err(), "fits with neither ordering");
+    let small = Estimate::of_sizes((262_144, 197_120, 256), 4, false);
+    assert_eq!(small.memory_metis, None, "AMD below the nested-dissection size: no fallback");
+    assert!(small.check(Some(small.memory - 1), None, None).is_err());
+}

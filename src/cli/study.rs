@@ -57,7 +57,8 @@ fn check_memory(scene: &Scene, levels: &[Level], reference: Option<Level>, max_m
     let each = levels.iter().map(|&l| estimate(l)).collect::<Result<Vec<_>>>()?;
     for (i, (l, e)) in levels.iter().zip(&each).enumerate() {
         let held: u64 = each[i.saturating_sub(2)..i].iter().map(|e| e.memory).sum();
-        let together = Estimate { memory: e.memory.saturating_add(held).saturating_add(kept), ..*e };
+        let more = |m: u64| m.saturating_add(held).saturating_add(kept);
+        let together = Estimate { memory: more(e.memory), memory_metis: e.memory_metis.map(more), ..*e };
         together.check(max_memory, None, None).with_context(|| {
             format!(
                 "study level {}:{} (with the levels before it and the reference it is held beside)",

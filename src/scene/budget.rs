@@ -11,7 +11,12 @@
 //! squares of the relative misfit to the five, which it then gives within 5 %. An estimate, not a bound: the fill
 //! also depends on the ordering (AMD below 1M unknowns, nested dissection above). The factorisation checks
 //! its exact size once the symbolic factorisation is known (`solve::Symbolic::fits`) and refuses a factor
-//! that would not fit, or first tries METIS's ordering, which fills less.
+//! that would not fit, or first tries METIS's ordering, which fills less. The estimate gives that
+//! fallback's peak beside ([`Estimate::memory_metis`]): the coordinate nested dissection's factor has
+//! about `FILL_ND` · n log₂ n entries (15.4 at 1.57 M unknowns, 16.0–16.2 at 3.5–6.3 M) and METIS's
+//! `METIS_FILL` of them (0.870 at 6,292,480 unknowns: 2.007e9 against 2.307e9 entries; 0.87 in nnz(L) at
+//! 1,573,376, `reference/bench_factorisation_r8.json`), 8 bytes an entry; refine 9 of Example 5.1 ran
+//! with METIS at a 21.66 GB peak against 21.8 GB so estimated (24.2 GB with the coordinate fill).
 
 use super::{MeshSpec, PartKind, Scene};
 use crate::error::{human, Error, Result};
@@ -29,6 +34,9 @@ pub struct Estimate {
     pub steps: u64,
     /// Peak memory, bytes.
     pub memory: u64,
+    /// Peak memory with METIS's ordering, which the set-up falls back to from `FALLBACK_MIN_UNKNOWNS`
+    /// unknowns when the coordinate ordering's factor does not fit (module doc); `None` below.
+    pub memory_metis: Option<u64>,
     /// Results file, bytes (0 when no file is written).
     pub disk: u64,
 }
@@ -38,6 +46,12 @@ pub struct Estimate {
 const BYTES_FIXED: f64 = 1.524e7;
 const BYTES_PER_UNKNOWN: f64 = -1166.7;
 const BYTES_PER_UNKNOWN_LOG2: f64 = 219.62;
+/// Factor entries of the coordinate nested dissection per n log₂ n, and METIS's share of them (module doc).
+const FILL_ND: f64 = 16.0;
+const METIS_FILL: f64 = 0.87;
+/// From this many unknowns K is ordered by nested dissection and the set-up can fall back to METIS
+/// (`solve::ordering::ND_MIN_SIZE`, which `tests/budget.rs` checks it equals).
+pub const FALLBACK_MIN_UNKNOWNS: u64 = 1_000_000;
 /// The values of the block of steps' buffers (`solve::free`): at most 16 columns and 2²⁴ values each.
 const BLOCK_COLUMNS: u64 = 16;
 const BLOCK_VALUES: u64 = 1 << 24;
@@ -64,6 +78,10 @@ impl Estimate {
             .saturating_add(blocks)
             .saturating_add(contact.saturating_mul(contact).saturating_mul(16))
             .saturating_add(steps.saturating_mul(BYTES_PER_STEP));
+        let memory_metis = (unknowns >= FALLBACK_MIN_UNKNOWNS).then(|| {
+            let n = unknowns as f64;
+            memory.saturating_sub((8.0 * (1.0 - METIS_FILL) * FILL_ND * n * n.log2()) as u64)
+        });
         let disk = if results {
             // per step: u (edges × 2 f64), 8 scalars, 5 contact series (4 f64 + 1 byte), 3 errors
             let row = 16 * edges + 64 + 33 * contact + 24;
@@ -74,7 +92,7 @@ impl Estimate {
         } else {
             0
         };
-        Estimate { triangles, edges, unknowns, contact, steps, memory, disk }
+        Estimate { triangles, edges, unknowns, contact, steps, memory, memory_metis, disk }
     }
 
     /// Refuse the run when memory or disk exceed what there is: the limits given (bytes), else what the
@@ -88,10 +106,11 @@ impl Estimate {
             Some(m) => (Some(m), "is the limit given (--max-memory)"),
             None => (available_memory(), "is available on this machine"),
         };
-        if let Some(have) = mem.filter(|&h| self.memory > h) {
+        let least = self.memory_metis.unwrap_or(self.memory);
+        if let Some(have) = mem.filter(|&h| least > h) {
             return Err(Error::TooLarge {
                 what: "memory",
-                need: self.memory,
+                need: least,
                 have,
                 limit: mem_limit,
                 hint: format!("{sizes}: use a coarser mesh (--refine) or fewer steps (--steps)"),
@@ -118,7 +137,8 @@ impl Estimate {
     /// One line for `check`.
     pub fn describe(&self) -> String {
         let mem = available_memory().map(|m| format!(" of {} available", human(m))).unwrap_or_default();
-        format!("memory ~{}{mem}; results file ~{}", human(self.memory), human(self.disk))
+        let metis = self.memory_metis.map(|m| format!(" (~{} with METIS's ordering, the fallback)", human(m)));
+        format!("memory ~{}{}{mem}; results file ~{}", human(self.memory), metis.unwrap_or_default(), human(self.disk))
     }
 }
 
