@@ -85,3 +85,20 @@ fn mms_elastic_plan_does_not_weigh_the_adaptive_route() {
     assert!(a.is_null(), "{a}");
     assert!(text.contains("Adaptive route not weighed: the uniform space order"), "{text}");
 }
+
+/// The system shall, with `--run`, run the route it recommends: on `mms_lshape` at 3e-2 within 1 GB only
+/// the adaptive route fits (the uniform plan is refine 6, 910,412 unknowns, 3 GB), so `plan --run` runs the
+/// `adapt` loop until η reaches the uniform plan's η, says whether it did and gives the true error (the
+/// scene has `[exact]`), and does not run the uniform plan's study; exit code 0.
+#[test]
+fn plan_run_runs_the_recommended_adaptive_route() {
+    let (code, adaptive, text) =
+        plan("verification/cases/mms_lshape.toml", "3e-2", &["--max-memory", "1G", "--run"], "run_adaptive");
+    assert_eq!(code, Some(0), "{text}");
+    assert_eq!(adaptive["choice"].as_str(), Some("adaptive"), "{adaptive}");
+    assert!(text.contains("Running the adaptive route"), "{text}");
+    assert!(!text.contains("Running the plan (levels"), "the uniform plan was run: {text}");
+    let reached = text.lines().find(|l| l.starts_with("reached η = ")).unwrap_or_else(|| panic!("{text}"));
+    assert!(reached.ends_with(": met"), "{reached}");
+    assert!(text.lines().any(|l| l.starts_with("true energy error")), "{text}");
+}

@@ -50,6 +50,11 @@ pub fn csv_text(rows: &[Row], exact: bool) -> String {
 
 /// Run the loop and report; returns the exit code (3: stopped before the goal, with the reason).
 pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<PathBuf>) -> Result<i32> {
+    run_rows(scene, opts, csv, json).map(|(code, _)| code)
+}
+
+/// [`run`], also returning the levels' rows (for `plan --run`).
+pub fn run_rows(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<PathBuf>) -> Result<(i32, Vec<Row>)> {
     let start = std::time::Instant::now();
     if let Some(dir) = &opts.out {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -114,11 +119,12 @@ pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<PathB
         summary.adapt = Some(super::summary::AdaptSummary::of(&opts, exact, &outcome.rows, outcome.stopped.clone()));
         super::summary::write(j, &summary)?;
     }
-    Ok(match outcome.stopped {
+    let code = match &outcome.stopped {
         Some(why) => {
             note!("refused: {why}");
             3
         }
         None => 0,
-    })
+    };
+    Ok((code, outcome.rows))
 }

@@ -1,5 +1,6 @@
 //! `tresca-cr plan`: print the pilot's evidence, the fitted models and the cheapest configuration predicted
-//! to meet the target (or the refusal), optionally write them as CSV, and with `--run` run the plan and
+//! to meet the target (or the refusal), optionally write them as CSV, and with `--run` run the plan (the
+//! adaptive route's `adapt` loop where that route is recommended) and
 //! report the achieved error estimate (and the true error when the scene has `[exact]`).
 
 use super::out::{note, say};
@@ -63,6 +64,9 @@ pub fn run(
         say!("\n{}: {why}", if chosen { "No uniform plan (the adaptive route above is)" } else { "No plan" });
         summarise(&p, None, &adaptive)?;
         super::out::report_written(csv.as_deref())?;
+        if let (true, Some(Ok(a))) = (chosen && execute, &adaptive) {
+            return super::plan_adaptive::execute(&scene, a, &p);
+        }
         return Ok(if chosen { 0 } else { REFUSED });
     }
     say!(
@@ -104,6 +108,13 @@ pub fn run(
         p.solver,
         p.tol
     );
+    if execute {
+        if let Some(Ok(a)) = adaptive.as_ref().filter(|_| adaptive_chosen(&adaptive)) {
+            summarise(&p, None, &adaptive)?;
+            super::out::report_written(csv.as_deref())?;
+            return super::plan_adaptive::execute(&scene, a, &p);
+        }
+    }
     let achieved = if execute { Some(execute_plan(&scene, &p, b)?) } else { None };
     summarise(&p, achieved, &adaptive)?;
     super::out::report_written(csv.as_deref())?;

@@ -75,3 +75,40 @@ fn print(a: &AdaptivePlan, file: &str) {
         );
     }
 }
+
+/// `plan --run` where the adaptive route is recommended: its `adapt` loop (θ, the plan's steps, until η ≤ the
+/// uniform plan's η, under the same memory and disk checks as `tresca-cr adapt` and the plan's memory limit and
+/// wall budget), printed as `adapt` prints it,
+/// then whether it reached that η and, with an exact solution, the true error against the target. Returns the
+/// exit code (3 when the loop was refused).
+pub fn execute(scene: &Scene, a: &AdaptivePlan, p: &Plan) -> Result<i32> {
+    let target = p.options.target;
+    let mut s = scene.clone();
+    s.set_steps(a.steps)?;
+    let opts = tresca_cr::adapt::Options {
+        target: Some(a.eta),
+        levels: None,
+        max_memory: p.options.max_memory,
+        budget: Some(p.options.budget),
+        ..tresca_cr::adapt::Options::levels(0, tresca_cr::plan::adaptive::THETA)
+    };
+    say!("\nRunning the adaptive route (θ = {}, {} steps, until η ≤ {:.3e}):", opts.theta, a.steps, a.eta);
+    let (code, rows) = super::adapt::run_rows(s, opts, None, None)?;
+    if let Some(last) = rows.last() {
+        let reached = last.estimator <= a.eta;
+        say!(
+            "reached η = {:.4e} with {} unknowns against the uniform plan's η = {:.3e}: {}",
+            last.estimator,
+            last.unknowns,
+            a.eta,
+            if reached { "met" } else { "NOT met" }
+        );
+        if let Some(e) = last.error {
+            say!(
+                "true energy error (max over the time nodes) {e:.4e}: {}",
+                if e <= target { "met" } else { "NOT met" }
+            );
+        }
+    }
+    Ok(code)
+}
