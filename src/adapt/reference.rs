@@ -20,7 +20,7 @@ use crate::fem::prolong::parent_triangles;
 use crate::fem::space::{CrSpace, Element};
 use crate::mesh::bisect::bisect;
 use crate::mesh::Mesh;
-use crate::scene::{Part, PartKind};
+use crate::scene::Part;
 
 /// A level's mesh, space and unknowns at every time node (times `t`), kept for comparisons; `parts` are
 /// the scene's boundary parts (u_D of the Dirichlet ones with data).
@@ -30,20 +30,6 @@ pub struct Kept {
     pub u: Vec<Vec<f64>>,
     pub t: Vec<f64>,
     pub parts: Vec<Part>,
-}
-
-impl Kept {
-    /// The stabilisation energy of node `i`'s displacement `mid`: jumps on Γ_D against u_D with data.
-    fn jump_energy(&self, jumps: &ErrorEvaluator, mid: &[[f64; 2]], i: usize) -> Result<f64> {
-        if self.space.data.is_none() {
-            return Ok(jumps.jump_energy(mid));
-        }
-        let t = self.t[i];
-        jumps.jump_energy_against(mid, |e, x| match self.space.edge_part[e].map(|k| &self.parts[k].kind) {
-            Some(PartKind::Dirichlet(Some(u))) => u.eval(x[0], x[1], t),
-            _ => Ok([0.0; 2]),
-        })
-    }
 }
 
 /// Generation of every triangle given the area of its initial ancestor.
@@ -75,7 +61,7 @@ pub fn distance(fine: &Kept, coarse: &Kept, law: &Elasticity, rho: f64) -> Resul
     for (i, (uf, uc)) in fine.u.iter().zip(&coarse.u).enumerate() {
         let mf = fine.space.displacement(uf, fine.t[i])?;
         let mc = coarse.space.displacement(uc, coarse.t[i])?;
-        let mut sum = coarse.jump_energy(&jumps, &mc, i)?;
+        let mut sum = jumps.jump_energy_at(&mc, &coarse.space, &coarse.parts, coarse.t[i])?;
         for (t, &p) in parent.iter().enumerate() {
             let gf = fe[t].gradient(fine.mesh.tri_edges[t].map(|e| mf[e]));
             let gc = ce[p].gradient(coarse.mesh.tri_edges[p].map(|e| mc[e]));

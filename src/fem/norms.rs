@@ -22,7 +22,7 @@ use crate::error::Error;
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::scene::expr::program::LANES;
-use crate::scene::Exact;
+use crate::scene::{Exact, Part, PartKind};
 use std::sync::Mutex;
 
 /// Elements per chunk of work: their 6 points each make whole batches of [`LANES`] points, and their
@@ -309,6 +309,19 @@ impl ErrorEvaluator {
         let sub: Vec<(usize, [f64; 2])> =
             self.boundary.iter().map(|&(q, e, x)| Ok((q, u_d(e, x)?))).collect::<Result<_>>()?;
         Ok(self.jump_energy_minus(mid, &sub))
+    }
+
+    /// The stabilisation part of the displacement `mid` (unknowns plus lifting) at time t of a scene with
+    /// boundary parts `parts`: with boundary data in `space`, [`ErrorEvaluator::jump_energy_against`] its
+    /// Dirichlet parts' u_D(t); without, [`ErrorEvaluator::jump_energy`].
+    pub fn jump_energy_at(&self, mid: &[[f64; 2]], space: &CrSpace, parts: &[Part], t: f64) -> Result<f64> {
+        if space.data.is_none() {
+            return Ok(self.jump_energy(mid));
+        }
+        self.jump_energy_against(mid, |e, x| match space.edge_part[e].map(|k| &parts[k].kind) {
+            Some(PartKind::Dirichlet(Some(u))) => u.eval(x[0], x[1], t),
+            _ => Ok([0.0; 2]),
+        })
     }
 
     /// [`ErrorEvaluator::jump_energy`] with `sub` (jump point, value; increasing points) subtracted

@@ -23,7 +23,6 @@ use crate::fem::forms::{dot2, FullForm};
 use crate::fem::norms::ErrorEvaluator;
 use crate::fem::prolong::{parent_triangles, Prolongation};
 use crate::fem::space::Element;
-use crate::scene::PartKind;
 use crate::sparse::symmetric_energy;
 use crate::stepping::Problem;
 
@@ -139,19 +138,7 @@ fn diff(a: &[f64], b: &[f64]) -> Vec<f64> {
 pub fn jumps(lv: &Kept) -> Result<Vec<f64>> {
     let p = &lv.problem;
     let ev = ErrorEvaluator::new(&p.mesh, &p.space, &p.law, p.scene.rho);
-    if !lv.has_data() {
-        return Ok(lv.u.iter().map(|u| ev.jump_energy(&p.space.midpoint_values(u))).collect());
-    }
-    let parts = &p.scene.parts;
-    (0..lv.u.len())
-        .map(|i| {
-            let t = lv.t[i];
-            ev.jump_energy_against(&lv.displacement(i)?, |e, x| match p.space.edge_part[e].map(|k| &parts[k].kind) {
-                Some(PartKind::Dirichlet(Some(u))) => u.eval(x[0], x[1], t),
-                _ => Ok([0.0; 2]),
-            })
-        })
-        .collect()
+    (0..lv.u.len()).map(|i| ev.jump_energy_at(&lv.displacement(i)?, &p.space, &p.scene.parts, lv.t[i])).collect()
 }
 
 /// |||u_ref − u_l||| at every common node (module doc).

@@ -127,20 +127,7 @@ fn adapt_summary_round_trips_and_old_summaries_still_read() {
         time_dissipation: 1e-3,
         time_load: 2e-3 / 3.0,
     };
-    let opts = tresca_cr::adapt::Options {
-        levels: Some(4),
-        target: None,
-        until_unknowns: None,
-        theta: 0.5,
-        out: None,
-        gmsh: false,
-        force: false,
-        max_memory: None,
-        max_disk: None,
-        budget: None,
-        reference: Some(12),
-        lean: false,
-    };
+    let opts = tresca_cr::adapt::Options { reference: Some(12), ..tresca_cr::adapt::Options::levels(4, 0.5) };
     let mut s = Summary::new("adapt", "verification/cases/lshape_adapt.toml", 2.0);
     s.adapt =
         Some(AdaptSummary::of(&opts, false, &[row.clone(), tresca_cr::adapt::Row { vs_reference: None, ..row }], None));
