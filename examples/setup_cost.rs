@@ -62,21 +62,19 @@ fn main() {
         let order = fill_order_at(&graph, points.as_deref(), nested).unwrap();
         tm(if nested { "nested dissection" } else { "amd" }, t.elapsed());
         let t = Clock::now();
-        let lower = pattern.unknown_pattern_lower(&space);
-        tm("lower pattern", t.elapsed());
-        let t = Clock::now();
         let pat = pattern.unknown_pattern(&space);
         tm("unknown pattern", t.elapsed());
         let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
         let t = Clock::now();
-        let sym = Symbolic::new(lower.as_ref(), &contact, order).unwrap();
+        let sym = Symbolic::from_symmetric(pat.as_ref(), &contact, order).unwrap();
         tm("symbolic", t.elapsed());
-        sizes = (lower.compute_nnz(), sym.len_val());
+        sizes = (sym.pattern_nnz(), sym.len_val());
         if symbolic_only {
             continue;
         }
         let t = Clock::now();
         let val = stiffness_values(&pattern, pat.as_ref(), &mesh, &space, &law, scene.rho);
+        let lower = tresca_cr::sparse::lower_pattern(pat.as_ref());
         let val = tresca_cr::sparse::lower_values(pat.as_ref(), val);
         tm("stiffness", t.elapsed());
         let k = faer::sparse::SparseColMat::new(lower, val);

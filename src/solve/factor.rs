@@ -18,10 +18,15 @@
 use super::ordering::{Graph, ND_MIN_SIZE};
 use super::pages::Pages;
 pub use super::symbolic::{fill_order, fill_order_at, Symbolic};
+use super::symbolic::{lower_nnz, numeric_scratch};
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
-use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, SymbolicCholeskyRaw};
+use faer::perm::PermRef;
+use faer::reborrow::Reborrow;
+use faer::sparse::linalg::cholesky::supernodal::{
+    factorize_supernodal_numeric_llt, SupernodalLltRef, SymbolicSupernodalCholesky,
+};
+use faer::sparse::utils::permute_self_adjoint_to_unsorted;
 use faer::sparse::SparseColMat;
 use faer::{Conj, MatMut, Par, Side};
 use nalgebra::DMatrix;
@@ -29,7 +34,7 @@ use std::sync::Mutex;
 
 /// The Cholesky factor of an SPD sparse matrix.
 pub struct Factor {
-    symbolic: SymbolicCholesky<usize>,
+    symbolic: SymbolicSupernodalCholesky<usize>,
     values: Pages,
     /// Solve scratch, sized for this many right-hand sides.
     /// (A mutex, not a cell, so the factor can be shared with the condition estimate's thread.)
@@ -44,8 +49,7 @@ pub struct Factor {
 }
 
 impl Factor {
-    /// Factorise the SPD matrix `k` (lower triangle read); faer chooses the simplicial or supernodal
-    /// kernel (supernodal for larger fill).
+    /// Factorise the SPD matrix `k` (lower triangle read) with faer's supernodal kernel.
     pub fn new(k: &SparseColMat<usize, f64>) -> Result<Factor> {
         Factor::with_last(k, &[])
     }
@@ -89,17 +93,17 @@ impl Factor {
         k: &SparseColMat<usize, f64>,
         beside: impl FnOnce() -> R + Send,
     ) -> (Result<Factor>, Option<R>) {
-        let Symbolic { symbolic, fwd, last, pattern_nnz, ordering } = symbolic;
+        let Symbolic { symbolic, fwd, inv, last, pattern_nnz, ordering } = symbolic;
         let n = k.nrows();
-        if symbolic.nrows() != n || k.compute_nnz() != pattern_nnz {
+        if symbolic.nrows() != n || lower_nnz(k.symbolic()) != pattern_nnz {
             let e = "internal: the matrix does not have the pattern of its symbolic factorisation";
             return (Err(Error::Linear(e.into())), None);
         }
         let oom = || Error::Linear("out of memory for the Cholesky factorisation".into());
-        if let Err(e) = Symbolic::fits_with(&symbolic, 0) {
+        if let Err(e) = Symbolic::fits_with(&symbolic, pattern_nnz, 0) {
             return (Err(e), None);
         }
-        let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
+        let scratch = numeric_scratch(&symbolic, pattern_nnz);
         let Some(mut values) = Pages::zeroed(symbolic.len_val()) else { return (Err(oom()), None) };
         let Ok(mut buf) = MemBuffer::try_new(scratch) else {
             return (Err(oom()), None);
@@ -111,23 +115,15 @@ impl Factor {
                 Pages::populate(range);
                 beside()
             });
-            let numeric = symbolic.factorize_numeric_llt(
-                &mut values,
-                k.as_ref(),
-                Side::Lower,
-                Default::default(),
-                Par::Seq,
-                MemStack::new(&mut buf),
-                Default::default(),
-            );
-            (numeric.map(|_| ()), r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            let numeric = numeric_llt(&symbolic, &mut values, (k, pattern_nnz), (&fwd, &inv), MemStack::new(&mut buf));
+            (numeric, r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
         });
         let factor = Factor::finish(symbolic, values, numeric, n, last, fwd).map(|f| Factor { ordering, ..f });
         (factor, Some(r))
     }
 
     fn finish(
-        symbolic: SymbolicCholesky<usize>,
+        symbolic: SymbolicSupernodalCholesky<usize>,
         values: Pages,
         numeric: std::result::Result<(), faer::linalg::solvers::LltError>,
         n: usize,
@@ -178,10 +174,7 @@ impl Factor {
     }
 
     fn supernodal(&self) -> Option<SupernodalLltRef<'_, usize, f64>> {
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Supernodal(s) => Some(SupernodalLltRef::new(s, &self.values)),
-            SymbolicCholeskyRaw::Simplicial(_) => None,
-        }
+        Some(SupernodalLltRef::new(&self.symbolic, &self.values))
     }
 
     /// L_ll, the trailing m × m block of L for the m unknowns ordered last (rows and columns in the
@@ -286,22 +279,61 @@ impl Factor {
 
     /// x ← K⁻¹ x for one vector.
     pub fn solve_in_place(&self, x: &mut [f64]) {
-        let llt = LltRef::new(&self.symbolic, &self.values);
+        let mut y = vec![0.0; self.n];
+        self.permute_in(x, &mut y);
         let mut buf = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
-        llt.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(x, self.n, 1),
-            Par::Seq,
-            MemStack::new(&mut buf.1),
-        );
+        let llt = SupernodalLltRef::new(&self.symbolic, &self.values);
+        let y_mat = MatMut::from_column_major_slice_mut(&mut y, self.n, 1);
+        llt.solve_in_place_with_conj(Conj::No, y_mat, Par::Seq, MemStack::new(&mut buf.1));
+        self.permute_out(&y, x);
     }
 
     /// X ← K⁻¹ X for a block of right-hand sides.
-    pub fn solve_many(&self, x: MatMut<'_, f64>) {
-        let llt = LltRef::new(&self.symbolic, &self.values);
-        let mut buf = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(x.ncols(), Par::Seq));
-        llt.solve_in_place_with_conj(Conj::No, x, Par::Seq, MemStack::new(&mut buf));
+    pub fn solve_many(&self, mut x: MatMut<'_, f64>) {
+        let cols = x.ncols();
+        let mut y = vec![0.0; self.n * cols];
+        for c in 0..cols {
+            let col = &mut y[c * self.n..(c + 1) * self.n];
+            col.iter_mut().zip(&self.fwd).for_each(|(yi, &old)| *yi = x[(old, c)]);
+        }
+        let llt = SupernodalLltRef::new(&self.symbolic, &self.values);
+        let mut buf = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq));
+        let y_mat = MatMut::from_column_major_slice_mut(&mut y, self.n, cols);
+        llt.solve_in_place_with_conj(Conj::No, y_mat, Par::Seq, MemStack::new(&mut buf));
+        for c in 0..cols {
+            let col = &y[c * self.n..(c + 1) * self.n];
+            col.iter().zip(&self.fwd).for_each(|(&yi, &old)| x[(old, c)] = yi);
+        }
     }
+}
+
+/// L's values for K = P L Lᵀ Pᵀ (K's lower triangle: `nnz` entries): that triangle permuted to P K Pᵀ's (as faer's
+/// `SymbolicCholesky::factorize_numeric_llt` does it, so the factor is the same bit for bit), then
+/// faer's supernodal kernel, sequential.
+fn numeric_llt(
+    symbolic: &SymbolicSupernodalCholesky<usize>,
+    values: &mut [f64],
+    (k, nnz): (&SparseColMat<usize, f64>, usize),
+    (fwd, inv): (&[usize], &[usize]),
+    stack: &mut MemStack,
+) -> std::result::Result<(), faer::linalg::solvers::LltError> {
+    let n = k.nrows();
+    let (mut new_val, stack) = stack.make_with(nnz, |_| 0.0f64);
+    let (mut new_col_ptr, stack) = stack.make_with(n + 1, |_| 0usize);
+    let (mut new_row_idx, stack) = stack.make_with(nnz, |_| 0usize);
+    let perm = PermRef::new_checked(fwd, inv, n);
+    let a = permute_self_adjoint_to_unsorted(
+        &mut new_val,
+        &mut new_col_ptr,
+        &mut new_row_idx,
+        k.as_ref(),
+        perm,
+        Side::Lower,
+        Side::Lower,
+        stack,
+    );
+    factorize_supernodal_numeric_llt(values, a.rb(), Default::default(), symbolic, Par::Seq, stack, Default::default())
+        .map(|_| ())
 }
 
 #[cfg(test)]

@@ -6,6 +6,7 @@ mod block;
 pub mod condense;
 pub mod condition;
 pub mod dissect;
+pub mod etree;
 pub mod factor;
 pub mod free;
 pub mod ordering;

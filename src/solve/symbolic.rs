@@ -1,26 +1,35 @@
 //! The symbolic half of the Cholesky factorisation ([`super::factor`]): the fill-reducing ordering
 //! with the unknowns ordered last moved to its end, and the structure of L. It needs only K's pattern,
 //! so `stepping` computes it while K's values are assembled.
+//!
+//! L's elimination tree and column counts come from [`super::etree`] (O(|K|)), and faer's supernodal
+//! analysis (`factorize_supernodal_symbolic_cholesky`) makes the supernodes from them: the same
+//! structure as faer's complete analysis, whose row-subtree walk costs O(|L|).
 
 use super::dissect::coordinate_dissection;
+use super::etree::{column_counts, elimination_tree, permuted_upper, postorder, symmetric, Cols, NONE};
 use super::ordering::{amd_order, nested_dissection, Graph};
 use crate::error::{Error, Result};
-use faer::perm::PermRef;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::simplicial::EliminationTreeRef;
+use faer::sparse::linalg::cholesky::supernodal::{
+    factorize_supernodal_numeric_llt_scratch, factorize_supernodal_symbolic_cholesky,
+    factorize_supernodal_symbolic_cholesky_scratch, SymbolicSupernodalCholesky,
 };
-use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::CholeskySymbolicParams;
 use faer::sparse::SymbolicSparseColMatRef;
-use faer::{Par, Side};
+use faer::Par;
 
 /// The symbolic factorisation of a sparsity pattern: the ordering (fill-reducing, with the unknowns
 /// `last` moved to its end) and the structure of L. It needs only K's pattern, so it is computed
 /// while K's values are assembled ([`Factor::numeric`] then fills it).
 pub struct Symbolic {
-    pub(super) symbolic: SymbolicCholesky<usize>,
+    pub(super) symbolic: SymbolicSupernodalCholesky<usize>,
+    /// The ordering: position → unknown, and its inverse.
     pub(super) fwd: Vec<usize>,
+    pub(super) inv: Vec<usize>,
     pub(super) last: Vec<usize>,
-    /// Entries of the pattern (the matrix factorised must have the same pattern).
+    /// Entries of the pattern's lower triangle (the matrix factorised must have the same pattern).
     pub(super) pattern_nnz: usize,
     /// How the fill-reducing ordering was made, as a run reports it ("given" unless named).
     pub(super) ordering: &'static str,
@@ -32,31 +41,28 @@ impl Symbolic {
     /// fill-reducing ordering `base` (position → unknown, a permutation; from [`fill_order`]) and the
     /// distinct unknowns `last` moved to its end, in the given order.
     pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>, last: &[usize], base: Vec<usize>) -> Result<Symbolic> {
-        let n = pattern.nrows();
-        let params = CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-            ..Default::default()
-        };
-        if base.len() != n || !is_permutation(&base) {
-            return Err(Error::Linear(
-                "internal: the fill-reducing ordering is not a permutation of the unknowns".into(),
-            ));
-        }
-        let mut is_last = vec![false; n];
-        for &i in last {
-            if i >= n || std::mem::replace(&mut is_last[i], true) {
-                return Err(Error::Linear(format!("unknown {i} cannot be ordered last (out of range or repeated)")));
-            }
-        }
-        let fwd: Vec<usize> = base.into_iter().filter(|&i| !is_last[i]).chain(last.iter().copied()).collect();
-        let mut inv = vec![0usize; n];
-        for (new, &old) in fwd.iter().enumerate() {
-            inv[old] = new;
-        }
-        let ordering = SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n));
-        let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, ordering, params)
-            .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))?;
-        Ok(Symbolic { symbolic, fwd, last: last.to_vec(), pattern_nnz: pattern.compute_nnz(), ordering: "given" })
+        let (fwd, inv) = ordering_with_last(pattern.nrows(), last, base)?;
+        let sym = symmetric(pattern);
+        let symbolic = supernodal_structure(sym.cols(), (&fwd, &inv))?;
+        Ok(Symbolic { symbolic, fwd, inv, last: last.to_vec(), pattern_nnz: lower_nnz(pattern), ordering: "given" })
+    }
+
+    /// As [`Symbolic::new`], from a symmetric pattern with both triangles stored (compact: without
+    /// separate column lengths), such as K's full pattern: no copy of it is made.
+    pub fn from_symmetric(
+        sym: SymbolicSparseColMatRef<'_, usize>,
+        last: &[usize],
+        base: Vec<usize>,
+    ) -> Result<Symbolic> {
+        let cols = Cols::of(sym).ok_or_else(|| Error::Linear("internal: the pattern is not compact".into()))?;
+        let (fwd, inv) = ordering_with_last(sym.nrows(), last, base)?;
+        let symbolic = supernodal_structure(cols, (&fwd, &inv))?;
+        Ok(Symbolic { symbolic, fwd, inv, last: last.to_vec(), pattern_nnz: lower_nnz(sym), ordering: "given" })
+    }
+
+    /// Entries of the lower triangle of the pattern it was made from (of the matrix factorised).
+    pub fn pattern_nnz(&self) -> usize {
+        self.pattern_nnz
     }
 
     /// Entries of L (supernodal blocks included).
@@ -70,25 +76,87 @@ impl Symbolic {
     }
 
     /// Bytes the numeric factorisation allocates: L's values and its scratch.
-    fn need_of(symbolic: &SymbolicCholesky<usize>) -> u64 {
-        let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
+    fn need_of(symbolic: &SymbolicSupernodalCholesky<usize>, pattern_nnz: usize) -> u64 {
+        let scratch = numeric_scratch(symbolic, pattern_nnz);
         (symbolic.len_val() as u64).saturating_mul(8).saturating_add(scratch.unaligned_bytes_required() as u64)
     }
 
     /// Whether the numeric factorisation, and `more` bytes the caller will allocate beside it, fit in the
     /// memory this machine has now (MemAvailable; `true` where the machine does not say).
     pub fn fits(&self, more: u64) -> bool {
-        Symbolic::fits_with(&self.symbolic, more).is_ok()
+        Symbolic::fits_with(&self.symbolic, self.pattern_nnz, more).is_ok()
     }
 
     /// Refuse a factor whose values and scratch (and `more` bytes beside them) do not fit in the memory
     /// this machine has now: L's pages are mapped lazily, so an allocation that does not fit would
     /// succeed and the process be killed later. The sizes are exact once the symbolic factorisation is
     /// done, where the pre-run estimate (`scene::budget`) is a fit.
-    pub(super) fn fits_with(symbolic: &SymbolicCholesky<usize>, more: u64) -> Result<()> {
-        let need = Symbolic::need_of(symbolic).saturating_add(more);
+    pub(super) fn fits_with(symbolic: &SymbolicSupernodalCholesky<usize>, pattern_nnz: usize, more: u64) -> Result<()> {
+        let need = Symbolic::need_of(symbolic, pattern_nnz).saturating_add(more);
         refuse_beyond(need, crate::machine::available_memory(), symbolic.nrows(), symbolic.len_val())
     }
+}
+
+/// The ordering `base` (position → unknown) of n unknowns with the distinct unknowns `last` moved
+/// to its end, in the given order: (fwd, inv), position → unknown and unknown → position.
+fn ordering_with_last(n: usize, last: &[usize], base: Vec<usize>) -> Result<(Vec<usize>, Vec<usize>)> {
+    if base.len() != n || !is_permutation(&base) {
+        return Err(Error::Linear("internal: the fill-reducing ordering is not a permutation of the unknowns".into()));
+    }
+    let mut is_last = vec![false; n];
+    for &i in last {
+        if i >= n || std::mem::replace(&mut is_last[i], true) {
+            return Err(Error::Linear(format!("unknown {i} cannot be ordered last (out of range or repeated)")));
+        }
+    }
+    let fwd: Vec<usize> = base.into_iter().filter(|&i| !is_last[i]).chain(last.iter().copied()).collect();
+    let mut inv = vec![0usize; n];
+    for (new, &old) in fwd.iter().enumerate() {
+        inv[old] = new;
+    }
+    Ok((fwd, inv))
+}
+
+/// Entries of a pattern's lower triangle, diagonal included (what the numeric factorisation reads).
+pub(super) fn lower_nnz(pattern: SymbolicSparseColMatRef<'_, usize>) -> usize {
+    (0..pattern.ncols()).map(|j| pattern.row_idx_of_col_raw(j).iter().filter(|&&i| i >= j).count()).sum()
+}
+
+/// L's supernodal structure for the ordering (fwd, inv) of the symmetric pattern `sym` (both
+/// triangles): the elimination tree and column counts of [`super::etree`], then faer's supernodal
+/// analysis (supernodes, relaxed as faer's default, and their row patterns).
+fn supernodal_structure(sym: Cols<'_>, (fwd, inv): (&[usize], &[usize])) -> Result<SymbolicSupernodalCholesky<usize>> {
+    let n = fwd.len();
+    let upper = permuted_upper(sym, fwd, inv);
+    let parent = elimination_tree(&upper);
+    let counts = column_counts(sym, (fwd, inv), &parent, &postorder(&parent));
+    let etree: Vec<isize> = parent.iter().map(|&p| if p == NONE { -1 } else { p as isize }).collect();
+    let upper = SymbolicSparseColMatRef::new_unsorted_checked(n, n, &upper.ptr, None, &upper.idx);
+    let mut mem = MemBuffer::try_new(factorize_supernodal_symbolic_cholesky_scratch::<usize>(n))
+        .map_err(|_| Error::Linear("out of memory for the symbolic Cholesky factorisation".into()))?;
+    // SAFETY: faer asks for the tree its `prefactorize_symbolic_cholesky` makes from the same matrix;
+    // the elimination tree of a pattern is unique, and `etree::tests` checks that both agree.
+    let etree = unsafe { EliminationTreeRef::<usize>::from_inner(&etree) };
+    let params = CholeskySymbolicParams::default().supernodal_params;
+    factorize_supernodal_symbolic_cholesky(upper, etree, &counts, MemStack::new(&mut mem), params)
+        .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))
+}
+
+/// The scratch of the numeric factorisation: K permuted (values, column pointers, row indices), as
+/// faer's `SymbolicCholesky::factorize_numeric_llt` allocates it, then the supernodal kernel's.
+pub(super) fn numeric_scratch(
+    symbolic: &SymbolicSupernodalCholesky<usize>,
+    pattern_nnz: usize,
+) -> faer::dyn_stack::StackReq {
+    use faer::dyn_stack::StackReq;
+    let n = symbolic.nrows();
+    let permuted = StackReq::all_of(&[
+        StackReq::new::<f64>(pattern_nnz),
+        StackReq::new::<usize>(n + 1),
+        StackReq::new::<usize>(pattern_nnz),
+    ]);
+    let kernel = factorize_supernodal_numeric_llt_scratch::<usize, f64>(symbolic, Par::Seq, Default::default());
+    StackReq::all_of(&[permuted, StackReq::or(StackReq::new::<usize>(n), kernel)])
 }
 
 /// `TooLarge` when `need` bytes exceed `have` (a factor of `n` unknowns and `len_val` entries).

@@ -3,7 +3,7 @@
 //! results file there).
 
 use super::*;
-use crate::sparse::lower_values;
+use crate::sparse::{lower_pattern, lower_values};
 use faer::sparse::SymbolicSparseColMat;
 
 /// From this many unknowns the caller's work beside the set-up starts with phase 3 ([`Discretised::set_up`]):
@@ -303,33 +303,33 @@ impl Discretised {
                 let points = EdgePattern::unknown_points(mesh, space);
                 let nested = space.n_dofs >= ND_MIN_SIZE;
                 let order = fill_order_at(&graph, Some(&points), nested)?;
-                let k_pattern = rx.recv().map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
+                let full = rx.recv().map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
                 let name = if nested { "nested dissection by coordinates" } else { "AMD" };
-                let symbolic = Symbolic::new(k_pattern.as_ref().as_ref(), contact, order)?.ordered_by(name);
+                let symbolic = Symbolic::from_symmetric(full.as_ref().as_ref(), contact, order)?.ordered_by(name);
                 // on top of the factor: K's values (its lower triangle, assembled meanwhile), the blocks of
                 // steps, and the larger of what comes beside the numeric factorisation (λ_max(K)'s Lanczos
                 // vectors) and after it ([`AFTER_FACTOR_BYTES`])
                 let n = space.n_dofs as u64;
                 let lanczos = 8 * (LAMBDA_ITERS as u64 + 2) * n;
-                let beside = 8 * k_pattern.compute_nnz() as u64 + lanczos.max(AFTER_FACTOR_BYTES * n) + BLOCK_BYTES;
+                let beside = 8 * symbolic.pattern_nnz() as u64 + lanczos.max(AFTER_FACTOR_BYTES * n) + BLOCK_BYTES;
                 if !nested || symbolic.fits(beside) {
                     return Ok(symbolic);
                 }
                 // The factor of the coordinate bisection does not fit: METIS's ordering fills less
                 // (about 13 % on Example 5.1 at 6.3 M unknowns) for a slower ordering (tens of seconds).
                 drop(symbolic);
-                Symbolic::new(k_pattern.as_ref().as_ref(), contact, fill_order_at(&graph, None, true)?)
+                Symbolic::from_symmetric(full.as_ref().as_ref(), contact, fill_order_at(&graph, None, true)?)
                     .map(|s| s.ordered_by("METIS nested dissection (the factor by coordinates did not fit in memory)"))
             });
-            // K is kept as its lower triangle, the one the factorisation reads (half the memory), and the
-            // symbolic factorisation is given that triangle's pattern; the values are assembled on both
-            // and compacted to it
-            let k_pattern = Arc::new(pattern.unknown_pattern_lower(space));
+            // K is kept as its lower triangle, the one the factorisation reads (half the memory); its
+            // values are assembled on the full pattern, which the symbolic factorisation reads meanwhile
+            // (both triangles: no permuted copy of its lower triangle is needed there), and compacted
+            let full = Arc::new(pattern.unknown_pattern(space));
             // a thread that failed before taking it has dropped the receiver: its error is the one reported
-            let _ = tx.send(Arc::clone(&k_pattern));
-            let full = pattern.unknown_pattern(space);
-            let val = stiffness_values(pattern, full.as_ref(), mesh, space, law, scene.rho);
-            let val = lower_values(full.as_ref(), val);
+            let _ = tx.send(Arc::clone(&full));
+            let val = stiffness_values(pattern, full.as_ref().as_ref(), mesh, space, law, scene.rho);
+            let k_pattern = lower_pattern(full.as_ref().as_ref());
+            let val = lower_values(full.as_ref().as_ref(), val);
             drop(full);
             let loads = Loads::new(scene, mesh, space)?;
             let symbolic = symbolic
@@ -338,8 +338,6 @@ impl Discretised {
                 .and_then(|r| r)?;
             Ok((val, loads, symbolic, k_pattern))
         })?;
-        // the second thread has ended, so this is the one reference left
-        let k_pattern = Arc::try_unwrap(k_pattern).unwrap_or_else(|k| (*k).clone());
         Ok((SparseColMat::new(k_pattern, val), loads, symbolic))
     }
 

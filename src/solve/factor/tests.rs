@@ -150,4 +150,64 @@ fn the_lower_triangle_gives_the_factor_of_both() {
     a.solve_in_place(&mut x);
     b.solve_in_place(&mut y);
     assert!(x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()));
+    // a run's path: the symbolic factorisation from the full pattern, the values from the lower triangle
+    let base = fill_order(&Graph::of_matrix(&full, &pairs(n)), false).unwrap();
+    let c = Factor::numeric(Symbolic::from_symmetric(full.symbolic(), &last, base).unwrap(), &lower).unwrap();
+    assert_eq!(bits(b.last_block().unwrap()), bits(c.last_block().unwrap()));
+    let bits_l = |f: &Factor| f.values.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits_l(&b), bits_l(&c), "L from the full pattern's analysis");
+    // a matrix of another pattern is refused
+    assert!(Factor::numeric(Symbolic::from_symmetric(full.symbolic(), &last, (0..n).collect()).unwrap(), &grid(29))
+        .is_err());
+}
+
+/// The system shall compute, from its own elimination tree and column counts (`solve::etree`), the
+/// same supernodal factor as faer's complete analysis (`factorize_symbolic_cholesky`), bit for bit,
+/// with unknowns ordered last, under AMD and nested dissection.
+#[test]
+fn the_factor_is_faers_own_bit_for_bit() {
+    use faer::perm::PermRef;
+    use faer::sparse::linalg::cholesky::{
+        factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholeskyRaw, SymmetricOrdering,
+    };
+    use faer::sparse::linalg::SupernodalThreshold;
+    let k = grid(45);
+    let n = k.nrows();
+    for nested in [false, true] {
+        let base = fill_order(&Graph::of_matrix(&k, &pairs(n)), nested).unwrap();
+        let f = Factor::with_order(&k, &[3, 1, 40], base).unwrap();
+        let inv: Vec<usize> = {
+            let mut inv = vec![0; n];
+            f.fwd.iter().enumerate().for_each(|(new, &old)| inv[old] = new);
+            inv
+        };
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        };
+        let ord = SymmetricOrdering::Custom(PermRef::new_checked(&f.fwd, &inv, n));
+        let theirs = factorize_symbolic_cholesky(k.symbolic(), Side::Lower, ord, params).unwrap();
+        let mut values = vec![0.0; theirs.len_val()];
+        let mut mem = MemBuffer::new(theirs.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()));
+        let stack = MemStack::new(&mut mem);
+        theirs
+            .factorize_numeric_llt(
+                &mut values,
+                k.as_ref(),
+                Side::Lower,
+                Default::default(),
+                Par::Seq,
+                stack,
+                Default::default(),
+            )
+            .unwrap();
+        let SymbolicCholeskyRaw::Supernodal(s) = theirs.raw() else { panic!("faer chose the simplicial kernel") };
+        assert_eq!(s.n_supernodes(), f.symbolic.n_supernodes(), "supernodes (nested {nested})");
+        for j in 0..s.n_supernodes() {
+            assert_eq!(s.supernode(j).start(), f.symbolic.supernode(j).start());
+            assert_eq!(s.supernode(j).pattern(), f.symbolic.supernode(j).pattern());
+        }
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&values), bits(&f.values), "L's values (nested {nested})");
+    }
 }
