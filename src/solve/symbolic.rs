@@ -130,6 +130,12 @@ fn supernodal_structure(sym: Cols<'_>, (fwd, inv): (&[usize], &[usize])) -> Resu
     let upper = permuted_upper(sym, fwd, inv);
     let parent = elimination_tree(&upper);
     let counts = column_counts(sym, (fwd, inv), &parent, &postorder(&parent));
+    // what faer's analysis relies on (it indexes by them): parents after their children, counts of
+    // at least the diagonal and at most the rows below it
+    let tree_ok = parent.iter().enumerate().all(|(j, &p)| p == NONE || (p > j && p < n));
+    if !tree_ok || counts.iter().enumerate().any(|(j, &c)| c == 0 || c > n - j) {
+        return Err(Error::Linear("internal: malformed elimination tree or column counts".into()));
+    }
     let etree: Vec<isize> = parent.iter().map(|&p| if p == NONE { -1 } else { p as isize }).collect();
     let upper = SymbolicSparseColMatRef::new_unsorted_checked(n, n, &upper.ptr, None, &upper.idx);
     let mut mem = MemBuffer::try_new(factorize_supernodal_symbolic_cholesky_scratch::<usize>(n))
