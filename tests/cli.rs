@@ -69,6 +69,30 @@ fn solver_failure_keeps_completed_steps_and_records_why() {
     assert!(status.as_str().contains("did not converge"), "{}", status.as_str());
 }
 
+/// The system shall refuse an existing results file (or its sidecar) before it sets the mesh up: from
+/// 1,000,000 unknowns the file is created only after the factorisation, so the refusal came after minutes
+/// of set-up. Under a 2 GB address-space limit the refine-8 set-up (about 5 GB) cannot run, so only a
+/// check made before it gives the refusal; a check made after it fails with an allocation error instead.
+#[test]
+fn an_existing_output_is_refused_before_the_set_up() {
+    let scene = root("verification/cases/paper_example_5_1.toml");
+    for (name, planted) in [("big.h5", "big.h5"), ("big_side.h5", "big_side.xdmf")] {
+        let out = tmp(name);
+        let planted = tmp(planted);
+        std::fs::write(&planted, b"not ours").unwrap();
+        let cmd = format!(
+            "ulimit -v 2000000 && exec '{}' run '{scene}' --refine 8 --steps 4 -o '{}'",
+            env!("CARGO_BIN_EXE_tresca-cr"),
+            out.display()
+        );
+        let o = spawn(std::process::Command::new("sh").args(["-c", &cmd])).wait_with_output().unwrap();
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        let e = stderr(&o);
+        assert!((e.contains("already exists") || e.contains("XDMF file exists")) && e.contains("--force"), "{e}");
+        assert_eq!(std::fs::read(&planted).unwrap(), b"not ours");
+    }
+}
+
 /// Output paths: unwritable → clear error, nothing written; existing → refused and left untouched;
 /// --force with --resume → refused by the argument parser; --resume needs a file.
 #[test]

@@ -127,7 +127,12 @@ fn check_output_args(out: &OutputArgs, path: Option<&Path>, scene: &Scene) -> Re
         "--commit-interval must be a non-negative number of seconds"
     );
     match path {
-        Some(p) => not_an_input(&[p.to_path_buf(), tresca_cr::output::sidecar(p)], scene, "the output")?,
+        Some(p) => {
+            not_an_input(&[p.to_path_buf(), tresca_cr::output::sidecar(p)], scene, "the output")?;
+            if !out.resume {
+                tresca_cr::output::Writer::refuse_existing(p, out.force)?;
+            }
+        }
         None => note!("note: no results file (give -o FILE or an [output] path): the steps are solved and only this summary is kept"),
     }
     Ok(())

@@ -22,14 +22,14 @@ impl Writer {
         Writer::create_locked(OutputLock::acquire(path)?, run, opts)
     }
 
-    /// [`Writer::create_with`] on the path of a lock already taken.
-    pub fn create_locked(lock: OutputLock, run: &Run, opts: &Options) -> Result<Writer> {
-        let path = lock.target().to_path_buf();
-        let path = path.as_path();
+    /// A new results file at `path` is refused where a directory is, and, unless `force`, where a file or
+    /// its sidecar already is. [`Writer::create_locked`] checks it; a run checks it before its set-up
+    /// too, since from 1,000,000 unknowns the file is created only after the factorisation.
+    pub fn refuse_existing(path: &Path, force: bool) -> Result<()> {
         if path.is_dir() {
             return Err(Error::Io { path: path.to_path_buf(), msg: "is a directory, not a results file".into() });
         }
-        if path.exists() && !opts.force {
+        if path.exists() && !force {
             return Err(Error::Io {
                 path: path.to_path_buf(),
                 msg:
@@ -38,12 +38,20 @@ impl Writer {
             });
         }
         let side = sidecar(path);
-        if side.exists() && !opts.force {
+        if side.exists() && !force {
             return Err(Error::Io {
                 path: side,
                 msg: "an XDMF file exists under the name of this run's sidecar; pass --force to overwrite it".into(),
             });
         }
+        Ok(())
+    }
+
+    /// [`Writer::create_with`] on the path of a lock already taken.
+    pub fn create_locked(lock: OutputLock, run: &Run, opts: &Options) -> Result<Writer> {
+        let path = lock.target().to_path_buf();
+        let path = path.as_path();
+        Writer::refuse_existing(path, opts.force)?;
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(ioerr(path, "cannot create the directory"))?;
         }
