@@ -16,6 +16,10 @@ const DEFER_BESIDE_MIN: usize = 1_000_000;
 /// Example 5.1, 0.65 GB over the factor and K less the blocks' 0.27 GB, for 1,573,376 unknowns.
 const AFTER_FACTOR_BYTES: u64 = 242;
 
+/// From this many unknowns the set-up's freed temporaries go back to the kernel before the factorisation;
+/// below, they are a few MB the factor reuses, and mapping them again costs page faults (CHANGELOG.md).
+const RELEASE_MIN: usize = 100_000;
+
 /// Lanczos steps of λ_max(K) at most (`solve::condition`), one vector of n values each.
 const LAMBDA_ITERS: usize = 12;
 
@@ -376,7 +380,9 @@ impl Discretised {
     fn factor(&self, stiffness: &SparseColMat<usize, f64>, symbolic: Symbolic) -> Result<Factored> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         // the set-up's temporaries are freed: their pages go back before the factor's are mapped
-        crate::machine::release_freed_memory();
+        if space.n_dofs >= RELEASE_MIN {
+            crate::machine::release_freed_memory();
+        }
         let (factor, aside) = Factor::numeric_beside(symbolic, stiffness, || {
             let top = (self.guard == Guard::Estimate).then(|| condition::largest_eigenvalue(stiffness, LAMBDA_ITERS));
             let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, law, scene.rho).with_exact(x));
