@@ -24,7 +24,7 @@ fn main() {
     scene
         .set_refine(a[1].parse().unwrap_or_else(|_| fail("REFINE: a number")))
         .unwrap_or_else(|e| fail(&e.to_string()));
-    let m = MeshSetUp::new(&scene).unwrap_or_else(|e| fail(&e.to_string()));
+    let m = MeshSetUp::new(&scene, tresca_cr::stepping::Guard::Estimate).unwrap_or_else(|e| fail(&e.to_string()));
     if a[2] == "--time" {
         let t = m.times();
         let (flops, entries) = m.factor().flops_and_entries();

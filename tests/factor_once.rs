@@ -55,7 +55,8 @@ fn a_shared_set_up_gives_the_results_of_a_fresh_run() {
 
 /// Requirement: the system shall factorise each pilot mesh of a plan once: the time pilot's levels (one
 /// mesh, several grids) and the space pilot's level on that mesh share its set-up, so the plan makes no
-/// more set-ups than it has pilot meshes, and fewer than it runs levels.
+/// more set-ups than it has pilot meshes, and fewer than it runs levels; and it shall estimate K's
+/// condition number on the first of them only (the time pilot's mesh, where the guard refuses a scene).
 #[test]
 fn a_plan_factorises_each_pilot_mesh_once() {
     let s = scene("verification/cases/mms_stop.toml");
@@ -70,6 +71,9 @@ fn a_plan_factorises_each_pilot_mesh_once() {
     assert_eq!(made.len(), meshes.len(), "a pilot mesh was set up twice: {made:?}");
     assert!(p.time.levels.iter().skip(1).all(|l| !l.factorised), "the time pilot shares its mesh");
     assert!(cache.problems() > made.len() + 2, "{} levels on {} set-ups", cache.problems(), made.len());
+    // issue 32 (the planner's own CPU): the condition estimate on the first mesh only, the time pilot's
+    assert_eq!(cache.guarded(), [p.time.levels[0].refine], "set-ups {made:?}");
+    assert!(made.len() > 1);
 }
 
 /// Requirement: the system shall solve each pilot level of a plan once: a level (mesh, steps, common

@@ -384,3 +384,14 @@ fn an_ill_conditioned_stiffness_is_refused_before_any_step_is_handed_out() {
     .unwrap();
     assert_eq!(steps, (0..=good.n_steps()).collect::<Vec<_>>());
 }
+
+/// Requirement (issue 32, the planner's condition estimate on its first pilot mesh only): the system
+/// shall refuse to plan a scene whose K is nearly singular (ρ = 1e-12), exiting 1 with the cause named,
+/// although its pilots on other meshes skip the estimate.
+#[test]
+fn the_planner_refuses_an_ill_conditioned_stiffness() {
+    let weak = scene_with("weak_plan.toml", "rho = 10.0", "rho = 1e-12");
+    let o = run(&["plan", &weak, "--target", "1e-3"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("ill-conditioned") && stderr(&o).contains("rho < 1"), "{}", stderr(&o));
+}

@@ -56,8 +56,8 @@ pub struct Options {
     /// generation ([`reference::overlay`]).
     pub reference: Option<u32>,
     /// A planner's pilot (`plan::adaptive`): only η and the unknowns are read, so no energy audit, no
-    /// time indicator and no distance between levels are computed (those fields of the rows stay 0 and
-    /// `None`, and the levels' fields are not kept).
+    /// time indicator, no distance between levels and no condition estimate (the uniform pilots made it)
+    /// are computed (those fields of the rows stay 0 and `None`, and the levels' fields are not kept).
     pub lean: bool,
 }
 
@@ -160,7 +160,9 @@ pub fn initial_mesh(scene: &Scene) -> Result<Mesh> {
 /// with `timed`; the energy audit and the fields at every node kept unless `lean`); write the results
 /// file.
 fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool, timed: bool, lean: bool) -> Result<Solved> {
-    let problem = Problem::with_mesh(scene.clone(), mesh)?;
+    // a lean pilot follows the planner's uniform pilots, whose first mesh had the condition estimate
+    let guard = if lean { crate::stepping::Guard::Skip } else { crate::stepping::Guard::Estimate };
+    let problem = Problem::with_mesh_guarded(scene.clone(), mesh, guard)?;
     let est = Estimator::new(&problem)?;
     let mut writer = match &out {
         Some(p) => Some(Writer::create(p, &Run::of(&problem), force)?),

@@ -68,21 +68,75 @@ impl Locator {
     }
 }
 
+/// A centroid whose smallest barycentric coordinate in a coarse triangle is at least this lies inside it
+/// by far more than rounding (the mesh check bounds the aspect ratio by 1e12, so the coordinates' rounding
+/// stays below 1e-4): no other triangle contains it, so point location would return that triangle. A
+/// centroid of nested red or structured refinement has at least 1/(3·2^k) in its parent k levels up.
+const INSIDE: f64 = 1e-3;
+
 /// For every fine triangle, the coarse triangle containing its centroid (nested meshes).
 pub fn parent_triangles(coarse: &Mesh, fine: &Mesh) -> Result<Vec<usize>> {
-    let loc = Locator::new(coarse);
-    (0..fine.tris.len())
-        .map(|t| {
-            let [a, b, c] = fine.tris[t].map(|v| fine.points[v]);
-            let centroid = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
-            loc.find(centroid).map(|(ct, _)| ct).ok_or_else(|| {
-                Error::mesh(
-                    &fine.source,
-                    format!("fine triangle at ({:.6}, {:.6}) lies outside the coarse mesh", centroid[0], centroid[1]),
-                )
-            })
-        })
-        .collect()
+    parents_counted(coarse, fine).map(|(p, _)| p)
+}
+
+/// [`parent_triangles`], and how many centroids needed point location. A centroid is first tried in the
+/// parents of the fine triangle before it and of its fine neighbours found already and in their coarse
+/// neighbours (nested refinement numbers the children of a coarse triangle together or row by row), then
+/// found by walking from the last parent towards it, across the edge of the most negative barycentric
+/// coordinate; a triangle it is [`INSIDE`] is its parent, the triangle point location gives. Only
+/// centroids the walk misses (a non-convex domain stops it at the boundary) are located (the bucket grid
+/// is built at the first).
+pub fn parents_counted(coarse: &Mesh, fine: &Mesh) -> Result<(Vec<usize>, usize)> {
+    let elements: Vec<Element> = (0..coarse.tris.len()).map(|t| Element::new(coarse, t)).collect();
+    let inside = |t: usize, x: [f64; 2]| {
+        let l = elements[t].bary(x);
+        l[0].min(l[1]).min(l[2]) >= INSIDE
+    };
+    // the triangle across edge i of t (opposite its vertex i)
+    let across = |t: usize, i: usize| match coarse.edge_tris[coarse.tri_edges[t][i]] {
+        (t1, t2) if t1 == t => t2,
+        (t1, _) => Some(t1),
+    };
+    let around = |t: usize| std::iter::once(t).chain((0..3).filter_map(move |i| across(t, i)));
+    let walk = |mut t: usize, x: [f64; 2]| {
+        for _ in 0..=coarse.tris.len() {
+            let l = elements[t].bary(x);
+            let i = (0..3).min_by(|&a, &b| l[a].total_cmp(&l[b])).unwrap_or(0);
+            match across(t, i) {
+                _ if l[i] >= INSIDE => return Some(t),
+                Some(next) if l[i] < 0.0 => t = next,
+                _ => return None,
+            }
+        }
+        None
+    };
+    let mut loc = None;
+    let (mut parents, mut located): (Vec<usize>, usize) = (Vec::with_capacity(fine.tris.len()), 0);
+    for t in 0..fine.tris.len() {
+        let [a, b, c] = fine.tris[t].map(|v| fine.points[v]);
+        let centroid = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
+        let done = |u: usize| (u < t).then(|| parents[u]);
+        let known = fine.tri_edges[t].map(|e| match fine.edge_tris[e] {
+            (t1, t2) if t1 == t => t2.and_then(done),
+            (t1, _) => done(t1),
+        });
+        let last = t.checked_sub(1).map_or(0, |u| parents[u]);
+        let seeds = std::iter::once(last).chain(known.into_iter().flatten());
+        let near = seeds.flat_map(around).find(|&g| inside(g, centroid));
+        if let Some(g) = near.or_else(|| walk(last, centroid)) {
+            parents.push(g);
+            continue;
+        }
+        located += 1;
+        let found = loc.get_or_insert_with(|| Locator::new(coarse)).find(centroid);
+        parents.push(found.map(|(ct, _)| ct).ok_or_else(|| {
+            Error::mesh(
+                &fine.source,
+                format!("fine triangle at ({:.6}, {:.6}) lies outside the coarse mesh", centroid[0], centroid[1]),
+            )
+        })?);
+    }
+    Ok((parents, located))
 }
 
 /// P u_c on the fine space, from the coarse unknowns `u_c`.
@@ -197,5 +251,44 @@ mod tests {
                 assert!((uf[k] - (co[0] * v[0] + co[1] * v[1])).abs() < 1e-13);
             }
         }
+    }
+
+    /// The parents by point location alone (the method before the walk).
+    fn located(coarse: &Mesh, fine: &Mesh) -> Vec<usize> {
+        let loc = Locator::new(coarse);
+        (0..fine.tris.len())
+            .map(|t| {
+                let [a, b, c] = fine.tris[t].map(|v| fine.points[v]);
+                loc.find([(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0]).unwrap().0
+            })
+            .collect()
+    }
+
+    /// Requirement (issue 32, the planner's own CPU): the system shall find the parents of nested
+    /// meshes' triangles (structured refinement of a parallelogram with either diagonal, one and two
+    /// levels; red refinement of a quadrilateral's mesh) without point location, and give the parents of
+    /// point location on every mesh pair, nested or not (a bilinear quadrilateral's structured meshes).
+    #[test]
+    fn parents_are_found_without_point_location_on_nested_meshes() {
+        let para = [[0.0, 0.0], [2.0, 0.5], [2.5, 2.0], [0.5, 1.5]];
+        let quad = [[0.0, 0.0], [2.0, 0.3], [2.6, 2.4], [0.2, 1.5]];
+        let mk = |c, [n, m]: [usize; 2], diagonal| {
+            Mesh::from_spec(&MeshSpec::Structured { corners: c, cells: [n, m], diagonal, refine: 0 }).unwrap()
+        };
+        for d in [Diagonal::First, Diagonal::Second] {
+            for (n, f) in [([3, 4], [6, 8]), ([3, 4], [12, 16]), ([5, 2], [10, 4])] {
+                let (cm, fm) = (mk(para, n, d), mk(para, f, d));
+                let (p, count) = parents_counted(&cm, &fm).unwrap();
+                assert_eq!(p, located(&cm, &fm), "{d:?} {n:?} -> {f:?}");
+                assert_eq!(count, 0, "{d:?} {n:?} -> {f:?}: point location on nested meshes");
+            }
+            let (cm, fm) = (mk(quad, [4, 4], d), mk(quad, [8, 8], d));
+            assert_eq!(parents_counted(&cm, &fm).unwrap().0, located(&cm, &fm), "bilinear {d:?}");
+        }
+        let raw = crate::mesh::structured_raw(&quad, [3, 4], Diagonal::First).unwrap();
+        let once = crate::mesh::refine::red(&raw);
+        let (cm, fm) = (Mesh::build(once.clone()).unwrap(), Mesh::build(crate::mesh::refine::red(&once)).unwrap());
+        let (p, count) = parents_counted(&cm, &fm).unwrap();
+        assert_eq!((p, count), (located(&cm, &fm), 0), "red refinement");
     }
 }

@@ -10,7 +10,7 @@ pub mod bisect;
 mod edge_index;
 mod gmsh;
 mod quality;
-mod refine;
+pub(crate) mod refine;
 mod structured;
 
 use crate::error::{Error, Result};

@@ -141,6 +141,8 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         return Err(Error::scene(&scene.file, "--target", format!("{target}: must be a positive number")));
     }
     let s = pilot_scene(scene, &options.quantity)?;
+    // the guard against a nearly singular K on the time pilot's mesh, the first made
+    cache.guard_first_mesh_only();
     let (r0, n0) = (s.mesh_level(), s.times.len() - 1);
     let q = &options.quantity;
     let nt = time_base(n0);

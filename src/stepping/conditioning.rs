@@ -6,6 +6,9 @@
 //! before the verdict (`Problem::conditioned`): the steps computed before it are held back (up to a
 //! budget, `stepping::run`), and a run that fails before it reports a refused K rather than what
 //! followed from it.
+//!
+//! A planner's pilots ([`Guard::Skip`]) estimate it on their first mesh only: a run of the plan checks its
+//! own K, and the pilots' walls model its cost, not their guard's.
 
 use crate::error::{Error, Result};
 use crate::fem::space::CrSpace;
@@ -15,6 +18,16 @@ use crate::solve::condition;
 use crate::solve::factor::Factor;
 use std::sync::{Arc, Mutex, OnceLock};
 use std::thread::JoinHandle;
+
+/// Whether a set-up estimates K's condition number.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Guard {
+    /// Estimate it and refuse a nearly singular K (every run).
+    #[default]
+    Estimate,
+    /// Accept K unchecked: a planner's pilot on a mesh other than the one its guard ran on (module doc).
+    Skip,
+}
 
 /// The condition estimate λ_max(K) · λ_max(K⁻¹) of a run, its solves under way on their own thread.
 pub(super) struct Pending {
@@ -31,6 +44,11 @@ impl Pending {
         let f = Arc::clone(factor);
         let solves = std::thread::spawn(move || condition::largest_inverse_eigenvalue(&f, n, 12));
         Pending { top, solves: Mutex::new(Some(solves)), verdict: OnceLock::new() }
+    }
+
+    /// No estimate ([`Guard::Skip`]): K is accepted.
+    pub(super) fn skipped() -> Pending {
+        Pending { top: f64::NAN, solves: Mutex::new(None), verdict: OnceLock::from(None) }
     }
 
     /// Whether the estimate is in (or its thread ended): [`Pending::verdict`] would not wait.

@@ -35,7 +35,7 @@ mod run;
 mod setup;
 
 pub use audit::{Audit, AuditState};
-pub use conditioning::MAX_CONDITION;
+pub use conditioning::{Guard, MAX_CONDITION};
 pub use run::RunOptions;
 pub use setup::{Discretised, MeshSetUp};
 
@@ -134,7 +134,12 @@ impl Problem {
 
     /// As [`Problem::new`] on a given mesh (the scene's `[mesh]` table is ignored).
     pub fn with_mesh(scene: Scene, mesh: Mesh) -> Result<Problem> {
-        Problem::with_mesh_beside(scene, mesh, None::<fn(&Discretised)>).map(|(p, _)| p).map_err(|(e, _)| e)
+        Problem::with_mesh_guarded(scene, mesh, Guard::Estimate)
+    }
+
+    /// [`Problem::with_mesh`], with the condition estimate only if `guard` asks for it (`conditioning`).
+    pub fn with_mesh_guarded(scene: Scene, mesh: Mesh, guard: Guard) -> Result<Problem> {
+        Problem::with_mesh_beside(scene, mesh, guard, None::<fn(&Discretised)>).map(|(p, _)| p).map_err(|(e, _)| e)
     }
 
     /// Number of time steps N.

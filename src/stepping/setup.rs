@@ -16,6 +16,10 @@ const DEFER_BESIDE_MIN: usize = 1_000_000;
 /// Example 5.1, 0.65 GB over the factor and K less the blocks' 0.27 GB, for 1,573,376 unknowns.
 const AFTER_FACTOR_BYTES: u64 = 242;
 
+/// From this many unknowns the set-up's freed temporaries go back to the kernel before the factorisation;
+/// below, they are a few MB the factor reuses, and mapping them again costs page faults (CHANGELOG.md).
+const RELEASE_MIN: usize = 100_000;
+
 /// Lanczos steps of λ_max(K) at most (`solve::condition`), one vector of n values each.
 const LAMBDA_ITERS: usize = 12;
 
@@ -33,7 +37,7 @@ impl Problem {
         beside: impl FnOnce(&Discretised) -> R + Send,
     ) -> (Result<Problem>, Option<R>) {
         match Mesh::from_spec(&scene.mesh) {
-            Ok(mesh) => match Problem::with_mesh_beside(scene, mesh, Some(beside)) {
+            Ok(mesh) => match Problem::with_mesh_beside(scene, mesh, Guard::Estimate, Some(beside)) {
                 Ok((p, r)) => (Ok(p), r),
                 Err((e, r)) => (Err(e), r),
             },
@@ -45,6 +49,7 @@ impl Problem {
     pub(super) fn with_mesh_beside<R: Send>(
         scene: Scene,
         mesh: Mesh,
+        guard: Guard,
         beside: Option<impl FnOnce(&Discretised) -> R + Send>,
     ) -> WithBeside<R> {
         let t0 = Instant::now();
@@ -52,9 +57,9 @@ impl Problem {
         crate::fem::lifting::consistency::check(&scene, &mesh, &space).map_err(|e| (e, None))?;
         let t1 = Instant::now();
         let law = Elasticity::new(&scene.material);
-        let p0 = Discretised { scene, mesh, space, law };
+        let p0 = Discretised { scene, mesh, space, law, guard };
         let (rest, r) = p0.set_up(beside);
-        let Discretised { scene, mesh, space, law } = p0;
+        let Discretised { scene, mesh, space, law, .. } = p0;
         let rest = match rest {
             Ok(rest) => rest,
             Err(e) => return Err((e, r)),
@@ -148,14 +153,14 @@ pub struct MeshSetUp {
 
 impl MeshSetUp {
     /// The set-up of `scene`'s mesh (assembly, factorisation, condensation; the phases of
-    /// [`Problem::new`] but the load superposition).
-    pub fn new(scene: &Scene) -> Result<MeshSetUp> {
+    /// [`Problem::new`] but the load superposition), with the condition estimate if `guard` asks for it.
+    pub fn new(scene: &Scene, guard: Guard) -> Result<MeshSetUp> {
         let t0 = Instant::now();
         let mesh = Mesh::from_spec(&scene.mesh)?;
         let space = CrSpace::new(&mesh, &scene.parts)?;
         let t1 = Instant::now();
         let law = Elasticity::new(&scene.material);
-        let p0 = Discretised { scene: scene.clone(), mesh, space, law };
+        let p0 = Discretised { scene: scene.clone(), mesh, space, law, guard };
         let (stiffness, loads, symbolic) = p0.assemble()?;
         let t2 = Instant::now();
         let f = p0.factor(&stiffness, symbolic)?;
@@ -226,6 +231,8 @@ pub struct Discretised {
     pub mesh: Mesh,
     pub space: CrSpace,
     pub law: Elasticity,
+    /// Whether the set-up estimates K's condition number.
+    pub guard: Guard,
 }
 
 /// The instants the set-up's phases ended at (the space's end and these give [`SetupTimes`]).
@@ -367,24 +374,27 @@ impl Discretised {
     }
 
     /// Phase 2: the numeric factorisation; beside it λ_max(K), the error quadrature and step 0; after it
-    /// the condition estimate's solves are started.
+    /// the condition estimate's solves are started (neither with [`Guard::Skip`]).
     fn factor(&self, stiffness: &SparseColMat<usize, f64>, symbolic: Symbolic) -> Result<Factored> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         // the set-up's temporaries are freed: their pages go back before the factor's are mapped
-        crate::machine::release_freed_memory();
+        if space.n_dofs >= RELEASE_MIN {
+            crate::machine::release_freed_memory();
+        }
         let (factor, aside) = Factor::numeric_beside(symbolic, stiffness, || {
-            let top = condition::largest_eigenvalue(stiffness, LAMBDA_ITERS);
+            let top = (self.guard == Guard::Estimate).then(|| condition::largest_eigenvalue(stiffness, LAMBDA_ITERS));
             let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, law, scene.rho).with_exact(x));
             let step0 = initial_state(scene, mesh, space, stiffness, errors.as_ref()).ok();
             (top, errors, step0)
         });
         let factor = factor?;
-        let (top, errors, step0) = aside.unwrap_or((f64::NAN, None, None));
+        let (top, errors, step0) = aside.unwrap_or((Some(f64::NAN), None, None));
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
         // ranges) factorises without complaint but returns meaningless displacements: it is refused
         // by the condition estimate, whose solves run on their own thread from here on (conditioning).
         let factor = Arc::new(factor);
-        let conditioning = Arc::new(Pending::start(&factor, stiffness.nrows(), top));
+        let conditioning =
+            Arc::new(top.map_or_else(Pending::skipped, |top| Pending::start(&factor, stiffness.nrows(), top)));
         Ok(Factored { factor, conditioning, errors: errors.map(Arc::new), step0 })
     }
 

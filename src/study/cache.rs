@@ -19,7 +19,7 @@ use super::{Level, LevelResult};
 use crate::error::Result;
 use crate::scene::budget::available_memory;
 use crate::scene::Scene;
-use crate::stepping::{MeshSetUp, Problem, SetupTimes};
+use crate::stepping::{Guard, MeshSetUp, Problem, SetupTimes};
 use std::sync::{Arc, Mutex};
 
 /// At most this share of the available memory is kept in set-ups other than the newest.
@@ -43,6 +43,10 @@ struct Inner {
     runs: Vec<(Level, usize, LevelResult, Arc<Kept>)>,
     /// Levels run (refinement, steps, common steps), in order: each solve of the steps.
     solved: Vec<(u32, usize, usize)>,
+    /// Estimate K's condition number on the first mesh only ([`SetupCache::guard_first_mesh_only`]).
+    guard_first_only: bool,
+    /// Set-ups made with the condition estimate, by refinement.
+    guarded: Vec<u32>,
 }
 
 impl SetupCache {
@@ -65,9 +69,20 @@ impl SetupCache {
         if let Some((_, m)) = self.lock().entries.iter().find(|(r, _)| *r == refine) {
             return Ok((Arc::clone(m), false));
         }
-        let m = Arc::new(MeshSetUp::new(scene)?);
+        let guard = {
+            let inner = self.lock();
+            if inner.guard_first_only && !inner.made.is_empty() {
+                Guard::Skip
+            } else {
+                Guard::Estimate
+            }
+        };
+        let m = Arc::new(MeshSetUp::new(scene, guard)?);
         let mut inner = self.lock();
         inner.made.push(refine);
+        if guard == Guard::Estimate {
+            inner.guarded.push(refine);
+        }
         inner.entries.push((refine, Arc::clone(&m)));
         let limit = available_memory().map_or(0.0, |a| a as f64 * SHARE_OF_MEMORY);
         while inner.entries.len() > 1
@@ -116,9 +131,21 @@ impl SetupCache {
         self.inner.lock().unwrap_or_else(|e| e.into_inner())
     }
 
+    /// Make the condition estimate (the guard against a nearly singular K, `stepping::conditioning`) on
+    /// the first mesh set up only: a planner's pilots, whose walls model the planned run's cost and whose
+    /// first mesh (the time pilot's) is where the guard refuses a scene; the planned run checks its own K.
+    pub fn guard_first_mesh_only(&self) {
+        self.lock().guard_first_only = true;
+    }
+
     /// Set-ups made so far (assemblies and numeric factorisations of K), by refinement, in order.
     pub fn factorised(&self) -> Vec<u32> {
         self.lock().made.clone()
+    }
+
+    /// Set-ups made with the condition estimate so far, by refinement, in order.
+    pub fn guarded(&self) -> Vec<u32> {
+        self.lock().guarded.clone()
     }
 
     /// Problems handed out so far (one per level run).

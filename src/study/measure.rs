@@ -74,11 +74,14 @@ impl<'a> Pair<'a> {
     /// `mf`, `mc` ([`Kept::displacement`]).
     pub fn density(&self, mf: &[[f64; 2]], mc: &[[f64; 2]]) -> Vec<f64> {
         let (fine, coarse) = (self.fine, self.coarse);
+        // the gradient of each coarse triangle once, not once per child
+        let coarse_gradient: Vec<[[f64; 2]; 2]> = (0..coarse.mesh.tris.len())
+            .map(|pt| self.coarse_elements[pt].gradient(coarse.mesh.tri_edges[pt].map(|e| mc[e])))
+            .collect();
         (0..fine.mesh.tris.len())
             .map(|t| {
                 let gf = self.fine_elements[t].gradient(fine.mesh.tri_edges[t].map(|e| mf[e]));
-                let pt = self.parent[t];
-                let gc = self.coarse_elements[pt].gradient(coarse.mesh.tri_edges[pt].map(|e| mc[e]));
+                let gc = coarse_gradient[self.parent[t]];
                 let d = [[gf[0][0] - gc[0][0], gf[0][1] - gc[0][1]], [gf[1][0] - gc[1][0], gf[1][1] - gc[1][1]]];
                 fine.law.energy_density(d)
             })
