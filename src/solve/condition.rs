@@ -4,7 +4,6 @@
 
 use super::factor::Factor;
 use faer::sparse::SparseColMat;
-use faer::MatMut;
 use nalgebra::DMatrix;
 
 /// Relative change of the Ritz value at which [`lanczos_max`] stops: the estimate is compared with a
@@ -39,7 +38,7 @@ pub fn largest_inverse_eigenvalue(factor: &Factor, n: usize, iters: usize) -> f6
     lanczos_max(n, iters, |v, w| {
         w.copy_from_slice(v);
         // a private scratch (solve_many), so this may run beside the factor's other users
-        factor.solve_many(MatMut::from_column_major_slice_mut(w, n, 1));
+        factor.solve_many(w, 1);
     })
 }
 

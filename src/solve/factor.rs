@@ -95,7 +95,9 @@ impl Factor {
     ) -> (Result<Factor>, Option<R>) {
         let Symbolic { symbolic, fwd, inv, last, pattern_nnz, ordering } = symbolic;
         let n = k.nrows();
-        if symbolic.nrows() != n || lower_nnz(k.symbolic()) != pattern_nnz {
+        // K kept as its lower triangle (a run's) has as many entries as the pattern's; both triangles stored, more
+        let same = k.compute_nnz() == pattern_nnz || lower_nnz(k.symbolic()) == pattern_nnz;
+        if symbolic.nrows() != n || !same {
             let e = "internal: the matrix does not have the pattern of its symbolic factorisation";
             return (Err(Error::Linear(e.into())), None);
         }
@@ -277,33 +279,31 @@ impl Factor {
         Ok(())
     }
 
-    /// x ← K⁻¹ x for one vector.
+    /// x ← K⁻¹ x for one vector (with the factor's own scratch).
     pub fn solve_in_place(&self, x: &mut [f64]) {
-        let mut y = vec![0.0; self.n];
-        self.permute_in(x, &mut y);
-        let mut buf = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
-        let llt = SupernodalLltRef::new(&self.symbolic, &self.values);
-        let y_mat = MatMut::from_column_major_slice_mut(&mut y, self.n, 1);
-        llt.solve_in_place_with_conj(Conj::No, y_mat, Par::Seq, MemStack::new(&mut buf.1));
-        self.permute_out(&y, x);
+        let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
+        self.solve_with(x, 1, MemStack::new(&mut scratch.1));
     }
 
-    /// X ← K⁻¹ X for a block of right-hand sides.
-    pub fn solve_many(&self, mut x: MatMut<'_, f64>) {
-        let cols = x.ncols();
-        let mut y = vec![0.0; self.n * cols];
-        for c in 0..cols {
-            let col = &mut y[c * self.n..(c + 1) * self.n];
-            col.iter_mut().zip(&self.fwd).for_each(|(yi, &old)| *yi = x[(old, c)]);
-        }
-        let llt = SupernodalLltRef::new(&self.symbolic, &self.values);
+    /// X ← K⁻¹ X for the `cols` columns of X (column-major, n rows), with a scratch of its own: it may
+    /// run beside the factor's other users (the condition estimate's thread).
+    pub fn solve_many(&self, x: &mut [f64], cols: usize) {
         let mut buf = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq));
-        let y_mat = MatMut::from_column_major_slice_mut(&mut y, self.n, cols);
-        llt.solve_in_place_with_conj(Conj::No, y_mat, Par::Seq, MemStack::new(&mut buf));
-        for c in 0..cols {
-            let col = &y[c * self.n..(c + 1) * self.n];
-            col.iter().zip(&self.fwd).for_each(|(&yi, &old)| x[(old, c)] = yi);
-        }
+        self.solve_with(x, cols, MemStack::new(&mut buf));
+    }
+
+    /// Pᵀ, faer's supernodal solve L Lᵀ y = Pᵀx, then P.
+    fn solve_with(&self, x: &mut [f64], cols: usize, stack: &mut MemStack) {
+        let mut y = vec![0.0; x.len()];
+        self.permute_in(x, &mut y);
+        let llt = SupernodalLltRef::new(&self.symbolic, &self.values);
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut y, self.n, cols),
+            Par::Seq,
+            stack,
+        );
+        self.permute_out(&y, x);
     }
 }
 

@@ -24,7 +24,6 @@ use super::factor::Factor;
 use crate::error::{Error, Result};
 use crate::fem::loads::Loads;
 use crate::sparse::dot;
-use faer::MatMut;
 use std::borrow::Cow;
 
 /// Largest number of load patterns handled by superposition.
@@ -195,7 +194,7 @@ impl LoadBasis {
         let responses = if n == 0 {
             vec![vec![]; b.len()]
         } else {
-            factor.solve_many(MatMut::from_column_major_slice_mut(&mut x, n, b.len()));
+            factor.solve_many(&mut x, b.len());
             x.chunks_exact(n).map(|c| c.to_vec()).collect()
         };
         LoadBasis { b, support: loads.support().to_vec(), responses, coef }

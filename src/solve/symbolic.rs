@@ -43,8 +43,8 @@ impl Symbolic {
     pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>, last: &[usize], base: Vec<usize>) -> Result<Symbolic> {
         let (fwd, inv) = ordering_with_last(pattern.nrows(), last, base)?;
         let sym = symmetric(pattern);
-        let symbolic = supernodal_structure(sym.cols(), (&fwd, &inv))?;
-        Ok(Symbolic { symbolic, fwd, inv, last: last.to_vec(), pattern_nnz: lower_nnz(pattern), ordering: "given" })
+        let (symbolic, pattern_nnz) = supernodal_structure(sym.cols(), (&fwd, &inv))?;
+        Ok(Symbolic { symbolic, fwd, inv, last: last.to_vec(), pattern_nnz, ordering: "given" })
     }
 
     /// As [`Symbolic::new`], from a symmetric pattern with both triangles stored (compact: without
@@ -56,8 +56,8 @@ impl Symbolic {
     ) -> Result<Symbolic> {
         let cols = Cols::of(sym).ok_or_else(|| Error::Linear("internal: the pattern is not compact".into()))?;
         let (fwd, inv) = ordering_with_last(sym.nrows(), last, base)?;
-        let symbolic = supernodal_structure(cols, (&fwd, &inv))?;
-        Ok(Symbolic { symbolic, fwd, inv, last: last.to_vec(), pattern_nnz: lower_nnz(sym), ordering: "given" })
+        let (symbolic, pattern_nnz) = supernodal_structure(cols, (&fwd, &inv))?;
+        Ok(Symbolic { symbolic, fwd, inv, last: last.to_vec(), pattern_nnz, ordering: "given" })
     }
 
     /// Entries of the lower triangle of the pattern it was made from (of the matrix factorised).
@@ -124,8 +124,12 @@ pub(super) fn lower_nnz(pattern: SymbolicSparseColMatRef<'_, usize>) -> usize {
 
 /// L's supernodal structure for the ordering (fwd, inv) of the symmetric pattern `sym` (both
 /// triangles): the elimination tree and column counts of [`super::etree`], then faer's supernodal
-/// analysis (supernodes, relaxed as faer's default, and their row patterns).
-fn supernodal_structure(sym: Cols<'_>, (fwd, inv): (&[usize], &[usize])) -> Result<SymbolicSupernodalCholesky<usize>> {
+/// analysis (supernodes, relaxed as faer's default, and their row patterns); with the entries of the
+/// pattern's lower triangle (as many as P A Pᵀ's upper one has).
+fn supernodal_structure(
+    sym: Cols<'_>,
+    (fwd, inv): (&[usize], &[usize]),
+) -> Result<(SymbolicSupernodalCholesky<usize>, usize)> {
     let n = fwd.len();
     let upper = permuted_upper(sym, fwd, inv);
     let parent = elimination_tree(&upper);
@@ -137,6 +141,7 @@ fn supernodal_structure(sym: Cols<'_>, (fwd, inv): (&[usize], &[usize])) -> Resu
         return Err(Error::Linear("internal: malformed elimination tree or column counts".into()));
     }
     let etree: Vec<isize> = parent.iter().map(|&p| if p == NONE { -1 } else { p as isize }).collect();
+    let pattern_nnz = upper.idx.len();
     let upper = SymbolicSparseColMatRef::new_unsorted_checked(n, n, &upper.ptr, None, &upper.idx);
     let mut mem = MemBuffer::try_new(factorize_supernodal_symbolic_cholesky_scratch::<usize>(n))
         .map_err(|_| Error::Linear("out of memory for the symbolic Cholesky factorisation".into()))?;
@@ -145,6 +150,7 @@ fn supernodal_structure(sym: Cols<'_>, (fwd, inv): (&[usize], &[usize])) -> Resu
     let etree = unsafe { EliminationTreeRef::<usize>::from_inner(&etree) };
     let params = CholeskySymbolicParams::default().supernodal_params;
     factorize_supernodal_symbolic_cholesky(upper, etree, &counts, MemStack::new(&mut mem), params)
+        .map(|s| (s, pattern_nnz))
         .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))
 }
 
