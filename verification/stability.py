@@ -2,11 +2,11 @@
 
     .venv/bin/python verification/stability.py [--json OUT] [--md FILE] [--only case_nu,...]
 
-The cases are in tresca_py/verify/stability.py.
+The cases are in the package tresca_py/verify/stability/.
 """
 import sys
 
-from tresca_py.verify.stability import main
+from tresca_py.verify.stability.main import main
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -1,5 +1,5 @@
 """The load-scaling requirement's judgement of which scales a results file can hold."""
-from tresca_py.verify.stability import load_scale_limit
+from tresca_py.verify.stability.extremes import load_scale_limit
 
 # Example 5.1's unit-load maxima (refine 2): smallest nonzero per-step max|u|, largest f32 view, energy
 LIM = dict(u_min=2.015e-5, views=0.0995, energy=2.6e-4)

@@ -9,7 +9,8 @@ import sympy as sp
 from tresca_py.expr import parse, symbols
 from tresca_py.mms.blocks import lam
 from tresca_py.mms.derive import derive, require
-from tresca_py.mms.elasticity import body_force, side_geometry, stress
+from tresca_py.mms.elasticity import body_force, stress
+from tresca_py.mms.tresca_law import check_tresca_law, np_grad, side_grid, stress_np
 
 x, y, t = symbols()
 
@@ -58,20 +59,6 @@ def check_exmex_binary(d, rng, binary, log):
         worst = max(worst, abs(float(o) - ref) / max(1.0, abs(ref)))
     require(worst < 1e-12, "%s: exmex evaluation differs by %.3e" % (d["name"], worst))
     log("exmex binary evaluates all %d strings (max rel diff %.1e)        ok" % (len(d["str"]), worst))
-
-
-def np_grad(d, which="parsed"):
-    src = d[which]
-    return [[lam(src["grad11"]), lam(src["grad12"])], [lam(src["grad21"]), lam(src["grad22"])]]
-
-
-def stress_np(Gf, lam_, mu, X, Y, T):
-    g = [[Gf[i][j](X, Y, T) for j in range(2)] for i in range(2)]
-    tr = g[0][0] + g[1][1]
-    s11 = lam_ * tr + 2 * mu * g[0][0]
-    s22 = lam_ * tr + 2 * mu * g[1][1]
-    s12 = mu * (g[0][1] + g[1][0])
-    return s11, s12, s22
 
 
 def check_derivatives(d, rng, log):
@@ -131,10 +118,8 @@ def check_sides(d):
     Gf = np_grad(d)
     s = np.linspace(0, 1, 201)
     tt = np.linspace(0, float(d["T"]), 21)
-    S_, TT = np.meshgrid(s, tt, indexing="ij")
     for side, kind in d["kinds"].items():
-        a, b, n, tau = side_geometry(d["corners"], side)
-        PX, PY = a[0] + S_ * (b[0] - a[0]), a[1] + S_ * (b[1] - a[1])
+        PX, PY, TT, n, _ = side_grid(d["corners"], side, s, tt)
         if kind == "neumann":
             s11, s12, s22 = stress_np(Gf, lam_, mu, PX, PY, TT)
             g1 = lam(P["g_%s_1" % side])(PX, PY, TT)
@@ -148,81 +133,14 @@ def check_sides(d):
 
 
 def check_contact(d, log):
-    """Pointwise Tresca conditions on Gamma_C on a fine space-time grid (parsed expressions;
-    velocities by sympy differentiation of the parsed u, independent of the PosPow/SStep rules)."""
-    sides = [s for s, k in d["kinds"].items() if k == "contact"]
-    if not sides:
-        return
-    P = d["parsed"]
-    lam_, mu = float(d["lam"]), float(d["mu"])
-    Gf = np_grad(d)
-    u = [lam(P["u1"]), lam(P["u2"])]
-    ud = [lam(sp.diff(P["u1"], t)), lam(sp.diff(P["u2"], t))]
-    ud_custom = [lam(sp.diff(d["sym"]["u1"], t)), lam(sp.diff(d["sym"]["u2"], t))]
-    ga_f = lam(P["g_a"])
-    Tn = float(d["T"])
-    times = set(np.linspace(0, Tn, 601).tolist())
+    """Pointwise Tresca conditions on every contact side (u.n = 0 there) on a fine space-time grid, with the
+    times of ``d["t_special"]`` and either side of them (tresca_py.mms.tresca_law)."""
+    times = set(np.linspace(0, float(d["T"]), 601).tolist())
     for ts in d.get("t_special", []):
         times |= {float(ts) - 1e-9, float(ts), float(ts) + 1e-9}
     times = np.array(sorted(times))
-    for side in sides:
-        a, b, n, tau = side_geometry(d["corners"], side)
-        s = np.linspace(0, 1, 2001)
-        S_, TT = np.meshgrid(s, times, indexing="ij")           # (space, time)
-        PX, PY = a[0] + S_ * (b[0] - a[0]), a[1] + S_ * (b[1] - a[1])
-        un = u[0](PX, PY, TT) * n[0] + u[1](PX, PY, TT) * n[1]
-        require(np.max(np.abs(un)) < 1e-13, "%s: u.n != 0 on Gamma_C (%.2e)" % (d["name"], np.max(np.abs(un))))
-        s11, s12, s22 = stress_np(Gf, lam_, mu, PX, PY, TT)
-        sn1, sn2 = s11 * n[0] + s12 * n[1], s12 * n[0] + s22 * n[1]
-        snn = sn1 * n[0] + sn2 * n[1]
-        st1, st2 = sn1 - snn * n[0], sn2 - snn * n[1]             # sigma_t (vector)
-        st_abs = np.hypot(st1, st2)
-        ga = ga_f(PX, PY, TT)
-        require(np.min(ga) > 0, "%s: g_a must be positive" % d["name"])
-        require(np.all(ga == ga[:, :1]), "%s: g_a depends on t" % d["name"])
-        v1, v2 = ud[0](PX, PY, TT), ud[1](PX, PY, TT)
-        w1, w2 = ud_custom[0](PX, PY, TT), ud_custom[1](PX, PY, TT)
-        vnd = max(np.max(np.abs(v1 - w1)), np.max(np.abs(v2 - w2)))
-        require(vnd < 1e-12, "%s: time derivative (Max/Heaviside) != custom rule (%.2e)" % (d["name"], vnd))
-        vn = v1 * n[0] + v2 * n[1]
-        vt1, vt2 = v1 - vn * n[0], v2 - vn * n[1]
-        vt_abs = np.hypot(vt1, vt2)
-        ttol = 1e-11 * np.max(ga)
-        vtol = 1e-11 * max(1e-3, np.max(vt_abs))
-        # |sigma_t| <= g_a
-        viol = np.max(st_abs - ga)
-        require(viol <= ttol, "%s: |sigma_t| exceeds g_a by %.2e" % (d["name"], viol))
-        # stick: |sigma_t| < g_a strictly  =>  u_t' = 0
-        stick = st_abs < ga - ttol
-        bad = np.max(vt_abs[stick]) if stick.any() else 0.0
-        require(bad <= vtol, "%s: stick point with slip velocity %.2e" % (d["name"], bad))
-        # slip: u_t' != 0  =>  |sigma_t| = g_a and u_t' = -theta sigma_t, theta >= 0
-        slip = vt_abs > vtol
-        if slip.any():
-            gap = np.max(np.abs(st_abs[slip] - ga[slip]))
-            require(gap <= ttol, "%s: slipping point with |sigma_t| != g_a (%.2e)" % (d["name"], gap))
-            theta = -(vt1 * st1 + vt2 * st2)[slip] / st_abs[slip] ** 2
-            require(np.min(theta) >= 0, "%s: slip velocity not opposite to sigma_t" % d["name"])
-            res = np.max(np.hypot(vt1[slip] + theta * st1[slip], vt2[slip] + theta * st2[slip]))
-            require(res <= vtol, "%s: u_t' not parallel to sigma_t (%.2e)" % (d["name"], res))
-        # compatibility of u0: |sigma_t(u0)| <= g_a (t = 0 column)
-        require(times[0] == 0 and np.max(st_abs[:, 0] - ga[:, 0]) <= ttol, "%s: u0 incompatible" % d["name"])
-        # non-vacuity and expected kinds of transitions
-        require(stick.mean() > 0.05 or d["name"] == "mms_stop", "%s: (almost) no stick samples" % d["name"])
-        require(slip.mean() > 0.05, "%s: (almost) no slip samples" % d["name"])
-        dsl = np.diff(slip.astype(int), axis=1)
-        n_ss = int(np.sum(np.any(dsl == 1, axis=1)))            # points that go stick -> slip
-        n_sk = int(np.sum(np.any(dsl == -1, axis=1)))           # points that go slip -> stick
-        exp = d["expect"]
-        require((n_ss > 0) == exp["stick_to_slip"], "%s: stick->slip transitions: %d" % (d["name"], n_ss))
-        require((n_sk > 0) == exp["slip_to_stick"], "%s: slip->stick transitions: %d" % (d["name"], n_sk))
-        st_tau = st1 * tau[0] + st2 * tau[1]
-        log("Tresca on %s (%d x %d samples): u.n=0, |sig_t|<=g_a, stick, slip dir, u0   ok"
-            % (side, len(s), len(times)))
-        log("   stick %.0f%%, slipping %.0f%% of samples; %d points stick->slip, %d slip->stick; "
-            "sigma_t.tau in [%.3g, %.3g], g_a in [%.3g, %.3g], max|slip rate| %.3g"
-            % (100 * stick.mean(), 100 * slip.mean(), n_ss, n_sk, st_tau.min(), st_tau.max(),
-               ga.min(), ga.max(), vt_abs.max()))
+    for side in [s for s, k in d["kinds"].items() if k == "contact"]:
+        check_tresca_law(d, side, np.linspace(0, 1, 2001), times, log=log)
 
 
 def run_checks(case, exmex_bin=None, log=print):

@@ -40,10 +40,17 @@ def derive(case):
     if case["g_a"] is not None:
         sym["g_a"] = case["g_a"]
     d["sym"] = sym
-    d["str"] = {k: ex(v) for k, v in sym.items()}
-    for k, v in d["str"].items():
-        try:
-            lint(v)                      # what the solver would refuse (src/scene/expr/lint.rs)
-        except ExprError as err:
-            raise CheckFailed("%s: %s violates exmex syntax rules: %s" % (case["name"], k, err)) from None
+    d["str"] = printed(case["name"], sym)
     return d
+
+
+def printed(name, sym):
+    """Every sympy expression of ``sym`` printed in exmex syntax; CheckFailed where the solver's scene lint
+    (src/scene/expr/lint.rs) would refuse a string."""
+    out = {k: ex(v) for k, v in sym.items()}
+    for k, v in out.items():
+        try:
+            lint(v)
+        except ExprError as err:
+            raise CheckFailed("%s: %s violates exmex syntax rules: %s" % (name, k, err)) from None
+    return out

@@ -122,3 +122,9 @@ def sstr(e):
     s = sp.sstr(e, full_prec=True)
     s = s.replace("**", "^").replace("pi", "PI")
     return "0 + " + s if s.startswith("-") else s
+
+
+def factored(e):
+    """sympy's factored form with ``^`` for powers (integer coefficients only): the printer of
+    verification/cases/near_incompressible.toml, whose strings the solvers have read since it was written."""
+    return str(sp.factor(e)).replace("**", "^")

@@ -24,7 +24,8 @@ import sympy as sp
 from tresca_py.expr import ExprError, lint, symbols
 from tresca_py.mms import williams
 from tresca_py.mms.blocks import PosPow, SStep, lam
-from tresca_py.mms.checks import check_contact, check_fields, check_roundtrip, np_grad, stress_np
+from tresca_py.mms.checks import check_contact, check_fields, check_roundtrip
+from tresca_py.mms.tresca_law import np_grad, stress_np
 from tresca_py.mms.derive import CheckFailed, require
 from tresca_py.mms.elasticity import Xs, body_force, grad_of, lame, local_field, stress, to_global
 from tresca_py.mms.exmex import ex
