@@ -8,6 +8,8 @@ is sqrt(½((σxx−σyy)² + (σyy−σzz)² + (σzz−σxx)²) + 3σxy²).
 """
 import numpy as np
 
+from tresca_py.elastic import lame
+
 
 def vertex_values(u, te):
     """(S, T, 3, 2): the field at the triangles' vertices, from midpoint values u (S, E, 2) and the
@@ -31,7 +33,7 @@ def basis_gradients(points, triangles):
 def stress(disp, gl, E, nu):
     """(σxx, σyy, σzz, σxy, von Mises), each (S, T), of the vertex values ``disp`` (S, T, 3, 2)."""
     G = np.einsum("stja,tjb->stab", disp, gl)
-    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    lam, mu = lame(E, nu)
     exx, eyy, exy = G[..., 0, 0], G[..., 1, 1], 0.5 * (G[..., 0, 1] + G[..., 1, 0])
     tr = exx + eyy
     sxx, syy, szz, sxy = lam * tr + 2 * mu * exx, lam * tr + 2 * mu * eyy, lam * tr, 2 * mu * exy

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tresca_py.elastic import lame
 from tresca_py.errors import InputError
 from tresca_py.expr import Expr, VecExpr
 
@@ -78,11 +79,11 @@ class Scene:
 
     @property
     def lam(self):
-        return self.E * self.nu / ((1 + self.nu) * (1 - 2 * self.nu))
+        return lame(self.E, self.nu)[0]
 
     @property
     def mu(self):
-        return self.E / (2 * (1 + self.nu))
+        return lame(self.E, self.nu)[1]
 
 
 def _num(tab, key, where, default=None, positive=False, integer=False):

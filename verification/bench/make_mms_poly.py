@@ -22,7 +22,8 @@ import sympy as sp
 from tresca_py.expr import symbols
 from tresca_py.mms.blocks import PosPow
 from tresca_py.mms.checks import run_checks
-from tresca_py.mms.elasticity import Xs, lame, local_field, to_global
+from tresca_py.elastic import lame
+from tresca_py.mms.elasticity import Xs, local_field, to_global
 from tresca_py.mms.scene_toml import check_toml, scene_text
 
 HERE = pathlib.Path(__file__).resolve().parent

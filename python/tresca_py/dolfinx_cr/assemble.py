@@ -10,7 +10,7 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from tresca_py.dolfinx_cr.edges import CrEdges
-from tresca_py.dolfinx_cr.forms import data_forms, error_forms, load_form
+from tresca_py.dolfinx_cr.forms import data_forms, error_forms, load_form, stiffness_forms
 from tresca_py.errors import InputError
 from tresca_py.mesh import match_points
 from tresca_py.scene import check_loads
@@ -53,24 +53,11 @@ class DolfinxProblem:
         tags = disc.part_of_edge[bedges[k]] + 1
         order = np.argsort(bfacets)
         self.ft = dmesh.meshtags(msh, tdim - 1, bfacets[order], tags[order].astype(np.int32))
-        ids = {kind: tuple(i + 1 for i, b in enumerate(scene.boundaries) if b.kind == kind)
-               for kind in ("dirichlet", "neumann", "contact")}
-
-        lam, mu, rho = scene.lam, scene.mu, scene.rho
-        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-        eps = lambda w: ufl.sym(ufl.grad(w))  # noqa: E731
-        sigma = lambda w: lam * ufl.tr(eps(w)) * ufl.Identity(2) + 2 * mu * eps(w)  # noqa: E731
-        dx0 = ufl.Measure("dx", domain=msh, metadata={"quadrature_degree": 0})   # integrand is constant
-        dS2 = ufl.Measure("dS", domain=msh, metadata={"quadrature_degree": 3})   # 2-point Gauss
-        ds = ufl.Measure("ds", domain=msh, subdomain_data=self.ft)
-        h = ufl.FacetArea(msh)
-        pen = 2.0 * rho * mu / h
-        a_el = ufl.inner(sigma(u), eps(v)) * dx0
-        a_j = 2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(u), ufl.jump(v)) * dS2
-        if ids["dirichlet"]:
-            a_j = a_j + pen * ufl.inner(u, v) * ds(ids["dirichlet"], metadata={"quadrature_degree": 3})
+        fm = stiffness_forms(scene, msh, V, self.ft)
+        v, ds, pen, ids = fm.v, fm.ds, fm.pen, fm.ids
+        a_j = fm.a_jump if fm.a_dir is None else fm.a_jump + fm.a_dir
         self.J = self._gather_matrix(fem.form(a_j))
-        Kel = self._gather_matrix(fem.form(a_el))
+        Kel = self._gather_matrix(fem.form(fm.a_el))
         self.K = None if rank else (Kel + self.J).tocsr()
 
         # loads: UFL expressions in x and the time constant t
@@ -85,7 +72,7 @@ class DolfinxProblem:
         self.err_forms = None
         if scene.exact_u is not None:
             self.uh = fem.Function(V)
-            self.err_forms = error_forms(scene, self.uh, self.t, (lam, mu, rho, pen), h, dS2, ds, ids["dirichlet"],
+            self.err_forms = error_forms(scene, self.uh, self.t, fm.params, fm.h, fm.dS2, ds, ids["dirichlet"],
                                          data=scene.has_boundary_data)
 
     def _gather_matrix(self, form):

@@ -1,11 +1,37 @@
-"""Scene expressions in UFL (sympy -> UFL) and the compiled load and true-error forms of the dolfinx
-re-implementation, with the fixed quadrature rules of the discrete problem."""
+"""Scene expressions in UFL (sympy -> UFL), the bilinear form a_h and the load and true-error forms of the
+dolfinx re-implementations (serial and distributed), with the fixed quadrature rules of the discrete problem."""
+from types import SimpleNamespace
+
 import dolfinx_solver  # noqa: F401  (loads libmpi for the wheel; must precede dolfinx)
 import ufl
 from dolfinx import fem
 
 from tresca_py.errors import InputError
 from tresca_py.quadrature import DUNAVANT_REF_W, DUNAVANT_REF_X
+
+
+def stiffness_forms(scene, msh, V, ft):
+    """The terms of a_h on V with the boundary tags ``ft`` (part index + 1): ``a_el`` (elasticity, one-point
+    rule: the integrand is constant), ``a_jump`` (the jump stabilisation 2ρμ/h [u]·[v], 2-point Gauss),
+    ``a_dir`` (the Dirichlet penalty 2ρμ/h u·v on Γ_D, None without a Dirichlet part), with the test
+    function ``v``, the measures ``dS2``, ``ds``, ``h`` = |e|, ``pen`` = 2ρμ/h and the part ``ids`` by kind."""
+    ids = {kind: tuple(i + 1 for i, b in enumerate(scene.boundaries) if b.kind == kind)
+           for kind in ("dirichlet", "neumann", "contact")}
+    lam, mu, rho = scene.lam, scene.mu, scene.rho
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    eps = lambda w: ufl.sym(ufl.grad(w))  # noqa: E731
+    sigma = lambda w: lam * ufl.tr(eps(w)) * ufl.Identity(2) + 2 * mu * eps(w)  # noqa: E731
+    dx0 = ufl.Measure("dx", domain=msh, metadata={"quadrature_degree": 0})   # integrand is constant
+    dS2 = ufl.Measure("dS", domain=msh, metadata={"quadrature_degree": 3})   # 2-point Gauss
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=ft)
+    h = ufl.FacetArea(msh)
+    pen = 2.0 * rho * mu / h
+    a_dir = None
+    if ids["dirichlet"]:
+        a_dir = pen * ufl.inner(u, v) * ds(ids["dirichlet"], metadata={"quadrature_degree": 3})
+    return SimpleNamespace(a_el=ufl.inner(sigma(u), eps(v)) * dx0,
+                           a_jump=2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(u), ufl.jump(v)) * dS2,
+                           a_dir=a_dir, v=v, dS2=dS2, ds=ds, h=h, pen=pen, ids=ids, params=(lam, mu, rho, pen))
 
 
 def sympy_to_ufl(expr, x, t, key="expression"):

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tresca_py.elastic import lame
 from tresca_py.expr import ExprError
 from tresca_py.expr import parse as expr_parse
 
@@ -185,7 +186,7 @@ def load(path):
     exact = None if ex is None else {"u": _vec(ex["u"], "exact.u"),
                                      "grad": [_vec(ex["grad"][i], f"exact.grad[{i}]") for i in range(2)]}
     return {"title": sc.get("title", Path(path).stem), "scene": str(path), "mesh": mesh, "parts": parts,
-            "E": E, "nu": nu, "lam": E * nu / ((1 + nu) * (1 - 2 * nu)), "mu": E / (2 * (1 + nu)),
+            "E": E, "nu": nu, "lam": lame(E, nu)[0], "mu": lame(E, nu)[1],
             "f": _vec(sc.get("loads", {}).get("f"), "loads.f"),
             "u0": _vec(sc.get("initial", {}).get("u0"), "initial.u0"),
             "T": _num(tm, "T", "time"), "steps": int(tm.get("steps", 1)), "exact": exact}

@@ -20,8 +20,12 @@ from dataclasses import dataclass
 
 from tresca_py.common import observed_order
 
-#: GCI-ratio tolerance of the fourth-level check (the value of tresca-cr's ``RATIO_TOL``)
+#: GCI-ratio tolerance of the fourth-level check, and Roache's safety factors with an observed order (three
+#: levels) and with the order assumed: tresca-cr's ``RATIO_TOL``, ``FS_THREE`` and ``FS_TWO`` of
+#: src/study/richardson.rs (python/tests/test_richardson_constants.py fails if they drift apart)
 RATIO_TOL = 0.1
+FS_THREE = 1.25
+FS_TWO = 3.0
 
 
 @dataclass
@@ -58,8 +62,8 @@ def limit(h, q, p_th=1.0, p_max=5.0):
         if 0.5 <= p <= p_max:
             qstar = q3 + d2 / (r ** p - 1)
             if _confirmed(h, q, p, qstar):
-                return Limit(qstar, 1.25 * abs(d2) / (r ** p - 1), p, True)
-    return Limit(q3, 3.0 * max(abs(d1), abs(d2)) / (r ** p_th - 1), math.nan, False)
+                return Limit(qstar, FS_THREE * abs(d2) / (r ** p - 1), p, True)
+    return Limit(q3, FS_TWO * max(abs(d1), abs(d2)) / (r ** p_th - 1), math.nan, False)
 
 
 #: rounding floor of a band, relative to the value: the codes stop Newton at a relative residual of 1e-10

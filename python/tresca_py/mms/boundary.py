@@ -16,7 +16,8 @@ from tresca_py.expr import symbols
 from tresca_py.mms.blocks import SStep
 from tresca_py.mms.cases import UNIT_SQUARE, case_stop
 from tresca_py.mms.derive import require
-from tresca_py.mms.elasticity import PHI0, PHI1, Xs, Ys, lame, to_global
+from tresca_py.elastic import lame
+from tresca_py.mms.elasticity import PHI0, PHI1, Xs, Ys, to_global
 
 x, y, t = symbols()
 R = sp.Rational

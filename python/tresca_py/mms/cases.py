@@ -6,7 +6,8 @@ from tresca_py.expr import symbols
 from tresca_py.mms.blocks import PosPow, SStep
 from tresca_py.mms.checks import run_checks
 from tresca_py.mms.derive import CheckFailed
-from tresca_py.mms.elasticity import Xs, lame, local_field, to_global
+from tresca_py.elastic import lame
+from tresca_py.mms.elasticity import Xs, local_field, to_global
 
 x, y, t = symbols()
 R = sp.Rational

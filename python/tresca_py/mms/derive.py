@@ -3,7 +3,8 @@ sigma(u) n on every Neumann side, u0 = u(., 0), grad u, and every one of them pr
 import sympy as sp
 
 from tresca_py.expr import ExprError, lint, symbols
-from tresca_py.mms.elasticity import body_force, grad_of, lame, side_normal_exact, stress
+from tresca_py.elastic import lame
+from tresca_py.mms.elasticity import body_force, grad_of, side_normal_exact, stress
 from tresca_py.mms.exmex import ex
 
 x, y, t = symbols()

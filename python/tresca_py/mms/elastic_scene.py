@@ -3,7 +3,8 @@ exact u vanishing on the clamped side, f = -div sigma(u) and sigma(u) n on the o
 the float printer ``exmex.sstr``."""
 import sympy as sp
 
-from tresca_py.mms.elasticity import body_force, grad_of, lame, stress
+from tresca_py.elastic import lame
+from tresca_py.mms.elasticity import body_force, grad_of, stress
 from tresca_py.mms.exmex import sstr
 
 E, NU = 100.0, 0.3

@@ -8,11 +8,6 @@ from tresca_py.expr import symbols
 
 x, y, t = symbols()
 
-def lame(E, nu):
-    """Plane-strain Lame constants (lambda, mu)."""
-    return E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
-
-
 def grad_of(u):
     """[[du1/dx, du1/dy], [du2/dx, du2/dy]]."""
     return sp.Matrix([[sp.diff(u[0], x), sp.diff(u[0], y)], [sp.diff(u[1], x), sp.diff(u[1], y)]])

@@ -27,7 +27,8 @@ from tresca_py.mms.blocks import PosPow, SStep, lam
 from tresca_py.mms.checks import check_contact, check_fields, check_roundtrip
 from tresca_py.mms.tresca_law import np_grad, stress_np
 from tresca_py.mms.derive import CheckFailed, require
-from tresca_py.mms.elasticity import Xs, body_force, grad_of, lame, local_field, stress, to_global
+from tresca_py.elastic import lame
+from tresca_py.mms.elasticity import Xs, body_force, grad_of, local_field, stress, to_global
 from tresca_py.mms.exmex import ex
 
 x, y, t = symbols()

@@ -21,7 +21,7 @@ import mpmath as mp
 import sympy as sp
 
 from tresca_py.expr import symbols
-from tresca_py.mms.elasticity import lame
+from tresca_py.elastic import lame
 
 x, y, t = symbols()
 LAM, Q = sp.symbols("lamW qW", positive=True)

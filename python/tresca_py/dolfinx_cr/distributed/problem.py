@@ -11,7 +11,6 @@ import dolfinx_solver  # noqa: F401  (loads libmpi for the wheel; must precede d
 import dolfinx
 import dolfinx.fem.petsc
 import numpy as np
-import ufl
 from dolfinx import fem
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
@@ -21,7 +20,7 @@ from tresca_py.dolfinx_cr.distributed import consistency
 from tresca_py.dolfinx_cr.distributed.data import Lifting, boundary_data
 from tresca_py.dolfinx_cr.distributed.linear import condense, factorise_relaxed, petsc_lib
 from tresca_py.dolfinx_cr.distributed.mesh import Fail, agree, gmsh_mesh, structured_mesh
-from tresca_py.dolfinx_cr.forms import error_forms, load_form
+from tresca_py.dolfinx_cr.forms import error_forms, load_form, stiffness_forms
 from tresca_py.errors import InputError
 from tresca_py.quadrature import GAUSS3_S, GAUSS3_W
 from tresca_py.scene import check_loads
@@ -87,8 +86,8 @@ class Problem:
         self.mem_setup["mesh"] = peak_mb()
 
         tic = time.perf_counter()
-        h, dS2, ds, pen, ids = self._stiffness(bf, side)
-        self._loads_and_errors(h, dS2, ds, pen, ids)
+        fm = self._stiffness(bf, side)
+        self._loads_and_errors(fm)
         self.times_setup["assembly"] = time.perf_counter() - tic
         memlog("loads and error forms compiled")
         self.mem_setup["assembly"] = peak_mb()
@@ -219,25 +218,13 @@ class Problem:
 
     def _stiffness(self, bf, side):
         """K_r = R^T K R with the constrained rows and columns zeroed (unit diagonal): self.Kr. Returns the
-        measures and data the load and error forms share (h, dS2, ds, pen, ids)."""
+        forms, measures and data the load and error forms share (tresca_py.dolfinx_cr.forms.stiffness_forms)."""
         scene, msh, V, memlog = self.scene, self.msh, self.V, self.memlog
         tags_idx = np.argsort(bf)
         self.ft = dmesh.meshtags(msh, 1, bf[tags_idx].astype(np.int32), (side[tags_idx] + 1).astype(np.int32))
-        ids = {k: tuple(i + 1 for i, bb in enumerate(scene.boundaries) if bb.kind == k)
-               for k in ("dirichlet", "neumann", "contact")}
-        lam, mu, rho = scene.lam, scene.mu, scene.rho
-        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-        eps = lambda w: ufl.sym(ufl.grad(w))  # noqa: E731
-        sigma = lambda w: lam * ufl.tr(eps(w)) * ufl.Identity(2) + 2 * mu * eps(w)  # noqa: E731
-        dx0 = ufl.Measure("dx", domain=msh, metadata={"quadrature_degree": 0})
-        dS2 = ufl.Measure("dS", domain=msh, metadata={"quadrature_degree": 3})   # 2-point Gauss
-        ds = ufl.Measure("ds", domain=msh, subdomain_data=self.ft)
-        h = ufl.FacetArea(msh)
-        pen = 2.0 * rho * mu / h
-        a_int = ufl.inner(sigma(u), eps(v)) * dx0 + 2.0 * rho * mu / h("+") * ufl.inner(ufl.jump(u), ufl.jump(v)) * dS2
-        a_h = a_int
-        if ids["dirichlet"]:
-            a_h = a_h + pen * ufl.inner(u, v) * ds(ids["dirichlet"], metadata={"quadrature_degree": 3})
+        fm = stiffness_forms(scene, msh, V, self.ft)
+        a_int = fm.a_el + fm.a_jump
+        a_h = a_int if fm.a_dir is None else a_int + fm.a_dir
         self.a_int, self.a_ufl = a_int, a_h
         a_form = fem.form(a_h)
         memlog("a_h compiled")
@@ -258,8 +245,8 @@ class Problem:
         Kr.zeroRowsColumns(np.sort(cons).astype(PETSc.IntType), diag=1.0)
         Kr.setOption(PETSc.Mat.Option.SPD, True)
         self.Kr = Kr
-        self.v = v
-        return h, dS2, ds, pen, ids
+        self.v = fm.v
+        return fm
 
     def _rotation(self):
         """R: owned rows, identity except [tau n] on contact edges (u = R r)."""
@@ -285,20 +272,19 @@ class Problem:
         R.assemble()
         return R
 
-    def _loads_and_errors(self, h, dS2, ds, pen, ids):
-        scene, msh, V = self.scene, self.msh, self.V
-        lam, mu, rho = scene.lam, scene.mu, scene.rho
+    def _loads_and_errors(self, fm):
+        scene, msh, V, ds = self.scene, self.msh, self.V, fm.ds
         self.t = fem.Constant(msh, 0.0)
         self.L = load_form(scene, msh, self.v, ds, self.t)
         self.lvec = dolfinx.fem.petsc.create_vector(V)     # ghosted, layout of V
         self.uh = fem.Function(V)
         self.err_forms = None
         if self.lift is not None:
-            self.lift.compile(self.a_int, self.a_ufl, pen, ds)
+            self.lift.compile(self.a_int, self.a_ufl, fm.pen, ds)
         if scene.exact_u is not None:
             # with boundary data the error's jump on Γ_D is u_h − u: the lifting's form, not u_h alone
-            dirichlet = ids["dirichlet"] if self.lift is None else ()
-            self.err_forms = error_forms(scene, self.uh, self.t, (lam, mu, rho, pen), h, dS2, ds, dirichlet)
+            dirichlet = fm.ids["dirichlet"] if self.lift is None else ()
+            self.err_forms = error_forms(scene, self.uh, self.t, fm.params, fm.h, fm.dS2, ds, dirichlet)
 
     def solve(self, b, x):
         self.ksp.solve(b, x)

@@ -7,7 +7,7 @@ import sympy as sp
 
 from tresca_py.expr import symbols
 
-from tresca_py.mms.elasticity import lame
+from tresca_py.elastic import lame
 from tresca_py.mms.near_incompressible import field
 
 x, y, t = symbols()
