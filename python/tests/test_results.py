@@ -127,7 +127,7 @@ class TestRustFile:
             r.require_contact("a contact plot needs one")
 
     def test_values(self, runs):
-        """σ_τ = −μ/|e| and the contact unknown equal to the slip (the README's table)."""
+        """σ_τ = −μ/|e| and the contact unknown equal to the slip (docs/results.md's table)."""
         r = results.read(runs["contact"])
         m, c = r.mesh, r.contact
         length = np.linalg.norm(np.diff(m.points[m.edges[c.edges]], axis=1)[:, 0], axis=1)

@@ -6,7 +6,7 @@ A file's module path follows from its place (`src/solve/free.rs` is `solve::free
 exists. An edge a → b is kept when b is neither a nor the crate root (`lib.rs`). Two findings:
 
 * **circles**: the strongly connected components of more than one file (Tarjan's algorithm);
-* **upward imports**: a path that resolves to the crate root itself (`crate::named_enum!`, `crate::Foo`
+* **upward imports**: a path that resolves to the crate root itself (`crate::<macro>!`, `crate::<Type>`
   re-exported by `lib.rs`), from any file other than `lib.rs` and `main.rs`.
 
 A folder's `mod.rs` declares its children (`mod sub;` is not an edge; neither are its `pub use sub::…`

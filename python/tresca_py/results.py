@@ -1,4 +1,4 @@
-"""The one ``/tresca`` layout of a results file, for writing and reading (the README's layout table; written
+"""The one ``/tresca`` layout of a results file, for writing and reading (docs/results.md's layout table; written
 by ``src/output/tresca.rs`` and by ``write`` here for the serial Python solvers).
 
 ``read(path)`` returns a validated ``Results`` of the committed steps, or raises ``ResultsError`` naming the

@@ -9,7 +9,7 @@ uⁿ = wⁿ + u_Lⁿ solves the friction step (``TaoStepSolver``) with the load
 the stabilisation's jump on Γ_D being measured against u_D. The energy written is a_h(u,u) without data and
 a_h(u,u) − 2b_D(u) + c(t) with them (the Dirichlet jump u − u_D; c(t) = Σ (2ρμ/h_e) ∫_e |u_D|²). An edge of Γ_C
 slips when its friction force is at the bound, |μ_e| ≥ w_e(1 − 1e-9), and its slip increment is not rounding,
-|Δs_e| > 1e-9 max(‖Δs‖∞, ‖d‖∞): the rule of the Rust solver (``contact::classify``), so the stick/slip sets
+|Δs_e| > 1e-9 max(‖Δs‖∞, ‖d‖∞): the rule of the Rust solver (``friction::classify``), so the stick/slip sets
 of the three codes can be compared exactly.
 """
 import math

@@ -114,7 +114,7 @@ class StepSolver:
 
 
 def classify(mu, ds, d, w):
-    """Stick (0) / slip (1) per contact edge, the convention of the Rust solver (contact::classify):
+    """Stick (0) / slip (1) per contact edge, the convention of the Rust solver (friction::classify):
     slip when |mu_e| >= w_e (1 - 1e-9) and |ds_e| > 1e-9 max(|ds|_inf, |d|_inf), where ds = d - C mu is
     the slip increment of the step and d = s_free - s^{n-1} the increment without friction
     (w_e = 0: slip when |ds_e| exceeds the threshold)."""

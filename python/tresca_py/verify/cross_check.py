@@ -72,20 +72,15 @@ PAIRS = (("rust", "skfem"), ("rust", "dolfinx"), ("skfem", "dolfinx"))
 
 NOTES = """## Notes
 
-**Disagreements found while building this check** (git history of scripts/, commit 138f209 and later):
+**What the three codes share.** They read the same scene expressions the same way and classify contact
+edges by the same rule, so identical numbers and identical stick/slip sets can be required:
 
-1. `signum(0)`: exmex evaluates Rust's `f64::signum`, +1 at 0; the Python reader mapped `signum` to
-   `sympy.sign`, 0 at 0. On `expr_signum` (g_a, traction and f containing `signum(0*x)`) the old Python
-   solvers differed from Rust by du = 0.57, dE = 0.75, dsig = 0.40 (relative). Fixed in
-   tresca_py/expr.py (`signum`, a Piecewise with value +1 at 0) and scripts/dolfinx_solve.py
-   (Piecewise -> `ufl.conditional`). Both codes now agree with Rust to 1e-14.
-2. Stick/slip flag: the Python solvers flagged slip when |s_e - s_e^(n-1)| > 1e-12 max(|u^n|, |u^(n-1)|);
-   Rust (`contact::classify`) when |Δs_e| > 1e-9 max(|Δs|, |d|). No case here produced a differing flag with
-   the old rule, but the rules differ for increments between the two thresholds; the Python codes now use
-   Rust's rule (`tresca_py.skfem_cr.friction.classify`), so identical sets can be required.
-3. Lower-case `pi`: the README lists the constants `pi` and `e`; the Python reader accepts `pi`, the Rust
-   reader rejects it ("unknown variable `pi`"; exmex knows only `PI`, `π`, `E`, `e`, `TAU`). A reading
-   difference, not a numerical one; the scenes here use `PI`.
+1. `signum(0) = +1` everywhere: Rust evaluates `f64::signum`; the Python reader (tresca_py/expr.py) writes
+   `signum` as a Piecewise with value +1 at 0, which the dolfinx solvers translate to `ufl.conditional`.
+2. Stick/slip: an edge slips at step n when |Δs_e| > 1e-9 max(|Δs|, |d|), in Rust (`friction::classify`) and
+   in Python (`tresca_py.skfem_cr.friction.classify`, used by both Python solvers).
+3. Constants: `PI`, `π`, `E`, `e`, `TAU`, `τ`, and lower-case `pi` read as `PI` by both readers
+   (src/scene/expr/lint.rs, tresca_py/expr.py).
 
 **Rounding amplification of derr.** |e_A - e_B| <= |||u_A - u_B||| (reverse triangle inequality), so the
 relative difference of the true errors is up to du·|||u|||/e: the DOF vectors agree to about κ(a_h)·eps
@@ -97,17 +92,14 @@ or below refine 2. Beyond that a bound on |e_A - e_B| / |||u||| is the meaningfu
 **Near incompressibility.** near_incompressible (ν = 0.4999) agrees to 1e-11, but with ν = 0.4999999
 (E = 2(1+ν)) κ(a_h)·eps reaches about 1e-7: Rust differs from both Python codes by du 2e-8 (refine 1) and
 1e-7 (refine 2), skfem from dolfinx by 2e-9 and 2e-8. Against a skfem solve with 5 steps of iterative
-refinement the errors at refine 2 are: Rust 1.1e-7, dolfinx 1.8e-8, skfem (1 refinement step, as shipped)
-1.6e-9, skfem without refinement 1.8e-8. The Python solvers do one step of iterative refinement after
-SuperLU; the Rust solver (src/factor.rs, `Factor::solve_in_place` / `solve_many`) does none. A 1e-8
+refinement the errors at refine 2 are: Rust 1.1e-7, dolfinx 1.8e-8, skfem (1 refinement step) 1.6e-9,
+skfem without refinement 1.8e-8. The Python solvers do one step of iterative refinement after SuperLU;
+the Rust solver (src/solve/factor.rs, `Factor::solve_in_place` / `solve_many`) does none. A 1e-8
 agreement is not a meaningful requirement there (assembly rounding alone moves dolfinx 1.8e-8 from skfem).
 
 **Wall times.** The Python processes spend 1.5–3 s in start-up (imports; dolfinx form compilation on
 first use, cached afterwards), so on these small meshes the whole-process times compare start-up costs;
-the bracketed in-process times compare the solvers. On the MMS scenes about three quarters of the Rust run time
-is exmex evaluation of the long generated load/exact expressions (perf: `FlatEx::eval` and exmex's
-`NumberTracker::get_previous/get_next`), e.g. mms_front refine 1 with 64 steps: 4.0 s in all, 1.7 s
-without `[exact]`.
+the bracketed in-process times compare the solvers.
 """
 
 
@@ -408,7 +400,7 @@ def main(argv=None):
           "# Cross-check: Rust, scikit-fem and dolfinx (issue 6)", "",
           f"`{self_cmd}{' --no-mpi' if args.no_mpi else ''}` — {len(reqs) - nfail}/{len(reqs)} requirements passed, "
           f"{total:.0f} s in all. Tolerance {TOL:g}; stick/slip sets must be identical.", "",
-          "Stick/slip convention of all three codes (Rust `contact::classify`): an edge slips at step n when "
+          "Stick/slip convention of all three codes (Rust `friction::classify`): an edge slips at step n when "
           "|μ_e| ≥ w_e(1 − 1e-9) and |Δs_e| > 1e-9·max(‖Δs‖∞, ‖d‖∞), Δs = d − Cμ the slip increment, d the "
           "increment without friction; state 0 and μ = 0 at step 0; σ_τ = −μ/|e|; exmex's signum(0) = 1.", "",
           "## Requirements", "", "| id | passed | measured |", "|---|---|---|"]

@@ -41,7 +41,7 @@ def partitioner(comm):
 
 
 def structured_mesh(comm, scene):
-    """The README's structured mesh, generated in slabs (each rank a contiguous range of points and
+    """The structured mesh of docs/scene.md, generated in slabs (each rank a contiguous range of points and
     cells in the scene's numbering) and distributed by dolfinx.  Returns (mesh, part tag per local
     exterior facet as a function)."""
     ms = scene.mesh
