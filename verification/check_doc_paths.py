@@ -1,5 +1,5 @@
 """Check that every path the documentation names exists (README.md, docs/, the READMEs under verification/),
-and that every Rust name (`module::item`) and `src/…rs` path in a comment or a document exists
+and that every Rust name (`<module>::<item>`) and `src/…rs` path in a comment or a document exists
 (tresca_py.docnames).
 
     .venv/bin/python verification/check_doc_paths.py [--root DIR]
