@@ -48,7 +48,7 @@ import time
 from tresca_py.common import BIN, REF, ROOT, case, cmdline, load1, run, strip_exact
 from tresca_py.verify import summary as cli_summary
 from tresca_py.verify.harness import Harness, out_dir
-from tresca_py.verify.timing import timed
+from tresca_py.bench.timing import timed
 
 # grid per case: steps N_s·2^j for j < len; refinements 0..R
 CASES = {

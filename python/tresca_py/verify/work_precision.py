@@ -28,7 +28,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from tresca_py.common import BIN, REF, ROOT, load1, short_path, strip_exact  # noqa: E402
 from tresca_py.verify import summary as cli_summary  # noqa: E402
-from tresca_py.verify.timing import timed  # noqa: E402
+from tresca_py.bench.timing import timed  # noqa: E402
 CASES = {
     "mms_front": dict(path="verification/cases/mms_front.toml", h_N=32, h_r=3, k_r=2, k_N=[8, 16, 32, 64, 128, 256],
                       joint=[(0, 8), (1, 16), (2, 32), (3, 64)], tol_level=(2, 32)),

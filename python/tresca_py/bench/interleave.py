@@ -1,6 +1,6 @@
 """Compare two binaries on one command line by alternating their runs (A, B, A, B, ...) and printing the
 median and minimum process wall time of each: on a shared VM whose speed drifts by up to 1.7x within
-minutes, only runs interleaved like this compare two builds fairly (:func:`tresca_py.verify.timing.timed`,
+minutes, only runs interleaved like this compare two builds fairly (:func:`tresca_py.bench.timing.timed`,
 as bench.py times; output discarded, exit status not checked). A benchmark tool: nothing of `make verify`
 or `make test` uses it.
 
@@ -10,7 +10,7 @@ import os
 import statistics
 import sys
 
-from tresca_py.verify.timing import timed
+from tresca_py.bench.timing import timed
 
 
 def interleave(n, a, b, args):

@@ -51,7 +51,7 @@ import numpy as np
 from tresca_py.common import BIN, PY, REF, ROOT, load1
 from tresca_py.compare import CompareError, compare_files
 from tresca_py.verify import summary as cli_summary
-from tresca_py.verify.timing import timed
+from tresca_py.bench.timing import timed
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
 ELASTIC = os.path.join(ROOT, "verification", "bench", "bench_elastic.toml")
 
