@@ -24,7 +24,7 @@ import re
 import tomllib
 from dataclasses import dataclass
 
-from tresca_py.doccheck import default_docs, expand_braces
+from tresca_py.doccheck import Missing, default_docs, expand_braces
 
 _NAME = re.compile(r"(?<![\w:])((?:[A-Za-z_]\w*::)+[A-Za-z_]\w*)")
 _SRC_PATH = re.compile(r"(?<![\w./-])(src/[\w./{},-]*\.rs)\b")
@@ -35,12 +35,8 @@ _ITEM = r"(?:fn|struct|enum|trait|type|const|static|mod|macro_rules!|union)\s+{}
 
 
 @dataclass(frozen=True)
-class Stale:
+class Stale(Missing):
     """A Rust name or source path in `doc` at `line` that names nothing in src/."""
-
-    doc: str
-    line: int
-    ref: str
 
     def __str__(self) -> str:
         return f"{self.doc}:{self.line}: `{self.ref}` names no module, item or file of src/"
