@@ -13,7 +13,8 @@ not scanned.
   either a submodule of it (`a/b.rs`, `a/b/mod.rs`, or `mod b` inside its file) or an item its file
   defines or re-exports (`fn b`, `struct b`, `enum`, `trait`, `type`, `const`, `static`, `macro_rules! b`,
   `pub use …b`); the parts after an item (methods, variants) are not followed.
-* Not ours, so not checked: placeholders (a part of one letter: `a::b`), CamelCase first parts (types: `Factor::solve_in_place`), primitive types
+* Not ours, so not checked: placeholders (a part of one letter: `a::b`), CamelCase first parts (types:
+  `Factor::solve_in_place`), primitive types
   (`f64::signum`), `std`/`core`/`alloc`, and the crates of Cargo.toml (`faer::`, `hdf5::`, `exmex::`, …).
 """
 from __future__ import annotations

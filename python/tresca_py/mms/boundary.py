@@ -108,7 +108,8 @@ def case_data_stop():
     phi1 = y * (1 - y) ** 2
     v = [y ** 2 * h - phi1 * sp.diff(g, x), g]
     c = dict(c, u=[c["u"][0] + v[0], c["u"][1] + v[1]], name="mms_data_stop", static=False,
-             title="MMS (issue 30 c): slip stops abruptly at t* = 1/3, with Dirichlet data and imposed normal displacement")
+             title="MMS (issue 30 c): slip stops abruptly at t* = 1/3, with Dirichlet data and imposed normal "
+                   "displacement")
     c["header"] = c["header"].split("\nMeasured errors")[0] + """
 Plus boundary data (issue 30): u + v with v = (y^2 (1+t) sin(x)/20 - y(1-y)^2 g_x, g), g = (1 + x/2)(1 + t)/40:
 v = (0, g) on y = 0 and dv1/dy + dv2/dx = 0 there, so slip and sigma_t.tau are mms_stop's, u.n = -g on

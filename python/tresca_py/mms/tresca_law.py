@@ -96,7 +96,8 @@ def check_tresca_law(d, side, s, times, gap=None, log=print):
     require(res <= vtol, "%s: u_t' not parallel to sigma_t (%.2e)" % (name, res))
     n_ss, n_sk = (0, 0) if static else check_in_time(d, stick, slip, st_abs - ga, times, ttol)
     st_tau = st1 * tau[0] + st2 * tau[1]
-    log("Tresca on %s (%d x %d samples): u.n = gap, |sig_t|<=g_a, stick, slip dir, u0   ok" % (side, len(s), len(times)))
+    log("Tresca on %s (%d x %d samples): u.n = gap, |sig_t|<=g_a, stick, slip dir, u0   ok"
+        % (side, len(s), len(times)))
     log("   stick %.0f%%, slipping %.0f%% of samples; %d points stick->slip, %d slip->stick; "
         "sigma_t.tau in [%.3g, %.3g], g_a in [%.3g, %.3g], max|slip rate| %.3g, max|u.n| %.3g"
         % (100 * stick.mean(), 100 * slip.mean(), n_ss, n_sk, st_tau.min(), st_tau.max(),

@@ -3,7 +3,8 @@
     .venv/bin/python verification/stability.py [--json OUT] [--md FILE] [--only case_nu,...]
 
 (verification/stability.py is the entry point; ``main`` the report, ``harness`` the runs, ``p1`` the
-reference solver and eigenvalues, ``material`` and ``extremes`` the cases.) Each case records its requirements S<i>-stability in a
+reference solver and eigenvalues, ``material`` and ``extremes`` the cases.)
+Each case records its requirements S<i>-stability in a
 harness (:class:`Stability`: the temporary directory, the results files written and the harness, passed
 to every case; no module-level state).
 Each case states the expected behaviour, what was measured (release CLI; results read back from the HDF5

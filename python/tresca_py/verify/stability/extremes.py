@@ -123,7 +123,8 @@ def case_singular(st):
     r = run(st, write(st, txt, "nodirichlet.toml"))
     st.check("singular set-up: no Dirichlet part (rigid motions free)",
           "refused with a message naming the cause, non-zero exit, no results file written",
-          f"rc {r['rc']}, stderr '{r['stderr'][:200]}'", r["rc"] != 0 and ("positive definite" in r["stderr"] or "rigid motions" in r["stderr"]))
+          f"rc {r['rc']}, stderr '{r['stderr'][:200]}'",
+          r["rc"] != 0 and ("positive definite" in r["stderr"] or "rigid motions" in r["stderr"]))
 
 
 def case_finite(st):

@@ -16,7 +16,8 @@ def main(argv=None):
     ap.add_argument("--regenerate", action="store_true")
     ap.add_argument("--only", help="comma-separated case functions to run (no report is written)")
     ap.add_argument("--json", help="write the requirement list here")
-    ap.add_argument("--md", default=os.path.join(REF, "stability.md"), help="the report (default reference/stability.md)")
+    ap.add_argument("--md", default=os.path.join(REF, "stability.md"),
+                    help="the report (default reference/stability.md)")
     args = ap.parse_args(argv)
     if args.regenerate or not os.path.exists(NEAR):
         open(NEAR, "w").write(near_scene_text())

@@ -151,5 +151,6 @@ def case_rho(st):
           "singular/ill-conditioned set-up and stop with a message (or warn) rather than return a polluted "
           "solution silently",
           f"ρ=1e-12: rc {r12['rc']}, errors {r12['err']}, κ(K) {c12[0]:.2e}; ρ=1e-4: errors {rows[1e-4][0]['err']}; "
-          f"ρ=1e-2: L2 error {rows[1e-2][0]['err'][2]:.2e} = {rows[1e-2][0]['err'][2] / base_l2:.0f}× the ρ = 10 value; "
+          f"ρ=1e-2: L2 error {rows[1e-2][0]['err'][2]:.2e} = "
+          f"{rows[1e-2][0]['err'][2] / base_l2:.0f}× the ρ = 10 value; "
           f"stderr '{r12['stderr'][:150]}'", not silent_bad)
