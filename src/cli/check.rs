@@ -117,6 +117,9 @@ pub fn check(scene: Scene, estimate: Estimate, json: Option<std::path::PathBuf>)
     say!("solver     {} (tol {:.1e}, max_iter {})", s.solver.method.name(), s.solver.tol, s.solver.max_iter());
     say!("exact      {}", if s.exact.is_some() { "given: true errors computed" } else { "none" });
     say!("estimate   {}", estimate.describe());
+    let points = tresca_cr::fem::singular::singularities(m, &sp.edge_part, &s.parts, s.material.nu);
+    let (lines, singular) = super::corners::describe(&points, &s.parts);
+    lines.iter().for_each(|l| say!("{l}"));
     if let Some(j) = &json {
         let mut summary = super::summary::Summary::new("check", &s.file, start.elapsed().as_secs_f64());
         summary.check = Some(super::summary::CheckSummary {
@@ -135,6 +138,7 @@ pub fn check(scene: Scene, estimate: Estimate, json: Option<std::path::PathBuf>)
             setup: problem.setup.into(),
             memory: estimate.memory,
             disk: estimate.disk,
+            singular,
         });
         super::summary::write(j, &summary)?;
     }

@@ -20,7 +20,8 @@
 //! `check` ([`CheckSummary`]): `vertices`, `triangles`, `edges`, `h` (largest edge) of the mesh; `unknowns`,
 //! `paper_dofs` (the paper's count 2(edges − Dirichlet edges)), `contact_unknowns`; `steps`; `solver`, `tol`,
 //! `max_iter`; `exact` (true errors computed); `setup` ([`Phases`]); `memory`, `disk`: the pre-run estimate
-//! of the peak memory and of the results file (bytes).
+//! of the peak memory and of the results file (bytes); `singular` ([`Singular`]): every polygon corner and
+//! change of condition with its leading exponent α, `uniform_order` = min(1, min Re α), `adaptive_order` ½.
 //!
 //! `run` ([`RunSummary`]): `refine` (the mesh level), `unknowns`, `paper_dofs`, `contact_edges`, `steps` (time
 //! steps of the run); `solver`, `tol`; `setup` ([`Phases`]); `ordering` (how K's fill-reducing ordering
@@ -199,6 +200,31 @@ pub struct CheckSummary {
     pub setup: Phases,
     pub memory: u64,
     pub disk: u64,
+    /// The singular exponents of the scene's boundary points (`cli/corners.rs`).
+    pub singular: Singular,
+}
+
+/// `check`'s singular exponents: every corner and change of condition, and the orders that follow.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct Singular {
+    pub points: Vec<SingularPoint>,
+    /// min(1, min Re α): the energy-norm order in h of uniform refinement.
+    pub uniform_order: f64,
+    /// The order in N (unknowns) that adaptive refinement can reach: ½.
+    pub adaptive_order: f64,
+}
+
+/// One boundary point: where, its interior angle (radians), its two parts and the pair of conditions
+/// with the smallest exponent, and that exponent α (`null` when Re α ≥ 1).
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct SingularPoint {
+    pub x: f64,
+    pub y: f64,
+    pub angle: f64,
+    pub parts: [String; 2],
+    pub sides: [String; 2],
+    pub alpha: Option<f64>,
+    pub alpha_imag: Option<f64>,
 }
 
 /// One time step's statistics.

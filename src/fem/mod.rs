@@ -11,4 +11,6 @@ pub mod loads;
 pub mod norms;
 pub mod prolong;
 pub mod quadrature;
+pub mod singular;
 pub mod space;
+pub mod williams;

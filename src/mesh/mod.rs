@@ -7,6 +7,8 @@
 //! that every boundary edge belongs to exactly one declared part. [`bisect`] refines locally.
 
 pub mod bisect;
+mod corners;
+pub use corners::BoundaryPoint;
 mod edge_index;
 mod gmsh;
 mod quality;

@@ -1,0 +1,77 @@
+//! The singular exponents of a scene: at every polygon corner and every boundary point where the condition
+//! changes type, the leading exponent α of plane-strain elasticity ([`williams`](super::williams)), and
+//! from the smallest, the energy-norm order that uniform refinement can reach, min(1, Re α) in h.
+//!
+//! A part's side conditions for the homogeneous problem: Dirichlet is clamped, Neumann free, and a contact
+//! part may stick (clamped, the tangential motion held) or slip (sliding, u·n given and σ_τ = ±g_a, data
+//! that do not change the exponent): its bound is the smaller of the two. Adaptive refinement that
+//! resolves the singularities reaches N^(−1/2) in the number of unknowns N whatever α.
+
+use super::williams::{leading_exponent, Side};
+use crate::mesh::Mesh;
+use crate::scene::{Part, PartKind};
+use nalgebra::Complex;
+
+/// One boundary point with its leading exponent.
+#[derive(Clone, Debug)]
+pub struct Singularity {
+    pub point: [f64; 2],
+    /// Interior angle ω in (0, 2π].
+    pub angle: f64,
+    /// The parts of the two sides.
+    pub parts: [usize; 2],
+    /// The conditions of the pair that gives the smallest exponent.
+    pub sides: [Side; 2],
+    /// The leading exponent with 0 < Re α < 1, if there is one.
+    pub alpha: Option<Complex<f64>>,
+}
+
+impl Singularity {
+    /// min(1, Re α): the energy-norm order in h that uniform refinement reaches near this point.
+    pub fn uniform_order(&self) -> f64 {
+        self.alpha.map_or(1.0, |a| a.re.min(1.0))
+    }
+}
+
+/// The conditions a part can impose, for the homogeneous problem.
+pub fn sides_of(kind: &PartKind) -> &'static [Side] {
+    match kind {
+        PartKind::Dirichlet(_) => &[Side::Clamped],
+        PartKind::Neumann(_) => &[Side::Free],
+        PartKind::Contact(..) => &[Side::Clamped, Side::Sliding],
+    }
+}
+
+/// Every corner and change of condition of the mesh's boundary with its exponent; `edge_part` gives each
+/// boundary edge's part (as `CrSpace::edge_part`).
+pub fn singularities(mesh: &Mesh, edge_part: &[Option<usize>], parts: &[Part], nu: f64) -> Vec<Singularity> {
+    let part = |e: usize| edge_part[e].expect("boundary edges belong to a part");
+    let points = mesh.boundary_points(|a, b| sides_of(&parts[part(a)].kind) != sides_of(&parts[part(b)].kind));
+    points
+        .into_iter()
+        .map(|p| {
+            let pair = [part(p.edges[0]), part(p.edges[1])];
+            let (sides, alpha) = worst(pair.map(|q| sides_of(&parts[q].kind)), p.angle, nu);
+            Singularity { point: p.point, angle: p.angle, parts: pair, sides, alpha }
+        })
+        .collect()
+}
+
+/// The pair of conditions with the smallest exponent, over the conditions each side can be in.
+fn worst(can: [&[Side]; 2], angle: f64, nu: f64) -> ([Side; 2], Option<Complex<f64>>) {
+    let mut out = ([can[0][0], can[1][0]], None);
+    for &a in can[0] {
+        for &b in can[1] {
+            let alpha = leading_exponent([a, b], angle, nu);
+            if alpha.map_or(f64::INFINITY, |z| z.re) < out.1.map_or(f64::INFINITY, |z: Complex<f64>| z.re) {
+                out = ([a, b], alpha);
+            }
+        }
+    }
+    out
+}
+
+/// min(1, min Re α) over the points: the energy-norm order in h of uniform refinement (1 without any).
+pub fn uniform_order(points: &[Singularity]) -> f64 {
+    points.iter().map(Singularity::uniform_order).fold(1.0, f64::min)
+}
