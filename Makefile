@@ -89,7 +89,7 @@ reference: venv
 
 # Timings live here only (no pass/fail of make verify or make test depends on a time).
 bench: build venv bench-env
-	$(PY) verification/bench.py
+	$(PY) verification/bench/report.py
 	$(PY) verification/planner.py --costs
 	$(MAKE) bench-factorisation
 

@@ -14,7 +14,7 @@ from tresca_py.expr import Expr, VecExpr
 from tresca_py.quadrature import GAUSS3_S, GAUSS3_W
 
 SCRIPT = os.path.join(SCRIPTS, "dolfinx_distributed.py")
-# Agreement with Rust: the tolerance of the cross-check's distributed rows (verify/distributed.py TOL): far above
+# Agreement with Rust: the tolerance of the cross-check's distributed rows (verify/distributed/runs.py TOL): far above
 # the rounding of two direct solvers on these meshes (observed <= 5e-11, the derr of mms_data_cep), far below any
 # effect of a wrongly applied lifting (the data are O(1e-2) of the displacement or more).
 TOL = 1e-8
@@ -177,9 +177,9 @@ def test_names_data_that_cannot_be_evaluated(tmp_path):
 
 def test_gmsh_scene_with_data_agrees_with_rust(tmp_path):
     """The system shall apply boundary data on a Gmsh mesh read on rank 0 and distributed (the L-shape of
-    verify/distributed.py with Dirichlet data on its clamp and a gap on its floor) as the Rust solver does,
+    verify/distributed/agreement.py with Dirichlet data on its clamp and a gap on its floor) as the Rust solver does,
     within the same 1e-8, at 2 ranks."""
-    from tresca_py.verify.distributed import GMSH_SCENE, gmsh_data_scene
+    from tresca_py.verify.distributed.agreement import GMSH_SCENE, gmsh_data_scene
     scene = tmp_path / "lshape_data.toml"
     scene.write_text(gmsh_data_scene(GMSH_SCENE.format(msh=case("lshape")[:-5] + ".msh")))
     rs, dx = str(tmp_path / "rust.h5"), str(tmp_path / "np2.h5")
