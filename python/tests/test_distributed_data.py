@@ -132,15 +132,23 @@ def scene_with(tmp_path, name, old, new):
 
 
 @pytest.mark.parametrize("ranks", [1, 2])
-@pytest.mark.parametrize("name, key, shift, message", [
-    # u0's first component shifted by 0.01: contradicts u_D(t0) on the top side (u0·n on Γ_C is -u0[1]: unchanged)
-    ("mms_data_front", 'u0 = ["', "(1/100)+", "initial.u0[0] and part `top`'s u[0] at t0 = 0"),
-    # the gap shifted by 0.01, u0 unchanged: u0·n contradicts it at t0
-    ("mms_data_stop", 'gap = "', "(1/100)+", "initial.u0·n and part `bottom`'s gap at t0 = 0"),
-    # the right side's u[0] shifted by t/100: fits u0 at t0 = 0, but not the top side's u[0] at their common
-    # vertex (1, 1) at the first step t = 0.5 (at (1, 0) only u[1] = -u·n meets the gap: unchanged)
-    ("mms_data_cep", 'name = "right"\nkind = "dirichlet"\nu = ["', "(t/100)+", "at their common vertex (u[0], t = 0.5)"),
-])
+@pytest.mark.parametrize(
+    "name, key, shift, message",
+    [
+        # u0's first component shifted by 0.01: contradicts u_D(t0) on the top side (u0·n on Γ_C is -u0[1]: unchanged)
+        ("mms_data_front", 'u0 = ["', "(1/100)+", "initial.u0[0] and part `top`'s u[0] at t0 = 0"),
+        # the gap shifted by 0.01, u0 unchanged: u0·n contradicts it at t0
+        ("mms_data_stop", 'gap = "', "(1/100)+", "initial.u0·n and part `bottom`'s gap at t0 = 0"),
+        # the right side's u[0] shifted by t/100: fits u0 at t0 = 0, but not the top side's u[0] at their common
+        # vertex (1, 1) at the first step t = 0.5 (at (1, 0) only u[1] = -u·n meets the gap: unchanged)
+        (
+            "mms_data_cep",
+            'name = "right"\nkind = "dirichlet"\nu = ["',
+            "(t/100)+",
+            "at their common vertex (u[0], t = 0.5)",
+        ),
+    ],
+)
 def test_refuses_inconsistent_data(tmp_path, ranks, name, key, shift, message):
     """The system shall refuse, on every rank, boundary data that do not fit together (u0 against u_D(t0) on Γ_D,
     u0·n against the gap at t0 on Γ_C, two parts' data at their common vertex) with one error line naming them,

@@ -11,7 +11,8 @@ with every measurement: the machine is shared, so absolute times carry that nois
 Sections:
  1. Example 5.1 (verification/cases/paper_example_5_1.toml) at every level of the paper's Table 5.1
     (refine k = 0..4 -> n = 2..32, N = 40*2^k steps), ssn and uzawa, solve-only (no -o) and written in full
-    (-o out.h5 --force; and with --commit-interval 10, i.e. one commit at the end); total, per step, iterations per step, set-up split.
+    (-o out.h5 --force; and with --commit-interval 10, i.e. one commit at the end); total, per step,
+    iterations per step, set-up split.
  2. The same problem run by scripts/skfem_solve.py and scripts/dolfinx_solve.py (process wall, their own
     total without the Python start-up), as ratios to the Rust times; the results are compared with
     scripts/compare.py (equal accuracy = the same discrete solution to ~1e-11).
@@ -50,8 +51,11 @@ def parse_args(argv=None):
     ap.add_argument("--max-refine-growth", type=int, default=7)
     ap.add_argument("--no-python", action="store_true")
     ap.add_argument("--no-perf", action="store_true")
-    ap.add_argument("--mms-only", action="store_true",
-                    help="only section 6 (issue 13): replaces section 6 and its target rows in reference/performance.md")
+    ap.add_argument(
+        "--mms-only",
+        action="store_true",
+        help="only section 6 (issue 13): replaces section 6 and its target rows in reference/performance.md",
+    )
     return ap.parse_args(argv)
 
 

@@ -69,5 +69,6 @@ def header_section(b):
              "(set-up + steps + writing, without process start/exit); per step = (CLI wall − set-up)/N "
              "(includes forming u and, when written, the writing of every step)",
              "* set-up = mesh+space / assembly (K and the load operator) / factorisation (AMD + Cholesky, faer, "
-             "sequential, contact unknowns ordered last) / condensation (C = (L_cc L_ccᵀ)⁻¹ from the factor's trailing block, and "
+             "sequential, contact unknowns ordered last) / condensation (C = (L_cc L_ccᵀ)⁻¹ from the factor's trailing "
+             "block, and "
              "the load superposition basis)", ""]

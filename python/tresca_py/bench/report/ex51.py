@@ -28,7 +28,8 @@ def ex51_section(b):
     b.md += ["", f"Finest level (n = {2 * 2 ** kf}, N = {40 * 2 ** kf}, {fin_s.info['paper_dofs']} paper DOF, "
              f"{fin_s.info['unknowns']} unknowns), ssn: solve-only {fmt_t(fin_s.wall)} of which set-up "
              f"{fmt_t(sum(fin_s.setup))} (assembly {fmt_t(fin_s.setup[1])}, factorisation {fmt_t(fin_s.setup[2])}, "
-             f"load superposition {fmt_t(fin_s.setup[3])}, condensation {fmt_t(fin_s.setup[4])}); the {40 * 2 ** kf} steps take "
+             "load superposition "
+             f"{fmt_t(fin_s.setup[3])}, condensation {fmt_t(fin_s.setup[4])}); the {40 * 2 ** kf} steps take "
              f"{fmt_t(fin_s.per_step * 40 * 2 ** kf)} ({fmt_t(fin_s.per_step)} per step). "
              f"Written in full: {fmt_t(fin_w.wall)}.", ""]
 

@@ -13,11 +13,13 @@ def growth_section(b):
              "Scene `verification/bench/bench_elastic.toml`: plain plane-strain elasticity (no contact) on the "
              "unit square, structured cells [4,4] refined k times (n = 4·2^k cells a side, 2n² triangles), clamped "
              "left, non-separable traction on the right, so each step is a load assembly + one pair of triangular "
-             "solves. One step: `run --refine k --steps 1 -q` (no output). Five steps: `--steps 5 -o out.h5 --force -q`; "
+             "solves. One step: `run --refine k --steps 1 -q` (no output). Five steps: `--steps 5 -o out.h5 --force "
+             "-q`; "
              "the step time is the median of the 5 per-step wall times the file records (compute only, without "
              "writing). Peak memory = max RSS from `/usr/bin/time -f %M`. "
              f"Repeats: {b.R} up to refine 6, 1 at refine ≥ 7 (a run takes minutes there).", "",
-             "| k | unknowns | 1 step: total | 1 step: peak RSS | set-up asm / fact / superposition+cond | step compute (median of 5) | "
+             "| k | unknowns | 1 step: total | 1 step: peak RSS | set-up asm / fact / superposition+cond | step "
+             "compute (median of 5) | "
              "5 steps written: total | peak RSS | load |", "|---|---|---|---|---|---|---|---|---|"]
     for k in range(2, b.gmax + 1):
         growth_row(b, k)

@@ -14,11 +14,25 @@ from tresca_py.common import BIN, PY, ROOT, load1
 
 MMS_RUNS = (
     # (label, scene, extra arguments, wall target in s or None)
-    ("mms_stop, refine 5, 64 steps", os.path.join("verification", "cases", "mms_stop.toml"), ("--refine", "5", "--steps", "64"), 5.0),
+    (
+        "mms_stop, refine 5, 64 steps",
+        os.path.join("verification", "cases", "mms_stop.toml"),
+        ("--refine", "5", "--steps", "64"),
+        5.0,
+    ),
     ("bench_mms_poly (256×128, 80 steps)", os.path.join("verification", "bench", "bench_mms_poly.toml"), (), 5.0),
-    ("mms_front, refine 2, 256 steps", os.path.join("verification", "cases", "mms_front.toml"), ("--refine", "2", "--steps", "256"), 0.5),
-    ("Example 5.1 n = 64 (refine 5, 1280 steps)", os.path.join("verification", "cases", "paper_example_5_1.toml"),
-     ("--refine", "5", "--steps", "1280"), 0.12),
+    (
+        "mms_front, refine 2, 256 steps",
+        os.path.join("verification", "cases", "mms_front.toml"),
+        ("--refine", "2", "--steps", "256"),
+        0.5,
+    ),
+    (
+        "Example 5.1 n = 64 (refine 5, 1280 steps)",
+        os.path.join("verification", "cases", "paper_example_5_1.toml"),
+        ("--refine", "5", "--steps", "1280"),
+        0.12,
+    ),
 )
 
 
@@ -40,10 +54,12 @@ def mms_runs(b):
              "CPU = user + sys time of the process (both cores count), next to the wall time: on this shared "
              "machine the wall time also contains waiting for a core. Set-up split from the CLI's --json summary. "
              "Before issue 13 (2-core machine, from the issue): mms_stop r5 87 s (condensation 21 s), the "
-             "196,608-unknown polynomial case 54 s (condensation 12.6 s), mms_front r2 7–16 s, Example 5.1 n = 64 0.36 s. "
+             "196,608-unknown polynomial case 54 s (condensation 12.6 s), mms_front r2 7–16 s, Example 5.1 n = 64 0.36 "
+             "s. "
              "Steps with contact run in blocks of up to 16 that share one forward and one backward triangular solve "
              "with 16 right-hand sides (`solve::free::Block`): at 196,608 unknowns 9 ms a step instead of 61 ms.", "",
-             "| run | unknowns | contact edges | process wall (median) | CPU | set-up mesh / asm / fact / superposition / cond | per step | target | load |",
+             "| run | unknowns | contact edges | process wall (median) | CPU | set-up mesh / asm / fact / "
+             "superposition / cond | per step | target | load |",
              "|---|---|---|---|---|---|---|---|---|"]
     rec = {}
     for label, scene, extra, target in MMS_RUNS:
@@ -51,14 +67,36 @@ def mms_runs(b):
         rec[label] = r
         i = r.info
         st = " / ".join(f"{v * 1e3:.0f}" for v in r.setup) + " ms"
-        b.md.append(f"| `{scene} {' '.join(extra)}` | {i['unknowns']} | {i['contact']} | {fmt_t(r.wall)} | {fmt_t(r.cpu)} | "
+        b.md.append("| "
+                    f"`{scene} "
+                    f"{' '.join(extra)}` | {i['unknowns']} | {i['contact']} | {fmt_t(r.wall)} | {fmt_t(r.cpu)} | "
                     f"{st} | {fmt_t(r.per_step)} | < {fmt_t(target)} | {r.load} |")
-        b.csvrows.append(dict(section="mms", mode=label, dofs=i["unknowns"], steps=i["steps"], wall=r.wall, cli_wall=med(r.cli),
-                              per_step=r.per_step, setup_mesh=r.setup[0], setup_asm=r.setup[1], setup_fact=r.setup[2],
-                              setup_sup=r.setup[3], setup_cond=r.setup[4], load=r.load))
+        b.csvrows.append(
+            dict(
+                section="mms",
+                mode=label,
+                dofs=i["unknowns"],
+                steps=i["steps"],
+                wall=r.wall,
+                cli_wall=med(r.cli),
+                per_step=r.per_step,
+                setup_mesh=r.setup[0],
+                setup_asm=r.setup[1],
+                setup_fact=r.setup[2],
+                setup_sup=r.setup[3],
+                setup_cond=r.setup[4],
+                load=r.load,
+            )
+        )
         print(b.md[-1], flush=True)
-        tg.append((f"(issue 13) {label} < {fmt_t(target)}", f"{fmt_t(r.wall)} wall, CPU {fmt_t(r.cpu)}", r.wall < target))
-    conds = [(lab, r.setup[4], r.info["contact"], r.info["unknowns"]) for lab, r in rec.items() if r.info["unknowns"] >= 1e5 or r.info["contact"] >= 128]
+        tg.append(
+            (f"(issue 13) {label} < {fmt_t(target)}", f"{fmt_t(r.wall)} wall, CPU {fmt_t(r.cpu)}", r.wall < target)
+        )
+    conds = [
+        (lab, r.setup[4], r.info["contact"], r.info["unknowns"])
+        for lab, r in rec.items()
+        if r.info["unknowns"] >= 1e5 or r.info["contact"] >= 128
+    ]
     for _lab, c, nc, n in conds:
         tg.append((f"(issue 13) condensation, {nc} contact unknowns on {n} unknowns < 0.3 s", fmt_t(c), c < 0.3))
     b.md.append("")
@@ -72,10 +110,13 @@ def expr_throughput(b):
     if p.returncode == 0:
         e = json.loads(p.stdout.strip().splitlines()[-1])
         b.md += ["### Expression throughput (one core)", "",
-                 f"The longest expression of `verification/cases/` (`{e['file']}`, `{e['key']}`, {e['chars']} characters; "
+                 "The longest expression of `verification/cases/` "
+                 f"(`{e['file']}`, `{e['key']}`, {e['chars']} characters; "
                  f"{e['instructions']} instructions per point once compiled): exmex's interpreter "
                  f"{e['interpreted_points_per_s']:.3g} points/s, the compiled program {e['compiled_points_per_s']:.3g} "
-                 f"points/s ({e['speedup']:.0f}×; median of 5, `RAYON_NUM_THREADS=1 cargo run --release --example expr_throughput`).", ""]
+                 "points/s "
+                 f"({e['speedup']:.0f}×; median of 5, `RAYON_NUM_THREADS=1 cargo run --release --example "
+                 "expr_throughput`).", ""]
     else:
         b.md += [f"expr_throughput failed: {p.stderr[-300:]}", ""]
 

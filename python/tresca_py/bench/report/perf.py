@@ -13,7 +13,8 @@ def perf_section(b):
     kf = b.kf
     print("== 5. perf", flush=True)
     b.md += ["## 5. Profile of the Example 5.1 finest run", "",
-             f"`perf record -F 20000 -g -- tresca-cr run paper_example_5_1.toml --refine {kf} --steps {40 * 2 ** kf} -q "
+             "`perf record -F 20000 -g -- tresca-cr run paper_example_5_1.toml --refine "
+             f"{kf} --steps {40 * 2 ** kf} -q "
              "[-o out.h5 --force]`, `perf report --stdio --no-children --sort symbol` (self time; symbols ≥ 0.7 %), "
              "and the self time grouped by what it does.", ""]
     for label, extra in [("solve-only", []), ("written", ["-o", os.path.join(b.tmp, "perf.h5"), "--force"])]:

@@ -41,24 +41,35 @@ def classify(dso, sym):
         return "expression evaluation: compiled program"
     if "libc" in dso or "libm" in dso:
         return "libc (memcpy, memset, malloc)"
-    for key, name in [("subtract_friction", "K⁻¹Eμ recovery of u (free::subtract_friction)"),
-                      ("LoadBasis::build", "load superposition set-up (superpose::LoadBasis::build)"),
-                      ("LoadBasis::response", "u_f = Σ c_j w_j (superpose::response)"),
-                      ("from_triplets", "sparse matrix from triplets (assembly)"), ("scatter", "assembly"),
-                      ("assemble", "assembly"), ("sort", "assembly (triplet sort)"),
-                      ("cholesky", "Cholesky (symbolic+numeric+solves)"), ("amd", "Cholesky (symbolic+numeric+solves)"),
-                      # Factor::with_ordering: faer's numeric factorisation inlined into it
-                      ("factor::", "Cholesky (symbolic+numeric+solves)"),
-                      ("pulp::", "faer SIMD kernels (pulp: factorisation updates, triangular solves)"),
-                      ("matvec", "sparse K·v (condition estimate, energies)"),
-                      ("llt", "Cholesky (symbolic+numeric+solves)"), ("gemm", "dense kernels (gemm, condensation)"),
-                      ("exmex", "expression evaluation: exmex interpreter"),
-                      ("forward_solve", "Cholesky (symbolic+numeric+solves)"),
-                      ("backward_solve", "Cholesky (symbolic+numeric+solves)"),
-                      ("loads::", "load assembly (scatter of the values)"), ("norms::", "error norms (sums)"), ("output", "results writer (Rust side)"),
-                      ("hdf5", "HDF5 library"), ("ssn", "friction QP (ssn/uzawa)"), ("uzawa", "friction QP (ssn/uzawa)"),
-                      ("contact", "friction QP (ssn/uzawa)"), ("finish", "finiteness check + errors (finish)"),
-                      ("Condensed::new", "condensation")]:
+    for key, name in [
+        ("subtract_friction", "K⁻¹Eμ recovery of u (free::subtract_friction)"),
+        ("LoadBasis::build", "load superposition set-up (superpose::LoadBasis::build)"),
+        ("LoadBasis::response", "u_f = Σ c_j w_j (superpose::response)"),
+        ("from_triplets", "sparse matrix from triplets (assembly)"),
+        ("scatter", "assembly"),
+        ("assemble", "assembly"),
+        ("sort", "assembly (triplet sort)"),
+        ("cholesky", "Cholesky (symbolic+numeric+solves)"),
+        ("amd", "Cholesky (symbolic+numeric+solves)"),
+        # Factor::with_ordering: faer's numeric factorisation inlined into it
+        ("factor::", "Cholesky (symbolic+numeric+solves)"),
+        ("pulp::", "faer SIMD kernels (pulp: factorisation updates, triangular solves)"),
+        ("matvec", "sparse K·v (condition estimate, energies)"),
+        ("llt", "Cholesky (symbolic+numeric+solves)"),
+        ("gemm", "dense kernels (gemm, condensation)"),
+        ("exmex", "expression evaluation: exmex interpreter"),
+        ("forward_solve", "Cholesky (symbolic+numeric+solves)"),
+        ("backward_solve", "Cholesky (symbolic+numeric+solves)"),
+        ("loads::", "load assembly (scatter of the values)"),
+        ("norms::", "error norms (sums)"),
+        ("output", "results writer (Rust side)"),
+        ("hdf5", "HDF5 library"),
+        ("ssn", "friction QP (ssn/uzawa)"),
+        ("uzawa", "friction QP (ssn/uzawa)"),
+        ("contact", "friction QP (ssn/uzawa)"),
+        ("finish", "finiteness check + errors (finish)"),
+        ("Condensed::new", "condensation"),
+    ]:
         if key.lower() in sym.lower():
             return name
     return "other"

@@ -18,7 +18,8 @@ def python_section(b):
              "\"process\" = whole process (interpreter start, imports, JIT for dolfinx, solve, write); "
              "\"own total\" = the script's own `total_time` attribute (assembly + factorisation + steps, "
              "without imports and writing). Ratios: Python process / Rust written-in-full process "
-             "(both write a results file), and own total / Rust solve-only process (conservative: the Rust time includes process start). "
+             "(both write a results file), and own total / Rust solve-only process (conservative: the Rust time "
+             "includes process start). "
              "\"max du\": `scripts/compare.py` between the Rust and the Python results file "
              "(relative, max over time nodes) — equal accuracy means the same discrete solution.", "",
              "| n | N | solver | process (median) | own total | ratio process/Rust written | "

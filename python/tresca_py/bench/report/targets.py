@@ -25,7 +25,8 @@ def targets_section(b, tg13):
                 w, o, rw, rs, du = py[(kf, name)]
                 ok = rw >= want and rs >= want and du < 1e-8
                 tg.append((f"≥ {want}× faster than {name} at equal accuracy (finest level)",
-                           f"{rw:.1f}× (process, both written), {rs:.1f}× (own solve total vs Rust solve-only process); "
+                           f"{rw:.1f}× (process, both written), "
+                           f"{rs:.1f}× (own solve total vs Rust solve-only process); "
                            f"max du {du:.1e}", ok))
     if growth and growth[-1][0] >= 1e6:
         n, w1, rss, st, step, w5, rss5 = growth[-1]
@@ -34,7 +35,8 @@ def targets_section(b, tg13):
                    f"assembly {fmt_t(st[1])}), peak {rss / 1024 ** 2:.2f} GB", step < 2.0))
         tg.append((f"(stricter reading) a whole 1-step run at {n} unknowns < 2 s", fmt_t(w1), w1 < 2.0))
     if kf == 4:
-        tg.append(("(issue 13) Example 5.1 finest solved < 25 ms (process)", f"{fmt_t(fin_s.wall)} (CPU {fmt_t(fin_s.cpu)})",
+        tg.append(("(issue 13) Example 5.1 finest solved < 25 ms (process)", f"{fmt_t(fin_s.wall)} (CPU "
+                                                                             f"{fmt_t(fin_s.cpu)})",
                    fin_s.wall < 0.025))
         tg.append(("(issue 13) Example 5.1 finest written in full, per-step commits < 80 ms (process)",
                    f"{fmt_t(fin_w.wall)} (CPU {fmt_t(fin_w.cpu)})", fin_w.wall < 0.08))
@@ -69,8 +71,10 @@ def splice_section_6(b, tg):
     j = next(k for k, line in enumerate(old) if line.startswith("## Targets"))
     sec = md[next(k for k, line in enumerate(md) if line.startswith("## 6.")):]
     note = (f"Section 6 alone regenerated on {time.strftime('%Y-%m-%d', time.gmtime())} by "
-            f"`.venv/bin/python verification/bench/report.py --mms-only --repeats {b.R}` (binary `{b.version}`, load average "
-            f"at its start {' '.join(b.la0)}); sections 1-5 and the other target rows are from the last full `make bench`.")
+            "`.venv/bin/python verification/bench/report.py --mms-only --repeats "
+            f"{b.R}` (binary `{b.version}`, load average "
+            "at its start "
+            f"{' '.join(b.la0)}); sections 1-5 and the other target rows are from the last full `make bench`.")
     new = old[:i] + [sec[0], "", note] + sec[1:] + old[j:]
     for t, m, ok in tg:
         row = f"| {t} | {m} | {'PASS' if ok else 'FAIL'} |"

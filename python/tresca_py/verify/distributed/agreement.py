@@ -15,8 +15,9 @@ from tresca_py.verify.distributed.vtk_check import vtk_check
 # drops them from the case list fails D1 instead of passing it silently
 DATA_CASES = ("mms_data_front", "mms_data_cep", "mms_data_stop")
 
-GMSH_SCENE = """title = "L-shape Gmsh mesh (verification/cases/lshape.msh) with Tresca contact on its floor (verification/distributed.py)"
-[mesh]
+GMSH_SCENE = ('title = "L-shape Gmsh mesh (verification/cases/lshape.msh) with Tresca contact on its floor '
+              '(verification/distributed.py)"\n'
+              """[mesh]
 file = "{msh}"
 [material]
 E = 200.0
@@ -35,7 +36,7 @@ g_a = "0.001*(1+x)"
 [time]
 T = 1.0
 steps = 8
-"""
+""")
 
 
 def gmsh_data_scene(text):
@@ -43,7 +44,8 @@ def gmsh_data_scene(text):
     at their common vertex (0, 0) (u·n = -u_y = gap) and with u0 = 0 at t0 = 0."""
     out = text.replace('kind = "dirichlet"\n', 'kind = "dirichlet"\nu = ["0.001*t*y", "0.002*t*(1+x)"]\n')
     out = out.replace('g_a = "0.001*(1+x)"', 'g_a = "0.001*(1+x)"\ngap = "-0.002*t*(1+x)"')
-    out = out.replace('on its floor (verification/distributed.py)', 'on its floor, boundary data (verification/distributed.py)')
+    out = out.replace('on its floor (verification/distributed.py)', 'on its floor, boundary data '
+                                                                    '(verification/distributed.py)')
     assert out.count("gap =") == 1 and out.count("u = [") == 1, "GMSH_SCENE changed: update gmsh_data_scene"
     return out
 
@@ -123,7 +125,9 @@ def check_d1(hs, args, self_cmd):
     rows, commands = agreement(args.bin, args.work)
     t_d1 = time.perf_counter() - t_start
     nfail = sum(not row_ok(r) for r in rows)
-    worst = {k: max((r["r"][k] for r in rows if r.get("r")), default=float("nan")) for k in ("du", "dE", "dsig", "derr")}
+    worst = {
+        k: max((r["r"][k] for r in rows if r.get("r")), default=float("nan")) for k in ("du", "dE", "dsig", "derr")
+    }
     missing = [c for c in DATA_CASES if not any(r["case"] == c and r.get("r") for r in rows)]
     d1_ok = nfail == 0 and len(rows) > 0 and not missing
     d1_meas = (f"{len(rows) - nfail}/{len(rows)} runs agree; worst du {worst['du']:.1e}, dE {worst['dE']:.1e}, "
@@ -131,7 +135,9 @@ def check_d1(hs, args, self_cmd):
     if missing:
         d1_meas += f"; boundary-data scenes not run: {', '.join(missing)}"
     if nfail:
-        d1_meas += "; failing: " + "; ".join(f"{r['case']} -n {r['ranks']}: {fmt(r)}" for r in rows if not row_ok(r))[:400]
+        d1_meas += (
+            "; failing: " + "; ".join(f"{r['case']} -n {r['ranks']}: {fmt(r)}" for r in rows if not row_ok(r))[:400]
+        )
     # the visualisation output of the last 3-rank run with contact (Example 5.1), read back with VTK
     vtk_h5 = next((r["file"] for r in rows if r["case"] == "paper_example_5_1" and r["ranks"] == 3 and r.get("file")),
                   None)
@@ -141,7 +147,8 @@ def check_d1(hs, args, self_cmd):
     d1_meas += f"; VTK pieces of the -n 3 Example 5.1 run read back: {'ok' if vtk_ok else 'FAIL'} ({vtk_msg})"
     hs.require("D1-distributed-agree", d1_ok, d1_meas,
                statement=(f"the distributed dolfinx/PETSc route under mpirun -n 1, 2 and 3 shall agree with the Rust "
-                          f"solver on every cross-check scene (quick level; the boundary-data scenes {', '.join(DATA_CASES)} "
+                          "solver on every cross-check scene (quick level; the boundary-data scenes "
+                          f"{', '.join(DATA_CASES)} "
                           f"among them) within {TOL:g} relative in u, energy, σ_τ and "
                           f"true errors at every time node, with identical stick/slip sets; its parallel VTK output "
                           f"(discontinuous P1) shall read back in VTK with the CR values at every edge midpoint"),

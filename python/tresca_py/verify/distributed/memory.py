@@ -92,8 +92,10 @@ def check_d2(hs, args, self_cmd):
             agree_ok = ag and max(ag["du"], ag["dE"], ag["dsig"]) <= TOL and ag["flags"] == 0
             big_ok = meas["runs"]["1"]["unknowns"] >= 10 ** 6
             ok = m2 <= MEM_RATIO * m1 and agree_ok and big_ok
-            d2_meas = (f"{meas['runs']['1']['unknowns']} unknowns: peak RSS -n 1 {m1:.0f} MB, -n 2 largest rank {m2:.0f} MB "
-                       f"(ratio {m2 / m1:.2f}); -n 1 vs -n 2 du {ag.get('du', float('nan')):.1e}, flags {ag.get('flags')}")
+            d2_meas = (f"{meas['runs']['1']['unknowns']} unknowns: peak RSS -n 1 "
+                       f"{m1:.0f} MB, -n 2 largest rank {m2:.0f} MB "
+                       "(ratio "
+                       f"{m2 / m1:.2f}); -n 1 vs -n 2 du {ag.get('du', float('nan')):.1e}, flags {ag.get('flags')}")
         else:
             ok = False
             d2_meas = "; ".join(f"-n {n}: {r.get('error', 'ok')}" for n, r in meas["runs"].items())

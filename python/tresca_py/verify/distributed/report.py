@@ -17,20 +17,34 @@ def write_report(hs, args, self_cmd, rows, commands, meas, total):
           f"requirements passed, {total:.0f} s.", "",
           "| id | passed | measured |", "|---|---|---|"]
     md += [f"| {r.id} | {'PASS' if r.passed else 'FAIL'} | {r.measured} |" for r in hs.results]
-    md += ["", "## D1: agreement with the Rust solver", "",
-           "`scripts/dolfinx_distributed.py` under `mpirun -n P` against `tresca-cr run` on the cross-check scenes at their "
-           "quick level (verification/cross_check.py QUICK). Max over the time nodes; du, dE, derr relative; dsig relative to "
-           "max ḡ; flags = differing stick/slip states summed over the nodes. Tolerance 1e-8.", "",
-           "| case | refine | N | ranks | du | dE | dsig | derr | flags | wall s | ok |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    md += [
+        "",
+        "## D1: agreement with the Rust solver",
+        "",
+        "`scripts/dolfinx_distributed.py` under `mpirun -n P` against `tresca-cr run` on the cross-check scenes at "
+        "their "
+        "quick level (verification/cross_check.py QUICK). Max over the time nodes; du, dE, derr relative; dsig "
+        "relative to "
+        "max ḡ; flags = differing stick/slip states summed over the nodes. Tolerance 1e-8.",
+        "",
+        "| case | refine | N | ranks | du | dE | dsig | derr | flags | wall s | ok |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for row in rows:
         r = row.get("r")
         if r is None:
-            md.append(f"| {row['case']} | {row['refine']} | {row['steps'] or '–'} | {row['ranks']} | – | – | – | – | – | – | FAIL: "
+            md.append("| "
+                      f"{row['case']} | "
+                      f"{row['refine']} | {row['steps'] or '–'} | {row['ranks']} | – | – | – | – | – | – | FAIL: "
                       f"{(row.get('err') or '')[:120]} |")
             continue
         derr = f"{r['derr']:.1e}" if r["has_errors"] else "–"
-        md.append(f"| {row['case']} | {row['refine']} | {row['steps']} | {row['ranks']} | {r['du']:.1e} | {r['dE']:.1e} | "
-                  f"{r['dsig']:.1e} | {derr} | {r['flags']} | {row['wall']:.1f} | {'PASS' if row_ok(row) else 'FAIL'} |")
+        md.append(
+            "| "
+            f"{row['case']} | "
+            f"{row['refine']} | {row['steps']} | {row['ranks']} | {r['du']:.1e} | {r['dE']:.1e} | "
+            f"{r['dsig']:.1e} | {derr} | {r['flags']} | {row['wall']:.1f} | {'PASS' if row_ok(row) else 'FAIL'} |"
+        )
     if meas is not None and all(str(n) in meas["runs"] and "error" not in meas["runs"][str(n)] for n in (1, 2)):
         md += memory_tables(meas, args.memory)
     if os.path.exists(SOLVER_JSON):
@@ -49,15 +63,18 @@ def write_report(hs, args, self_cmd, rows, commands, meas, total):
 def memory_tables(meas, fresh):
     r1, r2 = meas["runs"]["1"], meas["runs"]["2"]
     md = ["", "## D2: memory and time at 1 and 2 ranks", "",
-          f"Example 5.1 (`verification/cases/{meas['case']}.toml`) at refine {meas['refine']}: {r1['unknowns']:,} unknowns, "
+          "Example 5.1 "
+          f"(`verification/cases/{meas['case']}.toml`) at refine {meas['refine']}: {r1['unknowns']:,} unknowns, "
           f"{r1['n_contact']} contact edges, {meas['steps']} steps, no visualisation frames. Measured {meas['date']}"
           f"{'' if fresh else ' (not re-run by this invocation; `--memory` re-measures)'}; the machine has 2 cores and "
           "other jobs may run beside it, so times vary" +
           (f" (5-minute load average {meas['load_before']:.1f} when D2 started)." if "load_before" in meas else ".") +
           " Memory does not depend on the load.", "",
           "Peak resident memory per rank, from `/usr/bin/time -f \"RSS %M\"` around each rank's process (one line per "
-          "rank) and, beside it, the process's own `getrusage` maximum (the same quantity, recorded in the results file):", "",
-          "| ranks | rank | peak RSS (time) MB | peak RSS (getrusage) MB | after mesh | after assembly | after factorisation | after C |",
+          "rank) and, beside it, the process's own `getrusage` maximum (the same quantity, recorded in the results "
+          "file):", "",
+          "| ranks | rank | peak RSS (time) MB | peak RSS (getrusage) MB | after mesh | after assembly | after "
+          "factorisation | after C |",
           "|---|---|---|---|---|---|---|---|"]
     for n, r in (("1", r1), ("2", r2)):
         for k, (a, b) in enumerate(zip(r["rss_time_mb"], r["rss_self_mb"], strict=False)):
@@ -66,46 +83,67 @@ def memory_tables(meas, fresh):
                       f"{sp.get('factorisation', 0):.0f} | {sp.get('condensation', 0):.0f} |")
     m1, m2 = max(r1["rss_time_mb"]), max(r2["rss_time_mb"])
     md += ["", f"Largest rank at -n 2 / -n 1: {m2:.0f} / {m1:.0f} MB = **{m2 / m1:.2f}** (required ≤ {MEM_RATIO}).", "",
-           "| ranks | set-up s | mesh | assembly + JIT | factorisation (MUMPS) | C (selected entries of K⁻¹) | per step (median) | whole run | MUMPS factor entries | MUMPS flops | MUMPS memory max rank / total MB |",
+           "| ranks | set-up s | mesh | assembly + JIT | factorisation (MUMPS) | C (selected entries of K⁻¹) | per "
+           "step (median) | whole run | MUMPS factor entries | MUMPS flops | MUMPS memory max rank / total MB |",
            "|---|---|---|---|---|---|---|---|---|---|---|"]
     for n, r in (("1", r1), ("2", r2)):
         st, mu = r["setup_times"], r["mumps"]
-        md.append(f"| {n} | {r['setup_time']:.1f} | {st['mesh']:.1f} | {st['assembly']:.1f} | {st['factorisation']:.1f} | "
-                  f"{st['condensation']:.1f} | {r['step_median']:.2f} | {r['wall']:.1f} | {mu.get('factor_entries', 0):.3g} | "
+        md.append("| "
+                  f"{n} | "
+                  f"{r['setup_time']:.1f} | {st['mesh']:.1f} | {st['assembly']:.1f} | {st['factorisation']:.1f} | "
+                  f"{st['condensation']:.1f} | "
+                  f"{r['step_median']:.2f} | {r['wall']:.1f} | {mu.get('factor_entries', 0):.3g} | "
                   f"{mu.get('flops', 0):.3g} | {mu.get('mem_max_rank_mb')} / {mu.get('mem_total_mb')} |")
     ag = meas.get("agree_1_2")
     if ag:
-        md += ["", f"-n 1 vs -n 2 on this case: du {ag['du']:.1e}, dE {ag['dE']:.1e}, dsig {ag['dsig']:.1e}, flags {ag['flags']}."]
+        md += ["", "-n 1 vs -n 2 on this case: du "
+                   f"{ag['du']:.1e}, dE {ag['dE']:.1e}, dsig {ag['dsig']:.1e}, flags {ag['flags']}."]
     if meas.get("rust"):
         ru = meas["rust"]
         a = ru.get("agree_np2", {})
         md += [f"Rust binary on the same case: peak RSS {ru['rss_mb']:.0f} MB, {ru['wall']:.1f} s whole run; vs -n 2: "
-               f"du {a.get('du', float('nan')):.1e}, dE {a.get('dE', float('nan')):.1e}, dsig {a.get('dsig', float('nan')):.1e}, "
+               "du "
+               f"{a.get('du', float('nan')):.1e}, dE "
+               f"{a.get('dE', float('nan')):.1e}, dsig {a.get('dsig', float('nan')):.1e}, "
                f"flags {a.get('flags')}."]
     md += ["", "Commands:", "", "```"] + meas["commands"] + ["```"]
     mo = meas.get("model")
     mu1, mu2 = r1["mumps"].get("mem_total_mb"), r2["mumps"].get("mem_max_rank_mb")
     if mo:
         md += ["", "## Scaling model (an estimate, not a measurement)", "",
-               f"From the two measured points the largest rank's peak is m(P) = c + D/P with c = {mo['c_mb']:.0f} MB and "
-               f"D = {mo['D_mb']:.0f} MB at n₀ = {mo['n0']:,} unknowns. D spreads over the ranks. Of c, b = {mo['b_mb']:.0f} MB "
+               "From the two measured points the largest rank's peak is m(P) = c + D/P with c = "
+               f"{mo['c_mb']:.0f} MB and "
+               "D = "
+               f"{mo['D_mb']:.0f} MB at n₀ = "
+               f"{mo['n0']:,} unknowns. D spreads over the ranks. Of c, b = {mo['b_mb']:.0f} MB "
                "is the import footprint (Python, dolfinx, PETSc, MPI; measured before the mesh exists). The rest, "
-               f"{mo['c_mb'] - mo['b_mb']:.0f} MB, is what did not halve from 1 to 2 ranks: MUMPS' parallel overhead (by its "
-               f"own count, INFOG(21/22): {mu1} MB at 1 rank, {mu2} MB on the largest rank at 2) and PETSc/dolfinx structures "
-               "(ghosts, the PtAP product, the host's sequential METIS analysis of the whole graph). Two points cannot tell "
-               "whether that part is a constant, grows with n on every rank, or falls with P; the column *per-rank peak* "
+               f"{mo['c_mb'] - mo['b_mb']:.0f} MB, is what did not halve from 1 to 2 ranks: MUMPS' parallel overhead "
+               "(by its "
+               "own count, INFOG(21/22): "
+               f"{mu1} MB at 1 rank, {mu2} MB on the largest rank at 2) and PETSc/dolfinx structures "
+               "(ghosts, the PtAP product, the host's sequential METIS analysis of the whole graph). Two points cannot "
+               "tell "
+               "whether that part is a constant, grows with n on every rank, or falls with P; the column *per-rank "
+               "peak* "
                "assumes the worst (∝ n on every rank), the column *if spread* the best (it spreads like D). "
-               "(`--mumps-analysis parallel`, PT-Scotch, removes the host's analysis but gave a 10 % larger factor here.)", "",
-               "Assumptions: structured 2D meshes with contact on one side, n_c ≈ √(n/6) contact edges; factor entries and "
-               "solve work ∝ n log₂ n and factorisation flops ∝ n^1.5 (2D nested dissection); D grows like the factor and "
+               "(`--mumps-analysis parallel`, PT-Scotch, removes the host's analysis but gave a 10 % larger factor "
+               "here.)", "",
+               "Assumptions: structured 2D meshes with contact on one side, n_c ≈ √(n/6) contact edges; factor entries "
+               "and "
+               "solve work ∝ n log₂ n and factorisation flops ∝ n^1.5 (2D nested dissection); D grows like the factor "
+               "and "
                "is split over P ranks with a load imbalance of 1.3; the non-spreading part grows ∝ n on every rank "
                "(pessimistic: column *per-rank peak*) or is removed (column *if spread*); times scale from the 1-rank "
                "measurement with parallel efficiency 0.5 (MUMPS across nodes, not measured here; this machine's times "
-               "were taken under load and vary by ~1.5×); C is bounded by n_c solves (MUMPS prunes its tree for selected "
+               "were taken under load and vary by ~1.5×); C is bounded by n_c solves (MUMPS prunes its tree for "
+               "selected "
                "inverse entries, so it is cheaper); the dense C (n_c² doubles) and the friction step sit on rank 0, "
-               "a dense active-set solve of O(n_c³) per iteration (n_c ≈ 4,100 at 10⁸ unknowns: ~7·10¹⁰ flop, seconds to "
-               "tens of seconds per iteration) — beyond ~10⁸ unknowns the contact problem itself needs a distributed solver.", "",
-               "| unknowns | ranks | n_c | per-rank peak GB | if spread GB | factorisation s | C s (bound) | per step s | C on rank 0 MB |",
+               "a dense active-set solve of O(n_c³) per iteration (n_c ≈ 4,100 at 10⁸ unknowns: ~7·10¹⁰ flop, seconds "
+               "to "
+               "tens of seconds per iteration) — beyond ~10⁸ unknowns the contact problem itself needs a distributed "
+               "solver.", "",
+               "| unknowns | ranks | n_c | per-rank peak GB | if spread GB | factorisation s | C s (bound) | per step "
+               "s | C on rank 0 MB |",
                "|---|---|---|---|---|---|---|---|---|"]
         for r in mo["rows"]:
             md.append(f"| {r['n']:.0e} | {r['P']} | {r['nc']:.0f} | {r['mem_gb']:.1f} | {r['mem_spread_gb']:.1f} | "

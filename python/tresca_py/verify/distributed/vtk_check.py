@@ -45,5 +45,7 @@ def vtk_check(h5path):
     # tolerance: the pieces are ASCII with 16 significant digits, so midpoint means carry ~1e-15 relative
     # rounding; 1e-12 leaves room and still catches any wrong value, ordering or ghost handling
     ok = len(cells) == ntri and float(np.max(dist)) < 1e-9 and err <= 1e-12 and len(np.unique(idx)) == len(M)
-    return ok, (f"{rel(files[-1])}: {len(cells)} non-ghost cells (results file: {ntri}), "
-                f"edge-midpoint means vs u^N: max rel. diff {err:.1e}, every edge seen: {len(np.unique(idx)) == len(M)}")
+    return ok, (
+        f"{rel(files[-1])}: {len(cells)} non-ghost cells (results file: {ntri}), "
+        f"edge-midpoint means vs u^N: max rel. diff {err:.1e}, every edge seen: {len(np.unique(idx)) == len(M)}"
+    )
