@@ -100,23 +100,17 @@ def report(hs, results):
                          f"{kind if first else ''} | {p if first else ''} | {beta if first else ''} | "
                          f"{int(r['refine'])}:{int(r['steps'])} | {f(est)} | {f(r['gci'])} | {f(t)} | "
                          f"{'-' if eff is None else f'{eff:.3f}'} | {v} |")
-    lines += [
-        "",
-        "Reading: β near 1 is Galerkin orthogonality of nested levels (the h sequences: the CR gradient is "
-        "the "
-        "elementwise mean of ∇u to leading order), β = 0 parallel errors (the k sequence: backward Euler's error "
-        "θkW has one shape). Both are measured from three distances, never fitted to a true error.",
-        "",
-        "## Scalar outputs at T (finest level)",
-        "",
-        "Extrapolated with Celik's three-level order; theoretical order 2 for the energy in h (1 in k), 1 "
-        "otherwise. "
-        "No exact values are required here; for `mms_front` the exact maximum slip at T is 1/20 (s = S(·)/20, S "
-        "≤ 1).",
-        "",
-        "| sequence | output | finest value | extrapolated | p | estimate | GCI | verdict |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
+    lines += ["", "Reading: β near 1 is Galerkin orthogonality of nested levels (the h sequences: the CR gradient is "
+                  "the "
+              "elementwise mean of ∇u to leading order), β = 0 parallel errors (the k sequence: backward Euler's error "
+              "θkW has one shape). Both are measured from three distances, never fitted to a true error.", "",
+              "## Scalar outputs at T (finest level)", "",
+              "Extrapolated with Celik's three-level order; theoretical order 2 for the energy in h (1 in k), 1 "
+              "otherwise. "
+              "No exact values are required here; for `mms_front` the exact maximum slip at T is 1/20 (s = S(·)/20, S "
+              "≤ 1).", "",
+              "| sequence | output | finest value | extrapolated | p | estimate | GCI | verdict |",
+              "|---|---|---|---|---|---|---|---|"]
     for name, *_ in CASES:
         rows, _ = results[name]
         last = rows[-1]
@@ -130,19 +124,14 @@ def report(hs, results):
     lines += ["", "Commands:", ""] + [f"    {c}" for c in cmds]
     hs.write("estimates.md", "\n".join(lines) + "\n")
     ok1 = not bad and {"h", "k", "joint"} <= in_range_kinds
-    req(
-        hs,
-        "R1-estimate-effectivity",
-        'where the verdict says "in the asymptotic range", the estimated energy '
-        "error of the "
-        "finest two levels shall be within "
-        f"[{EFF_BAND[0]}, {EFF_BAND[1]}] of the true error (every manufactured case; "
-        "h, k and joint each in range at least once)",
-        ok1,
-        ("; ".join(checked) + (f"; OUT OF BAND: {bad}" if bad else "") + f"; in range: {sorted(in_range_kinds)}"),
-        "verification/run_all.py --only estimates",
-        "reference/estimates.md",
-    )
+    req(hs, "R1-estimate-effectivity", "where the verdict says \"in the asymptotic range\", the estimated energy "
+                                       "error of the "
+            "finest two levels shall be within "
+            f"[{EFF_BAND[0]}, {EFF_BAND[1]}] of the true error (every manufactured case; "
+            "h, k and joint each in range at least once)", ok1,
+            ("; ".join(checked) + (f"; OUT OF BAND: {bad}" if bad else "") +
+             f"; in range: {sorted(in_range_kinds)}"), "verification/run_all.py --only estimates",
+             "reference/estimates.md")
     front0 = refusals["est_h_mms_front"][0]
     k2 = refusals["est_k_mms_stop_2j"]
     ok2 = front0.startswith("not yet") and all(v.startswith("not yet") for v in k2)
@@ -158,13 +147,9 @@ def differences(hs):
     import meshio
     import numpy as np
     d = os.path.join(out_dir(), "differences")
-    rows, cmd = study(
-        hs,
-        "verification/cases/paper_example_5_1.toml",
-        [(0, 40), (1, 80), (2, 160)],
-        "est_differences_ex51",
-        extra=["--differences", d],
-    )
+    rows, cmd = study(hs, "verification/cases/paper_example_5_1.toml", [(0, 40), (1, 80), (2, 160)],
+                      "est_differences_ex51",
+                      extra=["--differences", d])
     files = [os.path.join(d, f"difference_{r}_{n}.xdmf") for r, n in [(1, 80), (2, 160)]]
     msg, ok = [], True
     for f in files:
@@ -184,17 +169,10 @@ def differences(hs):
         except Exception as e:  # noqa: BLE001
             ok = False
             msg.append(f"{os.path.basename(f)}: {e}")
-    req(
-        hs,
-        "R3-differences",
-        "`study --differences DIR` shall write per level an XDMF file with the elementwise "
-        "energy density of "
-        "u_l − P u_{l−1} as a cell field that meshio and VTK's vtkXdmfReader (ParaView's XDMF Reader) open",
-        ok,
-        "; ".join(msg),
-        cmd,
-        "out/verify/differences/",
-    )
+    req(hs, "R3-differences", "`study --differences DIR` shall write per level an XDMF file with the elementwise "
+                              "energy density of "
+            "u_l − P u_{l−1} as a cell field that meshio and VTK's vtkXdmfReader (ParaView's XDMF Reader) open", ok,
+            "; ".join(msg), cmd, "out/verify/differences/")
 
 
 def paper_estimate_rows(rows1):

@@ -108,44 +108,50 @@ def memory_tables(meas, fresh):
                f"flags {a.get('flags')}."]
     md += ["", "Commands:", "", "```"] + meas["commands"] + ["```"]
     mo = meas.get("model")
-    mu1, mu2 = r1["mumps"].get("mem_total_mb"), r2["mumps"].get("mem_max_rank_mb")
     if mo:
-        md += ["", "## Scaling model (an estimate, not a measurement)", "",
-               "From the two measured points the largest rank's peak is m(P) = c + D/P with c = "
-               f"{mo['c_mb']:.0f} MB and "
-               "D = "
-               f"{mo['D_mb']:.0f} MB at n₀ = "
-               f"{mo['n0']:,} unknowns. D spreads over the ranks. Of c, b = {mo['b_mb']:.0f} MB "
-               "is the import footprint (Python, dolfinx, PETSc, MPI; measured before the mesh exists). The rest, "
-               f"{mo['c_mb'] - mo['b_mb']:.0f} MB, is what did not halve from 1 to 2 ranks: MUMPS' parallel overhead "
-               "(by its "
-               "own count, INFOG(21/22): "
-               f"{mu1} MB at 1 rank, {mu2} MB on the largest rank at 2) and PETSc/dolfinx structures "
-               "(ghosts, the PtAP product, the host's sequential METIS analysis of the whole graph). Two points cannot "
-               "tell "
-               "whether that part is a constant, grows with n on every rank, or falls with P; the column *per-rank "
-               "peak* "
-               "assumes the worst (∝ n on every rank), the column *if spread* the best (it spreads like D). "
-               "(`--mumps-analysis parallel`, PT-Scotch, removes the host's analysis but gave a 10 % larger factor "
-               "here.)", "",
-               "Assumptions: structured 2D meshes with contact on one side, n_c ≈ √(n/6) contact edges; factor entries "
-               "and "
-               "solve work ∝ n log₂ n and factorisation flops ∝ n^1.5 (2D nested dissection); D grows like the factor "
-               "and "
-               "is split over P ranks with a load imbalance of 1.3; the non-spreading part grows ∝ n on every rank "
-               "(pessimistic: column *per-rank peak*) or is removed (column *if spread*); times scale from the 1-rank "
-               "measurement with parallel efficiency 0.5 (MUMPS across nodes, not measured here; this machine's times "
-               "were taken under load and vary by ~1.5×); C is bounded by n_c solves (MUMPS prunes its tree for "
-               "selected "
-               "inverse entries, so it is cheaper); the dense C (n_c² doubles) and the friction step sit on rank 0, "
-               "a dense active-set solve of O(n_c³) per iteration (n_c ≈ 4,100 at 10⁸ unknowns: ~7·10¹⁰ flop, seconds "
-               "to "
-               "tens of seconds per iteration) — beyond ~10⁸ unknowns the contact problem itself needs a distributed "
-               "solver.", "",
-               "| unknowns | ranks | n_c | per-rank peak GB | if spread GB | factorisation s | C s (bound) | per step "
-               "s | C on rank 0 MB |",
-               "|---|---|---|---|---|---|---|---|---|"]
-        for r in mo["rows"]:
-            md.append(f"| {r['n']:.0e} | {r['P']} | {r['nc']:.0f} | {r['mem_gb']:.1f} | {r['mem_spread_gb']:.1f} | "
-                      f"{r['fact_s']:.0f} | {r['cond_s']:.0f} | {r['step_s']:.1f} | {r['C_mb']:.0f} |")
+        md += scaling_tables(mo, r1["mumps"].get("mem_total_mb"), r2["mumps"].get("mem_max_rank_mb"))
+    return md
+
+
+def scaling_tables(mo, mu1, mu2):
+    """The scaling model's section: its derivation and the per-rank estimates of ``mo`` (scaling.scaling_model);
+    mu1, mu2: MUMPS' own memory count at 1 rank and on the largest rank at 2."""
+    md = ["", "## Scaling model (an estimate, not a measurement)", "",
+           "From the two measured points the largest rank's peak is m(P) = c + D/P with c = "
+           f"{mo['c_mb']:.0f} MB and "
+           "D = "
+           f"{mo['D_mb']:.0f} MB at n₀ = "
+           f"{mo['n0']:,} unknowns. D spreads over the ranks. Of c, b = {mo['b_mb']:.0f} MB "
+           "is the import footprint (Python, dolfinx, PETSc, MPI; measured before the mesh exists). The rest, "
+           f"{mo['c_mb'] - mo['b_mb']:.0f} MB, is what did not halve from 1 to 2 ranks: MUMPS' parallel overhead "
+           "(by its "
+           "own count, INFOG(21/22): "
+           f"{mu1} MB at 1 rank, {mu2} MB on the largest rank at 2) and PETSc/dolfinx structures "
+           "(ghosts, the PtAP product, the host's sequential METIS analysis of the whole graph). Two points cannot "
+           "tell "
+           "whether that part is a constant, grows with n on every rank, or falls with P; the column *per-rank "
+           "peak* "
+           "assumes the worst (∝ n on every rank), the column *if spread* the best (it spreads like D). "
+           "(`--mumps-analysis parallel`, PT-Scotch, removes the host's analysis but gave a 10 % larger factor "
+           "here.)", "",
+           "Assumptions: structured 2D meshes with contact on one side, n_c ≈ √(n/6) contact edges; factor entries "
+           "and "
+           "solve work ∝ n log₂ n and factorisation flops ∝ n^1.5 (2D nested dissection); D grows like the factor "
+           "and "
+           "is split over P ranks with a load imbalance of 1.3; the non-spreading part grows ∝ n on every rank "
+           "(pessimistic: column *per-rank peak*) or is removed (column *if spread*); times scale from the 1-rank "
+           "measurement with parallel efficiency 0.5 (MUMPS across nodes, not measured here; this machine's times "
+           "were taken under load and vary by ~1.5×); C is bounded by n_c solves (MUMPS prunes its tree for "
+           "selected "
+           "inverse entries, so it is cheaper); the dense C (n_c² doubles) and the friction step sit on rank 0, "
+           "a dense active-set solve of O(n_c³) per iteration (n_c ≈ 4,100 at 10⁸ unknowns: ~7·10¹⁰ flop, seconds "
+           "to "
+           "tens of seconds per iteration) — beyond ~10⁸ unknowns the contact problem itself needs a distributed "
+           "solver.", "",
+           "| unknowns | ranks | n_c | per-rank peak GB | if spread GB | factorisation s | C s (bound) | per step "
+           "s | C on rank 0 MB |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for r in mo["rows"]:
+        md.append(f"| {r['n']:.0e} | {r['P']} | {r['nc']:.0f} | {r['mem_gb']:.1f} | {r['mem_spread_gb']:.1f} | "
+                  f"{r['fact_s']:.0f} | {r['cond_s']:.0f} | {r['step_s']:.1f} | {r['C_mb']:.0f} |")
     return md
