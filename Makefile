@@ -65,13 +65,10 @@ venv: $(VENV)/.stamp
 
 # The lint half of `make test` (CI): formatting, clippy with warnings as errors, ruff on the Python
 # (config python/pyproject.toml [tool.ruff]) and every path the documentation names exists.
-# TEMPORARY: E501 (line > 120) is ignored here: 217 long lines remain in verification/ (run_all.py 70,
-# distributed.py 43, bench.py 25, …), files the issue-31 harness work is restructuring; drop the
-# --extend-ignore once they are wrapped (`ruff check --config python/pyproject.toml python scripts verification`).
 lint: venv
 	cargo fmt --check
 	cargo clippy --all-targets --locked -- -D warnings
-	$(VENV)/bin/ruff check --config python/pyproject.toml python scripts verification --extend-ignore E501
+	$(VENV)/bin/ruff check --config python/pyproject.toml python scripts verification
 	$(PY) verification/check_doc_paths.py
 
 test: build venv getfem
@@ -89,7 +86,7 @@ reference: venv
 
 # Timings live here only (no pass/fail of make verify or make test depends on a time).
 bench: build venv bench-env
-	$(PY) verification/bench.py
+	$(PY) verification/bench/report.py
 	$(PY) verification/planner.py --costs
 	$(MAKE) bench-factorisation
 

@@ -1,5 +1,5 @@
 """The distributed dolfinx + PETSc/MUMPS route (issue 16): agreement (D1) and memory spreading (D2).
-The logic is in tresca_py/verify/distributed.py; this is its entry point.
+The logic is in tresca_py/verify/distributed/; this is its entry point.
 
     .venv/bin/python verification/distributed.py [--memory] [--bin target/release/tresca-cr]
 """

@@ -1,6 +1,7 @@
 """Compare two binaries by interleaved runs (tresca_py/bench/interleave.py); a benchmark tool.
 
-    .venv/bin/python verification/interleave.py 21 OLD_BINARY NEW_BINARY -- run verification/cases/mms_stop.toml --refine 4 --steps 16 -q
+    .venv/bin/python verification/interleave.py 21 OLD_BINARY NEW_BINARY -- \\
+        run verification/cases/mms_stop.toml --refine 4 --steps 16 -q
 """
 import sys
 

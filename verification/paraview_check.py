@@ -51,9 +51,14 @@ def dump(xdmf, reader_name, which):
                     arrays[a.GetName()] = [[a.GetComponent(j, c) for c in range(a.GetNumberOfComponents())]
                                            for j in range(a.GetNumberOfTuples())]
             kind = "contact" if "slip" in arrays else "body"
-            blocks[kind] = {"points": b.GetNumberOfPoints(), "cells": b.GetNumberOfCells(),
-                            "cell_arrays": sorted(b.GetCellData().GetArrayName(i) for i in range(b.GetCellData().GetNumberOfArrays())),
-                            "arrays": arrays}
+            blocks[kind] = {
+                "points": b.GetNumberOfPoints(),
+                "cells": b.GetNumberOfCells(),
+                "cell_arrays": sorted(
+                    b.GetCellData().GetArrayName(i) for i in range(b.GetCellData().GetNumberOfArrays())
+                ),
+                "arrays": arrays,
+            }
             it.GoToNextItem()
         out["frames"][str(k)] = blocks
     print("JSON" + json.dumps(out))

@@ -163,8 +163,11 @@ def test_the_system_shall_refuse_data_that_disagree_at_a_shared_vertex(tmp_path)
 
 def test_the_system_shall_read_zero_data_as_no_data_and_refuse_data_on_the_wrong_kind(tmp_path):
     path = tmp_path / "z.toml"
-    path.write_text(PATCH.replace('gap = "0.02*t*x"', 'gap = "0"')
-                    .replace('u = ["t*(0.01*x + 0.02*y)", "t*(-0.02*x + 0.03*y)"]\n[[boundary]]', 'u = ["0", "0*x"]\n[[boundary]]', 1))
+    path.write_text(
+        PATCH.replace('gap = "0.02*t*x"', 'gap = "0"').replace(
+            'u = ["t*(0.01*x + 0.02*y)", "t*(-0.02*x + 0.03*y)"]\n[[boundary]]', 'u = ["0", "0*x"]\n[[boundary]]', 1
+        )
+    )
     assert not load_scene(str(path)).has_boundary_data
     path.write_text(PATCH.replace('traction = ["0.024*t", "0"]', 'traction = ["0.024*t", "0"]\nu = ["0", "1"]'))
     with pytest.raises(SceneError, match="'u' is only allowed"):

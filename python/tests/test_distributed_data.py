@@ -14,7 +14,7 @@ from tresca_py.expr import Expr, VecExpr
 from tresca_py.quadrature import GAUSS3_S, GAUSS3_W
 
 SCRIPT = os.path.join(SCRIPTS, "dolfinx_distributed.py")
-# Agreement with Rust: the tolerance of the cross-check's distributed rows (verify/distributed.py TOL): far above
+# Agreement with Rust: the tolerance of the cross-check's distributed rows (verify/distributed/runs.py TOL): far above
 # the rounding of two direct solvers on these meshes (observed <= 5e-11, the derr of mms_data_cep), far below any
 # effect of a wrongly applied lifting (the data are O(1e-2) of the displacement or more).
 TOL = 1e-8
@@ -132,15 +132,23 @@ def scene_with(tmp_path, name, old, new):
 
 
 @pytest.mark.parametrize("ranks", [1, 2])
-@pytest.mark.parametrize("name, key, shift, message", [
-    # u0's first component shifted by 0.01: contradicts u_D(t0) on the top side (u0·n on Γ_C is -u0[1]: unchanged)
-    ("mms_data_front", 'u0 = ["', "(1/100)+", "initial.u0[0] and part `top`'s u[0] at t0 = 0"),
-    # the gap shifted by 0.01, u0 unchanged: u0·n contradicts it at t0
-    ("mms_data_stop", 'gap = "', "(1/100)+", "initial.u0·n and part `bottom`'s gap at t0 = 0"),
-    # the right side's u[0] shifted by t/100: fits u0 at t0 = 0, but not the top side's u[0] at their common
-    # vertex (1, 1) at the first step t = 0.5 (at (1, 0) only u[1] = -u·n meets the gap: unchanged)
-    ("mms_data_cep", 'name = "right"\nkind = "dirichlet"\nu = ["', "(t/100)+", "at their common vertex (u[0], t = 0.5)"),
-])
+@pytest.mark.parametrize(
+    "name, key, shift, message",
+    [
+        # u0's first component shifted by 0.01: contradicts u_D(t0) on the top side (u0·n on Γ_C is -u0[1]: unchanged)
+        ("mms_data_front", 'u0 = ["', "(1/100)+", "initial.u0[0] and part `top`'s u[0] at t0 = 0"),
+        # the gap shifted by 0.01, u0 unchanged: u0·n contradicts it at t0
+        ("mms_data_stop", 'gap = "', "(1/100)+", "initial.u0·n and part `bottom`'s gap at t0 = 0"),
+        # the right side's u[0] shifted by t/100: fits u0 at t0 = 0, but not the top side's u[0] at their common
+        # vertex (1, 1) at the first step t = 0.5 (at (1, 0) only u[1] = -u·n meets the gap: unchanged)
+        (
+            "mms_data_cep",
+            'name = "right"\nkind = "dirichlet"\nu = ["',
+            "(t/100)+",
+            "at their common vertex (u[0], t = 0.5)",
+        ),
+    ],
+)
 def test_refuses_inconsistent_data(tmp_path, ranks, name, key, shift, message):
     """The system shall refuse, on every rank, boundary data that do not fit together (u0 against u_D(t0) on Γ_D,
     u0·n against the gap at t0 on Γ_C, two parts' data at their common vertex) with one error line naming them,
@@ -177,9 +185,9 @@ def test_names_data_that_cannot_be_evaluated(tmp_path):
 
 def test_gmsh_scene_with_data_agrees_with_rust(tmp_path):
     """The system shall apply boundary data on a Gmsh mesh read on rank 0 and distributed (the L-shape of
-    verify/distributed.py with Dirichlet data on its clamp and a gap on its floor) as the Rust solver does,
+    verify/distributed/agreement.py with Dirichlet data on its clamp and a gap on its floor) as the Rust solver does,
     within the same 1e-8, at 2 ranks."""
-    from tresca_py.verify.distributed import GMSH_SCENE, gmsh_data_scene
+    from tresca_py.verify.distributed.agreement import GMSH_SCENE, gmsh_data_scene
     scene = tmp_path / "lshape_data.toml"
     scene.write_text(gmsh_data_scene(GMSH_SCENE.format(msh=case("lshape")[:-5] + ".msh")))
     rs, dx = str(tmp_path / "rust.h5"), str(tmp_path / "np2.h5")

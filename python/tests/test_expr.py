@@ -104,7 +104,9 @@ def test_the_system_shall_name_an_expression_whose_part_in_t_is_not_finite_with_
     x, y = np.array([0.25, 0.75]), np.array([0.5, 0.5])
     with pytest.raises(ExprError) as err:
         e(x, y, t)
-    assert str(err.value) == f"[loads] f[0]: expression {text!r} has the value {value} at (x, y) = (0.25, 0.5), t = {t:g}"
+    assert (
+        str(err.value) == f"[loads] f[0]: expression {text!r} has the value {value} at (x, y) = (0.25, 0.5), t = {t:g}"
+    )
     assert np.all(np.isfinite(e(x, y, t_ok)))        # the same expression where f64 has a value: no error
 
 

@@ -22,8 +22,13 @@ def test_no_regex_over_printed_output(path):
     """The system shall not match regular expressions against a process's standard output."""
     tree = ast.parse(open(path, encoding="utf-8").read())
     for node in ast.walk(tree):
-        if (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and isinstance(node.func.value, ast.Name)
-                and node.func.value.id == "re" and any("stdout" in names(a) for a in node.args)):
+        if (
+            isinstance(node, ast.Call)
+            and isinstance(node.func, ast.Attribute)
+            and isinstance(node.func.value, ast.Name)
+            and node.func.value.id == "re"
+            and any("stdout" in names(a) for a in node.args)
+        ):
             pytest.fail(f"{os.path.relpath(path, ROOT)}:{node.lineno}: re.{node.func.attr} over stdout")
 
 

@@ -10,7 +10,8 @@ Values are compared at the 3-point Gauss points of the edges and at the shared v
 of 1e-9 of the size of the data (the largest |u₀| at a mesh vertex or value compared: a real mismatch below
 that is far below what the discretisation resolves) and ROUNDING_ULPS ulps of the size the data reach over the
 time grid (the largest |u_D|, |g_n| at the vertices of the parts with data, at every time node): the floor for
-data that all vanish at t₀ by cancellation, whose terms are of that size and leave a few ulps of it. Scenes without boundary data are not checked (u₀ is projected onto V_h there).
+data that all vanish at t₀ by cancellation, whose terms are of that size and leave a few ulps of it.
+Scenes without boundary data are not checked (u₀ is projected onto V_h there).
 
 Each solver calls ``check_boundary_data`` with its own boundary edges; this module only reads the scene.
 """

@@ -4,7 +4,8 @@ minutes, only runs interleaved like this compare two builds fairly (:func:`tresc
 as bench.py times; output discarded, exit status not checked). A benchmark tool: nothing of `make verify`
 or `make test` uses it.
 
-    .venv/bin/python verification/interleave.py 21 OLD_BINARY NEW_BINARY -- run verification/cases/mms_stop.toml --refine 4 --steps 16 -q
+    .venv/bin/python verification/interleave.py 21 OLD_BINARY NEW_BINARY -- \\
+        run verification/cases/mms_stop.toml --refine 4 --steps 16 -q
 """
 import os
 import statistics

@@ -143,7 +143,9 @@ class CrEdges:
         constrained[self.dirichlet] = constrained[self.contact] = True
         free = np.flatnonzero(~constrained)
         nf, nc = 2 * len(free), len(self.contact)
-        rows = np.concatenate([np.column_stack([2 * free, 2 * free + 1]).ravel(), 2 * self.contact, 2 * self.contact + 1])
+        rows = np.concatenate(
+            [np.column_stack([2 * free, 2 * free + 1]).ravel(), 2 * self.contact, 2 * self.contact + 1]
+        )
         cols = np.concatenate([np.arange(nf), nf + np.arange(nc), nf + np.arange(nc)])
         vals = np.concatenate([np.ones(nf), self.tangent[:, 0], self.tangent[:, 1]])
         return sp.coo_matrix((vals, (rows, cols)), shape=(2 * ne, nf + nc)).tocsr(), nf + np.arange(nc)

@@ -9,8 +9,6 @@ verification/mms/cases_boundary.py:
 * a self-test: a flipped friction sign, a wrong bound and a wrong gap must each be caught.
 """
 import argparse
-import pathlib
-import sys
 
 import numpy as np
 import sympy as sp
@@ -19,10 +17,10 @@ from tresca_py.common import CASES
 from tresca_py.mms.blocks import lam
 from tresca_py.mms.boundary import R, case_data_cep, case_data_front, case_data_stop, check_cep_symbolic
 from tresca_py.mms.checks import check_derivatives, check_roundtrip
+from tresca_py.mms.cli import derive_check_write, derive_each, scene_of
 from tresca_py.mms.derive import CheckFailed, derive, printed, require
 from tresca_py.mms.elasticity import side_normal_exact
-from tresca_py.mms.exmex import NotPrintable
-from tresca_py.mms.scene_toml import check_toml, scene_text
+from tresca_py.mms.scene_toml import scene_text
 from tresca_py.mms.tresca_law import check_tresca_law, side_grid
 
 BOUNDARY_CASES = [case_data_front, case_data_cep, case_data_stop]
@@ -123,26 +121,8 @@ def main():
     ap.add_argument("--check", action="store_true", help="derive and check only, write nothing")
     ap.add_argument("--out", default=CASES, help="output directory (default verification/cases)")
     args = ap.parse_args()
-    derived = []
-    try:
+
+    def derive_all():
         check_cep_symbolic(print)
-        for make in BOUNDARY_CASES:
-            case = make()
-            print("== %s: %s" % (case["name"], case["title"]))
-            derived.append(run_checks(case, lambda m: print("   " + m)))
-        print("== selftest: deliberately wrong data must be rejected")
-        selftest()
-    except (CheckFailed, NotPrintable) as err:
-        print("\nCHECK FAILED: %s" % err, file=sys.stderr)
-        sys.exit(1)
-    if args.check:
-        print("all checks passed (nothing written)")
-        return
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    for d in derived:
-        path = out / (d["name"] + ".toml")
-        path.write_text(data_scene_text(d))
-        check_toml(path, d)
-        print("wrote %s" % path)
-    print("all checks passed")
+        return [scene_of(d, data_scene_text(d)) for d in derive_each(BOUNDARY_CASES, run_checks)]
+    derive_check_write(args, derive_all, selftest)

@@ -1,5 +1,6 @@
 """The derivation's command line (verification/mms/derive.py): derive and check every case of
-tresca_py.mms.cases and the L-shape, run the self-test, write the scenes."""
+tresca_py.mms.cases and the L-shape, run the self-test, write the scenes. derive_check_write is the flow it
+shares with the boundary-data cases' command line (tresca_py.mms.boundary_checks)."""
 import argparse
 import pathlib
 import sys
@@ -13,7 +14,63 @@ from tresca_py.mms.lshape import case_lshape
 from tresca_py.mms.lshape import check_toml as check_lshape_toml
 from tresca_py.mms.lshape import run_checks as run_lshape_checks
 from tresca_py.mms.lshape import scene_text as lshape_text
-from tresca_py.mms.scene_toml import check_toml, write_toml
+from tresca_py.mms.scene_toml import check_toml, scene_text
+
+
+def derive_each(makers, run):
+    """Derive and check every case ``make()`` of ``makers`` with ``run(case, log)``, printing as it goes;
+    returns the derived cases."""
+    derived = []
+    for make in makers:
+        case = make()
+        print("== %s: %s" % (case["name"], case["title"]))
+        derived.append(run(case, lambda msg: print("   " + msg)))
+    return derived
+
+
+def derive_check_write(args, derive_all, selftest=None):
+    """The flow of the derivation command lines: ``derive_all()`` derives and checks, returning the scenes
+    to write as (file name, text, check) triples; then ``selftest()`` (when given) shows that wrong data are
+    rejected. A CheckFailed or NotPrintable ends the program with status 1. Unless ``args.check``, each
+    scene is written into ``args.out`` and ``check(path)`` re-reads it."""
+    try:
+        scenes = derive_all()
+        if selftest is not None:
+            print("== selftest: deliberately wrong data must be rejected")
+            selftest()
+    except (CheckFailed, NotPrintable) as err:
+        print("\nCHECK FAILED: %s" % err, file=sys.stderr)
+        sys.exit(1)
+    if args.check:
+        print("all checks passed (nothing written)")
+        return
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    for name, text, check in scenes:
+        path = out / name
+        path.write_text(text)
+        check(path)
+        print("wrote %s" % path)
+    print("all checks passed")
+
+
+def scene_of(d, text):
+    """The (file name, text, check) triple of a derived case ``d`` whose scene text is ``text``."""
+    return d["name"] + ".toml", text, lambda path: check_toml(path, d)
+
+
+def derive_all(exmex):
+    """Every case of tresca_py.mms.cases and the L-shape, derived and checked: their scenes."""
+    def run(case, log):
+        d = run_checks(case, exmex, log)
+        log("longest printed expression: %d characters" % max(len(v) for v in d["str"].values()))
+        return d
+    derived = derive_each(CASES, run)
+    print("== mms_lshape: the L-shape with the re-entrant corner's singularity (tresca_py/mms/lshape.py)")
+    lshape = run_lshape_checks(case_lshape(), lambda msg: print("   " + msg))
+    text = lshape_text(lshape)
+    return [scene_of(d, scene_text(d)) for d in derived] + [
+        ("mms_lshape.toml", text, lambda path: check_lshape_toml(path.read_text(), lshape))]
 
 
 def main():
@@ -23,36 +80,4 @@ def main():
     ap.add_argument("--no-selftest", action="store_true", help="skip the check that wrong data are rejected")
     ap.add_argument("--out", default=CASES_DIR, help="output directory (default verification/cases)")
     args = ap.parse_args()
-    out = pathlib.Path(args.out)
-    derived = []
-    try:
-        for make in CASES:
-            case = make()
-            print("== %s: %s" % (case["name"], case["title"]))
-            def log(msg):
-                print("   " + msg)
-            d = run_checks(case, args.exmex, log)
-            log("longest printed expression: %d characters" % max(len(v) for v in d["str"].values()))
-            derived.append(d)
-        print("== mms_lshape: the L-shape with the re-entrant corner's singularity (tresca_py/mms/lshape.py)")
-        lshape = run_lshape_checks(case_lshape(), lambda msg: print("   " + msg))
-        if not args.no_selftest:
-            print("== selftest: deliberately wrong data must be rejected")
-            selftest()
-    except (CheckFailed, NotPrintable) as err:
-        print("\nCHECK FAILED: %s" % err, file=sys.stderr)
-        sys.exit(1)
-    if args.check:
-        print("all checks passed (nothing written)")
-        return
-    out.mkdir(parents=True, exist_ok=True)
-    for d in derived:
-        path = out / (d["name"] + ".toml")
-        write_toml(d, path)
-        check_toml(path, d)
-        print("wrote %s" % path)
-    text = lshape_text(lshape)
-    check_lshape_toml(text, lshape)
-    (out / "mms_lshape.toml").write_text(text)
-    print("wrote %s" % (out / "mms_lshape.toml"))
-    print("all checks passed")
+    derive_check_write(args, lambda: derive_all(args.exmex), None if args.no_selftest else selftest)

@@ -5,11 +5,13 @@ Usage:
     python verification/bit_identity.py compare DIR_A DIR_B     # compare them dataset by dataset
     python verification/bit_identity.py compare DIR_A DIR_B --rel 1e-10   # floats within a relative tolerance
 
-`run` solves every scene of ``verification/cases/`` (at its own refine and steps, and at one finer level)
-and the paper's Example 5.1 levels of Tables 5.1/5.2 (refine k, N = 40·2^k, k = 0..4),  with the SSN, Uzawa and PDAS solvers where the scene
-has contact. `compare` reads every dataset and attribute under ``/tresca`` and ``/VTKHDF`` with h5py and requires the
-bytes to be equal, except what is not a number of the method: wall times (``steps/wall_time``,
-``setup_times``, the Python solvers' ``*_time`` and ``*peak_rss_mb`` attributes, and ``steps/checksum``, which hashes the wall time with the rest of a step), the build (``version``, ``git_commit``). It prints one line per file and exits non-zero
+`run` solves every scene of ``verification/cases/`` (at its own refine and steps, and at one finer level) and
+the paper's Example 5.1 levels of Tables 5.1/5.2 (refine k, N = 40·2^k, k = 0..4), with the SSN, Uzawa and PDAS
+solvers where the scene has contact. `compare` reads every dataset and attribute under ``/tresca`` and
+``/VTKHDF`` with h5py and requires the bytes to be equal, except what is not a number of the method: wall times
+(``steps/wall_time``, ``setup_times``, the Python solvers' ``*_time`` and ``*peak_rss_mb`` attributes, and
+``steps/checksum``, which hashes the wall time with the rest of a step), the build (``version``,
+``git_commit``). It prints one line per file and exits non-zero
 if any value differs. With ``--rel TOL`` floating-point values may differ by TOL relative to the largest
 magnitude of their dataset (max |a - b| <= TOL max |a|, for changes that move results by rounding only;
 float32 visualisation copies within max(TOL, 1e-6), the solvers' residuals within 1e-12 absolute);

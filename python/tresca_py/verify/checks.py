@@ -70,8 +70,18 @@ def cross_check(hs, quick):
 def distributed(hs, quick):
     """D1 agreement at -n 1, 2, 3; D2 memory (full run only)."""
     out = os.path.join(hs.out, "distributed.json")
-    cmd = [PY, "verification/distributed.py", "--json", out, "--bin", BIN, "--work", os.path.join(hs.out, "distributed"),
-           "--md", hs.path("distributed.md") if not quick else os.path.join(hs.out, "distributed_quick.md")]
+    cmd = [
+        PY,
+        "verification/distributed.py",
+        "--json",
+        out,
+        "--bin",
+        BIN,
+        "--work",
+        os.path.join(hs.out, "distributed"),
+        "--md",
+        hs.path("distributed.md") if not quick else os.path.join(hs.out, "distributed_quick.md"),
+    ]
     full = ["--memory", "--memory-json", hs.path("distributed_memory.json")]
     hs.run_script(cmd + ([] if quick else full), out, "D0-distributed")
 

@@ -95,16 +95,22 @@ def report(hs, results):
                 if not (eff is not None and EFF_BAND[0] <= eff <= EFF_BAND[1]):
                     bad.append(f"{name} {int(r['refine'])}:{int(r['steps'])}: {eff}")
             first = i == 0
-            lines.append(f"| {name if first else ''} | {kind if first else ''} | {p if first else ''} | {beta if first else ''} | "
+            lines.append("| "
+                         f"{name if first else ''} | "
+                         f"{kind if first else ''} | {p if first else ''} | {beta if first else ''} | "
                          f"{int(r['refine'])}:{int(r['steps'])} | {f(est)} | {f(r['gci'])} | {f(t)} | "
                          f"{'-' if eff is None else f'{eff:.3f}'} | {v} |")
-    lines += ["", "Reading: β near 1 is Galerkin orthogonality of nested levels (the h sequences: the CR gradient is the "
+    lines += ["", "Reading: β near 1 is Galerkin orthogonality of nested levels (the h sequences: the CR gradient is "
+                  "the "
               "elementwise mean of ∇u to leading order), β = 0 parallel errors (the k sequence: backward Euler's error "
               "θkW has one shape). Both are measured from three distances, never fitted to a true error.", "",
               "## Scalar outputs at T (finest level)", "",
-              "Extrapolated with Celik's three-level order; theoretical order 2 for the energy in h (1 in k), 1 otherwise. "
-              "No exact values are required here; for `mms_front` the exact maximum slip at T is 1/20 (s = S(·)/20, S ≤ 1).", "",
-              "| sequence | output | finest value | extrapolated | p | estimate | GCI | verdict |", "|---|---|---|---|---|---|---|---|"]
+              "Extrapolated with Celik's three-level order; theoretical order 2 for the energy in h (1 in k), 1 "
+              "otherwise. "
+              "No exact values are required here; for `mms_front` the exact maximum slip at T is 1/20 (s = S(·)/20, S "
+              "≤ 1).", "",
+              "| sequence | output | finest value | extrapolated | p | estimate | GCI | verdict |",
+              "|---|---|---|---|---|---|---|---|"]
     for name, *_ in CASES:
         rows, _ = results[name]
         last = rows[-1]
@@ -112,22 +118,28 @@ def report(hs, results):
             if col == "":
                 continue
             lines.append(f"| {name} | {col} | {f(last[col])} | {f(last[col + '_limit'])} | "
-                         f"{'-' if last[col + '_p'] is None else f'{last[col + chr(95) + chr(112)]:.3f}'} | {f(last[col + '_est'])} | "
+                         f"{'-' if last[col + '_p'] is None else f'{last[col + chr(95) + chr(112)]:.3f}'} | "
+                         f"{f(last[col + '_est'])} | "
                          f"{f(last[col + '_gci'])} | {last[col + '_verdict']} |")
     lines += ["", "Commands:", ""] + [f"    {c}" for c in cmds]
     hs.write("estimates.md", "\n".join(lines) + "\n")
     ok1 = not bad and {"h", "k", "joint"} <= in_range_kinds
-    req(hs, "R1-estimate-effectivity", f"where the verdict says \"in the asymptotic range\", the estimated energy error of the "
-            f"finest two levels shall be within [{EFF_BAND[0]}, {EFF_BAND[1]}] of the true error (every manufactured case; "
+    req(hs, "R1-estimate-effectivity", "where the verdict says \"in the asymptotic range\", the estimated energy "
+                                       "error of the "
+            "finest two levels shall be within "
+            f"[{EFF_BAND[0]}, {EFF_BAND[1]}] of the true error (every manufactured case; "
             "h, k and joint each in range at least once)", ok1,
             ("; ".join(checked) + (f"; OUT OF BAND: {bad}" if bad else "") +
-             f"; in range: {sorted(in_range_kinds)}"), "verification/run_all.py --only estimates", "reference/estimates.md")
+             f"; in range: {sorted(in_range_kinds)}"), "verification/run_all.py --only estimates",
+             "reference/estimates.md")
     front0 = refusals["est_h_mms_front"][0]
     k2 = refusals["est_k_mms_stop_2j"]
     ok2 = front0.startswith("not yet") and all(v.startswith("not yet") for v in k2)
-    req(hs, "R2-estimate-refuses", "the verdict shall say \"not yet\" on the coarsest level of mms_front and on every level of "
+    req(hs, "R2-estimate-refuses", "the verdict shall say \"not yet\" on the coarsest level of mms_front and on every "
+                                   "level of "
             "mms_stop with N = 2^j (θ = frac(N/3) alternating)", ok2,
-            f"mms_front refine 0: {front0[:90]}; mms_stop N=2^j: {k2[-1][:140]}", "verification/run_all.py --only estimates",
+            f"mms_front refine 0: {front0[:90]}; mms_stop N=2^j: {k2[-1][:140]}", "verification/run_all.py --only "
+                                                                                  "estimates",
             "reference/estimates.md")
 
 
@@ -135,7 +147,8 @@ def differences(hs):
     import meshio
     import numpy as np
     d = os.path.join(out_dir(), "differences")
-    rows, cmd = study(hs, "verification/cases/paper_example_5_1.toml", [(0, 40), (1, 80), (2, 160)], "est_differences_ex51",
+    rows, cmd = study(hs, "verification/cases/paper_example_5_1.toml", [(0, 40), (1, 80), (2, 160)],
+                      "est_differences_ex51",
                       extra=["--differences", d])
     files = [os.path.join(d, f"difference_{r}_{n}.xdmf") for r, n in [(1, 80), (2, 160)]]
     msg, ok = [], True
@@ -151,12 +164,15 @@ def differences(hs):
             rd.Update()
             vr = rd.GetOutputDataObject(0).GetCellData().GetArray("density_T").GetRange()
             ok &= abs(vr[1] - v.max()) <= 1e-9 * v.max()
-            msg.append(f"{os.path.basename(f)}: {len(v)} cells, max density {v.max():.3e} (meshio), {vr[1]:.3e} (vtkXdmfReader)")
+            msg.append(f"{os.path.basename(f)}: "
+                       f"{len(v)} cells, max density {v.max():.3e} (meshio), {vr[1]:.3e} (vtkXdmfReader)")
         except Exception as e:  # noqa: BLE001
             ok = False
             msg.append(f"{os.path.basename(f)}: {e}")
-    req(hs, "R3-differences", "`study --differences DIR` shall write per level an XDMF file with the elementwise energy density of "
-            "u_l − P u_{l−1} as a cell field that meshio and VTK's vtkXdmfReader (ParaView's XDMF Reader) open", ok, "; ".join(msg), cmd, "out/verify/differences/")
+    req(hs, "R3-differences", "`study --differences DIR` shall write per level an XDMF file with the elementwise "
+                              "energy density of "
+            "u_l − P u_{l−1} as a cell field that meshio and VTK's vtkXdmfReader (ParaView's XDMF Reader) open", ok,
+            "; ".join(msg), cmd, "out/verify/differences/")
 
 
 def paper_estimate_rows(rows1):

@@ -51,7 +51,11 @@ def clients(check, h5, label):
 
 def state(h5):
     with h5py.File(h5, "r") as f:
-        return int(f["tresca/steps"].attrs["completed"]), str(f["tresca"].attrs["status"]), int(f["tresca"].attrs["steps"])
+        return (
+            int(f["tresca/steps"].attrs["completed"]),
+            str(f["tresca"].attrs["status"]),
+            int(f["tresca"].attrs["steps"]),
+        )
 
 
 def clear(h5):
@@ -97,7 +101,9 @@ def killed_and_resumed(check, out, run):
     clients(check, h5, "killed run")
     r = subprocess.run(run + ["-o", h5, "--resume"], capture_output=True, text=True)
     done, status, n = state(h5)
-    check(r.returncode == 0 and done == n + 1 and status == "completed", f"resumed run: {done} steps, status {status!r}")
+    check(
+        r.returncode == 0 and done == n + 1 and status == "completed", f"resumed run: {done} steps, status {status!r}"
+    )
     clients(check, h5, "resumed run")
     return h5
 
@@ -138,7 +144,9 @@ def killed_often(check, out, run):
     bad, seen = [], 0
     for _ in range(30):
         clear(h5)
-        p = subprocess.Popen(run + ["-o", h5, "--frame-every", "5"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        p = subprocess.Popen(
+            run + ["-o", h5, "--frame-every", "5"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+        )
         wait_for(h5, p)
         time.sleep(rng.uniform(0.0, 0.05))
         p.send_signal(signal.SIGKILL)
@@ -168,7 +176,8 @@ def stopped(check, out):
     h5 = os.path.join(out, "stopped.h5")
     r = subprocess.run([BIN, "run", scene, "-q", "-o", h5, "--force"], capture_output=True, text=True)
     done, status, n = state(h5)
-    check(r.returncode == 1 and done == 1 and status.startswith("stopped:"), f"stopped run: {done} step, status {status!r}")
+    check(r.returncode == 1 and done == 1 and status.startswith("stopped:"), "stopped run: "
+                                                                             f"{done} step, status {status!r}")
     clients(check, h5, "stopped run")
 
 

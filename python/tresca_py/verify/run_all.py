@@ -70,7 +70,8 @@ def versions():
     version = subprocess.run([BIN, "--version"], capture_output=True, text=True).stdout.strip()
     pyv = subprocess.run([PY, "-c", "import skfem, dolfinx_solver, dolfinx, numpy, scipy, sympy; print('scikit-fem', "
                           "skfem.__version__, 'dolfinx', dolfinx.__version__, 'numpy', numpy.__version__, 'scipy', "
-                          "scipy.__version__, 'sympy', sympy.__version__)"], capture_output=True, text=True).stdout.strip()
+                          "scipy.__version__, 'sympy', sympy.__version__)"],
+                         capture_output=True, text=True).stdout.strip()
     return f"{version}; {pyv}"
 
 

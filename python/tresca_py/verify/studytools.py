@@ -60,7 +60,13 @@ def table_md(name, title, rows, cols, xcol="h"):
     lines = [f"## {title}", "", "| refine | N | h | k | DOF | " + " | ".join(f"{c} | order" for c in cols) + " |",
              "|" + "---|" * (5 + 2 * len(cols))]
     for i, r in enumerate(rows):
-        cells = [f"{int(r['refine'])}", f"{int(r['steps'])}", f"{r['h']:.4e}", f"{r['k']:.4e}", f"{int(r['paper_dofs'])}"]
+        cells = [
+            f"{int(r['refine'])}",
+            f"{int(r['steps'])}",
+            f"{r['h']:.4e}",
+            f"{r['k']:.4e}",
+            f"{int(r['paper_dofs'])}",
+        ]
         for c in cols:
             v = r[c]
             o = "-"

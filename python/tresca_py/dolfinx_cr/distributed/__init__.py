@@ -29,7 +29,8 @@ Wadhawan), but nothing of size O(mesh) is held by one rank:
   n x n_c block exists.  (``--condense matsolve``: blocked multi-right-hand-side MatMatSolve instead,
   ``--rhs-block`` columns at a time; at 1.57M unknowns on 1 rank, blocks of 32: 76 s and +0.95 GB for C,
   against 10 s and no extra memory for the selected entries.)
-  Per step: u_f = K_r^{-1} l^n (distributed; with boundary data l^n + b_D - a_h(u_L, .), module ``data``), d = E^T u_f - s^{n-1} gathered to rank 0 (n_c numbers),
+  Per step: u_f = K_r^{-1} l^n (distributed; with boundary data l^n + b_D - a_h(u_L, .), module ``data``),
+  d = E^T u_f - s^{n-1} gathered to rank 0 (n_c numbers),
   the friction problem solved there by PETSc TAO TRON (``tresca_py.dolfinx_cr.friction.TaoBoxQP``),
   mu broadcast, u^n = u_f - K_r^{-1} E mu (distributed); the displacement written is R u^n + u_L(t_n).
 * True errors are assembled distributed (the UFL forms of ``tresca_py.dolfinx_cr.forms``).

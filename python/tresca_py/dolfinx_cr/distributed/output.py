@@ -9,7 +9,8 @@ dtypes of ``tresca_py.results.SPEC`` and the attributes ``read`` requires (``sta
 ``tresca/steps`` ``completed``, ``n_edges``, ``n_contact``), and the tests read its files with
 ``tresca_py.results.read``. Left out: ``tresca/steps/checksum`` (optional in the layout), which hashes
 whole steps of u that no rank holds, the energy audit and the visualisation views (``/VTKHDF``,
-``OUT.xdmf``) of the Rust solver; the displacement for ParaView is ``OUT_vtk/displacement.pvd`` (dolfinx's parallel VTKFile).
+``OUT.xdmf``) of the Rust solver; the displacement for ParaView is ``OUT_vtk/displacement.pvd``
+(dolfinx's parallel VTKFile).
 """
 import os
 
