@@ -115,13 +115,20 @@ struct Lift {
 impl Loads {
     /// Quadrature points of the body force (if any) and of every Neumann part with a traction; the
     /// terms that separate are assembled into patterns now (an error if a space part is not finite).
-    pub fn new(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<Loads> {
-        Self::with_separation(scene, mesh, space, true)
+    /// With `data`, the lifting's part of the right-hand side too.
+    pub fn new(scene: &Scene, mesh: &Mesh, space: &CrSpace, data: Option<&BoundaryData>) -> Result<Loads> {
+        Self::with_separation(scene, mesh, space, data, true)
     }
 
     /// As [`Loads::new`]; with `separate = false` every term is evaluated at every node (the reference
     /// route the patterns are tested against).
-    pub fn with_separation(scene: &Scene, mesh: &Mesh, space: &CrSpace, separate: bool) -> Result<Loads> {
+    pub fn with_separation(
+        scene: &Scene,
+        mesh: &Mesh,
+        space: &CrSpace,
+        data: Option<&BoundaryData>,
+        separate: bool,
+    ) -> Result<Loads> {
         let mut raw: Vec<(&Vec2Expr, Vec<LoadPoint>)> = Vec::new();
         if let Some(f) = &scene.f {
             let mut points = Vec::with_capacity(6 * mesh.tris.len());
@@ -166,7 +173,7 @@ impl Loads {
                 }
             }
         }
-        let lift_parts = space.data.as_ref().map(|data| {
+        let lift_parts = data.map(|data| {
             let law = Elasticity::new(&scene.material);
             let rhs = LiftRhs::new(mesh, &space.edge_dof, &space.contact, data, &law, scene.rho);
             rhs.unknowns().for_each(|k| touched[k] = true);

@@ -11,7 +11,6 @@
 //!
 //! The interpolant I_CR takes edge means (3-point Gauss), which commute with time derivatives.
 
-use super::lifting::BoundaryData;
 use super::quadrature::{edge_point, GAUSS3};
 use crate::error::Result;
 use crate::mesh::Mesh;
@@ -117,8 +116,6 @@ pub struct CrSpace {
     pub contact: Vec<ContactEdge>,
     /// Number of Dirichlet edges.
     pub n_dirichlet: usize,
-    /// Nonzero boundary data u_D, g_n (`None` without: u = w, the unknowns alone).
-    pub data: Option<BoundaryData>,
 }
 
 impl CrSpace {
@@ -156,8 +153,7 @@ impl CrSpace {
                 }
             });
         }
-        let data = BoundaryData::new(mesh, parts, &edge_part, &contact);
-        Ok(CrSpace { edge_dof, edge_part, n_dofs: n, contact, n_dirichlet, data })
+        Ok(CrSpace { edge_dof, edge_part, n_dofs: n, contact, n_dirichlet })
     }
 
     /// True if edge e carries the stabilisation (interior or Dirichlet).
@@ -193,24 +189,6 @@ impl CrSpace {
                 .iter()
                 .map(|d| d.terms().fold([0.0; 2], |acc, (k, c)| [acc[0] + c[0] * u[k], acc[1] + c[1] * u[k]])),
         );
-    }
-
-    /// The displacement u = w + u_L(t) at every edge midpoint: [`CrSpace::midpoint_values_into`] of the
-    /// unknowns `w` plus the lifting of the boundary data at time t (`fem::lifting`; none without data).
-    pub fn displacement_into(&self, w: &[f64], t: f64, out: &mut Vec<[f64; 2]>) -> Result<()> {
-        self.midpoint_values_into(w, out);
-        if let Some(data) = &self.data {
-            let v = data.values(t)?;
-            data.add_lifting(&self.contact, &v, out);
-        }
-        Ok(())
-    }
-
-    /// [`CrSpace::displacement_into`] into a new vector.
-    pub fn displacement(&self, w: &[f64], t: f64) -> Result<Vec<[f64; 2]>> {
-        let mut out = Vec::with_capacity(self.edge_dof.len());
-        self.displacement_into(w, t, &mut out)?;
-        Ok(out)
     }
 
     /// I_CR v: edge means by 3-point Gauss, restricted to V_h (tangential part on contact edges). The

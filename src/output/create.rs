@@ -129,6 +129,7 @@ impl Writer {
             file: o.file,
             raw: o.raw,
             space: run.space.clone(),
+            data: run.data.cloned(),
             fields,
             tresca: o.tresca,
             vtk: o.vtk,

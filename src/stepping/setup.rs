@@ -54,12 +54,13 @@ impl Problem {
     ) -> WithBeside<R> {
         let t0 = Instant::now();
         let space = CrSpace::new(&mesh, &scene.parts).map_err(|e| (e, None))?;
+        let data = BoundaryData::of(&mesh, &scene.parts, &space);
         crate::fem::lifting::consistency::check(&scene, &mesh, &space).map_err(|e| (e, None))?;
         let t1 = Instant::now();
         let law = Elasticity::new(&scene.material);
-        let p0 = Discretised { scene, mesh, space, law, guard };
+        let p0 = Discretised { scene, mesh, space, data, law, guard };
         let (rest, r) = p0.set_up(beside);
-        let Discretised { scene, mesh, space, law, .. } = p0;
+        let Discretised { scene, mesh, space, data, law, .. } = p0;
         let rest = match rest {
             Ok(rest) => rest,
             Err(e) => return Err((e, r)),
@@ -78,6 +79,7 @@ impl Problem {
             scene,
             mesh,
             space,
+            data,
             law,
             stiffness: Arc::new(stiffness),
             free,
@@ -118,6 +120,7 @@ impl Problem {
             scene,
             mesh: m.mesh.clone(),
             space: m.space.clone(),
+            data: m.data.clone(),
             law: m.law,
             stiffness: Arc::clone(&m.stiffness),
             free,
@@ -137,6 +140,7 @@ impl Problem {
 pub struct MeshSetUp {
     mesh: Mesh,
     space: CrSpace,
+    data: Option<BoundaryData>,
     law: Elasticity,
     stiffness: Arc<SparseColMat<usize, f64>>,
     loads: Loads,
@@ -158,20 +162,22 @@ impl MeshSetUp {
         let t0 = Instant::now();
         let mesh = Mesh::from_spec(&scene.mesh)?;
         let space = CrSpace::new(&mesh, &scene.parts)?;
+        let data = BoundaryData::of(&mesh, &scene.parts, &space);
         let t1 = Instant::now();
         let law = Elasticity::new(&scene.material);
-        let p0 = Discretised { scene: scene.clone(), mesh, space, law, guard };
+        let p0 = Discretised { scene: scene.clone(), mesh, space, data, law, guard };
         let (stiffness, loads, symbolic) = p0.assemble()?;
         let t2 = Instant::now();
         let f = p0.factor(&stiffness, symbolic)?;
         let t3 = Instant::now();
         let condensation = p0.condense(&f.factor)?;
         let t5 = Instant::now();
-        let Discretised { mesh, space, law, .. } = p0;
+        let Discretised { mesh, space, data, law, .. } = p0;
         let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
         Ok(MeshSetUp {
             mesh,
             space,
+            data,
             law,
             stiffness: Arc::new(stiffness),
             loads,
@@ -225,11 +231,14 @@ struct Factored {
     step0: Option<StepResult>,
 }
 
-/// A discretised problem, what the set-up starts from: the scene, its mesh and CR space, and the law.
+/// A discretised problem, what the set-up starts from: the scene, its mesh, CR space and boundary data
+/// (the lifting, added outside V_h), and the law.
 pub struct Discretised {
     pub scene: Scene,
     pub mesh: Mesh,
     pub space: CrSpace,
+    /// Nonzero boundary data u_D, g_n (`None` without).
+    pub data: Option<BoundaryData>,
     pub law: Elasticity,
     /// Whether the set-up estimates K's condition number.
     pub guard: Guard,
@@ -338,7 +347,7 @@ impl Discretised {
             let k_pattern = lower_pattern(full.as_ref().as_ref());
             let val = lower_values(full.as_ref().as_ref(), val);
             drop(full);
-            let loads = Loads::new(scene, mesh, space)?;
+            let loads = Loads::new(scene, mesh, space, self.data.as_ref())?;
             let symbolic = symbolic
                 .join()
                 .map_err(|_| Error::Linear("the symbolic factorisation failed".into()))
@@ -383,8 +392,10 @@ impl Discretised {
         }
         let (factor, aside) = Factor::numeric_beside(symbolic, stiffness, || {
             let top = (self.guard == Guard::Estimate).then(|| condition::largest_eigenvalue(stiffness, LAMBDA_ITERS));
-            let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, law, scene.rho).with_exact(x));
-            let step0 = initial_state(scene, mesh, space, stiffness, errors.as_ref()).ok();
+            let has_data = self.data.is_some();
+            let errors =
+                scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, has_data, law, scene.rho).with_exact(x));
+            let step0 = initial_state(self.parts(), stiffness, errors.as_ref()).ok();
             (top, errors, step0)
         });
         let factor = factor?;
@@ -396,6 +407,10 @@ impl Discretised {
         let conditioning =
             Arc::new(top.map_or_else(Pending::skipped, |top| Pending::start(&factor, stiffness.nrows(), top)));
         Ok(Factored { factor, conditioning, errors: errors.map(Arc::new), step0 })
+    }
+
+    fn parts(&self) -> Parts<'_> {
+        Parts { scene: &self.scene, mesh: &self.mesh, space: &self.space, data: self.data.as_ref() }
     }
 
     /// C = EᵀK⁻¹E and W from the factor (`None` without Γ_C).
