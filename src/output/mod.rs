@@ -77,7 +77,7 @@ pub use background::Background;
 pub use lock::{lock_path, OutputLock};
 pub use paths::{check_target, check_writable};
 pub use take::Unknowns;
-pub use xdmf::sidecar;
+pub use paths::sidecar;
 
 /// Default upper bound on the number of visualisation frames.
 pub const AUTO_FRAMES: usize = 51;
