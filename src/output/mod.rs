@@ -75,9 +75,9 @@ use xdmf::Xdmf;
 
 pub use background::Background;
 pub use lock::{lock_path, OutputLock};
+pub use paths::sidecar;
 pub use paths::{check_target, check_writable};
 pub use take::Unknowns;
-pub use paths::sidecar;
 
 /// Default upper bound on the number of visualisation frames.
 pub const AUTO_FRAMES: usize = 51;
