@@ -3,7 +3,17 @@
 //! through its slip and μ, both stored exactly). A run killed before its step 0 was committed left only
 //! `.partial` files: it is started afresh.
 
-use super::*;
+use super::fields::Fields;
+use super::h5::{self, io, Raw};
+use super::lock::OutputLock;
+use super::paths;
+use super::tresca::Tresca;
+use super::vtkhdf::{Frames, VtkHdf};
+use super::xdmf::Xdmf;
+use super::{ioerr, partial_path, Opened, Options, Run, Writer};
+use crate::error::{Error, Result};
+use crate::stepping::StepResult;
+use std::path::Path;
 
 impl Writer {
     /// Reopen a results file of `run` (same scene text, time grid, solver and mesh, else an error),

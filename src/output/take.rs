@@ -2,7 +2,12 @@
 //! cannot hold (nothing of such a step is written), its rows of `/tresca` and, for a frame, its VTKHDF
 //! fields.
 
-use super::*;
+use super::Writer;
+use crate::error::{Error, Result};
+use crate::fem::lifting::BoundaryData;
+use crate::fem::space::CrSpace;
+use crate::stepping::StepResult;
+use std::path::Path;
 
 /// An error naming the first non-finite value of `v`, if any.
 fn check_finite(path: &Path, n: usize, what: &str, v: &[f64]) -> Result<()> {

@@ -9,23 +9,15 @@
 //! ([`Problem::displacement`]), which the errors, the audit and the results file use.
 
 use crate::error::{Error, Result};
-use crate::fem::assemble::{stiffness_values, EdgePattern};
 use crate::fem::elasticity::Elasticity;
 use crate::fem::lifting::{self, BoundaryData};
-use crate::fem::loads::Loads;
 use crate::fem::norms::{ErrorEvaluator, ErrorNorms};
 use crate::fem::space::CrSpace;
 use crate::friction::{EdgeState, Friction, FrictionSolution};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
-use crate::solve::condense::{condense, Condensation};
-use crate::solve::condition;
-use crate::solve::factor::{fill_order_at, Factor, Symbolic};
-use crate::solve::free::{FreeResponse, BLOCK_BYTES};
-use crate::solve::ordering::{Graph, ND_MIN_SIZE};
-use crate::solve::superpose::LoadBasis;
+use crate::solve::free::FreeResponse;
 use crate::sparse::{dot, symmetric_energy};
-use conditioning::Pending;
 use faer::sparse::SparseColMat;
 use std::sync::Arc;
 use std::time::Instant;

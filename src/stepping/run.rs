@@ -2,7 +2,11 @@
 //! few time nodes at a time, and every result handed out in order once K's condition estimate is
 //! accepted.
 
-use super::*;
+use super::{checked, contact, contact_result, Problem, StepResult};
+use crate::error::{Error, Result};
+use crate::friction::Friction;
+use crate::sparse::dot;
+use std::time::Instant;
 
 /// Steps whose true errors are evaluated together (`Problem::finish_block`): the exact solution's
 /// spatial values bound to a chunk of elements are then read from memory once for this many time nodes.

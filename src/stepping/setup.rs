@@ -2,9 +2,29 @@
 //! work of the caller on a second thread beside it ([`Problem::new_beside`]: `tresca-cr run` creates its
 //! results file there).
 
-use super::*;
+use super::conditioning::{Guard, Pending};
+use super::{initial_state, Parts, Problem, SetupTimes, StepResult};
+use crate::error::{Error, Result};
+use crate::fem::assemble::{stiffness_values, EdgePattern};
+use crate::fem::elasticity::Elasticity;
+use crate::fem::lifting::BoundaryData;
+use crate::fem::loads::Loads;
+use crate::fem::norms::ErrorEvaluator;
+use crate::fem::space::CrSpace;
+use crate::friction::Friction;
+use crate::mesh::Mesh;
+use crate::scene::Scene;
+use crate::solve::condense::{condense, Condensation};
+use crate::solve::condition;
+use crate::solve::factor::{fill_order_at, Factor, Symbolic};
+use crate::solve::free::{FreeResponse, BLOCK_BYTES};
+use crate::solve::ordering::{Graph, ND_MIN_SIZE};
+use crate::solve::superpose::LoadBasis;
 use crate::sparse::{lower_pattern, lower_values};
+use faer::sparse::SparseColMat;
 use faer::sparse::SymbolicSparseColMat;
+use std::sync::Arc;
+use std::time::Instant;
 
 /// From this many unknowns the caller's work beside the set-up starts with phase 3 ([`Discretised::set_up`]):
 /// where phases 1 and 2 take seconds (1,000,000 unknowns, as the switch to nested dissection,
