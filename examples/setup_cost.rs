@@ -19,8 +19,8 @@ use tresca_cr::fem::loads::Loads;
 use tresca_cr::fem::norms::ErrorEvaluator;
 use tresca_cr::fem::space::CrSpace;
 use tresca_cr::mesh::Mesh;
-use tresca_cr::solve::factor::{fill_order_at, Factor, Symbolic};
-use tresca_cr::solve::ordering::Graph;
+use tresca_cr::solve::cholesky::Graph;
+use tresca_cr::solve::cholesky::{fill_order_at, Factor, Symbolic};
 use tresca_cr::Scene;
 
 fn main() {
@@ -30,7 +30,7 @@ fn main() {
     let passes: usize = a.get(2).map_or(7, |p| p.parse().unwrap());
     let n_est = tresca_cr::scene::budget::Estimate::of(&scene, 1, false).unwrap().unknowns as usize;
     let nested = match a.get(3).map_or("auto", |s| s.as_str()) {
-        "auto" => n_est >= tresca_cr::solve::ordering::ND_MIN_SIZE,
+        "auto" => n_est >= tresca_cr::solve::cholesky::ND_MIN_SIZE,
         "nd" | "metis" => true,
         "amd" => false,
         o => panic!("ordering `{o}`: auto, amd, nd (by coordinates) or metis"),

@@ -50,7 +50,7 @@ const BYTES_PER_UNKNOWN_LOG2: f64 = 219.62;
 const FILL_ND: f64 = 16.0;
 const METIS_FILL: f64 = 0.87;
 /// From this many unknowns K is ordered by nested dissection and the set-up can fall back to METIS
-/// (`solve::ordering::ND_MIN_SIZE`, which `tests/budget.rs` checks it equals).
+/// (`solve::cholesky::ND_MIN_SIZE`, which `tests/budget.rs` checks it equals).
 pub const FALLBACK_MIN_UNKNOWNS: u64 = 1_000_000;
 /// The values of the block of steps' buffers (`solve::free`): at most 16 columns and 2²⁴ values each.
 const BLOCK_COLUMNS: u64 = 16;

@@ -14,11 +14,11 @@ use crate::fem::space::CrSpace;
 use crate::friction::Friction;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
+use crate::solve::cholesky::{fill_order_at, Factor, Symbolic};
+use crate::solve::cholesky::{Graph, ND_MIN_SIZE};
 use crate::solve::condense::{condense, Condensation};
 use crate::solve::condition;
-use crate::solve::factor::{fill_order_at, Factor, Symbolic};
 use crate::solve::free::{FreeResponse, BLOCK_BYTES};
-use crate::solve::ordering::{Graph, ND_MIN_SIZE};
 use crate::solve::superpose::LoadBasis;
 use crate::sparse::{lower_pattern, lower_values};
 use faer::sparse::SparseColMat;
@@ -28,7 +28,7 @@ use std::time::Instant;
 
 /// From this many unknowns the caller's work beside the set-up starts with phase 3 ([`Discretised::set_up`]):
 /// where phases 1 and 2 take seconds (1,000,000 unknowns, as the switch to nested dissection,
-/// `solve::ordering::ND_MIN_SIZE`).
+/// `solve::cholesky::ND_MIN_SIZE`).
 const DEFER_BESIDE_MIN: usize = 1_000_000;
 
 /// Bytes an unknown that a large run allocates after the factor besides the blocks of steps (the results
