@@ -26,11 +26,13 @@ pub mod audit;
 mod conditioning;
 mod run;
 mod setup;
+mod shared;
 
 pub use audit::{Audit, AuditState};
 pub use conditioning::{Guard, MAX_CONDITION};
 pub use run::RunOptions;
-pub use setup::{Discretised, MeshSetUp};
+pub use setup::Discretised;
+pub use shared::MeshSetUp;
 
 /// Everything assembled once per run.
 pub struct Problem {
