@@ -10,6 +10,19 @@
 //! * (u_x, u_y) elsewhere, two unknowns.
 //!
 //! The interpolant I_CR takes edge means (3-point Gauss), which commute with time derivatives.
+//!
+//! ```
+//! use tresca_cr::fem::quadrature::{edge_point, GAUSS3};
+//! use tresca_cr::fem::space::Element;
+//!
+//! // φ_i = 1 − 2λ_i is 1 at the midpoint of the edge opposite vertex i and 0 at the other two
+//! let mid0 = [0.0, 0.5, 0.5]; // the midpoint of the edge opposite vertex 0, in barycentric coordinates
+//! assert_eq!(Element::phi(mid0), [1.0, 0.0, 0.0]);
+//! // the edge mean of a function is 3-point Gauss on the edge: exact for degree 5 along it
+//! let (a, b) = ([0.0, 0.0], [2.0, 0.0]);
+//! let mean: f64 = GAUSS3.iter().map(|&(s, w)| w * edge_point(a, b, s)[0].powi(5)).sum();
+//! assert!((mean - 32.0 / 6.0).abs() < 1e-13); // (1/2) ∫₀² x⁵ dx
+//! ```
 
 use super::quadrature::{edge_point, GAUSS3};
 use crate::error::Result;
