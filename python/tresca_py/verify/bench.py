@@ -26,7 +26,7 @@ Sections:
     (196,608 unknowns, 80 steps), mms_front refine 2 (256 steps), Example 5.1 n = 64 (refine 5, 1280 steps),
     all with true errors at every node where the scene has [exact]; process wall and CPU time (user + sys of
     the child), the set-up split; the expression throughput of the longest expression of verification/cases/
-    (examples/expr_throughput.rs, one thread: exmex's interpreter against the compiled program); mms_stop
+    (probes/expr_throughput.rs, one thread: exmex's interpreter against the compiled program); mms_stop
     refine 4 side by side with scripts/skfem_solve.py and scripts/dolfinx_solve.py (the three run in
     interleaved rounds, so a drift of the machine's speed affects them alike); a perf profile of
     mms_stop refine 5.
@@ -644,7 +644,7 @@ def mms_runs(b):
 
 
 def expr_throughput(b):
-    """The expression throughput paragraph (examples/expr_throughput.rs, one thread)."""
+    """The expression throughput paragraph (probes/expr_throughput.rs, one thread)."""
     p = subprocess.run(["cargo", "run", "--release", "--quiet", "--example", "expr_throughput"], capture_output=True,
                        text=True, cwd=ROOT, env=dict(os.environ, RAYON_NUM_THREADS="1"))
     if p.returncode == 0:
