@@ -1,6 +1,6 @@
 //! What this machine has: the memory available to a new allocation and the free space of a file system.
 //! Read by the pre-run estimate (`scene::budget`) and by the factorisation, which checks the exact size of
-//! the factor before it allocates it (`solve::factor`).
+//! the factor before it allocates it (`solve::cholesky`).
 
 use std::path::Path;
 

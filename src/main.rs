@@ -23,10 +23,8 @@ enum Cmd {
     /// Validate a scene and print what it will model, with the memory and disk a run will need.
     Check {
         scene: PathBuf,
-        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::refine)]
-        refine: Option<u32>,
-        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::count)]
-        steps: Option<usize>,
+        #[command(flatten)]
+        grid: Grid,
         #[command(flatten)]
         limits: Limits,
         #[command(flatten)]
@@ -35,18 +33,8 @@ enum Cmd {
     /// Run a scene.
     Run {
         scene: PathBuf,
-        /// Uniform refinements (overrides mesh.refine).
-        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::refine)]
-        refine: Option<u32>,
-        /// Uniform time steps (overrides time.steps).
-        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::count)]
-        steps: Option<usize>,
-        /// Per-step solver (overrides solver.method).
-        #[arg(long)]
-        solver: Option<Method>,
-        /// Solver tolerance (overrides solver.tol).
-        #[arg(long, allow_negative_numbers = true)]
-        tol: Option<f64>,
+        #[command(flatten)]
+        overrides: Overrides,
         #[command(flatten)]
         out: OutputArgs,
         /// Print one line per step.
@@ -69,12 +57,8 @@ enum Cmd {
         /// A finer reference run (refine:steps) to measure errors against.
         #[arg(long, allow_hyphen_values = true, value_parser = cli::args::level)]
         reference: Option<tresca_cr::study::Level>,
-        /// Per-step solver (overrides solver.method).
-        #[arg(long)]
-        solver: Option<Method>,
-        /// Solver tolerance (overrides solver.tol).
-        #[arg(long, allow_negative_numbers = true)]
-        tol: Option<f64>,
+        #[command(flatten)]
+        solver: SolverArgs,
         /// Write the table as CSV.
         #[arg(long)]
         csv: Option<PathBuf>,
@@ -100,18 +84,9 @@ enum Cmd {
         /// Dörfler's parameter: mark the fewest triangles carrying this share of η².
         #[arg(long, default_value_t = 0.5, allow_hyphen_values = true, value_parser = cli::args::theta)]
         theta: f64,
-        /// Starting mesh: uniform refinements (overrides mesh.refine).
-        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::refine)]
-        refine: Option<u32>,
-        /// Uniform time steps (overrides time.steps).
-        #[arg(long, allow_negative_numbers = true, value_parser = cli::args::count)]
-        steps: Option<usize>,
-        /// Per-step solver (overrides solver.method).
-        #[arg(long)]
-        solver: Option<Method>,
-        /// Solver tolerance (overrides solver.tol).
-        #[arg(long, allow_negative_numbers = true)]
-        tol: Option<f64>,
+        // --refine: of the starting mesh
+        #[command(flatten)]
+        overrides: Overrides,
         /// Write DIR/level_<k>.h5, each level's results file with its mesh.
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
@@ -181,16 +156,56 @@ struct Limits {
     max_disk: Option<u64>,
 }
 
-/// Apply the --solver and --tol overrides.
-fn solver_overrides(s: &mut Scene, solver: Option<Method>, tol: Option<f64>) -> Result<()> {
-    if let Some(m) = solver {
-        s.solver.method = m;
+impl Limits {
+    /// No limit given (the commands that estimate per level themselves).
+    fn none() -> Limits {
+        Limits { max_memory: None, max_disk: None }
     }
-    if let Some(t) = tol {
-        anyhow::ensure!(t.is_finite() && t > 0.0, "--tol {t}: must be a positive number");
-        s.solver.tol = t;
+}
+
+/// --refine and --steps: the scene's mesh and time grid overridden.
+#[derive(clap::Args, Clone, Copy, Default)]
+struct Grid {
+    /// Uniform refinements (overrides mesh.refine; adapt: of the starting mesh).
+    #[arg(long, allow_negative_numbers = true, value_parser = cli::args::refine)]
+    refine: Option<u32>,
+    /// Uniform time steps (overrides time.steps).
+    #[arg(long, allow_negative_numbers = true, value_parser = cli::args::count)]
+    steps: Option<usize>,
+}
+
+/// --solver and --tol: the scene's per-step solver overridden.
+#[derive(clap::Args, Clone, Copy)]
+struct SolverArgs {
+    /// Per-step solver (overrides solver.method).
+    #[arg(long)]
+    solver: Option<Method>,
+    /// Solver tolerance (overrides solver.tol).
+    #[arg(long, allow_negative_numbers = true)]
+    tol: Option<f64>,
+}
+
+/// The overrides of a command that runs a scene: --refine, --steps, --solver, --tol.
+#[derive(clap::Args, Clone, Copy)]
+struct Overrides {
+    #[command(flatten)]
+    grid: Grid,
+    #[command(flatten)]
+    solver: SolverArgs,
+}
+
+impl SolverArgs {
+    /// Apply the --solver and --tol overrides.
+    fn apply(self, s: &mut Scene) -> Result<()> {
+        if let Some(m) = self.solver {
+            s.solver.method = m;
+        }
+        if let Some(t) = self.tol {
+            anyhow::ensure!(t.is_finite() && t > 0.0, "--tol {t}: must be a positive number");
+            s.solver.tol = t;
+        }
+        Ok(())
     }
-    Ok(())
 }
 
 /// Read the scene, estimate what the run needs (refused when it does not fit: before anything large is
@@ -198,8 +213,7 @@ fn solver_overrides(s: &mut Scene, solver: Option<Method>, tol: Option<f64>) -> 
 /// this process will create it (`run`), so a path that cannot be a results file is refused first.
 fn load(
     path: &Path,
-    refine: Option<u32>,
-    steps: Option<usize>,
+    Grid { refine, steps }: Grid,
     limits: Limits,
     output: impl FnOnce(&Scene) -> Option<PathBuf>,
     creates: bool,
@@ -269,102 +283,109 @@ pub(crate) fn hand_back_memory() {
 
 fn main() {
     tune_malloc();
-    let cli = Cli::parse();
-    let result = match cli.cmd {
-        Cmd::Check { scene, refine, steps, limits, json } => {
-            // the estimate of the results file is for the scene's [output] path, else the current directory
-            let out = |s: &Scene| Some(s.output.clone().unwrap_or_else(|| PathBuf::from("run.h5")));
-            cli::summary::check_path(json.json.as_deref())
-                .and_then(|()| load(&scene, refine, steps, limits, out, false))
-                .and_then(|(s, e)| cli::check::check(s, e, json.json))
+    let result = match Cli::parse().cmd {
+        Cmd::Check { scene, grid, limits, json } => check(&scene, grid, limits, json),
+        Cmd::Run { scene, overrides, out, verbose, quiet, limits, json } => {
+            run(&scene, overrides, out, (verbose, quiet), limits, json)
         }
-        Cmd::Run { scene, refine, steps, solver, tol, out, verbose, quiet, limits, json } => {
-            // a resumed run's file already holds its disk space: only memory is checked then
-            let (given, resume) = (out.output.clone(), out.resume);
-            let new_file = move |s: &Scene| given.or_else(|| s.output.clone()).filter(|_| !resume);
+        Cmd::Study { scene, levels, reference, solver, csv, differences, max_memory, json } => {
             cli::summary::check_path(json.json.as_deref())
-                .and_then(|()| load(&scene, refine, steps, limits, new_file, true))
+                .and_then(|()| load(&scene, Grid::default(), Limits::none(), |_| None, false))
                 .and_then(|(mut s, _)| {
-                    solver_overrides(&mut s, solver, tol)?;
-                    cli::run::run(s, out, verbose, quiet, json.json)
-                })
-        }
-        Cmd::Study { scene, levels, reference, solver, tol, csv, differences, max_memory, json } => {
-            let no_limits = Limits { max_memory: None, max_disk: None };
-            cli::summary::check_path(json.json.as_deref())
-                .and_then(|()| load(&scene, None, None, no_limits, |_| None, false))
-                .and_then(|(mut s, _)| {
-                    solver_overrides(&mut s, solver, tol)?;
+                    solver.apply(&mut s)?;
                     cli::study::study(s, &levels, reference, csv, differences, max_memory, json.json)
                 })
         }
-        Cmd::Adapt {
-            scene,
-            target,
-            levels,
-            theta,
-            refine,
-            steps,
-            solver,
-            tol,
-            out,
-            force,
-            gmsh,
-            csv,
-            budget,
-            reference,
-            limits,
-            json,
-        } => cli::summary::check_path(json.json.as_deref())
-            .and_then(|()| load(&scene, refine, steps, limits, |_| None, false))
-            .and_then(|(mut s, _)| {
-                solver_overrides(&mut s, solver, tol)?;
-                let (max_memory, max_disk) = (limits.max_memory, limits.max_disk);
-                let opts = tresca_cr::adapt::Options {
-                    levels,
-                    target,
-                    until_unknowns: None,
-                    theta,
-                    out,
-                    gmsh,
-                    force,
-                    max_memory,
-                    max_disk,
-                    budget,
-                    reference,
-                    lean: false,
-                };
-                let code = cli::adapt::run(s, opts, csv, json.json)?;
-                if code != 0 {
-                    std::process::exit(code);
-                }
-                Ok(())
-            }),
-        Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory, uniform_only, json } => {
-            let no_limits = Limits { max_memory: None, max_disk: None };
-            if let Some(d) = tresca_cr::plan::pilot::Quantity::deprecation(&quantity) {
-                note!("warning: {d}");
-            }
-            let options = tresca_cr::plan::Options {
-                target,
-                quantity: tresca_cr::plan::pilot::Quantity::parse(&quantity),
-                budget,
-                pilot_budget: pilot_budget.unwrap_or(budget / 10.0),
-                max_memory,
-            };
-            cli::summary::check_path(json.json.as_deref())
-                .and_then(|()| load(&scene, None, None, no_limits, |_| None, false))
-                .and_then(|(s, _)| {
-                    let code = cli::plan::run(s, options, csv, run, !uniform_only, json.json)?;
-                    if code != 0 {
-                        std::process::exit(code);
-                    }
-                    Ok(())
-                })
-        }
+        cmd @ Cmd::Adapt { .. } => adapt(cmd),
+        cmd @ Cmd::Plan { .. } => plan(cmd),
     };
     if let Err(e) = result {
         note!("error: {e:#}");
         std::process::exit(1);
+    }
+}
+
+/// `check`: the estimate of the results file is for the scene's [output] path, else the current directory.
+fn check(scene: &Path, grid: Grid, limits: Limits, json: cli::summary::JsonArg) -> Result<()> {
+    let out = |s: &Scene| Some(s.output.clone().unwrap_or_else(|| PathBuf::from("run.h5")));
+    cli::summary::check_path(json.json.as_deref())
+        .and_then(|()| load(scene, grid, limits, out, false))
+        .and_then(|(s, e)| cli::check::check(s, e, json.json))
+}
+
+/// `run`: a resumed run's file already holds its disk space, so only memory is checked then.
+fn run(
+    scene: &Path,
+    overrides: Overrides,
+    out: OutputArgs,
+    (verbose, quiet): (bool, bool),
+    limits: Limits,
+    json: cli::summary::JsonArg,
+) -> Result<()> {
+    let (given, resume) = (out.output.clone(), out.resume);
+    let new_file = move |s: &Scene| given.or_else(|| s.output.clone()).filter(|_| !resume);
+    cli::summary::check_path(json.json.as_deref())
+        .and_then(|()| load(scene, overrides.grid, limits, new_file, true))
+        .and_then(|(mut s, _)| {
+            overrides.solver.apply(&mut s)?;
+            cli::run::run(s, out, verbose, quiet, json.json)
+        })
+}
+
+/// `adapt` (exits with its code when that is not 0).
+fn adapt(cmd: Cmd) -> Result<()> {
+    let Cmd::Adapt { scene, target, levels, theta, overrides, out, force, gmsh, csv, budget, reference, limits, json } =
+        cmd
+    else {
+        unreachable!("adapt() is called with Cmd::Adapt")
+    };
+    let (mut s, _) = cli::summary::check_path(json.json.as_deref())
+        .and_then(|()| load(&scene, overrides.grid, limits, |_| None, false))?;
+    overrides.solver.apply(&mut s)?;
+    let (max_memory, max_disk) = (limits.max_memory, limits.max_disk);
+    let opts = tresca_cr::adapt::Options {
+        levels,
+        target,
+        until_unknowns: None,
+        theta,
+        out,
+        gmsh,
+        force,
+        max_memory,
+        max_disk,
+        budget,
+        reference,
+        lean: false,
+    };
+    exit_unless_zero(cli::adapt::run(s, opts, csv, json.json)?);
+    Ok(())
+}
+
+/// `plan` (exits with its code when that is not 0).
+fn plan(cmd: Cmd) -> Result<()> {
+    let Cmd::Plan { scene, target, quantity, budget, pilot_budget, run, csv, max_memory, uniform_only, json } = cmd
+    else {
+        unreachable!("plan() is called with Cmd::Plan")
+    };
+    if let Some(d) = tresca_cr::plan::pilot::Quantity::deprecation(&quantity) {
+        note!("warning: {d}");
+    }
+    let options = tresca_cr::plan::Options {
+        target,
+        quantity: tresca_cr::plan::pilot::Quantity::parse(&quantity),
+        budget,
+        pilot_budget: pilot_budget.unwrap_or(budget / 10.0),
+        max_memory,
+    };
+    let (s, _) = cli::summary::check_path(json.json.as_deref())
+        .and_then(|()| load(&scene, Grid::default(), Limits::none(), |_| None, false))?;
+    exit_unless_zero(cli::plan::run(s, options, csv, run, !uniform_only, json.json)?);
+    Ok(())
+}
+
+/// Exit with `code` unless it is 0 (a command's own exit code: 3 when stopped before the goal).
+fn exit_unless_zero(code: i32) {
+    if code != 0 {
+        std::process::exit(code);
     }
 }

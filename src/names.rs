@@ -5,7 +5,6 @@
 //! clap's `ValueEnum` (command-line options), so a name is spelled in one place.
 
 /// `named_enum! { /// doc  pub enum Name { /// doc  Variant = "name", … } }`.
-#[macro_export]
 macro_rules! named_enum {
     ($(#[$m:meta])* pub enum $name:ident { $($(#[$vm:meta])* $var:ident = $s:literal),+ $(,)? }) => {
         $(#[$m])*
@@ -75,6 +74,7 @@ macro_rules! named_enum {
         }
     };
 }
+pub(crate) use named_enum;
 
 #[cfg(test)]
 mod tests {

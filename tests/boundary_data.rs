@@ -59,7 +59,7 @@ fn affine_data_are_reproduced_exactly() {
         // |u| ≤ 0.03: rounding of sums of O(100) terms of that size
         assert!(e.energy < 1e-12 && e.l2 < 1e-13, "step {}: {e:?}", r.n);
         // the displacement written is w + u_L: at every midpoint the affine field itself
-        let mid = p.space.displacement(&r.u, r.t).unwrap();
+        let mid = p.displacement(&r.u, r.t).unwrap();
         for (e, m) in mid.iter().enumerate() {
             let x = p.mesh.midpoint(e);
             let t = r.t;

@@ -46,7 +46,7 @@ fn the_memory_estimate_is_within_15_percent_of_the_peak() {
 /// refuse it when neither fits; below the nested-dissection size (no fallback) only the one estimate counts.
 #[test]
 fn the_memory_check_counts_the_metis_fallback_from_the_nested_dissection_size() {
-    assert_eq!(tresca_cr::scene::budget::FALLBACK_MIN_UNKNOWNS, tresca_cr::solve::ordering::ND_MIN_SIZE as u64);
+    assert_eq!(tresca_cr::scene::budget::FALLBACK_MIN_UNKNOWNS, tresca_cr::solve::cholesky::ND_MIN_SIZE as u64);
     let big = Estimate::of_sizes((4_194_304, 3_146_240, 1024), 4, false);
     let metis = big.memory_metis.expect("3.1 M edges: nested dissection, so a fallback");
     assert!(metis < big.memory, "METIS fills less");

@@ -5,7 +5,7 @@ use common::*;
 use faer::sparse::{SparseColMat, Triplet};
 use tresca_cr::friction::EdgeState;
 use tresca_cr::scene::{Method, PartKind};
-use tresca_cr::solve::factor::Factor;
+use tresca_cr::solve::cholesky::Factor;
 use tresca_cr::{Problem, Scene};
 
 /// Every scene in the repository with a contact part, at its own mesh level.

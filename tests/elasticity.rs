@@ -316,7 +316,7 @@ fn compressed_assembly_equals_the_sum_of_contributions() {
 #[test]
 fn graph_from_the_mesh_is_the_graph_of_k() {
     use tresca_cr::fem::assemble::EdgePattern;
-    use tresca_cr::solve::ordering::Graph;
+    use tresca_cr::solve::cholesky::Graph;
     for case in ["mms_rotated", "paper_example_5_1", "mms_stop"] {
         let path = format!("{}/verification/cases/{case}.toml", env!("CARGO_MANIFEST_DIR"));
         let p = Problem::new(Scene::from_file(std::path::Path::new(&path)).unwrap()).unwrap();

@@ -54,7 +54,7 @@ fn bound(p: &Problem, prev: &StepResult, r: &StepResult) -> f64 {
         }
     }
     let knorm = row.iter().fold(0.0f64, |a, v| a.max(*v));
-    let (u, u0) = (p.space.displacement(&r.u, r.t).unwrap(), p.space.displacement(&prev.u, prev.t).unwrap());
+    let (u, u0) = (p.displacement(&r.u, r.t).unwrap(), p.displacement(&prev.u, prev.t).unwrap());
     let du: Vec<[f64; 2]> = u.iter().zip(&u0).map(|(a, b)| [a[0] - b[0], a[1] - b[1]]).collect();
     b + 1000.0 * f64::EPSILON * knorm * norm(&u) * norm(&du)
 }

@@ -28,7 +28,7 @@ fn non_finite_exact_value_names_expression_and_first_point() {
     let mut exact = scene.exact.clone().unwrap();
     // infinite where x >= 0.9: in many chunks of elements, none of them the first
     exact.grad[1][0] = Expr::parse("exact.grad[1][0]", "1/max(0.9-x, 0)").unwrap();
-    let ev = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(&exact);
+    let ev = ErrorEvaluator::new(&mesh, &space, scene.has_boundary_data(), &law, scene.rho).with_exact(&exact);
     let mid = vec![[0.0; 2]; mesh.edges.len()];
     let first = mesh
         .tris
@@ -43,9 +43,11 @@ fn non_finite_exact_value_names_expression_and_first_point() {
     }
     // the exact solution itself: finite norms, the same bits every time
     let exact = scene.exact.clone().unwrap();
-    let ev = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(&exact);
+    let ev = ErrorEvaluator::new(&mesh, &space, scene.has_boundary_data(), &law, scene.rho).with_exact(&exact);
     let a = ev.errors(&mesh, &exact, &mid, 0.5).unwrap();
-    let b = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).errors(&mesh, &exact, &mid, 0.5).unwrap();
+    let b = ErrorEvaluator::new(&mesh, &space, scene.has_boundary_data(), &law, scene.rho)
+        .errors(&mesh, &exact, &mid, 0.5)
+        .unwrap();
     assert!(a.energy.is_finite() && a.energy > 0.0);
     assert_eq!([a.energy, a.h1, a.l2].map(f64::to_bits), [b.energy, b.h1, b.l2].map(f64::to_bits));
 }
@@ -57,7 +59,7 @@ fn non_finite_exact_value_names_expression_and_first_point() {
 fn error_norms_of_several_nodes_at_once_equal_node_by_node() {
     let (scene, mesh, space, law) = mms_stop(3);
     let exact = scene.exact.clone().unwrap();
-    let ev = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(&exact);
+    let ev = ErrorEvaluator::new(&mesh, &space, scene.has_boundary_data(), &law, scene.rho).with_exact(&exact);
     let mids: Vec<Vec<[f64; 2]>> = (0..3)
         .map(|k| (0..mesh.edges.len()).map(|e| [(e * (k + 1)) as f64 * 1e-5, 1e-3 * k as f64]).collect())
         .collect();
@@ -71,7 +73,7 @@ fn error_norms_of_several_nodes_at_once_equal_node_by_node() {
     // not finite from t = 0.7 on: the first two nodes' norms, then the error
     let mut late = exact.clone();
     late.u.0[0] = Expr::parse("exact.u[0]", "x/max(0.7-t, 0)").unwrap();
-    let ev = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(&late);
+    let ev = ErrorEvaluator::new(&mesh, &space, scene.has_boundary_data(), &law, scene.rho).with_exact(&late);
     let (norms, failed) = ev.errors_at(&mesh, &late, &fields);
     assert_eq!(norms.len(), 2);
     assert!(failed.is_some_and(|e| e.to_string().contains("x/max(0.7-t, 0)")));

@@ -5,7 +5,7 @@
 
 mod common;
 use common::*;
-use tresca_cr::solve::factor::Factor;
+use tresca_cr::solve::cholesky::Factor;
 use tresca_cr::solve::free::Free;
 use tresca_cr::Problem;
 

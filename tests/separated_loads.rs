@@ -7,6 +7,7 @@
 //! a node is an error naming the expression and the time.
 
 use std::path::Path;
+use tresca_cr::fem::lifting::BoundaryData;
 use tresca_cr::fem::loads::Loads;
 use tresca_cr::fem::space::CrSpace;
 use tresca_cr::mesh::Mesh;
@@ -37,8 +38,9 @@ fn separated_loads_equal_the_pointwise_loads() {
         }
         let mesh = Mesh::from_spec(&s.mesh).unwrap();
         let space = CrSpace::new(&mesh, &s.parts).unwrap();
-        let fast = Loads::new(&s, &mesh, &space).unwrap();
-        let slow = Loads::with_separation(&s, &mesh, &space, false).unwrap();
+        let fast = Loads::new(&s, &mesh, &space, BoundaryData::of(&mesh, &s.parts, &space).as_ref()).unwrap();
+        let slow = Loads::with_separation(&s, &mesh, &space, BoundaryData::of(&mesh, &s.parts, &space).as_ref(), false)
+            .unwrap();
         separated += usize::from(fast.n_patterns() > 0);
         let (t0, t1) = (s.times[0], *s.times.last().unwrap());
         let (mut a, mut b) = (Vec::new(), Vec::new());
@@ -62,7 +64,7 @@ fn non_finite_time_factor_names_the_expression_and_time() {
     s.f = Some(Vec2Expr::parse("loads.f", &[text.into(), "0".into()]).unwrap());
     let mesh = Mesh::from_spec(&s.mesh).unwrap();
     let space = CrSpace::new(&mesh, &s.parts).unwrap();
-    let loads = Loads::new(&s, &mesh, &space).unwrap();
+    let loads = Loads::new(&s, &mesh, &space, BoundaryData::of(&mesh, &s.parts, &space).as_ref()).unwrap();
     assert!(loads.n_patterns() > 0);
     let mut l = Vec::new();
     loads.assemble_on_support(0.25, &mut l).unwrap();
@@ -81,7 +83,7 @@ fn a_refused_superposition_keeps_the_loads_it_assembled() {
     s.set_refine(0).unwrap();
     s.set_steps(16).unwrap();
     let p = tresca_cr::Problem::new(s.clone()).unwrap();
-    let loads = Loads::new(&s, &p.mesh, &p.space).unwrap();
+    let loads = Loads::new(&s, &p.mesh, &p.space, p.data.as_ref()).unwrap();
     let mut kept = vec![(99, vec![1.0])];
     let basis = LoadBasis::build(&loads, &s.times, p.free.factor(), &mut kept).unwrap();
     assert!(basis.is_none(), "mms_front's loads were superposed");

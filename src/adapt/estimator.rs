@@ -148,7 +148,7 @@ impl Estimator {
     /// The indicator of step `r` (module doc).
     pub fn at(&self, p: &Problem, r: &StepResult) -> Result<Indicator> {
         let mesh = &p.mesh;
-        let mid = p.space.displacement(&r.u, r.t)?;
+        let mid = p.displacement(&r.u, r.t)?;
         let sigma: Vec<[[f64; 2]; 2]> = (0..mesh.tris.len()).map(|t| self.stress(p, t, &mid)).collect();
         let sn = |t: usize, n: [f64; 2]| {
             let s = sigma[t];

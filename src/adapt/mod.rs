@@ -196,7 +196,8 @@ fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool, timed: bo
     result?;
     let (unknowns, paper_dofs) = (problem.space.n_dofs, problem.space.paper_dofs());
     let parts = problem.scene.parts.clone();
-    let kept = Kept { mesh: problem.mesh.clone(), space: problem.space.clone(), u, t, parts };
+    let (mesh, space, data) = (problem.mesh.clone(), problem.space.clone(), problem.data.clone());
+    let kept = Kept { mesh, space, data, u, t, parts };
     Ok(Solved { kept, acc, error, time, unknowns, paper_dofs })
 }
 

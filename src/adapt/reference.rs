@@ -15,6 +15,7 @@
 
 use crate::error::Result;
 use crate::fem::elasticity::Elasticity;
+use crate::fem::lifting::{displacement, BoundaryData};
 use crate::fem::norms::ErrorEvaluator;
 use crate::fem::prolong::parent_triangles;
 use crate::fem::space::{CrSpace, Element};
@@ -27,6 +28,7 @@ use crate::scene::Part;
 pub struct Kept {
     pub mesh: Mesh,
     pub space: CrSpace,
+    pub data: Option<BoundaryData>,
     pub u: Vec<Vec<f64>>,
     pub t: Vec<f64>,
     pub parts: Vec<Part>,
@@ -56,12 +58,13 @@ pub fn distance(fine: &Kept, coarse: &Kept, law: &Elasticity, rho: f64) -> Resul
     let parent = parent_triangles(&coarse.mesh, &fine.mesh)?;
     let fe: Vec<Element> = (0..fine.mesh.tris.len()).map(|t| Element::new(&fine.mesh, t)).collect();
     let ce: Vec<Element> = (0..coarse.mesh.tris.len()).map(|t| Element::new(&coarse.mesh, t)).collect();
-    let jumps = ErrorEvaluator::new(&coarse.mesh, &coarse.space, law, rho);
+    let has_data = coarse.data.is_some();
+    let jumps = ErrorEvaluator::new(&coarse.mesh, &coarse.space, has_data, law, rho);
     let mut worst = 0.0f64;
     for (i, (uf, uc)) in fine.u.iter().zip(&coarse.u).enumerate() {
-        let mf = fine.space.displacement(uf, fine.t[i])?;
-        let mc = coarse.space.displacement(uc, coarse.t[i])?;
-        let mut sum = jumps.jump_energy_at(&mc, &coarse.space, &coarse.parts, coarse.t[i])?;
+        let mf = displacement(&fine.space, fine.data.as_ref(), uf, fine.t[i])?;
+        let mc = displacement(&coarse.space, coarse.data.as_ref(), uc, coarse.t[i])?;
+        let mut sum = jumps.jump_energy_at(&mc, &coarse.space, has_data, &coarse.parts, coarse.t[i])?;
         for (t, &p) in parent.iter().enumerate() {
             let gf = fe[t].gradient(fine.mesh.tri_edges[t].map(|e| mf[e]));
             let gc = ce[p].gradient(coarse.mesh.tri_edges[p].map(|e| mc[e]));

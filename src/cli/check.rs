@@ -70,21 +70,7 @@ pub fn check(scene: Scene, estimate: Estimate, json: Option<std::path::PathBuf>)
     );
     for (p, part) in s.parts.iter().enumerate() {
         let n = edges_of(sp.edge_part.iter().filter(|&&q| q == Some(p)).count());
-        let what = match &part.kind {
-            PartKind::Dirichlet(None) => "dirichlet (u = 0)".to_string(),
-            PartKind::Dirichlet(Some(u)) => {
-                format!("dirichlet, u_D = ({}, {})", short(u.0[0].text()), short(u.0[1].text()))
-            }
-            PartKind::Neumann(None) => "neumann, traction free (nothing assembled)".to_string(),
-            PartKind::Neumann(Some(g)) => {
-                format!("neumann, g = ({}, {})", short(g.0[0].text()), short(g.0[1].text()))
-            }
-            PartKind::Contact(g, None) => format!("contact u.n = 0, Tresca g_a = {}", short(g.text())),
-            PartKind::Contact(g, Some(n)) => {
-                format!("contact u.n = {}, Tresca g_a = {}", short(n.text()), short(g.text()))
-            }
-        };
-        say!("part       {:<10} {:>6} edges  {}", part.name, n, what);
+        say!("part       {:<10} {:>6} edges  {}", part.name, n, describe(&part.kind));
     }
     // two unknowns per free edge, one per contact edge, none on Dirichlet edges
     let (dirichlet, contact) = (edges_of(sp.n_dirichlet), edges_of(sp.contact.len()));
@@ -93,20 +79,7 @@ pub fn check(scene: Scene, estimate: Estimate, json: Option<std::path::PathBuf>)
         "unknowns   {unknowns} (paper's count 2(edges - Dirichlet edges) = {}), {contact} contact unknowns",
         2 * (e - dirichlet)
     );
-    let stab = format!("jump stabilisation (rho = {})", s.rho);
-    let mut terms = vec!["elastic stiffness", stab.as_str()];
-    if s.f.is_some() {
-        terms.push("body force");
-    }
-    if s.parts.iter().any(|p| matches!(p.kind, PartKind::Neumann(Some(_)))) {
-        terms.push("Neumann traction");
-    }
-    if s.has_contact() {
-        terms.push("Tresca friction (condensed on contact unknowns)");
-    } else {
-        terms.push("no contact: plain elasticity");
-    }
-    say!("assembled  {}", terms.join(", "));
+    say!("assembled  {}", assembled_terms(s));
     say!(
         "time       {} steps on [{}, {}]{}",
         s.times.len() - 1,
@@ -121,29 +94,75 @@ pub fn check(scene: Scene, estimate: Estimate, json: Option<std::path::PathBuf>)
     let (lines, singular) = super::corners::describe(&points, &s.parts);
     lines.iter().for_each(|l| say!("{l}"));
     if let Some(j) = &json {
-        let mut summary = super::summary::Summary::new("check", &s.file, start.elapsed().as_secs_f64());
-        summary.check = Some(super::summary::CheckSummary {
-            vertices: m.points.len(),
-            triangles: m.tris.len(),
-            edges: m.edges.len(),
-            h: m.h_max(),
-            unknowns: sp.n_dofs,
-            paper_dofs: sp.paper_dofs(),
-            contact_unknowns: sp.contact.len(),
-            steps: problem.n_steps(),
-            solver: s.solver.method.name().into(),
-            tol: s.solver.tol,
-            max_iter: s.solver.max_iter(),
-            exact: s.exact.is_some(),
-            setup: problem.setup.into(),
-            memory: estimate.memory,
-            disk: estimate.disk,
-            singular,
-        });
-        super::summary::write(j, &summary)?;
+        write_json(j, &problem, s, &estimate, singular, start.elapsed().as_secs_f64())?;
     }
     match super::out::stdout_error() {
         Some(e) => anyhow::bail!("cannot write to standard output: {e}"),
         None => Ok(()),
     }
+}
+
+/// What a boundary part imposes, for the `part` lines.
+fn describe(kind: &PartKind) -> String {
+    match kind {
+        PartKind::Dirichlet(None) => "dirichlet (u = 0)".to_string(),
+        PartKind::Dirichlet(Some(u)) => {
+            format!("dirichlet, u_D = ({}, {})", short(u.0[0].text()), short(u.0[1].text()))
+        }
+        PartKind::Neumann(None) => "neumann, traction free (nothing assembled)".to_string(),
+        PartKind::Neumann(Some(g)) => format!("neumann, g = ({}, {})", short(g.0[0].text()), short(g.0[1].text())),
+        PartKind::Contact(g, None) => format!("contact u.n = 0, Tresca g_a = {}", short(g.text())),
+        PartKind::Contact(g, Some(n)) => format!("contact u.n = {}, Tresca g_a = {}", short(n.text()), short(g.text())),
+    }
+}
+
+/// The terms the scene assembles, for the `assembled` line.
+fn assembled_terms(s: &Scene) -> String {
+    let stab = format!("jump stabilisation (rho = {})", s.rho);
+    let mut terms = vec!["elastic stiffness", stab.as_str()];
+    if s.f.is_some() {
+        terms.push("body force");
+    }
+    if s.parts.iter().any(|p| matches!(p.kind, PartKind::Neumann(Some(_)))) {
+        terms.push("Neumann traction");
+    }
+    if s.has_contact() {
+        terms.push("Tresca friction (condensed on contact unknowns)");
+    } else {
+        terms.push("no contact: plain elasticity");
+    }
+    terms.join(", ")
+}
+
+/// The JSON summary of `check` (the assembled level's counts) to `j`.
+fn write_json(
+    j: &std::path::Path,
+    problem: &Problem,
+    s: &Scene,
+    estimate: &Estimate,
+    singular: super::summary::Singular,
+    wall: f64,
+) -> Result<()> {
+    let (m, sp) = (&problem.mesh, &problem.space);
+    let mut summary = super::summary::Summary::new("check", &s.file, wall);
+    summary.check = Some(super::summary::CheckSummary {
+        vertices: m.points.len(),
+        triangles: m.tris.len(),
+        edges: m.edges.len(),
+        h: m.h_max(),
+        unknowns: sp.n_dofs,
+        paper_dofs: sp.paper_dofs(),
+        contact_unknowns: sp.contact.len(),
+        steps: problem.n_steps(),
+        solver: s.solver.method.name().into(),
+        tol: s.solver.tol,
+        max_iter: s.solver.max_iter(),
+        exact: s.exact.is_some(),
+        setup: problem.setup.into(),
+        memory: estimate.memory,
+        disk: estimate.disk,
+        singular,
+    });
+    super::summary::write(j, &summary)?;
+    Ok(())
 }

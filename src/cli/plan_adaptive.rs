@@ -16,7 +16,7 @@ const ORDER_SCATTER: f64 = 0.05;
 
 /// Weigh and print; `None` for targets the indicator does not bound (outputs other than the energy norm),
 /// when the uniform plan has no error model, or when its space order is already optimal (then the
-/// adaptive pilots would only add to the planner's cost: issue 32 bounds it by 5 % of the plan).
+/// adaptive pilots would only add to the planner's cost, which is to stay within 5 % of the plan).
 pub fn weigh(scene: &Scene, p: &Plan) -> Result<Option<std::result::Result<AdaptivePlan, String>>> {
     let Some(model) = p.error.as_ref().filter(|_| p.options.quantity == Quantity::Energy) else {
         return Ok(None);

@@ -26,7 +26,7 @@
 //! `run` ([`RunSummary`]): `refine` (the mesh level), `unknowns`, `paper_dofs`, `contact_edges`, `steps` (time
 //! steps of the run); `solver`, `tol`; `setup` ([`Phases`]); `ordering` (how K's fill-reducing ordering
 //! was made: AMD, nested dissection by coordinates, or METIS when the factor by coordinates would not fit
-//! in memory; absent before 2026-11-26's second session); `step_stats`: one [`Step`] per step solved (step
+//! in memory; absent from the summaries of older versions); `step_stats`: one [`Step`] per step solved (step
 //! 0 included: `n`, `t`, `iterations`, `residual` (the solver's final KKT residual), `stick`, `slip` (contact
 //! edges), `errors` (true errors at tⁿ with `[exact]`, else `null`)); `iterations` (sum over the steps),
 //! `max_residual`; `max_errors`: the true errors, max over the time nodes (`null` without `[exact]`);

@@ -60,7 +60,7 @@ impl EdgePattern {
     }
 
     /// The graph of K's unknowns with the unknowns of an edge as one vertex, as (`first`, `start`,
-    /// `adj`) for `solve::ordering::Graph`: vertex g = the g-th edge with unknowns, holding the unknowns
+    /// `adj`) for `solve::cholesky::Graph`: vertex g = the g-th edge with unknowns, holding the unknowns
     /// `first[g]..first[g + 1]`, adjacent to the coupled edges with unknowns (sorted, no self loop).
     /// Equal to the graph read from K as long as no 2 × 2 block of two coupled edges vanishes entirely
     /// (on each side e of their triangles, two CR basis functions whose traces are ±(1, −1) have
@@ -94,7 +94,7 @@ impl EdgePattern {
     }
 
     /// The points of the vertices of [`EdgePattern::unknown_graph`]: the midpoints of the edges with
-    /// unknowns, in the same order (for the ordering by coordinate bisection, `solve::dissect`).
+    /// unknowns, in the same order (for the ordering by coordinate bisection, `solve::cholesky`'s coordinate bisection).
     pub fn unknown_points(mesh: &Mesh, space: &CrSpace) -> Vec<[f64; 2]> {
         let with_unknowns = |e: &usize| space.edge_dof[*e].terms().next().is_some();
         (0..space.edge_dof.len()).filter(with_unknowns).map(|e| mesh.midpoint(e)).collect()

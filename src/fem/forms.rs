@@ -12,7 +12,7 @@
 //! a quadratic form Q of the pair X = (U, p); without data, E = ½a_h(U, U).
 
 use super::elasticity::Elasticity;
-use super::lifting::{gauss3_points, DataValues};
+use super::lifting::{gauss3_points, BoundaryData, DataValues};
 use super::quadrature::{GAUSS2, GAUSS3};
 use super::space::{jump_terms_with, CrSpace, Element};
 use crate::mesh::Mesh;
@@ -34,11 +34,12 @@ pub struct FullForm {
 }
 
 impl FullForm {
-    pub fn new(mesh: &Mesh, space: &CrSpace, law: &Elasticity, rho: f64) -> FullForm {
+    /// The forms on `mesh` with the space's stabilised edges and the Dirichlet edges of `data`.
+    pub fn new(mesh: &Mesh, space: &CrSpace, data: Option<&BoundaryData>, law: &Elasticity, rho: f64) -> FullForm {
         let pen = 2.0 * rho * law.mu;
         let stabilised = (0..mesh.edges.len()).filter(|&e| space.is_stabilised(mesh, e)).collect();
         let mut data_points = Vec::new();
-        if let Some(data) = &space.data {
+        if let Some(data) = data {
             for &e in &data.dirichlet {
                 let t = mesh.edge_tris[e].0;
                 let (te, el) = (mesh.tri_edges[t], Element::new(mesh, t));

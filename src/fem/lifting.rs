@@ -26,7 +26,7 @@ pub mod consistency;
 
 use super::elasticity::Elasticity;
 use super::quadrature::{edge_point, GAUSS2, GAUSS3};
-use super::space::{jump_terms, ContactEdge, EdgeDof, Element};
+use super::space::{jump_terms, ContactEdge, CrSpace, EdgeDof, Element};
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::scene::expr::{BoundSet, ExprSet};
@@ -88,7 +88,36 @@ pub fn mean3<const K: usize>(v: &[[f64; K]; 3]) -> [f64; K] {
     m
 }
 
+/// The displacement u = w + u_L(t) at every edge midpoint: [`CrSpace::midpoint_values_into`] of the
+/// unknowns `w` plus the lifting of the boundary data at time t (none without `data`).
+pub fn displacement_into(
+    space: &CrSpace,
+    data: Option<&BoundaryData>,
+    w: &[f64],
+    t: f64,
+    out: &mut Vec<[f64; 2]>,
+) -> Result<()> {
+    space.midpoint_values_into(w, out);
+    if let Some(data) = data {
+        let v = data.values(t)?;
+        data.add_lifting(&space.contact, &v, out);
+    }
+    Ok(())
+}
+
+/// [`displacement_into`] into a new vector.
+pub fn displacement(space: &CrSpace, data: Option<&BoundaryData>, w: &[f64], t: f64) -> Result<Vec<[f64; 2]>> {
+    let mut out = Vec::with_capacity(space.edge_dof.len());
+    displacement_into(space, data, w, t, &mut out)?;
+    Ok(out)
+}
+
 impl BoundaryData {
+    /// The data of `parts` on the space's mesh ([`BoundaryData::new`] with the space's parts and Γ_C edges).
+    pub fn of(mesh: &Mesh, parts: &[Part], space: &CrSpace) -> Option<BoundaryData> {
+        BoundaryData::new(mesh, parts, &space.edge_part, &space.contact)
+    }
+
     /// The data of `parts` on the mesh (`edge_part`: the part of each boundary edge, `contact`: the Γ_C
     /// edges of the space); `None` when no part gives nonzero data.
     pub fn new(

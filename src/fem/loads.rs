@@ -23,24 +23,25 @@
 
 use super::elasticity::Elasticity;
 use super::lifting::{BoundaryData, LiftRhs};
-use super::quadrature::{edge_point, tri_point, GAUSS3, TRI4};
-use super::space::{CrSpace, Element};
+use super::space::CrSpace;
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::scene::expr::program::Program;
 use crate::scene::expr::sym::Sym;
 use crate::scene::expr::{factor_slot, BoundSet, Expr, ExprSet, Vec2Expr};
-use crate::scene::{PartKind, Scene};
+use crate::scene::Scene;
 use constrained::constrained_terms;
+use points::load_points;
 
 mod constrained;
+mod points;
 
 /// Per point of a load term feeding constrained components: (component, weight w·φ, vector coefficient).
 pub(super) type PointWeights = Vec<(usize, f64, [f64; 2])>;
 
 /// A quadrature point of a load term: position, and the (edge, weight · φ) pairs it feeds.
 #[derive(Clone, Debug)]
-struct LoadPoint {
+pub(super) struct LoadPoint {
     x: [f64; 2],
     edges: [(usize, f64); 3],
 }
@@ -115,49 +116,34 @@ struct Lift {
 impl Loads {
     /// Quadrature points of the body force (if any) and of every Neumann part with a traction; the
     /// terms that separate are assembled into patterns now (an error if a space part is not finite).
-    pub fn new(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<Loads> {
-        Self::with_separation(scene, mesh, space, true)
+    /// With `data`, the lifting's part of the right-hand side too.
+    pub fn new(scene: &Scene, mesh: &Mesh, space: &CrSpace, data: Option<&BoundaryData>) -> Result<Loads> {
+        Self::with_separation(scene, mesh, space, data, true)
     }
 
     /// As [`Loads::new`]; with `separate = false` every term is evaluated at every node (the reference
     /// route the patterns are tested against).
-    pub fn with_separation(scene: &Scene, mesh: &Mesh, space: &CrSpace, separate: bool) -> Result<Loads> {
-        let mut raw: Vec<(&Vec2Expr, Vec<LoadPoint>)> = Vec::new();
-        if let Some(f) = &scene.f {
-            let mut points = Vec::with_capacity(6 * mesh.tris.len());
-            for t in 0..mesh.tris.len() {
-                let el = Element::new(mesh, t);
-                for (l, w) in TRI4 {
-                    let phi = Element::phi(l);
-                    let wt = w * el.area;
-                    let edges = [0, 1, 2].map(|i| (mesh.tri_edges[t][i], wt * phi[i]));
-                    points.push(LoadPoint { x: tri_point(el.pts, l), edges });
-                }
-            }
-            raw.push((f, points));
-        }
-        for (p, part) in scene.parts.iter().enumerate() {
-            let PartKind::Neumann(Some(g)) = &part.kind else {
-                continue;
-            };
-            let mut points = Vec::new();
-            for e in 0..mesh.edges.len() {
-                if space.edge_part[e] != Some(p) {
-                    continue;
-                }
-                let t = mesh.edge_tris[e].0;
-                let el = Element::new(mesh, t);
-                let [a, b] = mesh.edges[e].map(|v| mesh.points[v]);
-                let len = mesh.edge_length(e);
-                for (s, w) in GAUSS3 {
-                    let x = edge_point(a, b, s);
-                    let phi = Element::phi(el.bary(x));
-                    let edges = [0, 1, 2].map(|i| (mesh.tri_edges[t][i], w * len * phi[i]));
-                    points.push(LoadPoint { x, edges });
-                }
-            }
-            raw.push((g, points));
-        }
+    pub fn with_separation(
+        scene: &Scene,
+        mesh: &Mesh,
+        space: &CrSpace,
+        data: Option<&BoundaryData>,
+        separate: bool,
+    ) -> Result<Loads> {
+        let raw = load_points(scene, mesh, space);
+        let mut loads = Loads::on_support(scene, mesh, (space, data), &raw);
+        loads.add_terms(raw, separate)?;
+        Ok(loads)
+    }
+
+    /// The loads of the quadrature points `raw` with no term yet: their support (the unknowns they and
+    /// the lifting of `data` touch) and the lifting's part.
+    fn on_support(
+        scene: &Scene,
+        mesh: &Mesh,
+        (space, data): (&CrSpace, Option<&BoundaryData>),
+        raw: &[(&Vec2Expr, Vec<LoadPoint>)],
+    ) -> Loads {
         let mut touched = vec![false; space.n_dofs];
         for p in raw.iter().flat_map(|t| &t.1) {
             for &(e, _) in &p.edges {
@@ -166,11 +152,11 @@ impl Loads {
                 }
             }
         }
-        let lift_parts = space.data.as_ref().map(|data| {
+        let lift_parts = data.map(|data| {
             let law = Elasticity::new(&scene.material);
             let rhs = LiftRhs::new(mesh, &space.edge_dof, &space.contact, data, &law, scene.rho);
             rhs.unknowns().for_each(|k| touched[k] = true);
-            (data.clone(), rhs, constrained_terms(&raw, data, space))
+            (data.clone(), rhs, constrained_terms(raw, data, space))
         });
         let support: Vec<usize> = (0..space.n_dofs).filter(|&k| touched[k]).collect();
         let mut slot = vec![usize::MAX; space.n_dofs];
@@ -183,7 +169,7 @@ impl Loads {
             edge_terms.extend(dof.terms().map(|(k, c)| (slot[k] as u32, c)));
             edge_first.push(edge_terms.len() as u32);
         }
-        let mut loads = Loads {
+        Loads {
             terms: Vec::new(),
             patterns: Patterns { factors: Program::new(&[]), names: Vec::new(), vectors: Vec::new() },
             edge_first,
@@ -197,7 +183,13 @@ impl Loads {
                 n_constrained,
             }),
             support,
-        };
+        }
+    }
+
+    /// Add the terms of the quadrature points `raw`: those that separate (unless `separate` is false)
+    /// to the patterns, the others as terms evaluated at every node.
+    fn add_terms(&mut self, raw: Vec<(&Vec2Expr, Vec<LoadPoint>)>, separate: bool) -> Result<()> {
+        let loads = self;
         let mut factors: Vec<(String, Sym)> = Vec::new();
         let mut values = Vec::new();
         for (e, pts) in raw {
@@ -226,7 +218,7 @@ impl Loads {
             }
         }
         loads.patterns.factors = Program::new(&factors.iter().map(|(_, tau)| tau).collect::<Vec<_>>());
-        Ok(loads)
+        Ok(())
     }
 
     /// Number of load patterns (distinct time factors of the separated terms).

@@ -1,6 +1,13 @@
-//! The discretisation in space: the Crouzeix–Raviart space V_h ([`space`]), quadrature rules
-//! ([`quadrature`]), the one elasticity law ([`elasticity`]), the stiffness a_h ([`assemble`]) and loads
-//! lⁿ ([`loads`]), the exact solution at quadrature points ([`exact`]) and true-error norms ([`norms`]) and the prolongation between nested meshes ([`prolong`]).
+//! The discretisation in space:
+//!
+//! * [`space`]: the Crouzeix–Raviart element and the space V_h (zero boundary values);
+//! * [`lifting`]: nonzero boundary data u_D, g_n, added to V_h's unknowns by their lifting;
+//! * [`quadrature`]: the quadrature rules on triangles and edges;
+//! * [`elasticity`]: the one elasticity law (plane strain);
+//! * [`assemble`]: the stiffness K of a_h; [`loads`]: the load functional lⁿ;
+//! * [`exact`]: the exact solution at quadrature points; [`norms`]: true-error norms;
+//! * [`forms`]: the energy audit's forms on full midpoint fields;
+//! * [`prolong`]: the prolongation between nested meshes.
 
 pub mod assemble;
 pub mod elasticity;

@@ -264,7 +264,7 @@ mod tests {
             .collect()
     }
 
-    /// Requirement (issue 32, the planner's own CPU): the system shall find the parents of nested
+    /// Requirement (the planner's own CPU): the system shall find the parents of nested
     /// meshes' triangles (structured refinement of a parallelogram with either diagonal, one and two
     /// levels; red refinement of a quadrilateral's mesh) without point location, and give the parents of
     /// point location on every mesh pair, nested or not (a bilinear quadrilateral's structured meshes).

@@ -4,6 +4,19 @@
 //!   (multiply by |T|). Used for body forces and for error norms.
 //! * Edge: 2-point Gauss (exact for the stabilisation: products of two P1 traces) and 3-point Gauss
 //!   (degree 5; Neumann loads, edge means of g_a and of u₀), on the parameter s ∈ [0, 1], weights summing to 1.
+//!
+//! ```
+//! use tresca_cr::fem::quadrature::{tri_point, GAUSS2, TRI4};
+//!
+//! // Dunavant 4 integrates x²y² over the unit triangle exactly: 2!·2!/6! = 1/180
+//! let tri = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+//! let area = 0.5;
+//! let i: f64 = TRI4.iter().map(|&(l, w)| { let p = tri_point(tri, l); w * area * p[0] * p[0] * p[1] * p[1] }).sum();
+//! assert!((i - 1.0 / 180.0).abs() < 1e-15);
+//! // 2-point Gauss is exact for cubics on [0, 1]
+//! let c: f64 = GAUSS2.iter().map(|&(s, w)| w * s * s * s).sum();
+//! assert!((c - 0.25).abs() < 1e-15);
+//! ```
 
 /// Dunavant degree 4: (barycentric coordinates, weight).
 #[allow(clippy::excessive_precision)] // the rule's published 18 digits, kept to compare with the table; they round to the same f64

@@ -10,8 +10,20 @@
 //! * (u_x, u_y) elsewhere, two unknowns.
 //!
 //! The interpolant I_CR takes edge means (3-point Gauss), which commute with time derivatives.
+//!
+//! ```
+//! use tresca_cr::fem::quadrature::{edge_point, GAUSS3};
+//! use tresca_cr::fem::space::Element;
+//!
+//! // φ_i = 1 − 2λ_i is 1 at the midpoint of the edge opposite vertex i and 0 at the other two
+//! let mid0 = [0.0, 0.5, 0.5]; // the midpoint of the edge opposite vertex 0, in barycentric coordinates
+//! assert_eq!(Element::phi(mid0), [1.0, 0.0, 0.0]);
+//! // the edge mean of a function is 3-point Gauss on the edge: exact for degree 5 along it
+//! let (a, b) = ([0.0, 0.0], [2.0, 0.0]);
+//! let mean: f64 = GAUSS3.iter().map(|&(s, w)| w * edge_point(a, b, s)[0].powi(5)).sum();
+//! assert!((mean - 32.0 / 6.0).abs() < 1e-13); // (1/2) ∫₀² x⁵ dx
+//! ```
 
-use super::lifting::BoundaryData;
 use super::quadrature::{edge_point, GAUSS3};
 use crate::error::Result;
 use crate::mesh::Mesh;
@@ -117,8 +129,6 @@ pub struct CrSpace {
     pub contact: Vec<ContactEdge>,
     /// Number of Dirichlet edges.
     pub n_dirichlet: usize,
-    /// Nonzero boundary data u_D, g_n (`None` without: u = w, the unknowns alone).
-    pub data: Option<BoundaryData>,
 }
 
 impl CrSpace {
@@ -156,8 +166,7 @@ impl CrSpace {
                 }
             });
         }
-        let data = BoundaryData::new(mesh, parts, &edge_part, &contact);
-        Ok(CrSpace { edge_dof, edge_part, n_dofs: n, contact, n_dirichlet, data })
+        Ok(CrSpace { edge_dof, edge_part, n_dofs: n, contact, n_dirichlet })
     }
 
     /// True if edge e carries the stabilisation (interior or Dirichlet).
@@ -193,24 +202,6 @@ impl CrSpace {
                 .iter()
                 .map(|d| d.terms().fold([0.0; 2], |acc, (k, c)| [acc[0] + c[0] * u[k], acc[1] + c[1] * u[k]])),
         );
-    }
-
-    /// The displacement u = w + u_L(t) at every edge midpoint: [`CrSpace::midpoint_values_into`] of the
-    /// unknowns `w` plus the lifting of the boundary data at time t (`fem::lifting`; none without data).
-    pub fn displacement_into(&self, w: &[f64], t: f64, out: &mut Vec<[f64; 2]>) -> Result<()> {
-        self.midpoint_values_into(w, out);
-        if let Some(data) = &self.data {
-            let v = data.values(t)?;
-            data.add_lifting(&self.contact, &v, out);
-        }
-        Ok(())
-    }
-
-    /// [`CrSpace::displacement_into`] into a new vector.
-    pub fn displacement(&self, w: &[f64], t: f64) -> Result<Vec<[f64; 2]>> {
-        let mut out = Vec::with_capacity(self.edge_dof.len());
-        self.displacement_into(w, t, &mut out)?;
-        Ok(out)
     }
 
     /// I_CR v: edge means by 3-point Gauss, restricted to V_h (tangential part on contact edges). The

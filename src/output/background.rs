@@ -16,6 +16,7 @@
 
 use super::{Unknowns, Writer};
 use crate::error::{Error, Result};
+use crate::fem::lifting::BoundaryData;
 use crate::fem::space::CrSpace;
 use crate::stepping::StepResult;
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
@@ -45,8 +46,9 @@ pub struct Background {
     thread: Option<JoinHandle<Result<usize>>>,
     failure: Arc<Mutex<Failure>>,
     path: std::path::PathBuf,
-    /// The writer's space: the caller's thread evaluates [`Unknowns`] with it.
+    /// The writer's space and boundary data: the caller's thread evaluates [`Unknowns`] with them.
     space: CrSpace,
+    data: Option<BoundaryData>,
     /// The status of a run whose step this thread refused (a non-finite u): what the file records.
     refused: Option<String>,
 }
@@ -86,12 +88,12 @@ impl Background {
         let (tx, rx) = sync_channel(QUEUE);
         let failure = Arc::new(Mutex::new(Failure::default()));
         let f = Arc::clone(&failure);
-        let (path, space) = (w.path().to_path_buf(), w.space.clone());
+        let (path, space, data) = (w.path().to_path_buf(), w.space.clone(), w.data.clone());
         let thread = std::thread::Builder::new()
             .name("writer".into())
             .spawn(move || serve(w, rx, f))
             .map_err(|e| Error::Io { path: path.clone(), msg: format!("cannot start the writer thread: {e}") })?;
-        Ok(Background { tx: Some(tx), thread: Some(thread), failure, path, space, refused: None })
+        Ok(Background { tx: Some(tx), thread: Some(thread), failure, path, space, data, refused: None })
     }
 
     /// The writer's first error if the caller has not been told of it yet.
@@ -109,7 +111,7 @@ impl Background {
             // told already: the steps after a failed one are not written
             return Ok(());
         }
-        let u = match Unknowns::of(&self.path, &self.space, r, Vec::new()) {
+        let u = match Unknowns::of(&self.path, (&self.space, self.data.as_ref()), r, Vec::new()) {
             Ok(u) => u,
             Err(e) => {
                 if let Ok(mut f) = self.failure.lock() {

@@ -1,7 +1,18 @@
 //! A new results file: built under `run.h5.partial` and moved into place at its first commit (see the
 //! module doc of [`super`]), on a path this run owns ([`OutputLock`]).
 
-use super::*;
+use super::fields::{Fields, StepFields};
+use super::h5::{self, io, Raw};
+use super::lock::OutputLock;
+use super::paths::{self, sidecar};
+use super::rows::Rows;
+use super::tresca::Tresca;
+use super::vtkhdf::{FrameRows, Frames, VtkHdf};
+use super::xdmf::Xdmf;
+use super::{ioerr, partial_path, Opened, Options, Pending, Run, Writer, AUTO_FRAMES};
+use crate::error::{Error, Result};
+use std::path::Path;
+use std::time::Instant;
 
 /// The file a new one replaces, held open for reading (see [`Pending`]); not through a symbolic link,
 /// and without waiting on a FIFO.
@@ -129,6 +140,7 @@ impl Writer {
             file: o.file,
             raw: o.raw,
             space: run.space.clone(),
+            data: run.data.cloned(),
             fields,
             tresca: o.tresca,
             vtk: o.vtk,

@@ -59,6 +59,7 @@ pub mod xdmf;
 
 use crate::error::{Error, Result};
 use crate::fem::elasticity::Elasticity;
+use crate::fem::lifting::BoundaryData;
 use crate::fem::space::CrSpace;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
@@ -74,9 +75,9 @@ use xdmf::Xdmf;
 
 pub use background::Background;
 pub use lock::{lock_path, OutputLock};
+pub use paths::sidecar;
 pub use paths::{check_target, check_writable};
 pub use take::Unknowns;
-pub use xdmf::sidecar;
 
 /// Default upper bound on the number of visualisation frames.
 pub const AUTO_FRAMES: usize = 51;
@@ -118,6 +119,8 @@ pub struct Run<'a> {
     pub scene: &'a Scene,
     pub mesh: &'a Mesh,
     pub space: &'a CrSpace,
+    /// The boundary data whose lifting the written displacement includes.
+    pub data: Option<&'a BoundaryData>,
     pub law: Elasticity,
     pub meta: RunMeta,
 }
@@ -125,24 +128,30 @@ pub struct Run<'a> {
 impl<'a> Run<'a> {
     /// The run of `p` with this build's version and commit.
     pub fn of(p: &'a Problem) -> Run<'a> {
-        Run::new(&p.scene, &p.mesh, &p.space, p.law, p.setup)
+        Run::new(&p.scene, &p.mesh, (&p.space, p.data.as_ref()), p.law, p.setup)
     }
 
     /// The run of a problem whose set-up is still under way ([`Problem::new_beside`]): its set-up times
     /// are zeros until [`Writer::set_setup_times`].
     pub fn before_setup(p: &'a Discretised) -> Run<'a> {
-        Run::new(&p.scene, &p.mesh, &p.space, p.law, SetupTimes::default())
+        Run::new(&p.scene, &p.mesh, (&p.space, p.data.as_ref()), p.law, SetupTimes::default())
     }
 
     /// With this build's version and commit; true errors are computed when the scene gives `[exact]`.
-    fn new(scene: &'a Scene, mesh: &'a Mesh, space: &'a CrSpace, law: Elasticity, setup: SetupTimes) -> Run<'a> {
+    fn new(
+        scene: &'a Scene,
+        mesh: &'a Mesh,
+        (space, data): (&'a CrSpace, Option<&'a BoundaryData>),
+        law: Elasticity,
+        setup: SetupTimes,
+    ) -> Run<'a> {
         let meta = RunMeta {
             version: env!("CARGO_PKG_VERSION"),
             commit: env!("TRESCA_BUILD_COMMIT"),
             setup,
             true_errors: scene.exact.is_some(),
         };
-        Run { scene, mesh, space, law, meta }
+        Run { scene, mesh, space, data, law, meta }
     }
 
     /// Number of time steps N.
@@ -168,6 +177,7 @@ pub struct Writer {
     /// Plain handle for the direct writes of the series ([`h5::Series`]).
     raw: Raw,
     space: CrSpace,
+    data: Option<BoundaryData>,
     fields: Fields,
     tresca: Tresca,
     vtk: VtkHdf,
@@ -246,7 +256,7 @@ impl Writer {
     /// at hand or [`background::QUEUE`] steps are buffered, and always at the last step.
     pub fn write_step_then(&mut self, r: &StepResult, more: bool) -> Result<()> {
         let start = Instant::now();
-        let u = Unknowns::of(&self.path, &self.space, r, std::mem::take(&mut self.mid));
+        let u = Unknowns::of(&self.path, (&self.space, self.data.as_ref()), r, std::mem::take(&mut self.mid));
         self.seconds[0] += start.elapsed().as_secs_f64();
         self.write_unknowns(u, more)
     }

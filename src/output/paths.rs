@@ -8,12 +8,11 @@
 //! a device node such as `/dev/null` under `--force`); an existing file is replaced only by a rename,
 //! which leaves any other link to it as it was.
 
-use super::xdmf::sidecar;
 use crate::error::{Error, Result};
 use crate::input::kind_of;
 use std::fs::{File, Metadata, OpenOptions};
 use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 fn refuse(path: &Path, msg: String) -> Error {
     Error::Io { path: path.to_path_buf(), msg }
@@ -26,6 +25,11 @@ pub(super) fn lstat(path: &Path) -> Result<Option<Metadata>> {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
         Err(e) => Err(refuse(path, format!("cannot inspect the path: {e}"))),
     }
+}
+
+/// The XDMF path of a results file: same stem, extension `xdmf`.
+pub fn sidecar(h5: &Path) -> PathBuf {
+    h5.with_extension("xdmf")
 }
 
 /// Refuse a results path (or its sidecar) that is not a regular file, or that names the sidecar itself.

@@ -3,7 +3,17 @@
 //! through its slip and μ, both stored exactly). A run killed before its step 0 was committed left only
 //! `.partial` files: it is started afresh.
 
-use super::*;
+use super::fields::Fields;
+use super::h5::{self, io, Raw};
+use super::lock::OutputLock;
+use super::paths;
+use super::tresca::Tresca;
+use super::vtkhdf::{Frames, VtkHdf};
+use super::xdmf::Xdmf;
+use super::{ioerr, partial_path, Opened, Options, Run, Writer};
+use crate::error::{Error, Result};
+use crate::stepping::StepResult;
+use std::path::Path;
 
 impl Writer {
     /// Reopen a results file of `run` (same scene text, time grid, solver and mesh, else an error),
@@ -32,101 +42,12 @@ impl Writer {
             .map_err(io(path, "cannot open for --resume"))?;
         let raw = Raw::open(path).map_err(ioerr(path, "cannot open for --resume"))?;
         let mut tresca = Tresca::open(&file).map_err(io(path, "not a tresca-cr results file"))?;
-        let mismatch = |what: &str| Error::Io {
-            path: path.to_path_buf(),
-            msg: format!("--resume: the file was written for a different {what}; rerun with --force to overwrite it"),
-        };
-        let g = &*tresca.group;
-        let text = h5::read_str(g, "scene").map_err(io(path, "attribute scene"))?;
-        if text != run.scene.text {
-            return Err(mismatch("scene (the stored scene text differs)"));
-        }
-        let int = |k: &str| g.attr(k).and_then(|a| a.read_scalar::<i64>()).unwrap_or(-1);
-        if int("steps") != run.n_steps() as i64 {
-            return Err(mismatch("number of time steps (--steps)"));
-        }
-        if int("n_edges") != run.mesh.edges.len() as i64 || int("n_dofs") != run.space.n_dofs as i64 {
-            return Err(mismatch("mesh (--refine)"));
-        }
-        let solver = h5::read_str(g, "solver").unwrap_or_default();
-        if solver != run.scene.solver.method.name() {
-            return Err(mismatch(&format!("solver ({solver}, not {}: --solver)", run.scene.solver.method.name())));
-        }
-        // every setting that changes the answer must be the file's (the scene text covers the rest)
-        let float = |k: &str| g.attr(k).and_then(|a| a.read_scalar::<f64>()).ok();
-        let s = &run.scene.solver;
-        for (key, stored, asked, option) in [
-            ("tol", float("tol"), s.tol, "--tol / solver.tol"),
-            ("uzawa_step", float("uzawa_step"), s.uzawa_step, "solver.uzawa_step"),
-            ("rho", float("rho"), run.scene.rho, "discretisation.rho"),
-        ] {
-            if stored.map(f64::to_bits) != Some(asked.to_bits()) {
-                let was = stored.map_or("none".to_string(), |v| format!("{v:e}"));
-                return Err(mismatch(&format!(
-                    "{key} ({option}: the file's steps were solved with {was}, this run asks {asked:e})"
-                )));
-            }
-        }
-        if int("max_iter") != s.max_iter() as i64 {
-            return Err(mismatch(&format!("max_iter ({} in the file, {} asked)", int("max_iter"), s.max_iter())));
-        }
-        let pts =
-            tresca.group.dataset("mesh/points").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "mesh/points"))?;
-        if pts != run.mesh.points.as_flattened() {
-            // the scene text and the mesh's sizes are the file's: the coordinates come from them, unless a
-            // Gmsh file they name was edited since
-            let msg = match &run.scene.mesh {
-                crate::mesh::MeshSpec::Gmsh { path: m, .. } => format!(
-                    "--resume: the stored vertex coordinates (tresca/mesh/points) differ from those of {}: the mesh \
-                     file was changed since the run, or the results file was damaged; rerun with --force",
-                    m.display()
-                ),
-                _ => "--resume: the stored vertex coordinates (tresca/mesh/points) differ from the mesh the scene \
-                      (the file's own text) generates: the file was damaged after it was written; rerun with --force"
-                    .into(),
-            };
-            return Err(Error::Io { path: path.to_path_buf(), msg });
-        }
+        check_settings(&tresca.group, run, path)?;
+        check_points(&tresca.group, run, path)?;
         let contact = !run.space.contact.is_empty();
         let mut vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
-        let completed = tresca.completed().map_err(io(path, "tresca/steps completed"))?;
-        if completed == 0 {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: "--resume: the file holds no committed step (not written by this version); run again with --force"
-                    .into(),
-            });
-        }
-        let every = int("frame_every").max(1) as usize;
-        let times: Vec<f64> =
-            tresca.group.dataset("times").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "tresca/times"))?;
-        if completed > run.n_steps() + 1 || completed > times.len() {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: format!(
-                    "--resume: the file's counter of committed steps (tresca/steps completed = {completed}) exceeds the \
-                     {} steps it has room for: the file was damaged after it was written; rerun with --force",
-                    times.len().min(run.n_steps() + 1)
-                ),
-            });
-        }
-        // storage corruption since the steps were written: refuse, naming the first bad step
-        if let Some(n) =
-            tresca.first_corrupt_step(completed).map_err(io(path, "--resume: verifying the step checksums"))?
-        {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: format!(
-                    "--resume: step {n} does not match its checksum (tresca/steps/checksum): the file was \
-                     damaged after it was written. Steps 0..{} are intact; rerun with --force",
-                    n as i64 - 1
-                ),
-            });
-        }
-        // the steps match their checksums, so these are the times they were solved at
-        if times[..completed] != run.scene.times[..completed] {
-            return Err(mismatch("time grid"));
-        }
+        let (completed, times) = completed_steps(&mut tresca, run, path)?;
+        let every = int(&tresca.group, "frame_every").max(1) as usize;
         let frames = Frames { every, last: run.n_steps() };
         let frames_done = frames.before(completed);
         let frame_list: Vec<(usize, f64)> =
@@ -152,4 +73,117 @@ impl Writer {
         w.lock = Some(lock);
         Ok((w, Some(last)))
     }
+}
+
+/// An error for a file written for a different `what` than this run.
+fn mismatch(path: &Path, what: &str) -> Error {
+    Error::Io {
+        path: path.to_path_buf(),
+        msg: format!("--resume: the file was written for a different {what}; rerun with --force to overwrite it"),
+    }
+}
+
+/// The integer attribute `k` of the `/tresca` group (−1 when absent).
+fn int(g: &hdf5::Group, k: &str) -> i64 {
+    g.attr(k).and_then(|a| a.read_scalar::<i64>()).unwrap_or(-1)
+}
+
+/// Refuse a file whose run differs from `run` in a setting that changes the answer: the scene text, the
+/// number of steps, the mesh's sizes, the solver and its settings (the scene text covers the rest).
+fn check_settings(g: &hdf5::Group, run: &Run, path: &Path) -> Result<()> {
+    let text = h5::read_str(g, "scene").map_err(io(path, "attribute scene"))?;
+    if text != run.scene.text {
+        return Err(mismatch(path, "scene (the stored scene text differs)"));
+    }
+    if int(g, "steps") != run.n_steps() as i64 {
+        return Err(mismatch(path, "number of time steps (--steps)"));
+    }
+    if int(g, "n_edges") != run.mesh.edges.len() as i64 || int(g, "n_dofs") != run.space.n_dofs as i64 {
+        return Err(mismatch(path, "mesh (--refine)"));
+    }
+    let solver = h5::read_str(g, "solver").unwrap_or_default();
+    if solver != run.scene.solver.method.name() {
+        return Err(mismatch(path, &format!("solver ({solver}, not {}: --solver)", run.scene.solver.method.name())));
+    }
+    let float = |k: &str| g.attr(k).and_then(|a| a.read_scalar::<f64>()).ok();
+    let s = &run.scene.solver;
+    for (key, stored, asked, option) in [
+        ("tol", float("tol"), s.tol, "--tol / solver.tol"),
+        ("uzawa_step", float("uzawa_step"), s.uzawa_step, "solver.uzawa_step"),
+        ("rho", float("rho"), run.scene.rho, "discretisation.rho"),
+    ] {
+        if stored.map(f64::to_bits) != Some(asked.to_bits()) {
+            let was = stored.map_or("none".to_string(), |v| format!("{v:e}"));
+            return Err(mismatch(
+                path,
+                &format!("{key} ({option}: the file's steps were solved with {was}, this run asks {asked:e})"),
+            ));
+        }
+    }
+    if int(g, "max_iter") != s.max_iter() as i64 {
+        return Err(mismatch(path, &format!("max_iter ({} in the file, {} asked)", int(g, "max_iter"), s.max_iter())));
+    }
+    Ok(())
+}
+
+/// Refuse a file whose stored vertex coordinates are not those of `run`'s mesh.
+fn check_points(g: &hdf5::Group, run: &Run, path: &Path) -> Result<()> {
+    let pts = g.dataset("mesh/points").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "mesh/points"))?;
+    if pts == run.mesh.points.as_flattened() {
+        return Ok(());
+    }
+    // the scene text and the mesh's sizes are the file's: the coordinates come from them, unless a
+    // Gmsh file they name was edited since
+    let msg = match &run.scene.mesh {
+        crate::mesh::MeshSpec::Gmsh { path: m, .. } => format!(
+            "--resume: the stored vertex coordinates (tresca/mesh/points) differ from those of {}: the mesh \
+             file was changed since the run, or the results file was damaged; rerun with --force",
+            m.display()
+        ),
+        _ => "--resume: the stored vertex coordinates (tresca/mesh/points) differ from the mesh the scene \
+              (the file's own text) generates: the file was damaged after it was written; rerun with --force"
+            .into(),
+    };
+    Err(Error::Io { path: path.to_path_buf(), msg })
+}
+
+/// The file's committed steps and its time nodes, refused when there are none, more than it has room
+/// for, a step does not match its checksum, or their times are not `run`'s.
+fn completed_steps(tresca: &mut Tresca, run: &Run, path: &Path) -> Result<(usize, Vec<f64>)> {
+    let completed = tresca.completed().map_err(io(path, "tresca/steps completed"))?;
+    if completed == 0 {
+        return Err(Error::Io {
+            path: path.to_path_buf(),
+            msg: "--resume: the file holds no committed step (not written by this version); run again with --force"
+                .into(),
+        });
+    }
+    let times: Vec<f64> =
+        tresca.group.dataset("times").and_then(|d| d.read_raw::<f64>()).map_err(io(path, "tresca/times"))?;
+    if completed > run.n_steps() + 1 || completed > times.len() {
+        return Err(Error::Io {
+            path: path.to_path_buf(),
+            msg: format!(
+                "--resume: the file's counter of committed steps (tresca/steps completed = {completed}) exceeds the \
+                 {} steps it has room for: the file was damaged after it was written; rerun with --force",
+                times.len().min(run.n_steps() + 1)
+            ),
+        });
+    }
+    // storage corruption since the steps were written: refuse, naming the first bad step
+    if let Some(n) = tresca.first_corrupt_step(completed).map_err(io(path, "--resume: verifying the step checksums"))? {
+        return Err(Error::Io {
+            path: path.to_path_buf(),
+            msg: format!(
+                "--resume: step {n} does not match its checksum (tresca/steps/checksum): the file was \
+                 damaged after it was written. Steps 0..{} are intact; rerun with --force",
+                n as i64 - 1
+            ),
+        });
+    }
+    // the steps match their checksums, so these are the times they were solved at
+    if times[..completed] != run.scene.times[..completed] {
+        return Err(mismatch(path, "time grid"));
+    }
+    Ok((completed, times))
 }

@@ -2,7 +2,12 @@
 //! cannot hold (nothing of such a step is written), its rows of `/tresca` and, for a frame, its VTKHDF
 //! fields.
 
-use super::*;
+use super::Writer;
+use crate::error::{Error, Result};
+use crate::fem::lifting::BoundaryData;
+use crate::fem::space::CrSpace;
+use crate::stepping::StepResult;
+use std::path::Path;
 
 /// An error naming the first non-finite value of `v`, if any.
 fn check_finite(path: &Path, n: usize, what: &str, v: &[f64]) -> Result<()> {
@@ -51,7 +56,12 @@ pub struct Unknowns {
 
 impl Unknowns {
     /// Check u of step `r` and evaluate what is written of it (`mid`: memory to reuse).
-    pub fn of(path: &Path, space: &CrSpace, r: &StepResult, mut mid: Vec<[f64; 2]>) -> Result<Unknowns> {
+    pub fn of(
+        path: &Path,
+        (space, data): (&CrSpace, Option<&BoundaryData>),
+        r: &StepResult,
+        mut mid: Vec<[f64; 2]>,
+    ) -> Result<Unknowns> {
         let n = r.n;
         if r.u.len() != space.n_dofs {
             return Err(Error::Io {
@@ -62,7 +72,7 @@ impl Unknowns {
             });
         }
         check_finite(path, n, "u", &r.u)?;
-        space.displacement_into(&r.u, r.t, &mut mid)?;
+        crate::fem::lifting::displacement_into(space, data, &r.u, r.t, &mut mid)?;
         let dof = space.contact.iter().map(|c| r.u[c.dof]).collect();
         let r = StepResult { u: Vec::new(), mu: r.mu.clone(), slip: r.slip.clone(), state: r.state.clone(), ..*r };
         Ok(Unknowns { r, mid, dof })

@@ -35,6 +35,7 @@
 
 use super::fields::Fields;
 use super::h5::{put, rows};
+use super::paths::sidecar;
 use super::vtkhdf::{BODY_CELLS, CONTACT_CELLS};
 use hdf5::{File, Group};
 use std::io::Write;
@@ -107,11 +108,6 @@ pub struct Xdmf {
     published: bool,
     /// After publishing, the file at `partial` that holds the previous text (see [`Xdmf::write_text`]).
     spare: Option<std::fs::File>,
-}
-
-/// The XDMF path of a results file: same stem, extension `xdmf`.
-pub fn sidecar(h5: &Path) -> PathBuf {
-    h5.with_extension("xdmf")
 }
 
 impl Xdmf {

@@ -3,7 +3,7 @@
 //! half the pilot budget), on the space pilot's time grid (where the plan's spatial error was sampled:
 //! the time pilot showed the coarser grid gives the same spatial answer), and lean: only η and the
 //! unknowns are computed (no energy audit, time indicator or distance between levels). So they cost a
-//! few per cent of the plan (issue 32).
+//! few per cent of the plan (the planner's own cost is to stay within 5 % of it).
 //!
 //! Both routes are compared through the same error indicator η (`adapt::estimator`, an upper bound of
 //! the energy-norm error up to a constant): a few levels of each — adaptive, and uniform as the θ = 1
@@ -38,7 +38,7 @@ pub const UNIFORM_LEVELS: usize = 9;
 /// Each pilot refines until this share of the uniform plan's unknowns (three and a half uniform
 /// refinements below it): deep enough for the laws' rates (Example 5.1 at 1e-4: 0.481 adaptive to 3,885
 /// unknowns against 0.482 to 7,267 and 0.488 to 18,106; 0.421 uniform to 3,088 against 0.415 to 6,176:
-/// N_a 117,223 against 106,811 with 1/64), cheap enough for the planner's 5 % of the plan (issue 32).
+/// N_a 117,223 against 106,811 with 1/64), cheap enough for the planner's 5 % of the plan.
 pub const PILOT_UNKNOWNS: f64 = 1.0 / 128.0;
 /// Fewest levels a law is fitted to.
 pub const FIT_LEVELS: usize = 4;

@@ -3,7 +3,7 @@
 //! estimates; `check` and `run` refuse a run whose estimate exceeds what the machine has (MemAvailable of
 //! `/proc/meminfo`, free space of the output's file system) or the limits the user gives.
 //!
-//! Calibration (Example 5.1 `--steps 4 -o`, peak RSS by `/usr/bin/time` in KiB, 2026-11-26, with K kept
+//! Calibration (Example 5.1 `--steps 4 -o`, peak RSS by `/usr/bin/time` in KiB, with K kept
 //! as its lower triangle; figures in `reference/performance.md` §8): five meshes from 24,640 to 3,539,712
 //! unknowns (refine 5–8 of `cells = [2, 2]`, refine 8 of `[3, 3]`). The factor's fill grows like n log n,
 //! so the estimate is γ + n (α + β log₂ n) plus the two buffers of a block of steps (`solve::free`, 16
@@ -50,7 +50,7 @@ const BYTES_PER_UNKNOWN_LOG2: f64 = 219.62;
 const FILL_ND: f64 = 16.0;
 const METIS_FILL: f64 = 0.87;
 /// From this many unknowns K is ordered by nested dissection and the set-up can fall back to METIS
-/// (`solve::ordering::ND_MIN_SIZE`, which `tests/budget.rs` checks it equals).
+/// (`solve::cholesky::ND_MIN_SIZE`, which `tests/budget.rs` checks it equals).
 pub const FALLBACK_MIN_UNKNOWNS: u64 = 1_000_000;
 /// The values of the block of steps' buffers (`solve::free`): at most 16 columns and 2²⁴ values each.
 const BLOCK_COLUMNS: u64 = 16;

@@ -6,6 +6,7 @@
 //! Only what the scene declares is modelled: no contact part means plain elasticity.
 
 use crate::error::{Error, Result};
+use crate::names::named_enum;
 use expr::{Expr, Vec2Expr};
 pub mod budget;
 pub mod expr;
@@ -31,7 +32,7 @@ pub struct Material {
     pub nu: f64,
 }
 
-crate::named_enum! {
+named_enum! {
     /// Per-step friction solver (`[solver] method`, `--solver`).
     pub enum Method {
         /// Semismooth Newton (projected Newton with Armijo search on the condensed dual).

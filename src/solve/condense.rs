@@ -8,7 +8,7 @@
 //! with K is made. W is kept: with y = L⁻¹Pᵀl (the forward half of a solve) the contact trace of
 //! u_f = K⁻¹l is Wᵀy_c, and L⁻¹E μ = [0; Wμ] (`free`).
 
-use super::factor::Factor;
+use super::cholesky::Factor;
 use crate::error::{Error, Result};
 use nalgebra::DMatrix;
 

@@ -2,7 +2,7 @@
 //! stiffness matrices (floating pieces, slivers, weak jump terms), checked once per run by `stepping`
 //! (the solves on a second thread, while the load superposition and the condensation are formed).
 
-use super::factor::Factor;
+use super::cholesky::Factor;
 use faer::sparse::SparseColMat;
 use nalgebra::DMatrix;
 

@@ -29,8 +29,8 @@
 //! started.
 
 pub use super::block::Block;
+use super::cholesky::Factor;
 use super::condense::Condensation;
-use super::factor::Factor;
 use super::superpose::LoadBasis;
 use crate::error::{Error, Result};
 use crate::fem::loads::Loads;

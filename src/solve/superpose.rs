@@ -20,7 +20,7 @@
 //! assemblies at refine 5. Spread nodes meet every pattern where it is large (residuals ≤ 2e-16 there),
 //! and loads that need more than [`MAX_RANK`] patterns are refused within a few nodes.
 
-use super::factor::Factor;
+use super::cholesky::Factor;
 use crate::error::{Error, Result};
 use crate::fem::loads::Loads;
 use crate::sparse::dot;

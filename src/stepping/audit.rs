@@ -69,7 +69,7 @@ pub struct AuditState {
 impl Problem {
     /// The forms of the audit, made at the first use.
     fn forms(&self) -> &FullForm {
-        self.forms.get_or_init(|| FullForm::new(&self.mesh, &self.space, &self.law, self.scene.rho))
+        self.forms.get_or_init(|| FullForm::new(&self.mesh, &self.space, self.data.as_ref(), &self.law, self.scene.rho))
     }
 
     /// `r` with its audit against `prev` (the state of step r.n − 1, if kept) and, with boundary data,
@@ -82,15 +82,15 @@ impl Problem {
         }
         let (forms, space) = (self.forms(), &self.space);
         let ne = self.mesh.edges.len();
-        let u = space.displacement(&r.u, r.t)?;
-        let p = match &space.data {
+        let u = self.displacement(&r.u, r.t)?;
+        let p = match &self.data {
             Some(d) => d.values(r.t)?,
             None => DataValues::default(),
         };
         let au = forms.apply(&self.mesh, &u);
         let bp = forms.data_vector(&p, ne);
         let stored = 0.5 * dot2(&au, &u) - dot2(&bp, &u) + 0.5 * forms.data_data(&p, &p);
-        if space.data.is_some() {
+        if self.data.is_some() {
             r.energy = 2.0 * stored;
         }
         let mut audit = Audit { stored_energy: stored, ..Audit::default() };
@@ -111,13 +111,13 @@ impl Problem {
             // patterns when superposed, within its span tolerance 1e-13 of the load); with data the
             // loads f, g alone (the solver's right-hand side then holds the lifting's part too)
             let mut l = Vec::new();
-            match space.data {
+            match self.data {
                 None => self.free.load_at(r.n, r.t, &mut l)?,
                 Some(_) => self.free.loads().assemble_loads(r.t, &mut l)?,
             }
             let mut external: f64 = l.iter().zip(r.u.iter().zip(&prev.w)).map(|(l, (a, b))| l * (a - b)).sum();
             let mut reactions = 0.0;
-            if let Some(data) = &space.data {
+            if let Some(data) = &self.data {
                 let lc = self.free.loads().constrained(r.t)?;
                 for ((e, a), lc) in data.constrained(&space.contact).into_iter().zip(lc) {
                     let d = du[e][0] * a[0] + du[e][1] * a[1];

@@ -14,8 +14,8 @@ use crate::error::{Error, Result};
 use crate::fem::space::CrSpace;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
+use crate::solve::cholesky::Factor;
 use crate::solve::condition;
-use crate::solve::factor::Factor;
 use std::sync::{Arc, Mutex, OnceLock};
 use std::thread::JoinHandle;
 

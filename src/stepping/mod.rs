@@ -6,25 +6,18 @@
 //! uⁿ = u_f − K⁻¹Eμ. Without Γ_C a step is the free response alone. Each completed step is handed to a
 //! callback (the writer), so nothing is lost if a later step fails, with its energy audit ([`audit`]).
 //! With boundary data (`fem::lifting`) u above is w, the unknowns; the displacement is w + u_L(tₙ)
-//! (`CrSpace::displacement`), which the errors, the audit and the results file use.
+//! ([`Problem::displacement`]), which the errors, the audit and the results file use.
 
 use crate::error::{Error, Result};
-use crate::fem::assemble::{stiffness_values, EdgePattern};
 use crate::fem::elasticity::Elasticity;
-use crate::fem::loads::Loads;
+use crate::fem::lifting::{self, BoundaryData};
 use crate::fem::norms::{ErrorEvaluator, ErrorNorms};
 use crate::fem::space::CrSpace;
 use crate::friction::{EdgeState, Friction, FrictionSolution};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
-use crate::solve::condense::{condense, Condensation};
-use crate::solve::condition;
-use crate::solve::factor::{fill_order_at, Factor, Symbolic};
-use crate::solve::free::{FreeResponse, BLOCK_BYTES};
-use crate::solve::ordering::{Graph, ND_MIN_SIZE};
-use crate::solve::superpose::LoadBasis;
+use crate::solve::free::FreeResponse;
 use crate::sparse::{dot, symmetric_energy};
-use conditioning::Pending;
 use faer::sparse::SparseColMat;
 use std::sync::Arc;
 use std::time::Instant;
@@ -33,17 +26,21 @@ pub mod audit;
 mod conditioning;
 mod run;
 mod setup;
+mod shared;
 
 pub use audit::{Audit, AuditState};
 pub use conditioning::{Guard, MAX_CONDITION};
 pub use run::RunOptions;
-pub use setup::{Discretised, MeshSetUp};
+pub use setup::Discretised;
+pub use shared::MeshSetUp;
 
 /// Everything assembled once per run.
 pub struct Problem {
     pub scene: Scene,
     pub mesh: Mesh,
     pub space: CrSpace,
+    /// Nonzero boundary data u_D, g_n (`None` without: u = w, the unknowns alone).
+    pub data: Option<BoundaryData>,
     pub law: Elasticity,
     /// K, the matrix of a_h on V_h, its lower triangle (rows ≥ columns; what the factorisation reads, and
     /// half the memory: `sparse::symmetric_matvec`); shared by the problems on one mesh's set-up
@@ -172,13 +169,23 @@ impl Problem {
     fn initial_unchecked(&self) -> Result<StepResult> {
         match &self.step0 {
             Some(r) => Ok(r.clone()),
-            None => initial_state(&self.scene, &self.mesh, &self.space, &self.stiffness, self.errors.as_deref()),
+            None => initial_state(self.discretised(), &self.stiffness, self.errors.as_deref()),
         }
+    }
+
+    /// The displacement u = w + u_L(t) at every edge midpoint from the unknowns `w` at time t
+    /// ([`lifting::displacement`]: the unknowns' midpoint values without boundary data).
+    pub fn displacement(&self, w: &[f64], t: f64) -> Result<Vec<[f64; 2]>> {
+        lifting::displacement(&self.space, self.data.as_ref(), w, t)
+    }
+
+    fn discretised(&self) -> Parts<'_> {
+        Parts { scene: &self.scene, mesh: &self.mesh, space: &self.space, data: self.data.as_ref() }
     }
 
     /// Finiteness check and true errors.
     fn finish(&self, r: StepResult) -> Result<StepResult> {
-        finish(r, &self.scene, &self.mesh, &self.space, self.errors.as_deref())
+        finish(r, self.discretised(), self.errors.as_deref())
     }
 
     /// True if `r` carries u (it is formed only at the steps a run wants; an empty space has none).
@@ -275,12 +282,11 @@ fn contact_result(
 
 /// Step 0: u⁰ = I_CR u₀ (zero without u₀), its energy, finiteness check and true errors.
 fn initial_state(
-    scene: &Scene,
-    mesh: &Mesh,
-    space: &CrSpace,
+    d: Parts<'_>,
     stiffness: &SparseColMat<usize, f64>,
     errors: Option<&ErrorEvaluator>,
 ) -> Result<StepResult> {
+    let (scene, mesh, space) = (d.scene, d.mesh, d.space);
     let t = scene.times[0];
     let u = match &scene.u0 {
         Some(u0) => space.interpolate(mesh, u0, t)?,
@@ -303,22 +309,26 @@ fn initial_state(
         wall: 0.0,
         audit: None,
     };
-    finish(r, scene, mesh, space, errors)
+    finish(r, d, errors)
 }
 
 /// Finiteness check and true errors (when the scene gives `[exact]`).
-fn finish(
-    r: StepResult,
-    scene: &Scene,
-    mesh: &Mesh,
-    space: &CrSpace,
-    errors: Option<&ErrorEvaluator>,
-) -> Result<StepResult> {
+fn finish(r: StepResult, d: Parts<'_>, errors: Option<&ErrorEvaluator>) -> Result<StepResult> {
     let mut r = checked(r)?;
-    if let (Some(ev), Some(ex), true) = (errors, &scene.exact, has_u(space, &r)) {
-        r.errors = Some(ev.errors(mesh, ex, &space.displacement(&r.u, r.t)?, r.t)?);
+    if let (Some(ev), Some(ex), true) = (errors, &d.scene.exact, has_u(d.space, &r)) {
+        let mid = lifting::displacement(d.space, d.data, &r.u, r.t)?;
+        r.errors = Some(ev.errors(d.mesh, ex, &mid, r.t)?);
     }
     Ok(r)
+}
+
+/// The discretised problem's parts that step 0 and a step's finish read.
+#[derive(Clone, Copy)]
+struct Parts<'a> {
+    scene: &'a Scene,
+    mesh: &'a Mesh,
+    space: &'a CrSpace,
+    data: Option<&'a BoundaryData>,
 }
 
 /// True if `r` carries u (it is formed only at the steps a run wants; an empty space has none).

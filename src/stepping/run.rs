@@ -2,7 +2,11 @@
 //! few time nodes at a time, and every result handed out in order once K's condition estimate is
 //! accepted.
 
-use super::*;
+use super::{checked, contact, contact_result, Problem, StepResult};
+use crate::error::{Error, Result};
+use crate::friction::Friction;
+use crate::sparse::dot;
+use std::time::Instant;
 
 /// Steps whose true errors are evaluated together (`Problem::finish_block`): the exact solution's
 /// spatial values bound to a chunk of elements are then read from memory once for this many time nodes.
@@ -68,7 +72,7 @@ impl Problem {
         if let (Some(ev), Some(ex)) = (&self.errors, &self.scene.exact) {
             let with_u: Vec<&StepResult> = done.iter().filter(|r| self.has_u(r)).collect();
             let mids: Vec<Vec<[f64; 2]>> =
-                with_u.iter().map(|r| self.space.displacement(&r.u, r.t)).collect::<Result<_>>()?;
+                with_u.iter().map(|r| self.displacement(&r.u, r.t)).collect::<Result<_>>()?;
             let fields: Vec<(&[[f64; 2]], f64)> = mids.iter().zip(&with_u).map(|(m, r)| (&m[..], r.t)).collect();
             (norms, failed) = ev.errors_at(&self.mesh, ex, &fields);
         }
@@ -159,7 +163,7 @@ impl Problem {
     ) -> Result<()> {
         let RunOptions { after, want, audit } = options;
         // with boundary data the audit also gives a step's energy (2Eⁿ): always run then
-        let audit = audit || self.space.data.is_some();
+        let audit = audit || self.data.is_some();
         match after {
             Some(from) => self.run_handing(from, None, (want, audit), on_step),
             None => {

@@ -2,13 +2,33 @@
 //! work of the caller on a second thread beside it ([`Problem::new_beside`]: `tresca-cr run` creates its
 //! results file there).
 
-use super::*;
+use super::conditioning::{Guard, Pending};
+use super::{initial_state, Parts, Problem, SetupTimes, StepResult};
+use crate::error::{Error, Result};
+use crate::fem::assemble::{stiffness_values, EdgePattern};
+use crate::fem::elasticity::Elasticity;
+use crate::fem::lifting::BoundaryData;
+use crate::fem::loads::Loads;
+use crate::fem::norms::ErrorEvaluator;
+use crate::fem::space::CrSpace;
+use crate::friction::Friction;
+use crate::mesh::Mesh;
+use crate::scene::Scene;
+use crate::solve::cholesky::{fill_order_at, Factor, Symbolic};
+use crate::solve::cholesky::{Graph, ND_MIN_SIZE};
+use crate::solve::condense::{condense, Condensation};
+use crate::solve::condition;
+use crate::solve::free::{FreeResponse, BLOCK_BYTES};
+use crate::solve::superpose::LoadBasis;
 use crate::sparse::{lower_pattern, lower_values};
+use faer::sparse::SparseColMat;
 use faer::sparse::SymbolicSparseColMat;
+use std::sync::Arc;
+use std::time::Instant;
 
 /// From this many unknowns the caller's work beside the set-up starts with phase 3 ([`Discretised::set_up`]):
 /// where phases 1 and 2 take seconds (1,000,000 unknowns, as the switch to nested dissection,
-/// `solve::ordering::ND_MIN_SIZE`).
+/// `solve::cholesky::ND_MIN_SIZE`).
 const DEFER_BESIDE_MIN: usize = 1_000_000;
 
 /// Bytes an unknown that a large run allocates after the factor besides the blocks of steps (the results
@@ -54,12 +74,13 @@ impl Problem {
     ) -> WithBeside<R> {
         let t0 = Instant::now();
         let space = CrSpace::new(&mesh, &scene.parts).map_err(|e| (e, None))?;
+        let data = BoundaryData::of(&mesh, &scene.parts, &space);
         crate::fem::lifting::consistency::check(&scene, &mesh, &space).map_err(|e| (e, None))?;
         let t1 = Instant::now();
         let law = Elasticity::new(&scene.material);
-        let p0 = Discretised { scene, mesh, space, law, guard };
+        let p0 = Discretised { scene, mesh, space, data, law, guard };
         let (rest, r) = p0.set_up(beside);
-        let Discretised { scene, mesh, space, law, .. } = p0;
+        let Discretised { scene, mesh, space, data, law, .. } = p0;
         let rest = match rest {
             Ok(rest) => rest,
             Err(e) => return Err((e, r)),
@@ -78,6 +99,7 @@ impl Problem {
             scene,
             mesh,
             space,
+            data,
             law,
             stiffness: Arc::new(stiffness),
             free,
@@ -89,147 +111,24 @@ impl Problem {
         };
         Ok((p, r))
     }
-
-    /// The problem of `scene` on the set-up `shared` of its mesh (made by [`MeshSetUp::new`] from a scene
-    /// that differs from this one at most in its time grid): only the load superposition, which depends
-    /// on the time nodes, is computed; K, its factor, the condensation and the condition estimate are
-    /// shared (the same values, so the same results as [`Problem::new`], bit for bit).
-    pub fn on_shared(scene: Scene, shared: &MeshSetUp) -> Result<Problem> {
-        let m = shared;
-        if scene.times.first() != m.t0.as_ref() {
-            return Err(Error::Linear("internal: a shared set-up used with another initial time".into()));
-        }
-        let t3 = Instant::now();
-        let mut assembled = Vec::new();
-        let basis = LoadBasis::build(&m.loads, &scene.times, &m.factor, &mut assembled)?;
-        let t4 = Instant::now();
-        let (free, c) = FreeResponse::new(
-            Arc::clone(&m.factor),
-            m.loads.clone(),
-            basis,
-            assembled,
-            m.condensation.clone(),
-            &m.space,
-        );
-        let friction = c.map(|c| Friction::new(&m.space, c, scene.solver));
-        Ok(Problem {
-            setup: SetupTimes { superposition: (t4 - t3).as_secs_f64(), ..SetupTimes::default() },
-            reused: Some(m.times),
-            scene,
-            mesh: m.mesh.clone(),
-            space: m.space.clone(),
-            law: m.law,
-            stiffness: Arc::clone(&m.stiffness),
-            free,
-            friction,
-            errors: m.errors.clone(),
-            conditioning: Arc::clone(&m.conditioning),
-            step0: m.step0.clone(),
-            forms: Default::default(),
-        })
-    }
-}
-
-/// The part of a set-up that depends on the mesh and not on the time grid: K, the loads' quadrature, the
-/// factor of K, the condensation onto Γ_C, the condition estimate and step 0. The levels of a study or a
-/// plan that share a mesh (same refinement, other steps) share one ([`Problem::on_shared`]), so the mesh
-/// is assembled and factorised once (`study::SetupCache`).
-pub struct MeshSetUp {
-    mesh: Mesh,
-    space: CrSpace,
-    law: Elasticity,
-    stiffness: Arc<SparseColMat<usize, f64>>,
-    loads: Loads,
-    factor: Arc<Factor>,
-    condensation: Option<Condensation>,
-    conditioning: Arc<Pending>,
-    errors: Option<Arc<ErrorEvaluator>>,
-    step0: Option<StepResult>,
-    /// The initial time the set-up was made for (step 0 depends on it).
-    t0: Option<f64>,
-    /// Wall times of its phases (no superposition: that is each run's own).
-    times: SetupTimes,
-}
-
-impl MeshSetUp {
-    /// The set-up of `scene`'s mesh (assembly, factorisation, condensation; the phases of
-    /// [`Problem::new`] but the load superposition), with the condition estimate if `guard` asks for it.
-    pub fn new(scene: &Scene, guard: Guard) -> Result<MeshSetUp> {
-        let t0 = Instant::now();
-        let mesh = Mesh::from_spec(&scene.mesh)?;
-        let space = CrSpace::new(&mesh, &scene.parts)?;
-        let t1 = Instant::now();
-        let law = Elasticity::new(&scene.material);
-        let p0 = Discretised { scene: scene.clone(), mesh, space, law, guard };
-        let (stiffness, loads, symbolic) = p0.assemble()?;
-        let t2 = Instant::now();
-        let f = p0.factor(&stiffness, symbolic)?;
-        let t3 = Instant::now();
-        let condensation = p0.condense(&f.factor)?;
-        let t5 = Instant::now();
-        let Discretised { mesh, space, law, .. } = p0;
-        let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
-        Ok(MeshSetUp {
-            mesh,
-            space,
-            law,
-            stiffness: Arc::new(stiffness),
-            loads,
-            factor: f.factor,
-            condensation,
-            conditioning: f.conditioning,
-            errors: f.errors,
-            step0: f.step0,
-            t0: scene.times.first().copied(),
-            times: SetupTimes {
-                space: d(t0, t1),
-                assembly: d(t1, t2),
-                factorisation: d(t2, t3),
-                superposition: 0.0,
-                condensation: d(t3, t5),
-            },
-        })
-    }
-
-    /// Unknowns of the mesh.
-    pub fn unknowns(&self) -> usize {
-        self.space.n_dofs
-    }
-
-    /// Bytes held: the factor's values and K (the mesh and space are a few percent of them).
-    pub fn bytes(&self) -> usize {
-        8 * self.factor.len_val() + 16 * self.stiffness.compute_nnz()
-    }
-
-    /// Wall times of its phases (no superposition: that is each run's own).
-    pub fn times(&self) -> SetupTimes {
-        self.times
-    }
-
-    /// The factor of K.
-    pub fn factor(&self) -> &Factor {
-        &self.factor
-    }
-
-    /// K, its lower triangle (`Problem::stiffness`).
-    pub fn stiffness(&self) -> &SparseColMat<usize, f64> {
-        &self.stiffness
-    }
 }
 
 /// The factor and what is computed beside it.
-struct Factored {
-    factor: Arc<Factor>,
-    conditioning: Arc<Pending>,
-    errors: Option<Arc<ErrorEvaluator>>,
-    step0: Option<StepResult>,
+pub(super) struct Factored {
+    pub(super) factor: Arc<Factor>,
+    pub(super) conditioning: Arc<Pending>,
+    pub(super) errors: Option<Arc<ErrorEvaluator>>,
+    pub(super) step0: Option<StepResult>,
 }
 
-/// A discretised problem, what the set-up starts from: the scene, its mesh and CR space, and the law.
+/// A discretised problem, what the set-up starts from: the scene, its mesh, CR space and boundary data
+/// (the lifting, added outside V_h), and the law.
 pub struct Discretised {
     pub scene: Scene,
     pub mesh: Mesh,
     pub space: CrSpace,
+    /// Nonzero boundary data u_D, g_n (`None` without).
+    pub data: Option<BoundaryData>,
     pub law: Elasticity,
     /// Whether the set-up estimates K's condition number.
     pub guard: Guard,
@@ -292,7 +191,7 @@ impl Discretised {
     }
 
     /// Phase 1: K (its lower triangle), the loads and the symbolic factorisation.
-    fn assemble(&self) -> Result<(SparseColMat<usize, f64>, Loads, Symbolic)> {
+    pub(super) fn assemble(&self) -> Result<(SparseColMat<usize, f64>, Loads, Symbolic)> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         let pattern = EdgePattern::new(mesh);
         // contact unknowns last: the condensation then comes from the factor (solve::condense)
@@ -338,7 +237,7 @@ impl Discretised {
             let k_pattern = lower_pattern(full.as_ref().as_ref());
             let val = lower_values(full.as_ref().as_ref(), val);
             drop(full);
-            let loads = Loads::new(scene, mesh, space)?;
+            let loads = Loads::new(scene, mesh, space, self.data.as_ref())?;
             let symbolic = symbolic
                 .join()
                 .map_err(|_| Error::Linear("the symbolic factorisation failed".into()))
@@ -375,7 +274,7 @@ impl Discretised {
 
     /// Phase 2: the numeric factorisation; beside it λ_max(K), the error quadrature and step 0; after it
     /// the condition estimate's solves are started (neither with [`Guard::Skip`]).
-    fn factor(&self, stiffness: &SparseColMat<usize, f64>, symbolic: Symbolic) -> Result<Factored> {
+    pub(super) fn factor(&self, stiffness: &SparseColMat<usize, f64>, symbolic: Symbolic) -> Result<Factored> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         // the set-up's temporaries are freed: their pages go back before the factor's are mapped
         if space.n_dofs >= RELEASE_MIN {
@@ -383,8 +282,10 @@ impl Discretised {
         }
         let (factor, aside) = Factor::numeric_beside(symbolic, stiffness, || {
             let top = (self.guard == Guard::Estimate).then(|| condition::largest_eigenvalue(stiffness, LAMBDA_ITERS));
-            let errors = scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, law, scene.rho).with_exact(x));
-            let step0 = initial_state(scene, mesh, space, stiffness, errors.as_ref()).ok();
+            let has_data = self.data.is_some();
+            let errors =
+                scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, has_data, law, scene.rho).with_exact(x));
+            let step0 = initial_state(self.parts(), stiffness, errors.as_ref()).ok();
             (top, errors, step0)
         });
         let factor = factor?;
@@ -398,8 +299,12 @@ impl Discretised {
         Ok(Factored { factor, conditioning, errors: errors.map(Arc::new), step0 })
     }
 
+    fn parts(&self) -> Parts<'_> {
+        Parts { scene: &self.scene, mesh: &self.mesh, space: &self.space, data: self.data.as_ref() }
+    }
+
     /// C = EᵀK⁻¹E and W from the factor (`None` without Γ_C).
-    fn condense(&self, factor: &Factor) -> Result<Option<Condensation>> {
+    pub(super) fn condense(&self, factor: &Factor) -> Result<Option<Condensation>> {
         let contact: Vec<usize> = self.space.contact.iter().map(|c| c.dof).collect();
         (!contact.is_empty()).then(|| condense(&contact, factor)).transpose()
     }

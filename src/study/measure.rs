@@ -37,11 +37,11 @@ impl Kept {
     /// The displacement u = w + u_L(t) at every edge midpoint at common node i (the unknowns' midpoint
     /// values without boundary data).
     pub fn displacement(&self, i: usize) -> Result<Vec<[f64; 2]>> {
-        self.problem.space.displacement(&self.u[i], self.t[i])
+        self.problem.displacement(&self.u[i], self.t[i])
     }
 
     fn has_data(&self) -> bool {
-        self.problem.space.data.is_some()
+        self.problem.data.is_some()
     }
 }
 
@@ -99,7 +99,7 @@ pub fn consecutive(fine: &Kept, coarse: &Kept) -> Result<Vec<f64>> {
     let (c, f) = (&coarse.problem, &fine.problem);
     let p = Prolongation::new(&parent_triangles(&c.mesh, &f.mesh)?, &c.mesh, (&f.mesh, &f.space));
     if fine.has_data() {
-        let form = FullForm::new(&f.mesh, &f.space, &f.law, f.scene.rho);
+        let form = FullForm::new(&f.mesh, &f.space, f.data.as_ref(), &f.law, f.scene.rho);
         return (0..fine.u.len())
             .map(|i| {
                 let (mf, pc) = (fine.displacement(i)?, p.apply_full(&coarse.displacement(i)?));
@@ -140,8 +140,11 @@ fn diff(a: &[f64], b: &[f64]) -> Vec<f64> {
 /// data the jump on Γ_D is u_l − u_D: the jump part of the level's true error).
 pub fn jumps(lv: &Kept) -> Result<Vec<f64>> {
     let p = &lv.problem;
-    let ev = ErrorEvaluator::new(&p.mesh, &p.space, &p.law, p.scene.rho);
-    (0..lv.u.len()).map(|i| ev.jump_energy_at(&lv.displacement(i)?, &p.space, &p.scene.parts, lv.t[i])).collect()
+    let has_data = p.data.is_some();
+    let ev = ErrorEvaluator::new(&p.mesh, &p.space, has_data, &p.law, p.scene.rho);
+    (0..lv.u.len())
+        .map(|i| ev.jump_energy_at(&lv.displacement(i)?, &p.space, has_data, &p.scene.parts, lv.t[i]))
+        .collect()
 }
 
 /// |||u_ref − u_l||| at every common node (module doc).

@@ -21,6 +21,7 @@ pub mod richardson;
 
 use crate::error::{Error, Result};
 use crate::fem::norms::ErrorNorms;
+use crate::names::named_enum;
 use crate::scene::Scene;
 use crate::stepping::{RunOptions, StepResult};
 pub use cache::SetupCache;
@@ -29,7 +30,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-crate::named_enum! {
+named_enum! {
     /// The axis a sequence of levels refines: the mesh size h, or the time step k on one mesh.
     pub enum Axis {
         /// The mesh size (the levels' meshes differ).

@@ -10,6 +10,21 @@
 //!   log(ε₂₁/ε₃₂) = p log r₃₂ + log((r₂₁ᵖ − 1)/(r₃₂ᵖ − 1)),   r₂₁ = x₁/x₂, r₃₂ = x₂/x₃,
 //! which for a constant ratio r is p = log(ε₂₁/ε₃₂)/log r, and otherwise is solved by bisection (the
 //! right side increases with p).
+//!
+//! ```
+//! use tresca_cr::study::orders::{fitted_order, observed_order, order_three, successive_orders};
+//!
+//! // e = 3 h² on h = 1/4, 1/8, 1/16: order 2 between levels and fitted
+//! let h = [0.25, 0.125, 0.0625];
+//! let e: Vec<f64> = h.iter().map(|h| 3.0 * h * h).collect();
+//! assert!((observed_order(e[0], e[1], h[0], h[1]) - 2.0).abs() < 1e-12);
+//! assert!(successive_orders(&h, &e).iter().all(|p| (p - 2.0).abs() < 1e-12));
+//! assert!((fitted_order(&h, &e) - 2.0).abs() < 1e-12);
+//! // without errors: Q = 1 + h² gives the differences 3/64 and 3/256, so order 2 again
+//! let q: Vec<f64> = h.iter().map(|h| 1.0 + h * h).collect();
+//! let p = order_three(h, (q[1] - q[0]).abs(), (q[2] - q[1]).abs()).unwrap();
+//! assert!((p - 2.0).abs() < 1e-9);
+//! ```
 
 /// p = log(e_a/e_b) / log(x_a/x_b).
 pub fn observed_order(e_a: f64, e_b: f64, x_a: f64, x_b: f64) -> f64 {

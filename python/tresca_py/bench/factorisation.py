@@ -1,6 +1,6 @@
 """The factorisation bench (issue 32): Example 5.1's reduced stiffness set up by tresca-cr and its peers.
 
-For each refinement the matrix is exported once (examples/export_matrix.rs), then every round runs, each
+For each refinement the matrix is exported once (probes/export_matrix.rs), then every round runs, each
 as a process of its own and in an order rotated from round to round (so a drift of the shared machine's
 speed affects all alike): tresca-cr from the scene (`export_matrix SCENE R --time`: mesh and space,
 assembly with the ordering and symbolic factorisation beside it, numeric factorisation), CHOLMOD

@@ -1,4 +1,4 @@
-"""One sparse Cholesky/LDLᵀ set-up of a matrix exported by examples/export_matrix.rs, in this process.
+"""One sparse Cholesky/LDLᵀ set-up of a matrix exported by probes/export_matrix.rs, in this process.
 
     python -m tresca_py.bench.peers SOLVER DIR      # SOLVER: cholmod, cholmod-metis, pardiso, mumps, dense
 

@@ -1,4 +1,4 @@
-//! The loads on the constrained components (issue 30, the energy audit's reactions): (lⁿ, ψ_k) of f and g
+//! The loads on the constrained components (the energy audit's reactions): (lⁿ, ψ_k) of f and g
 //! alone on the components that boundary data fix (both axes of a Dirichlet edge with data, the normal of
 //! a Γ_C edge with a gap), from the load terms' own quadrature points.
 

@@ -10,6 +10,17 @@
 //! checks every expression of `verification/cases/` at its quadrature points).
 //! Every evaluation is checked for finiteness, so a division by zero or `sqrt(-1)` at a quadrature point
 //! becomes an error naming the expression and the point instead of a NaN in the results.
+//!
+//! ```
+//! use tresca_cr::scene::expr::{Expr, ExprSet};
+//! let e = Expr::parse("f", "-(x^2) + 1.5e-1*sin(pi*t)")?; // -x^2 is refused: exmex reads (-x)^2
+//! assert!((e.eval(2.0, 3.0, 0.5)? - (-4.0 + 0.15)).abs() < 1e-12 && Expr::parse("f", "-x^2").is_err());
+//! let (set, mut out) = (ExprSet::new(&[&e, &Expr::parse("g", "x*y")?]), Vec::new());
+//! set.eval(&[[0.0, 1.0], [2.0, 3.0]], 0.0, &mut out)?;
+//! assert_eq!(out, vec![1.0, 0.0, -3.0, 6.0]); // point-major
+//! assert!(Expr::parse("h", "1/x")?.eval(0.0, 0.0, 0.0).is_err()); // an error, not a NaN
+//! # Ok::<(), tresca_cr::Error>(())
+//! ```
 
 mod eval;
 mod lint;

@@ -12,9 +12,9 @@
 //!   evaluated once per call, as scalars, and broadcast;
 //! * nodes that depend on x, y but not t ("spatial") can be evaluated once for a fixed set of points
 //!   ([`Program::fill_cache`]); the evaluations at each time then read some spatial values from that
-//!   cache and run the other instructions. Which ones is a cost model ([`plan_cache`]): a cached value is
+//!   cache and run the other instructions. Which ones is a cost model (`cache`): a cached value is
 //!   read from main memory at every time (the cache of a fine mesh is far larger than the processor's
-//!   caches), about as dear as [`LOAD_COST`] vectorised products, so a spatial value is cached only if
+//!   caches), about as dear as a few vectorised products, so a spatial value is cached only if
 //!   recomputing it costs more — sin, cos, exp, `powf` and long chains of products and divisions are
 //!   cached, polynomial factors such as `(1-y)^2*(2*y+1)` or `x/5` are recomputed. Either way a value comes from the same
 //!   operations, so the choice changes no bit.
@@ -22,8 +22,11 @@
 //! Evaluation (batches of points, the cache read in place, the finiteness check on the way out) is in
 //! [`super::eval`]; this module only lowers and schedules.
 
+mod cache;
+
 use super::regroup;
 use super::sym::{Bin, Sym, Un};
+use cache::plan_cache;
 use std::collections::HashMap;
 
 /// Points per batch (see [`super::eval`]).
@@ -39,67 +42,6 @@ pub(super) enum Op {
     T,
     Un(Un, u32),
     Bin(Bin, u32, u32),
-}
-
-/// Cost of reading a cached value at a time, in vectorised products (read in order: 4, not 16; mms_stop's
-/// error norms per node −10–40 %, mms_front's loads at r5 +11 %: the right value depends on cache size).
-const LOAD_COST: u32 = 4;
-
-/// Cost of recomputing an operation (same unit as [`LOAD_COST`]).
-fn op_cost(op: &Op) -> u32 {
-    match *op {
-        Op::Const(_) | Op::X | Op::Y | Op::T => 0,
-        Op::Un(Un::Neg | Un::Abs, _) => 1,
-        Op::Un(Un::Sqrt | Un::Floor | Un::Ceil | Un::Trunc | Un::Round | Un::Fract | Un::Signum, _) => 4,
-        Op::Un(..) => 40,
-        Op::Bin(Bin::Add | Bin::Sub | Bin::Mul | Bin::Min | Bin::Max, ..) => 1,
-        Op::Bin(Bin::Div, ..) => 4,
-        Op::Bin(..) => 60,
-    }
-}
-
-/// Which spatial nodes to cache, and which nodes to compute at each time when the cache is used.
-///
-/// Bottom-up, c(n) = cost(n) + Σ over n's spatial inputs i of min(c(i), LOAD_COST) estimates what
-/// computing n at a time costs when its dear inputs are cached. Top-down from what the time part needs
-/// (the inputs of nodes that depend on t, and the outputs), a needed spatial node is cached if
-/// c(n) > LOAD_COST, else computed at each time and its spatial inputs are needed in turn. x and y are
-/// never cached (they are the points).
-fn plan_cache(nodes: &[Op], varying: &[bool], timed: &[bool], outputs: &[u32]) -> (Vec<bool>, Vec<bool>) {
-    let n = nodes.len();
-    let spatial = |i: usize| varying[i] && !timed[i];
-    let reads = |op: &Op| -> ([u32; 2], usize) {
-        match *op {
-            Op::Un(_, a) => ([a, a], 1),
-            Op::Bin(_, a, c) => ([a, c], 2),
-            _ => ([0, 0], 0),
-        }
-    };
-    let mut cost = vec![0u32; n];
-    for (i, op) in nodes.iter().enumerate() {
-        let (r, k) = reads(op);
-        let inputs: u32 =
-            r[..k].iter().filter(|&&a| spatial(a as usize)).map(|&a| cost[a as usize].min(LOAD_COST)).sum();
-        cost[i] = op_cost(op).saturating_add(inputs);
-    }
-    let mut needed = vec![false; n];
-    for &o in outputs {
-        needed[o as usize] = true;
-    }
-    let (mut cache_it, mut at_time) = (vec![false; n], vec![false; n]);
-    for i in (0..n).rev() {
-        if !varying[i] || !(timed[i] || needed[i]) || matches!(nodes[i], Op::X | Op::Y) {
-            continue;
-        }
-        if !timed[i] && cost[i] > LOAD_COST {
-            cache_it[i] = true;
-            continue;
-        }
-        at_time[i] = true;
-        let (r, k) = reads(&nodes[i]);
-        r[..k].iter().for_each(|&a| needed[a as usize] = true);
-    }
-    (cache_it, at_time)
 }
 
 /// Hash key of a node: the operation with the constant's bits.
@@ -256,6 +198,155 @@ impl Builder {
     }
 }
 
+/// Per node: whether it depends on a leaf for which `leaf` holds (x or y: varying; t: timed).
+fn depends_on(nodes: &[Op], leaf: impl Fn(&Op) -> bool) -> Vec<bool> {
+    let mut v = vec![false; nodes.len()];
+    for (i, op) in nodes.iter().enumerate() {
+        v[i] = match *op {
+            Op::Un(_, a) => v[a as usize],
+            Op::Bin(_, a, c) => v[a as usize] || v[c as usize],
+            _ => leaf(op),
+        };
+    }
+    v
+}
+
+/// Per node: its last varying reader (`usize::MAX` for the outputs, read at the end).
+fn last_readers(nodes: &[Op], varying: &[bool], outputs: &[u32]) -> Vec<usize> {
+    let mut last = vec![0usize; nodes.len()];
+    for (i, op) in nodes.iter().enumerate() {
+        if varying[i] {
+            match *op {
+                Op::Un(_, a) => last[a as usize] = i,
+                Op::Bin(_, a, c) => {
+                    last[a as usize] = i;
+                    last[c as usize] = i;
+                }
+                _ => {}
+            }
+        }
+    }
+    for &o in outputs {
+        last[o as usize] = usize::MAX;
+    }
+    last
+}
+
+/// What the scheduler knows of every node.
+struct Plan<'a> {
+    varying: &'a [bool],
+    timed: &'a [bool],
+    cache_it: &'a [bool],
+    at_time: &'a [bool],
+    last: &'a [usize],
+}
+
+/// The instruction lists of a program ([`Program`]'s fields of the same names).
+struct Code {
+    all: Vec<Instr>,
+    spatial: Vec<Instr>,
+    timed: Vec<Instr>,
+    cached: Vec<u32>,
+}
+
+/// The slot of every node, the slots in use and those free for reuse.
+struct Slots {
+    slot: Vec<u32>,
+    n_slots: usize,
+    free: Vec<u32>,
+}
+
+impl Slots {
+    fn new(n: usize) -> Slots {
+        let mut slot = vec![u32::MAX; n];
+        slot[0] = SLOT_X;
+        slot[1] = SLOT_Y;
+        Slots { slot, n_slots: 2, free: Vec::new() }
+    }
+
+    /// A slot never used before.
+    fn fresh(&mut self) -> u32 {
+        self.n_slots += 1;
+        (self.n_slots - 1) as u32
+    }
+
+    /// A free slot, else a fresh one.
+    fn take(&mut self) -> u32 {
+        match self.free.pop() {
+            Some(s) => s,
+            None => self.fresh(),
+        }
+    }
+
+    /// Uniform nodes read by varying ones (or outputs) get a broadcast slot for the whole call:
+    /// (slot, node) of each.
+    fn broadcast(&mut self, nodes: &[Op], varying: &[bool]) -> Vec<(u32, u32)> {
+        let mut broadcast = Vec::new();
+        for (i, op) in nodes.iter().enumerate() {
+            let reads: &[u32] = match op {
+                Op::Un(_, a) if varying[i] => &[*a][..],
+                Op::Bin(_, a, c) if varying[i] => &[*a, *c][..],
+                _ => &[],
+            };
+            for &r in reads {
+                if !varying[r as usize] && self.slot[r as usize] == u32::MAX {
+                    self.slot[r as usize] = self.take();
+                    broadcast.push((self.slot[r as usize], r));
+                }
+            }
+        }
+        broadcast
+    }
+
+    /// The varying instructions in order, a slot freed after its node's last reader.
+    fn schedule(&mut self, nodes: &[Op], p: &Plan) -> Code {
+        let mut code = Code { all: Vec::new(), spatial: Vec::new(), timed: Vec::new(), cached: Vec::new() };
+        for (i, op) in nodes.iter().enumerate() {
+            if !p.varying[i] || matches!(op, Op::X | Op::Y) {
+                continue;
+            }
+            // a cached node keeps a slot of its own: the cache is loaded before any instruction runs
+            let dst = if p.cache_it[i] { self.fresh() } else { self.take() };
+            if p.cache_it[i] {
+                code.cached.push(dst);
+            }
+            self.slot[i] = dst;
+            let ins = match *op {
+                Op::Un(f, a) => {
+                    let ins = Instr::Un(f, dst, self.slot[a as usize]);
+                    self.release(p, i, a);
+                    ins
+                }
+                Op::Bin(f, a, c) => {
+                    let ins = Instr::Bin(f, dst, self.slot[a as usize], self.slot[c as usize]);
+                    self.release(p, i, a);
+                    if c != a {
+                        self.release(p, i, c);
+                    }
+                    ins
+                }
+                _ => continue,
+            };
+            code.all.push(ins);
+            if !p.timed[i] {
+                code.spatial.push(ins);
+            }
+            if p.at_time[i] {
+                code.timed.push(ins);
+            }
+        }
+        code
+    }
+
+    /// Free the slot of node r if node i is its last reader (never x's, y's or a cached node's).
+    fn release(&mut self, p: &Plan, i: usize, r: u32) {
+        let r = r as usize;
+        if p.varying[r] && !p.cache_it[r] && p.last[r] == i && r > 1 {
+            self.free.push(self.slot[r]);
+        }
+    }
+}
+
 impl Program {
     /// Compile the trees `outputs` into one program.
     pub fn new(outputs: &[&Sym]) -> Program {
@@ -265,117 +356,18 @@ impl Program {
         b.intern(Op::Y);
         let out_nodes: Vec<u32> = outputs.iter().map(|s| b.lower(s)).collect();
         let nodes = b.nodes;
-        let varying: Vec<bool> = {
-            let mut v = vec![false; nodes.len()];
-            for (i, op) in nodes.iter().enumerate() {
-                v[i] = match *op {
-                    Op::X | Op::Y => true,
-                    Op::Const(_) | Op::T => false,
-                    Op::Un(_, a) => v[a as usize],
-                    Op::Bin(_, a, c) => v[a as usize] || v[c as usize],
-                };
-            }
-            v
-        };
-        let timed: Vec<bool> = {
-            let mut v = vec![false; nodes.len()];
-            for (i, op) in nodes.iter().enumerate() {
-                v[i] = match *op {
-                    Op::T => true,
-                    Op::Const(_) | Op::X | Op::Y => false,
-                    Op::Un(_, a) => v[a as usize],
-                    Op::Bin(_, a, c) => v[a as usize] || v[c as usize],
-                };
-            }
-            v
-        };
+        let varying = depends_on(&nodes, |op| matches!(op, Op::X | Op::Y));
+        let timed = depends_on(&nodes, |op| matches!(op, Op::T));
         let (cache_it, at_time) = plan_cache(&nodes, &varying, &timed, &out_nodes);
-        // last varying reader of each node (outputs are read at the end)
-        let mut last = vec![0usize; nodes.len()];
-        for (i, op) in nodes.iter().enumerate() {
-            if varying[i] {
-                match *op {
-                    Op::Un(_, a) => last[a as usize] = i,
-                    Op::Bin(_, a, c) => {
-                        last[a as usize] = i;
-                        last[c as usize] = i;
-                    }
-                    _ => {}
-                }
-            }
-        }
-        for &o in &out_nodes {
-            last[o as usize] = usize::MAX;
-        }
-        let mut slot = vec![u32::MAX; nodes.len()];
-        slot[0] = SLOT_X;
-        slot[1] = SLOT_Y;
-        let mut n_slots = 2usize;
-        let mut free: Vec<u32> = Vec::new();
-        let mut broadcast = Vec::new();
-        let mut take = |free: &mut Vec<u32>| {
-            free.pop().unwrap_or_else(|| {
-                n_slots += 1;
-                (n_slots - 1) as u32
-            })
-        };
-        // uniform nodes read by varying ones (or outputs) get a broadcast slot for the whole call
-        for (i, op) in nodes.iter().enumerate() {
-            let reads: &[u32] = match op {
-                Op::Un(_, a) if varying[i] => &[*a][..],
-                Op::Bin(_, a, c) if varying[i] => &[*a, *c][..],
-                _ => &[],
-            };
-            for &r in reads {
-                if !varying[r as usize] && slot[r as usize] == u32::MAX {
-                    slot[r as usize] = take(&mut free);
-                    broadcast.push((slot[r as usize], r));
-                }
-            }
-        }
-        let (mut all, mut spatial, mut timed_instrs) = (Vec::new(), Vec::new(), Vec::new());
-        let mut cached = Vec::new();
-        for (i, op) in nodes.iter().enumerate() {
-            if !varying[i] || matches!(op, Op::X | Op::Y) {
-                continue;
-            }
-            // a cached node keeps a slot of its own: the cache is loaded before any instruction runs
-            let dst = if cache_it[i] { take(&mut Vec::new()) } else { take(&mut free) };
-            if cache_it[i] {
-                cached.push(dst);
-            }
-            slot[i] = dst;
-            let release = |r: u32, free: &mut Vec<u32>| {
-                if varying[r as usize] && !cache_it[r as usize] && last[r as usize] == i && r > 1 {
-                    free.push(slot[r as usize]);
-                }
-            };
-            let ins = match *op {
-                Op::Un(f, a) => {
-                    let ins = Instr::Un(f, dst, slot[a as usize]);
-                    release(a, &mut free);
-                    ins
-                }
-                Op::Bin(f, a, c) => {
-                    let ins = Instr::Bin(f, dst, slot[a as usize], slot[c as usize]);
-                    release(a, &mut free);
-                    if c != a {
-                        release(c, &mut free);
-                    }
-                    ins
-                }
-                _ => continue,
-            };
-            all.push(ins);
-            if !timed[i] {
-                spatial.push(ins);
-            }
-            if at_time[i] {
-                timed_instrs.push(ins);
-            }
-        }
+        let last = last_readers(&nodes, &varying, &out_nodes);
+        let mut slots = Slots::new(nodes.len());
+        let broadcast = slots.broadcast(&nodes, &varying);
+        let plan = Plan { varying: &varying, timed: &timed, cache_it: &cache_it, at_time: &at_time, last: &last };
+        let code = slots.schedule(&nodes, &plan);
+        let Slots { slot, n_slots, .. } = slots;
         let outputs = out_nodes.iter().map(|&o| (o, Some(slot[o as usize]).filter(|_| varying[o as usize]))).collect();
-        Program { nodes, varying, all, spatial, timed: timed_instrs, cached, broadcast, n_slots, outputs }
+        let Code { all, spatial, timed, cached } = code;
+        Program { nodes, varying, all, spatial, timed, cached, broadcast, n_slots, outputs }
     }
 
     /// Number of outputs.

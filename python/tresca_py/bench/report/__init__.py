@@ -27,7 +27,7 @@ Sections:
     (196,608 unknowns, 80 steps), mms_front refine 2 (256 steps), Example 5.1 n = 64 (refine 5, 1280 steps),
     all with true errors at every node where the scene has [exact]; process wall and CPU time (user + sys of
     the child), the set-up split; the expression throughput of the longest expression of verification/cases/
-    (examples/expr_throughput.rs, one thread: exmex's interpreter against the compiled program); mms_stop
+    (probes/expr_throughput.rs, one thread: exmex's interpreter against the compiled program); mms_stop
     refine 4 side by side with scripts/skfem_solve.py and scripts/dolfinx_solve.py (the three run in
     interleaved rounds, so a drift of the machine's speed affects them alike); a perf profile of
     mms_stop refine 5.

@@ -104,7 +104,7 @@ def mms_runs(b):
 
 
 def expr_throughput(b):
-    """The expression throughput paragraph (examples/expr_throughput.rs, one thread)."""
+    """The expression throughput paragraph (probes/expr_throughput.rs, one thread)."""
     p = subprocess.run(["cargo", "run", "--release", "--quiet", "--example", "expr_throughput"], capture_output=True,
                        text=True, cwd=ROOT, env=dict(os.environ, RAYON_NUM_THREADS="1"))
     if p.returncode == 0:

@@ -1,5 +1,5 @@
 //! Points per second, on one core, of the longest expression of `verification/cases/`: exmex's
-//! interpreter (what runs used before issue 13) against the compiled program (batches of points), and the
+//! interpreter (the parsed expression evaluated point by point) against the compiled program (batches of points), and the
 //! compiled program bound to the points (spatial part cached, as runs evaluate loads and exact solutions).
 //! Run by `verification/bench/report.py` as `RAYON_NUM_THREADS=1 cargo run --release --example expr_throughput`;
 //! prints one JSON line. Median of 5 timings each.

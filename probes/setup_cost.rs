@@ -14,12 +14,13 @@
 //! project's VMs; from the second pass on the allocator reuses memory, so these are compute costs.
 use tresca_cr::fem::assemble::{stiffness_values, EdgePattern};
 use tresca_cr::fem::elasticity::Elasticity;
+use tresca_cr::fem::lifting::BoundaryData;
 use tresca_cr::fem::loads::Loads;
 use tresca_cr::fem::norms::ErrorEvaluator;
 use tresca_cr::fem::space::CrSpace;
 use tresca_cr::mesh::Mesh;
-use tresca_cr::solve::factor::{fill_order_at, Factor, Symbolic};
-use tresca_cr::solve::ordering::Graph;
+use tresca_cr::solve::cholesky::Graph;
+use tresca_cr::solve::cholesky::{fill_order_at, Factor, Symbolic};
 use tresca_cr::Scene;
 
 fn main() {
@@ -29,7 +30,7 @@ fn main() {
     let passes: usize = a.get(2).map_or(7, |p| p.parse().unwrap());
     let n_est = tresca_cr::scene::budget::Estimate::of(&scene, 1, false).unwrap().unknowns as usize;
     let nested = match a.get(3).map_or("auto", |s| s.as_str()) {
-        "auto" => n_est >= tresca_cr::solve::ordering::ND_MIN_SIZE,
+        "auto" => n_est >= tresca_cr::solve::cholesky::ND_MIN_SIZE,
         "nd" | "metis" => true,
         "amd" => false,
         o => panic!("ordering `{o}`: auto, amd, nd (by coordinates) or metis"),
@@ -48,6 +49,7 @@ fn main() {
         tm("mesh", t.elapsed());
         let t = Clock::now();
         let space = CrSpace::new(&mesh, &scene.parts).unwrap();
+        let data = BoundaryData::of(&mesh, &scene.parts, &space);
         tm("space", t.elapsed());
         let law = Elasticity::new(&scene.material);
         let t = Clock::now();
@@ -79,7 +81,7 @@ fn main() {
         tm("stiffness", t.elapsed());
         let k = faer::sparse::SparseColMat::new(lower, val);
         let t = Clock::now();
-        let loads = Loads::new(&scene, &mesh, &space).unwrap();
+        let loads = Loads::new(&scene, &mesh, &space, data.as_ref()).unwrap();
         tm("loads", t.elapsed());
         let t = Clock::now();
         let factor = Factor::numeric(sym, &k).unwrap();
@@ -91,7 +93,10 @@ fn main() {
         let inv = tresca_cr::solve::condition::largest_inverse_eigenvalue(&factor, k.nrows(), 12);
         tm("inverse", t.elapsed());
         let t = Clock::now();
-        let ev = scene.exact.as_ref().map(|x| ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(x));
+        let ev = scene
+            .exact
+            .as_ref()
+            .map(|x| ErrorEvaluator::new(&mesh, &space, data.is_some(), &law, scene.rho).with_exact(x));
         tm("error evaluator", t.elapsed());
         std::hint::black_box((loads, top, inv, ev));
     }

@@ -17,7 +17,7 @@
 
 use super::ordering::{Graph, ND_MIN_SIZE};
 use super::pages::Pages;
-pub use super::symbolic::{fill_order, fill_order_at, Symbolic};
+use super::symbolic::{fill_order, Symbolic};
 use super::symbolic::{lower_nnz, numeric_scratch};
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};

@@ -7,7 +7,7 @@
 //! Why: on a 2D mesh the straight cut is a separator of O(√n) vertices, as nested dissection needs for
 //! its O(n log n) fill, and it costs O(n log n) comparisons in all. METIS_NodeND finds separators of
 //! the same kind by multilevel graph partitioning, at a much higher price on these graphs: 1.6 s of
-//! CPU at 393,216 unknowns (Example 5.1 refine 7) against about 0.1 s here (`examples/setup_cost.rs`).
+//! CPU at 393,216 unknowns (Example 5.1 refine 7) against about 0.1 s here (`probes/setup_cost.rs`).
 //! Any permutation is a valid ordering: the geometry only decides the fill, hence the speed.
 //!
 //! Deterministic: every choice is made by a total order (coordinate, then vertex number), so the

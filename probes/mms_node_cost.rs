@@ -11,6 +11,7 @@
 
 use std::time::Instant;
 use tresca_cr::fem::elasticity::Elasticity;
+use tresca_cr::fem::lifting::BoundaryData;
 use tresca_cr::fem::loads::Loads;
 use tresca_cr::fem::norms::ErrorEvaluator;
 use tresca_cr::fem::space::CrSpace;
@@ -40,12 +41,13 @@ fn main() {
         scene.set_steps(steps).unwrap();
         let mesh = Mesh::from_spec(&scene.mesh).unwrap();
         let space = CrSpace::new(&mesh, &scene.parts).unwrap();
+        let data = BoundaryData::of(&mesh, &scene.parts, &space);
         let law = Elasticity::new(&scene.material);
         let t0 = Instant::now();
-        let loads = Loads::new(&scene, &mesh, &space).unwrap();
-        let direct = Loads::with_separation(&scene, &mesh, &space, false).unwrap();
+        let loads = Loads::new(&scene, &mesh, &space, data.as_ref()).unwrap();
+        let direct = Loads::with_separation(&scene, &mesh, &space, data.as_ref(), false).unwrap();
         let exact = scene.exact.clone().unwrap();
-        let ev = ErrorEvaluator::new(&mesh, &space, &law, scene.rho).with_exact(&exact);
+        let ev = ErrorEvaluator::new(&mesh, &space, data.is_some(), &law, scene.rho).with_exact(&exact);
         let setup = t0.elapsed().as_secs_f64();
         let mid = vec![[0.0; 2]; mesh.edges.len()];
         let median = |mut v: Vec<f64>| {
