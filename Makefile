@@ -70,19 +70,24 @@ venv: $(VENV)/.stamp
 # --extend-ignore once they are wrapped (`ruff check --config python/pyproject.toml python scripts verification`).
 lint: venv
 	cargo fmt --check
-	cargo clippy --all-targets --locked -- -D warnings
+	cargo clippy --release --all-targets --locked -- -D warnings
 	$(VENV)/bin/ruff check --config python/pyproject.toml python scripts verification --extend-ignore E501
 	$(PY) verification/check_doc_paths.py
 
+# `make test` leaves the study-sized tests (Rust `#[ignore = "study-sized …"]`, pytest marker `study`) to
+# `make verify` (requirement T1). clippy runs in the release profile (`--release`) so that it reuses the
+# release build's build-script outputs (HDF5's CMake build) instead of building them again for `dev`.
 test: build venv getfem
 	$(MAKE) --no-print-directory lint
 	cargo test --release --locked
-	$(PY) -m pytest python/tests -q
+	$(PY) -m pytest python/tests -q -m "not study"
 
 # make verify writes under out/verify/ only (a clean clone stays clean); make reference publishes what it
 # staged in out/verify/reference/ into the tracked reference/ and regenerates verification/README.md's table.
+# The studies run on a pool of 2 worker processes (VERIFY_JOBS=N to change; run_all.py --jobs N).
+VERIFY_JOBS ?= 2
 verify: build venv paraview getfem
-	$(PY) verification/run_all.py
+	$(PY) verification/run_all.py --jobs $(VERIFY_JOBS)
 
 reference: venv
 	$(PY) -m tresca_py.verify.harness publish
