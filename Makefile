@@ -64,22 +64,29 @@ $(VENV)/.stamp: requirements.txt python/pyproject.toml
 venv: $(VENV)/.stamp
 
 # The lint half of `make test` (CI): formatting, clippy with warnings as errors, ruff on the Python
-# (config python/pyproject.toml [tool.ruff]) and every path the documentation names exists.
+# (config python/pyproject.toml [tool.ruff]), every path and Rust name the documentation and comments name
+# exists, and the crate's import graph has no circle and no upward import (scripts/import_graph.py).
 lint: venv
 	cargo fmt --check
-	cargo clippy --all-targets --locked -- -D warnings
+	cargo clippy --release --all-targets --locked -- -D warnings
 	$(VENV)/bin/ruff check --config python/pyproject.toml python scripts verification
 	$(PY) verification/check_doc_paths.py
+	$(PY) scripts/import_graph.py --check
 
+# `make test` leaves the study-sized tests (Rust `#[ignore = "study-sized …"]`, pytest marker `study`) to
+# `make verify` (requirement T1). clippy runs in the release profile (`--release`) so that it reuses the
+# release build's build-script outputs (HDF5's CMake build) instead of building them again for `dev`.
 test: build venv getfem
 	$(MAKE) --no-print-directory lint
 	cargo test --release --locked
-	$(PY) -m pytest python/tests -q
+	$(PY) -m pytest python/tests -q -m "not study"
 
 # make verify writes under out/verify/ only (a clean clone stays clean); make reference publishes what it
 # staged in out/verify/reference/ into the tracked reference/ and regenerates verification/README.md's table.
+# The studies run on a pool of 2 worker processes (VERIFY_JOBS=N to change; run_all.py --jobs N).
+VERIFY_JOBS ?= 2
 verify: build venv paraview getfem
-	$(PY) verification/run_all.py
+	$(PY) verification/run_all.py --jobs $(VERIFY_JOBS)
 
 reference: venv
 	$(PY) -m tresca_py.verify.harness publish

@@ -23,6 +23,7 @@ fn expressions(v: &toml::Value, key: &str, out: &mut Vec<(String, String)>) {
 }
 
 #[test]
+#[ignore = "study-sized (every case, every time node; ~50 s CPU): make verify runs it, requirement T1"]
 fn compiled_agrees_with_interpreter_on_all_cases() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/cases");
     let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();

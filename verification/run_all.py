@@ -1,6 +1,6 @@
 """make verify: every requirement of verification/README.md checked pass/fail (tresca_py.verify.run_all).
 
-    .venv/bin/python verification/run_all.py [--quick] [--only NAME ...]
+    .venv/bin/python verification/run_all.py [--quick] [--only NAME ...] [--jobs N]
 """
 import sys
 

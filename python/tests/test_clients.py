@@ -29,6 +29,7 @@ def test_the_system_shall_write_results_that_vtk_meshio_and_h5py_read(rust_bin, 
     check([PY, "scripts/check_results.py", h5])
 
 
+@pytest.mark.study
 def test_the_system_shall_leave_readable_files_after_killed_stopped_and_resumed_runs(rust_bin):
     check([PY, "verification/interrupted_runs.py"])
 
@@ -38,6 +39,7 @@ def test_the_system_shall_write_files_paraview_opens(rust_bin):
 
 
 @pytest.mark.mpi
+@pytest.mark.study
 def test_the_system_shall_agree_across_rust_skfem_and_dolfinx_on_every_case(rust_bin):
     os.makedirs(os.path.join(ROOT, "out"), exist_ok=True)
     check([PY, "verification/cross_check.py", "--quick", "--json", "out/cross_check_quick.json"])

@@ -69,6 +69,10 @@ class Harness:
         """A study or script that could not run: a failed result ``<name>-run``."""
         self._record(Result(f"{name}-run", f"`{name}` shall run", False, str(why)[:300], command, "—"))
 
+    def adopt(self, results):
+        """Append results recorded (and echoed) by another harness, e.g. a worker's (:mod:`.pool`)."""
+        self.results.extend(results)
+
     def _record(self, r):
         self.results.append(r)
         if self.echo:

@@ -275,6 +275,12 @@ REQUIREMENTS = (
         pattern='S\\d+-.+',
     ),
     Requirement(
+        'T1-study-tests',
+        'pass the study-sized tests that `make test` leaves to `make verify`: the Rust tests marked `#[ignore = "study-sized …"]` (`cargo test --release --locked --test NAME -- --ignored`) and the Python tests marked `study` (`pytest -m study`)',
+        'verification/run_all.py --only tests',
+        None,
+    ),
+    Requirement(
         'F1-fuzz',
         'not panic on 20 000 fuzzed inputs each for the scene parser (+ set-up and run), expressions and the Gmsh '
         'reader',

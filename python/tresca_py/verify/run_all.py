@@ -7,7 +7,10 @@ under out/verify/ (tables and plots for reference/ staged in out/verify/referenc
 publishes them; a --quick run writes under out/verify/quick/, never published); the summary is
 out/verify/summary.md. Exit status 1 if any requirement fails.
 
-    .venv/bin/python verification/run_all.py [--quick] [--only NAME ...]
+    .venv/bin/python verification/run_all.py [--quick] [--only NAME ...] [--jobs N]
+
+The studies run side by side on a pool of worker processes (:mod:`tresca_py.verify.pool`, 2 by default); the
+requirement table, summary.md and the staged reference files are the same whatever the finishing order.
 """
 import argparse
 import os
@@ -15,14 +18,35 @@ import subprocess
 import time
 
 from tresca_py.common import BIN, PY
-from tresca_py.verify import adaptive, audits, checks, estimates, paper, studies
+from tresca_py.verify import adaptive, audits, checks, estimates, paper, pool, studies, study_tests
 from tresca_py.verify.harness import Harness, out_dir
+from tresca_py.verify.pool import Study
+
+
+#: the results files (patterns relative to out/verify/) each study writes: its EB1 audit's files
+WRITES = {
+    "be_exact": ("stick_to_slip_*.h5",),
+    "estimates": ("differences/*",),
+    "adaptive": ("adaptive/*",),
+    "clients": ("verify_ex51.h5", "interrupted_runs/*"),
+    "paraview": ("paraview_check/*",),
+    "cross": ("cross_check/*",),
+    "distributed": ("distributed/*",),
+    "external": ("external/*",),
+    "audit": ("audit/*",),
+}
+#: studies that run with no other study beside them: `distributed` measures peak memory (D2) and runs
+#: mpirun -n 3 on every core; `tests` (T1) runs verification/interrupted_runs.py into out/interrupted/, as
+#: `clients` does, and mpirun -n 2
+ALONE = {"distributed", "tests"}
 
 
 def study_table(quick):
-    """The studies by name, each a function of the harness (run in this order)."""
+    """The studies by name, each a function of the harness, in the table's order (:class:`pool.Study`:
+    ``writes``, the results files it writes under out/verify/, for its EB1 audit; ``alone``, run with no
+    other study beside it)."""
     n = 4 if quick else 5
-    return {
+    fns = {
         "elastic": lambda hs: (
             studies.h_study(hs, "E1-rect", "verification/cases/elastic_rect.toml", "h_elastic_rect",
                             [(k, 1) for k in range(2, 7)], 1, 2,
@@ -63,7 +87,9 @@ def study_table(quick):
         "fuzz": lambda hs: checks.fuzz(hs, quick),
         "external": lambda hs: checks.external(hs, quick),
         "audit": lambda hs: audits.run_cases(hs, quick),
+        "tests": study_tests.run,
     }
+    return [Study(name, fn, alone=name in ALONE, writes=WRITES.get(name, ())) for name, fn in fns.items()]
 
 
 def versions():
@@ -77,25 +103,19 @@ def versions():
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="smaller levels (for make test)")
+    ap.add_argument("--quick", action="store_true", help="smaller levels")
     ap.add_argument("--only", nargs="*", help="run only these studies")
+    ap.add_argument("--jobs", type=int, default=pool.DEFAULT_JOBS,
+                    help=f"studies run side by side (default {pool.DEFAULT_JOBS}; 1: one after the other)")
     args = ap.parse_args(argv)
     table = study_table(args.quick)
-    unknown = sorted(set(args.only or []) - set(table))
+    unknown = sorted(set(args.only or []) - {s.name for s in table})
     if unknown:
-        ap.error(f"unknown studies {', '.join(unknown)}; known: {', '.join(table)}")
+        ap.error(f"unknown studies {', '.join(unknown)}; known: {', '.join(s.name for s in table)}")
     # a --quick run's tables are not the reference's: they go to out/verify/quick/, which `make reference` ignores
     hs = Harness(out=os.path.join(out_dir(), "quick") if args.quick else None)
     t0 = time.time()
-    for name, fn in table.items():
-        if args.only and name not in args.only:
-            continue
-        before = audits.snapshot(hs.out)  # A1 audits the results files the study writes
-        try:
-            fn(hs)
-        except Exception as e:  # a study that cannot run is a failed requirement, not a crash
-            hs.not_run(name, str(e).splitlines()[0][:300] if str(e) else repr(e))
-        audits.audit_study(hs, name, before)
+    pool.run(hs, [s for s in table if not args.only or s.name in args.only], jobs=args.jobs)
     header = (f"Machine: {os.uname().nodename}, {os.cpu_count()} cores; total {time.time() - t0:.0f} s. "
               f"Versions: {versions()}.")
     return hs.report(header, partial=bool(args.only))
