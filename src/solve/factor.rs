@@ -84,6 +84,12 @@ impl Factor {
         Factor::numeric_beside(symbolic, k, || ()).0
     }
 
+    /// As [`Factor::numeric`], with faer's parallelism `par` instead of the thread count in force
+    /// ([`crate::threads::par`]).
+    pub fn numeric_with(symbolic: Symbolic, k: &SparseColMat<usize, f64>, par: Par) -> Result<Factor> {
+        Factor::numeric_par(symbolic, k, par, || ()).0
+    }
+
     /// As [`Factor::numeric`], running `beside` on the second thread that maps the factor's pages
     /// (solve::pages) once they are mapped: the caller's work that needs neither the factor nor the
     /// whole of a core. Its result is returned whether the factorisation succeeds or not (`None` if
@@ -91,6 +97,15 @@ impl Factor {
     pub fn numeric_beside<R: Send>(
         symbolic: Symbolic,
         k: &SparseColMat<usize, f64>,
+        beside: impl FnOnce() -> R + Send,
+    ) -> (Result<Factor>, Option<R>) {
+        Factor::numeric_par(symbolic, k, crate::threads::par(), beside)
+    }
+
+    fn numeric_par<R: Send>(
+        symbolic: Symbolic,
+        k: &SparseColMat<usize, f64>,
+        par: Par,
         beside: impl FnOnce() -> R + Send,
     ) -> (Result<Factor>, Option<R>) {
         let Symbolic { symbolic, fwd, inv, last, pattern_nnz, ordering } = symbolic;
@@ -105,7 +120,7 @@ impl Factor {
         if let Err(e) = Symbolic::fits_with(&symbolic, pattern_nnz, 0) {
             return (Err(e), None);
         }
-        let scratch = numeric_scratch(&symbolic, pattern_nnz);
+        let scratch = numeric_scratch(&symbolic, pattern_nnz, par);
         let Some(mut values) = Pages::zeroed(symbolic.len_val()) else { return (Err(oom()), None) };
         let Ok(mut buf) = MemBuffer::try_new(scratch) else {
             return (Err(oom()), None);
@@ -117,7 +132,8 @@ impl Factor {
                 Pages::populate(range);
                 beside()
             });
-            let numeric = numeric_llt(&symbolic, &mut values, (k, pattern_nnz), (&fwd, &inv), MemStack::new(&mut buf));
+            let stack = MemStack::new(&mut buf);
+            let numeric = numeric_llt(&symbolic, &mut values, (k, pattern_nnz), (&fwd, &inv), par, stack);
             (numeric, r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
         });
         let factor = Factor::finish(symbolic, values, numeric, n, last, fwd).map(|f| Factor { ordering, ..f });
@@ -309,12 +325,13 @@ impl Factor {
 
 /// L's values for K = P L Lᵀ Pᵀ (K's lower triangle: `nnz` entries): that triangle permuted to P K Pᵀ's (as faer's
 /// `SymbolicCholesky::factorize_numeric_llt` does it, so the factor is the same bit for bit), then
-/// faer's supernodal kernel, sequential.
+/// faer's supernodal kernel, its dense blocks with the parallelism `par`.
 fn numeric_llt(
     symbolic: &SymbolicSupernodalCholesky<usize>,
     values: &mut [f64],
     (k, nnz): (&SparseColMat<usize, f64>, usize),
     (fwd, inv): (&[usize], &[usize]),
+    par: Par,
     stack: &mut MemStack,
 ) -> std::result::Result<(), faer::linalg::solvers::LltError> {
     let n = k.nrows();
@@ -332,7 +349,7 @@ fn numeric_llt(
         Side::Lower,
         stack,
     );
-    factorize_supernodal_numeric_llt(values, a.rb(), Default::default(), symbolic, Par::Seq, stack, Default::default())
+    factorize_supernodal_numeric_llt(values, a.rb(), Default::default(), symbolic, par, stack, Default::default())
         .map(|_| ())
 }
 

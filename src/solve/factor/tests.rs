@@ -211,3 +211,25 @@ fn the_factor_is_faers_own_bit_for_bit() {
         assert_eq!(bits(&values), bits(&f.values), "L's values (nested {nested})");
     }
 }
+
+/// L's values, bit for bit.
+fn value_bits(f: &Factor) -> Vec<u64> {
+    f.values.iter().map(|v| v.to_bits()).collect()
+}
+
+/// The system shall factorise bit-identically run after run with 2 threads, and (faer's dense kernels
+/// splitting their work by output blocks, each computed as the sequential kernel computes it) as with
+/// 1: the rule of docs/model.md, "Threads". The grid is large enough for the top separators' dense
+/// blocks to be split between threads.
+#[test]
+fn two_threads_factorise_bit_identically_run_after_run() {
+    let k = grid(160);
+    let n = k.nrows();
+    let base = fill_order(&Graph::of_matrix(&k, &pairs(n)), true).unwrap();
+    let factor = |par| Factor::numeric_with(Symbolic::new(k.symbolic(), &[0, 2], base.clone()).unwrap(), &k, par);
+    let first = factor(Par::rayon(2)).unwrap();
+    let second = factor(Par::rayon(2)).unwrap();
+    assert_eq!(value_bits(&first), value_bits(&second), "2 threads, run after run");
+    let seq = factor(Par::Seq).unwrap();
+    assert_eq!(value_bits(&first), value_bits(&seq), "2 threads against 1");
+}
