@@ -1,7 +1,8 @@
 //! Factorise once, solve many times: the sparse Cholesky factor K = P L Lᵀ Pᵀ of the stiffness (faer,
 //! supernodal), kept for the whole run. Every step and every friction iteration only performs the pair of
-//! triangular solves L Lᵀ x = b, with a scratch buffer allocated once. Sequential: the per-step solves
-//! of a 2D problem are too small to profit from threads, and sequential kernels keep runs bit-identical.
+//! triangular solves L Lᵀ x = b, with a scratch buffer allocated once. The numeric factorisation and the
+//! solves with several right-hand sides use the thread count in force (`crate::threads`) in faer's dense
+//! kernels; single-vector solves are sequential (see `solve_par`). Neither changes a bit with the count.
 //!
 //! Fill-reducing ordering P: see [`super::ordering`]; the symbolic half: [`super::symbolic`].
 //!
@@ -281,16 +282,17 @@ impl Factor {
             return Err(Error::Linear(format!("internal: a block of {} values for {cols} columns", y.len())));
         }
         let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
+        let par = solve_par(cols);
         if scratch.0 < cols {
-            scratch.1 = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq))
+            scratch.1 = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(cols, par))
                 .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
             scratch.0 = cols;
         }
         let (y, stack) = (MatMut::from_column_major_slice_mut(y, self.n, cols), MemStack::new(&mut scratch.1));
         if forward {
-            llt.l_solve_with_conj(Conj::No, y, Par::Seq, stack);
+            llt.l_solve_with_conj(Conj::No, y, par, stack);
         } else {
-            llt.l_transpose_solve_with_conj(Conj::No, y, Par::Seq, stack);
+            llt.l_transpose_solve_with_conj(Conj::No, y, par, stack);
         }
         Ok(())
     }
@@ -304,7 +306,7 @@ impl Factor {
     /// X ← K⁻¹ X for the `cols` columns of X (column-major, n rows), with a scratch of its own: it may
     /// run beside the factor's other users (the condition estimate's thread).
     pub fn solve_many(&self, x: &mut [f64], cols: usize) {
-        let mut buf = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq));
+        let mut buf = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(cols, solve_par(cols)));
         self.solve_with(x, cols, MemStack::new(&mut buf));
     }
 
@@ -316,10 +318,22 @@ impl Factor {
         llt.solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(&mut y, self.n, cols),
-            Par::Seq,
+            solve_par(cols),
             stack,
         );
         self.permute_out(&y, x);
+    }
+}
+
+/// The parallelism of a solve with `cols` right-hand sides: the thread count in force for several (faer's
+/// dense products then split by output blocks, each column as the sequential kernel computes it), and
+/// sequential for one, whose parallel products would split sums (and change their rounding) for a
+/// memory-bound kernel that gains little.
+fn solve_par(cols: usize) -> Par {
+    if cols > 1 {
+        crate::threads::par()
+    } else {
+        Par::Seq
     }
 }
 

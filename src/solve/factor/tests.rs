@@ -233,3 +233,25 @@ fn two_threads_factorise_bit_identically_run_after_run() {
     let seq = factor(Par::Seq).unwrap();
     assert_eq!(value_bits(&first), value_bits(&seq), "2 threads against 1");
 }
+
+/// The system shall solve with several right-hand sides bit-identically with 2 threads and with 1 (the
+/// blocked steps, superposition and condensation solve so: `solve_par`).
+#[test]
+fn block_solves_are_the_same_with_two_threads() {
+    let k = grid(160);
+    let n = k.nrows();
+    let f = Factor::with_last(&k, &[0, 2, 4, 6]).unwrap();
+    let cols = 16;
+    let rhs: Vec<f64> = (0..n * cols).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+    let solve = |par| {
+        let mut y = rhs.clone();
+        let llt = f.supernodal().unwrap();
+        let mut mem = MemBuffer::new(f.symbolic.solve_in_place_scratch::<f64>(cols, par));
+        let ym = MatMut::from_column_major_slice_mut(&mut y, n, cols);
+        llt.solve_in_place_with_conj(Conj::No, ym, par, MemStack::new(&mut mem));
+        y.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+    };
+    let seq = solve(Par::Seq);
+    assert_eq!(solve(Par::rayon(2)), seq);
+    assert_eq!(solve(Par::rayon(2)), seq);
+}
