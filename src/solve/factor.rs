@@ -339,7 +339,8 @@ fn solve_par(cols: usize) -> Par {
 
 /// L's values for K = P L Lᵀ Pᵀ (K's lower triangle: `nnz` entries): that triangle permuted to P K Pᵀ's (as faer's
 /// `SymbolicCholesky::factorize_numeric_llt` does it, so the factor is the same bit for bit), then
-/// faer's supernodal kernel, its dense blocks with the parallelism `par`.
+/// faer's supernodal kernel, sequential, or with several threads its computation by subtrees
+/// ([`super::subtrees`]: the same factor bit for bit).
 fn numeric_llt(
     symbolic: &SymbolicSupernodalCholesky<usize>,
     values: &mut [f64],
@@ -363,8 +364,21 @@ fn numeric_llt(
         Side::Lower,
         stack,
     );
-    factorize_supernodal_numeric_llt(values, a.rb(), Default::default(), symbolic, par, stack, Default::default())
-        .map(|_| ())
+    match par {
+        Par::Rayon(t) if t.get() > 1 && super::subtrees::available() => {
+            super::subtrees::factorize(values, a.rb(), symbolic, t.get())
+        }
+        _ => factorize_supernodal_numeric_llt(
+            values,
+            a.rb(),
+            Default::default(),
+            symbolic,
+            par,
+            stack,
+            Default::default(),
+        )
+        .map(|_| ()),
+    }
 }
 
 #[cfg(test)]

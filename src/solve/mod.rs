@@ -11,5 +11,6 @@ pub mod factor;
 pub mod free;
 pub mod ordering;
 pub mod pages;
+mod subtrees;
 pub mod superpose;
 pub mod symbolic;

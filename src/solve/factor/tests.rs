@@ -217,21 +217,39 @@ fn value_bits(f: &Factor) -> Vec<u64> {
     f.values.iter().map(|v| v.to_bits()).collect()
 }
 
-/// The system shall factorise bit-identically run after run with 2 threads, and (faer's dense kernels
-/// splitting their work by output blocks, each computed as the sequential kernel computes it) as with
-/// 1: the rule of docs/model.md, "Threads". The grid is large enough for the top separators' dense
-/// blocks to be split between threads.
+/// The system shall factorise bit-identically run after run with 2 threads, and as faer's sequential
+/// kernel does with 1 (`solve::subtrees`: subtrees on threads of their own, each supernode computed as
+/// faer computes it; the rule of docs/model.md, "Threads"), under AMD and nested dissection, with
+/// unknowns ordered last; and report a matrix that is not positive definite at the same column.
 #[test]
 fn two_threads_factorise_bit_identically_run_after_run() {
     let k = grid(160);
     let n = k.nrows();
-    let base = fill_order(&Graph::of_matrix(&k, &pairs(n)), true).unwrap();
-    let factor = |par| Factor::numeric_with(Symbolic::new(k.symbolic(), &[0, 2], base.clone()).unwrap(), &k, par);
-    let first = factor(Par::rayon(2)).unwrap();
-    let second = factor(Par::rayon(2)).unwrap();
-    assert_eq!(value_bits(&first), value_bits(&second), "2 threads, run after run");
-    let seq = factor(Par::Seq).unwrap();
-    assert_eq!(value_bits(&first), value_bits(&seq), "2 threads against 1");
+    for nested in [false, true] {
+        let base = fill_order(&Graph::of_matrix(&k, &pairs(n)), nested).unwrap();
+        let factor = |par| Factor::numeric_with(Symbolic::new(k.symbolic(), &[0, 2], base.clone()).unwrap(), &k, par);
+        let first = factor(Par::rayon(2)).unwrap();
+        let second = factor(Par::rayon(2)).unwrap();
+        assert_eq!(value_bits(&first), value_bits(&second), "2 threads, run after run (nested {nested})");
+        let seq = factor(Par::Seq).unwrap();
+        assert_eq!(value_bits(&first), value_bits(&seq), "2 threads against 1 (nested {nested})");
+        assert_eq!(value_bits(&factor(Par::rayon(3)).unwrap()), value_bits(&seq), "3 threads (nested {nested})");
+    }
+    // indefinite: a negative diagonal entry deep in the ordering
+    let mut bad = k.clone();
+    let (cp, ri) = (bad.symbolic().col_ptr().to_vec(), bad.symbolic().row_idx().to_vec());
+    let j = 2 * 80 * 160 + 7;
+    let p = (cp[j]..cp[j + 1]).find(|&p| ri[p] == j).unwrap();
+    bad.val_mut()[p] = -10.0;
+    let base = fill_order(&Graph::of_matrix(&bad, &pairs(n)), true).unwrap();
+    let err = |par| {
+        Factor::numeric_with(Symbolic::new(bad.symbolic(), &[], base.clone()).unwrap(), &bad, par)
+            .err()
+            .map(|e| e.to_string())
+    };
+    let seq = err(Par::Seq);
+    assert!(seq.is_some());
+    assert_eq!(err(Par::rayon(2)), seq);
 }
 
 /// The system shall solve with several right-hand sides bit-identically with 2 threads and with 1 (the
