@@ -78,6 +78,9 @@ struct Ctx<'a> {
 
 /// L's values of the lower triangle `a` (permuted) with `threads` threads (≥ 2), as faer's
 /// `factorize_supernodal_numeric_llt` with default parameters computes them. `values` must be zeros.
+/// In rounds: the subtrees of [`plan`] on threads of their own, then the same for the supernodes above
+/// them, until the subtrees would hold less than a quarter of what is left or one thread would do
+/// most of their work; the rest in order, with faer's parallel dense kernels.
 pub(super) fn factorize(
     values: &mut [f64],
     a: SparseColMatRef<'_, usize, f64>,
@@ -85,19 +88,45 @@ pub(super) fn factorize(
     threads: usize,
 ) -> Numeric {
     let (parent, update_ptr, updaters) = tree(symbolic);
-    let (groups, top) = plan(symbolic, &parent, threads);
+    let own = own_work(symbolic);
     let ctx = Ctx { symbolic, a, values: Values(values.as_mut_ptr(), values.len()), update_ptr, updaters };
-    let first: Vec<Numeric> = std::thread::scope(|sc| {
-        let ctx = &ctx;
-        let h: Vec<_> = groups.iter().map(|g| sc.spawn(move || run(ctx, g, Par::Seq))).collect();
-        h.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
-    });
-    // the failure of the first supernode in order, as faer's sequential kernel reports it
-    if let Some(e) = first.into_iter().filter_map(|r| r.err()).min_by_key(|LltError::NonPositivePivot { index }| *index)
-    {
-        return Err(e);
+    let mut members: Vec<usize> = (0..parent.len()).collect();
+    loop {
+        let (groups, top) = plan(&own, &parent, &members, threads);
+        let sum = |list: &[usize]| list.iter().map(|&s| own[s]).sum::<f64>();
+        let mut loads: Vec<f64> = groups.iter().map(|g| sum(g)).collect();
+        loads.sort_by(|a, b| b.total_cmp(a));
+        let left = sum(&members);
+        // little left for the subtrees, or one thread with most of it: the rest with parallel dense kernels
+        if left - sum(&top) < 0.25 * left || loads[1] < 0.25 * loads[0] {
+            return run(&ctx, &members, Par::rayon(threads));
+        }
+        let done: Vec<Numeric> = std::thread::scope(|sc| {
+            let ctx = &ctx;
+            let h: Vec<_> = groups.iter().map(|g| sc.spawn(move || run(ctx, g, Par::Seq))).collect();
+            h.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
+        });
+        // the failure of the first supernode in order among those computed
+        if let Some(e) =
+            done.into_iter().filter_map(|r| r.err()).min_by_key(|LltError::NonPositivePivot { index }| *index)
+        {
+            return Err(e);
+        }
+        if top.is_empty() {
+            return Ok(());
+        }
+        members = top;
     }
-    run(&ctx, &top, Par::rayon(threads))
+}
+
+/// The work of each supernode's own columns, Σ c² over them (c a column's entries, diagonal included).
+fn own_work(symbolic: &SymbolicSupernodalCholesky<usize>) -> Vec<f64> {
+    (0..symbolic.n_supernodes())
+        .map(|s| {
+            let (w, below) = (width(symbolic, s), symbolic.nnz_per_super()[s]);
+            (0..w).map(|j| ((w - j + below) as f64).powi(2)).sum::<f64>()
+        })
+        .collect()
 }
 
 /// The supernodal elimination tree (parent of each supernode, `NONE` at roots) and, for each supernode s,
@@ -137,30 +166,24 @@ fn pattern(symbolic: &SymbolicSupernodalCholesky<usize>, s: usize) -> &[usize] {
     &symbolic.row_idx()[symbolic.col_ptr_for_row_idx()[s]..][..symbolic.nnz_per_super()[s]]
 }
 
-/// The supernodes of each thread (whole subtrees, increasing) and those above the subtrees (increasing).
-/// The largest subtree is split (its root goes above, its children become subtrees) until none holds
-/// more than 1/(4·threads) of the subtrees' work (Σ c² over their columns, c the column's entries); the
-/// subtrees then go to the least loaded thread, largest first.
-fn plan(
-    symbolic: &SymbolicSupernodalCholesky<usize>,
-    parent: &[usize],
-    threads: usize,
-) -> (Vec<Vec<usize>>, Vec<usize>) {
+/// The supernodes of `members` (increasing, closed under parents) for each thread (whole subtrees of
+/// theirs, increasing), and those above the subtrees (increasing). The largest subtree is split (its root
+/// goes above, its children become subtrees) until none holds more than 1/(4·threads) of the subtrees'
+/// work (`own`); the subtrees then go to the least loaded thread, largest first.
+fn plan(own: &[f64], parent: &[usize], members: &[usize], threads: usize) -> (Vec<Vec<usize>>, Vec<usize>) {
     let ns = parent.len();
     let mut work = vec![0.0f64; ns];
     let mut children = vec![Vec::new(); ns];
-    for s in 0..ns {
-        let width = width(symbolic, s);
-        let below = symbolic.nnz_per_super()[s];
-        work[s] += (0..width).map(|j| ((width - j + below) as f64).powi(2)).sum::<f64>();
+    for &s in members {
+        work[s] += own[s];
         if parent[s] != NONE {
             work[parent[s]] += work[s];
             children[parent[s]].push(s);
         }
     }
-    let mut owner = vec![NONE; ns + 1];
-    let top_mark = threads;
-    let mut roots: Vec<usize> = (0..ns).filter(|&s| parent[s] == NONE).collect();
+    let mut owner = vec![NONE; ns];
+    let above = threads;
+    let mut roots: Vec<usize> = members.iter().copied().filter(|&s| parent[s] == NONE).collect();
     loop {
         let total: f64 = roots.iter().map(|&r| work[r]).sum();
         let Some(i) = (0..roots.len()).max_by(|&i, &j| work[roots[i]].total_cmp(&work[roots[j]])) else { break };
@@ -168,7 +191,7 @@ fn plan(
         if work[r] <= total / (4 * threads) as f64 || children[r].is_empty() {
             break;
         }
-        owner[r] = top_mark;
+        owner[r] = above;
         roots.swap_remove(i);
         roots.extend_from_slice(&children[r]);
     }
@@ -179,13 +202,13 @@ fn plan(
         load[t] += work[r];
         owner[r] = t;
     }
-    let mut groups = vec![Vec::new(); threads + 1];
-    for s in (0..ns).rev() {
+    for &s in members.iter().rev() {
         if owner[s] == NONE {
             owner[s] = owner[parent[s]];
         }
     }
-    (0..ns).for_each(|s| groups[owner[s]].push(s));
+    let mut groups = vec![Vec::new(); threads + 1];
+    members.iter().for_each(|&s| groups[owner[s]].push(s));
     let top = groups.pop().unwrap_or_default();
     (groups, top)
 }
