@@ -4,9 +4,10 @@
 //! [`crate::parallel`]) and the parallel kernels of the factorisation and of the large solves
 //! (`solve::factor`); results files record it (`/tresca@threads`).
 //!
-//! The factor, and so every result, is the same bit for bit run after run with a given count, and the
-//! same for every count: faer's dense kernels split their work by output blocks, each computed as the
-//! sequential kernel computes it (docs/model.md, "Threads"; tested in `solve::factor`).
+//! The factor, and so every result, is the same bit for bit run after run and for every count: the
+//! factorisation by subtrees computes each supernode as faer's sequential kernel does
+//! (`solve::subtrees`), and faer's parallel dense kernels split their work by output blocks, each computed
+//! as the sequential kernel computes it (docs/model.md, "Threads"; tested in `solve::factor`).
 
 use crate::error::{Error, Result};
 use faer::Par;
