@@ -100,7 +100,9 @@ impl Factor {
         k: &SparseColMat<usize, f64>,
         beside: impl FnOnce() -> R + Send,
     ) -> (Result<Factor>, Option<R>) {
-        Factor::numeric_par(symbolic, k, crate::threads::par(), beside)
+        // a small factor's work is over before threads would have started
+        let par = if symbolic.len_val() < super::subtrees::MIN_ENTRIES { Par::Seq } else { crate::threads::par() };
+        Factor::numeric_par(symbolic, k, par, beside)
     }
 
     fn numeric_par<R: Send>(

@@ -17,6 +17,11 @@ use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::sparse::SparseColMatRef;
 use faer::{MatMut, MatRef, Par};
 
+/// Factors with fewer entries are computed sequentially (`Factor::numeric_beside`): their factorisation
+/// takes about a millisecond, so threads would save a fraction of one while starting them (tens of µs a
+/// round) would be paid on every small mesh, as a planner's pilot levels make them by the hundred.
+pub(crate) const MIN_ENTRIES: usize = 1 << 16;
+
 type Numeric = std::result::Result<(), LltError>;
 const NONE: usize = usize::MAX;
 
