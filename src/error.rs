@@ -46,6 +46,10 @@ pub enum Error {
         human(*have)
     )]
     TooLarge { what: &'static str, need: u64, have: u64, limit: &'static str, hint: String },
+
+    /// The thread count (`--threads`, `TRESCA_THREADS`) is not a whole number ≥ 1.
+    #[error("the thread count (--threads, TRESCA_THREADS) must be a whole number ≥ 1, not {0:?}")]
+    Threads(String),
 }
 
 /// Bytes in a readable unit (decimal: kB, MB, GB, TB).

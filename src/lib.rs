@@ -37,6 +37,7 @@ pub mod solve;
 pub mod sparse;
 pub mod stepping;
 pub mod study;
+pub mod threads;
 
 pub use error::{Error, Result};
 pub use scene::Scene;

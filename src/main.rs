@@ -16,6 +16,10 @@ use tresca_cr::Scene;
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,
+    /// Threads of the factorisation, the large solves and the expression evaluation (default:
+    /// TRESCA_THREADS, else the cores available to the process).
+    #[arg(long, global = true, value_parser = cli::args::at_least_one)]
+    threads: Option<usize>,
 }
 
 #[derive(Subcommand)]
@@ -283,7 +287,15 @@ pub(crate) fn hand_back_memory() {
 
 fn main() {
     tune_malloc();
-    let result = match Cli::parse().cmd {
+    let cli = Cli::parse();
+    match tresca_cr::threads::requested(cli.threads) {
+        Ok(n) => tresca_cr::threads::set(n),
+        Err(e) => {
+            note!("error: {e}");
+            std::process::exit(1);
+        }
+    }
+    let result = match cli.cmd {
         Cmd::Check { scene, grid, limits, json } => check(&scene, grid, limits, json),
         Cmd::Run { scene, overrides, out, verbose, quiet, limits, json } => {
             run(&scene, overrides, out, (verbose, quiet), limits, json)

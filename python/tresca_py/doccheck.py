@@ -2,7 +2,7 @@
 
 A reference is any token with a slash whose first part is a tracked top-level entry of the repository
 (`src/`, `verification/`, `reference/`, …) or a folder of `src/` (the README's concept table writes
-`solve/factor.rs` for `src/solve/factor.rs`). It resolves against the repository root, then `src/`.
+`solve/factor.rs` for `src/solve/cholesky/factor.rs`). It resolves against the repository root, then `src/`.
 Shell braces are expanded (`friction/{ssn,uzawa}.rs`), globs must match at least one file, and a
 `:line` or `:line-line` suffix is dropped. Tokens with a placeholder (`<name>`, `…`, `...`) are passed
 over, as are HDF5 paths (`tresca/steps/checksum`) and outputs (`out/…`), whose first part is not a

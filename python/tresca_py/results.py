@@ -59,7 +59,7 @@ ATTRIBUTES = {
     "scene": str, "scene_path": str, "title": str, "version": str, "git_commit": str, "solver": str,
     "tol": float, "max_iter": int, "uzawa_step": float, "rho": float, "E": float, "nu": float, "steps": int,
     "n_edges": int, "n_contact": int, "n_dofs": int, "paper_dofs": int, "h": float, "setup_times": "floats",
-    "setup_times_meaning": str, "status": str, "frame_every": int,
+    "setup_times_meaning": str, "status": str, "frame_every": int, "threads": int,
 }
 REQUIRED = ("scene", "version", "solver", "E", "nu", "steps", "status")
 # Written by the Python solvers before this module: no status, completed, checksum, contact/mu, contact/dof.

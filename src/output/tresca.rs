@@ -134,6 +134,7 @@ impl Tresca {
         attr_str(loc, "title", &s.title)?;
         attr_str(loc, "version", p.meta.version)?;
         attr_str(loc, "git_commit", p.meta.commit)?;
+        attr(loc, "threads", crate::threads::count() as i64)?;
         attr_str(loc, "solver", s.solver.method.name())?;
         attr(loc, "tol", s.solver.tol)?;
         attr(loc, "max_iter", s.solver.max_iter() as i64)?;

@@ -10,7 +10,7 @@
 //! bytes a value, at most 16 columns and 2²⁴ values) and the dense contact parts: γ, α, β fitted by least
 //! squares of the relative misfit to the five, which it then gives within 5 %. An estimate, not a bound: the fill
 //! also depends on the ordering (AMD below 1M unknowns, nested dissection above). The factorisation checks
-//! its exact size once the symbolic factorisation is known (`solve::symbolic::Symbolic::fits`) and refuses a factor
+//! its exact size once the symbolic factorisation is known (`solve::cholesky::symbolic::Symbolic::fits`) and refuses a factor
 //! that would not fit, or first tries METIS's ordering, which fills less. The estimate gives that
 //! fallback's peak beside ([`Estimate::memory_metis`]): the coordinate nested dissection's factor has
 //! about `FILL_ND` · n log₂ n entries (15.4 at 1.57 M unknowns, 16.0–16.2 at 3.5–6.3 M) and METIS's

@@ -140,7 +140,7 @@ Command: `make bench-env && .venv-bench/bin/python verification/bench/factorisat
 {table(rows, rate1)}
 
 tresca-cr's orderings: AMD below 1,000,000 unknowns, nested dissection by coordinate bisection from there
-(`solve::ordering`); {len(tre)} tresca-cr set-ups in this table.
+(`solve::cholesky::ordering`); {len(tre)} tresca-cr set-ups in this table.
 """
 
 

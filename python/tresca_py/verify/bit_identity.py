@@ -1,7 +1,7 @@
 """Bit-identity check for refactors: a refactor changes no number.
 
 Usage:
-    python verification/bit_identity.py run DIR [--bin PATH]     # write every case's results into DIR
+    python verification/bit_identity.py run DIR [--bin PATH] [--threads N]   # every case's results into DIR
     python verification/bit_identity.py compare DIR_A DIR_B     # compare them dataset by dataset
     python verification/bit_identity.py compare DIR_A DIR_B --rel 1e-10   # floats within a relative tolerance
 
@@ -16,8 +16,10 @@ if any value differs. With ``--rel TOL`` floating-point values may differ by TOL
 magnitude of their dataset (max |a - b| <= TOL max |a|, for changes that move results by rounding only;
 float32 visualisation copies within max(TOL, 1e-6), the solvers' residuals within 1e-12 absolute);
 everything else (integers, flags, strings, shapes) must still be equal; the largest relative differences
-of every file are printed. ``scene_path`` (where the scene file was) is not compared; a dataset added by a
-later version (``tresca/steps/checksum``) is compared only when both files hold it.
+of every file are printed. Like is compared with like: files written with different thread counts
+(``/tresca@threads``; 1 in files of versions before it) differ unless ``--rel`` is given, which notes the
+counts (``run --threads N`` passes ``--threads N`` to the binary). ``scene_path`` (where the scene file
+was) is not compared; a dataset added by a later version (``tresca/steps/checksum``) is compared only when both files hold it.
 """
 import argparse
 import glob
@@ -44,6 +46,11 @@ ADDED = {"tresca/steps/checksum"} | {
 }
 
 
+# the thread count of the run that wrote a file (files of versions before it: 1, every kernel that could
+# change a bit with the count was sequential then)
+THREADS = "tresca@threads"
+
+
 def runs():
     """(name, scene, extra CLI arguments) of every run compared."""
     out = []
@@ -66,7 +73,8 @@ def cmd_run(args):
     failed = 0
     for name, scene, extra in runs():
         path = os.path.join(args.dir, name + ".h5")
-        p = subprocess.run([args.bin, "run", scene, "-o", path, "--force", "-q", *extra],
+        threads = [] if args.threads is None else ["--threads", str(args.threads)]
+        p = subprocess.run([args.bin, "run", scene, "-o", path, "--force", "-q", *threads, *extra],
                            capture_output=True, text=True, cwd=ROOT)
         status = "ok" if p.returncode == 0 else f"exit {p.returncode}: {p.stderr.strip()[-200:]}"
         failed += p.returncode != 0
@@ -142,9 +150,12 @@ def cmd_compare(args):
             ia, ib = items(fa), items(fb)
         keys = sorted(k for k in set(ia) | set(ib)
                       if k.split("@")[-1] not in VOLATILE and k.split("@")[0].removeprefix("tresca/") not in VOLATILE)
-        keys = [k for k in keys if not (k in ADDED and (k in ia) != (k in ib))]
+        keys = [k for k in keys if not (k in ADDED and (k in ia) != (k in ib)) and k != THREADS]
         diff = [k for k in keys if k not in ia or k not in ib or not same(ia[k], ib[k], args.rel, k)]
-        worst = ""
+        counts = (int(ia.get(THREADS, 1)), int(ib.get(THREADS, 1)))
+        worst = "" if counts[0] == counts[1] else f"  threads {counts[0]} vs {counts[1]}"
+        if counts[0] != counts[1] and args.rel is None:
+            diff.insert(0, f"{THREADS} (compare like with like, or give --rel)")
         if args.rel is not None:
             for kind, sel in (("float64", np.float64), ("float32", np.float32)):
                 r = [dataset_diff(ia[k], ib[k]) for k in keys if k in ia and k in ib and not k.endswith("residual")
@@ -163,6 +174,7 @@ def main():
     r = sub.add_parser("run")
     r.add_argument("dir")
     r.add_argument("--bin", default=os.path.join(ROOT, "target", "release", "tresca-cr"))
+    r.add_argument("--threads", type=int, default=None, help="the binary's --threads (default: its own)")
     c = sub.add_parser("compare")
     c.add_argument("a")
     c.add_argument("b")

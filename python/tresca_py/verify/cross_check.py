@@ -94,7 +94,7 @@ or below refine 2. Beyond that a bound on |e_A - e_B| / |||u||| is the meaningfu
 1e-7 (refine 2), skfem from dolfinx by 2e-9 and 2e-8. Against a skfem solve with 5 steps of iterative
 refinement the errors at refine 2 are: Rust 1.1e-7, dolfinx 1.8e-8, skfem (1 refinement step) 1.6e-9,
 skfem without refinement 1.8e-8. The Python solvers do one step of iterative refinement after SuperLU;
-the Rust solver (src/solve/factor.rs, `Factor::solve_in_place` / `solve_many`) does none. A 1e-8
+the Rust solver (src/solve/cholesky/factor.rs, `Factor::solve_in_place` / `solve_many`) does none. A 1e-8
 agreement is not a meaningful requirement there (assembly rounding alone moves dolfinx 1.8e-8 from skfem).
 
 **Wall times.** The Python processes spend 1.5–3 s in start-up (imports; dolfinx form compilation on

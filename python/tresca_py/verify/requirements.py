@@ -276,7 +276,9 @@ REQUIREMENTS = (
     ),
     Requirement(
         'T1-study-tests',
-        'pass the study-sized tests that `make test` leaves to `make verify`: the Rust tests marked `#[ignore = "study-sized …"]` (`cargo test --release --locked --test NAME -- --ignored`) and the Python tests marked `study` (`pytest -m study`)',
+        'pass the study-sized tests that `make test` leaves to `make verify`: the Rust tests marked '
+        '`#[ignore = "study-sized …"]` (`cargo test --release --locked --test NAME -- --ignored`) and the Python '
+        'tests marked `study` (`pytest -m study`)',
         'verification/run_all.py --only tests',
         None,
     ),

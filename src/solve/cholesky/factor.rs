@@ -1,7 +1,8 @@
 //! Factorise once, solve many times: the sparse Cholesky factor K = P L Lᵀ Pᵀ of the stiffness (faer,
 //! supernodal), kept for the whole run. Every step and every friction iteration only performs the pair of
-//! triangular solves L Lᵀ x = b, with a scratch buffer allocated once. Sequential: the per-step solves
-//! of a 2D problem are too small to profit from threads, and sequential kernels keep runs bit-identical.
+//! triangular solves L Lᵀ x = b, with a scratch buffer allocated once. The numeric factorisation and the
+//! solves with several right-hand sides use the thread count in force (`crate::threads`) in faer's dense
+//! kernels; single-vector solves are sequential (see `solve_par`). Neither changes a bit with the count.
 //!
 //! Fill-reducing ordering P: see [`super::ordering`]; the symbolic half: [`super::symbolic`].
 //!
@@ -84,13 +85,30 @@ impl Factor {
         Factor::numeric_beside(symbolic, k, || ()).0
     }
 
+    /// As [`Factor::numeric`], with faer's parallelism `par` instead of the thread count in force
+    /// ([`crate::threads::par`]).
+    pub fn numeric_with(symbolic: Symbolic, k: &SparseColMat<usize, f64>, par: Par) -> Result<Factor> {
+        Factor::numeric_par(symbolic, k, par, || ()).0
+    }
+
     /// As [`Factor::numeric`], running `beside` on the second thread that maps the factor's pages
-    /// (solve::pages) once they are mapped: the caller's work that needs neither the factor nor the
+    /// (solve::cholesky::pages) once they are mapped: the caller's work that needs neither the factor nor the
     /// whole of a core. Its result is returned whether the factorisation succeeds or not (`None` if
     /// the factorisation could not start).
     pub fn numeric_beside<R: Send>(
         symbolic: Symbolic,
         k: &SparseColMat<usize, f64>,
+        beside: impl FnOnce() -> R + Send,
+    ) -> (Result<Factor>, Option<R>) {
+        // a small factor's work is over before threads would have started
+        let par = if symbolic.len_val() < super::subtrees::MIN_ENTRIES { Par::Seq } else { crate::threads::par() };
+        Factor::numeric_par(symbolic, k, par, beside)
+    }
+
+    fn numeric_par<R: Send>(
+        symbolic: Symbolic,
+        k: &SparseColMat<usize, f64>,
+        par: Par,
         beside: impl FnOnce() -> R + Send,
     ) -> (Result<Factor>, Option<R>) {
         let Symbolic { symbolic, fwd, inv, last, pattern_nnz, ordering } = symbolic;
@@ -105,19 +123,20 @@ impl Factor {
         if let Err(e) = Symbolic::fits_with(&symbolic, pattern_nnz, 0) {
             return (Err(e), None);
         }
-        let scratch = numeric_scratch(&symbolic, pattern_nnz);
+        let scratch = numeric_scratch(&symbolic, pattern_nnz, par);
         let Some(mut values) = Pages::zeroed(symbolic.len_val()) else { return (Err(oom()), None) };
         let Ok(mut buf) = MemBuffer::try_new(scratch) else {
             return (Err(oom()), None);
         };
-        // the factor's pages are mapped on a second thread while this one computes (solve::pages)
+        // the factor's pages are mapped on a second thread while this one computes (solve::cholesky::pages)
         let range = values.range();
         let (numeric, r) = std::thread::scope(|s| {
             let r = s.spawn(move || {
                 Pages::populate(range);
                 beside()
             });
-            let numeric = numeric_llt(&symbolic, &mut values, (k, pattern_nnz), (&fwd, &inv), MemStack::new(&mut buf));
+            let stack = MemStack::new(&mut buf);
+            let numeric = numeric_llt(&symbolic, &mut values, (k, pattern_nnz), (&fwd, &inv), par, stack);
             (numeric, r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
         });
         let factor = Factor::finish(symbolic, values, numeric, n, last, fwd).map(|f| Factor { ordering, ..f });
@@ -265,16 +284,17 @@ impl Factor {
             return Err(Error::Linear(format!("internal: a block of {} values for {cols} columns", y.len())));
         }
         let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
+        let par = solve_par(cols);
         if scratch.0 < cols {
-            scratch.1 = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq))
+            scratch.1 = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(cols, par))
                 .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
             scratch.0 = cols;
         }
         let (y, stack) = (MatMut::from_column_major_slice_mut(y, self.n, cols), MemStack::new(&mut scratch.1));
         if forward {
-            llt.l_solve_with_conj(Conj::No, y, Par::Seq, stack);
+            llt.l_solve_with_conj(Conj::No, y, par, stack);
         } else {
-            llt.l_transpose_solve_with_conj(Conj::No, y, Par::Seq, stack);
+            llt.l_transpose_solve_with_conj(Conj::No, y, par, stack);
         }
         Ok(())
     }
@@ -288,7 +308,7 @@ impl Factor {
     /// X ← K⁻¹ X for the `cols` columns of X (column-major, n rows), with a scratch of its own: it may
     /// run beside the factor's other users (the condition estimate's thread).
     pub fn solve_many(&self, x: &mut [f64], cols: usize) {
-        let mut buf = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq));
+        let mut buf = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(cols, solve_par(cols)));
         self.solve_with(x, cols, MemStack::new(&mut buf));
     }
 
@@ -300,21 +320,35 @@ impl Factor {
         llt.solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(&mut y, self.n, cols),
-            Par::Seq,
+            solve_par(cols),
             stack,
         );
         self.permute_out(&y, x);
     }
 }
 
+/// The parallelism of a solve with `cols` right-hand sides: the thread count in force for several (faer's
+/// dense products then split by output blocks, each column as the sequential kernel computes it), and
+/// sequential for one, whose parallel products would split sums (and change their rounding) for a
+/// memory-bound kernel that gains little.
+fn solve_par(cols: usize) -> Par {
+    if cols > 1 {
+        crate::threads::par()
+    } else {
+        Par::Seq
+    }
+}
+
 /// L's values for K = P L Lᵀ Pᵀ (K's lower triangle: `nnz` entries): that triangle permuted to P K Pᵀ's (as faer's
 /// `SymbolicCholesky::factorize_numeric_llt` does it, so the factor is the same bit for bit), then
-/// faer's supernodal kernel, sequential.
+/// faer's supernodal kernel, sequential, or with several threads its computation by subtrees
+/// ([`super::subtrees`]: the same factor bit for bit).
 fn numeric_llt(
     symbolic: &SymbolicSupernodalCholesky<usize>,
     values: &mut [f64],
     (k, nnz): (&SparseColMat<usize, f64>, usize),
     (fwd, inv): (&[usize], &[usize]),
+    par: Par,
     stack: &mut MemStack,
 ) -> std::result::Result<(), faer::linalg::solvers::LltError> {
     let n = k.nrows();
@@ -332,8 +366,21 @@ fn numeric_llt(
         Side::Lower,
         stack,
     );
-    factorize_supernodal_numeric_llt(values, a.rb(), Default::default(), symbolic, Par::Seq, stack, Default::default())
-        .map(|_| ())
+    match par {
+        Par::Rayon(t) if t.get() > 1 && super::subtrees::available() => {
+            super::subtrees::factorize(values, a.rb(), symbolic, t.get())
+        }
+        _ => factorize_supernodal_numeric_llt(
+            values,
+            a.rb(),
+            Default::default(),
+            symbolic,
+            par,
+            stack,
+            Default::default(),
+        )
+        .map(|_| ()),
+    }
 }
 
 #[cfg(test)]

@@ -1,6 +1,6 @@
 //! Sparse Cholesky factorisation K = P L Lᵀ Pᵀ of a symmetric positive definite matrix, made once and
 //! solved with many times. It knows nothing of contact or of the finite elements; its one public face is
-//! this module's re-exports. As in faer's `sparse::linalg::cholesky`, the work is split in layers:
+//! this module's re-exports. As in `faer::sparse::linalg::cholesky`, the work is split in layers:
 //!
 //! * the fill-reducing ordering P on the graph of the unknowns or of groups of them ([`Graph`]:
 //!   AMD, METIS nested dissection, or a coordinate bisection when points are given; [`fill_order`],
@@ -50,6 +50,7 @@ pub(crate) mod etree;
 pub(crate) mod factor;
 pub(crate) mod ordering;
 pub(crate) mod pages;
+pub(crate) mod subtrees;
 pub(crate) mod symbolic;
 
 pub use factor::Factor;

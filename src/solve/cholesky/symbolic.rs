@@ -77,7 +77,7 @@ impl Symbolic {
 
     /// Bytes the numeric factorisation allocates: L's values and its scratch.
     fn need_of(symbolic: &SymbolicSupernodalCholesky<usize>, pattern_nnz: usize) -> u64 {
-        let scratch = numeric_scratch(symbolic, pattern_nnz);
+        let scratch = numeric_scratch(symbolic, pattern_nnz, crate::threads::par());
         (symbolic.len_val() as u64).saturating_mul(8).saturating_add(scratch.unaligned_bytes_required() as u64)
     }
 
@@ -159,6 +159,7 @@ fn supernodal_structure(
 pub(super) fn numeric_scratch(
     symbolic: &SymbolicSupernodalCholesky<usize>,
     pattern_nnz: usize,
+    par: Par,
 ) -> faer::dyn_stack::StackReq {
     use faer::dyn_stack::StackReq;
     let n = symbolic.nrows();
@@ -167,7 +168,7 @@ pub(super) fn numeric_scratch(
         StackReq::new::<usize>(n + 1),
         StackReq::new::<usize>(pattern_nnz),
     ]);
-    let kernel = factorize_supernodal_numeric_llt_scratch::<usize, f64>(symbolic, Par::Seq, Default::default());
+    let kernel = factorize_supernodal_numeric_llt_scratch::<usize, f64>(symbolic, par, Default::default());
     StackReq::all_of(&[permuted, StackReq::or(StackReq::new::<usize>(n), kernel)])
 }
 

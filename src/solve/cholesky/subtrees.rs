@@ -1,0 +1,338 @@
+//! The numeric supernodal factorisation on several threads, by subtrees of the supernodal elimination
+//! tree. faer's kernel (`factorize_supernodal_numeric_llt`) walks the supernodes in order and splits only
+//! each supernode's dense work between threads, which leaves the many small supernodes of a 2D problem on
+//! one thread. Here disjoint subtrees run on threads of their own (a supernode reads only its
+//! descendants' columns of L and writes only its own), then the supernodes above them, in order, with
+//! their dense work split between the threads. Every supernode is computed as faer's kernel computes it:
+//! the same updates in the same order, with faer's own kernels (its update kernel, `private_gemm_x86`,
+//! called with the arguments faer gives it), so the factor is faer's sequential one bit for bit whatever
+//! the thread count (test: `solve::cholesky::factor::tests::two_threads_factorise_bit_identically_run_after_run`).
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
+use faer::linalg::solvers::LltError;
+use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
+use faer::sparse::SparseColMatRef;
+use faer::{MatMut, MatRef, Par};
+
+/// Factors with fewer entries are computed sequentially (`Factor::numeric_beside`): their factorisation
+/// takes about a millisecond, so threads would save a fraction of one while starting them (tens of µs a
+/// round) would be paid on every small mesh, as a planner's pilot levels make them by the hundred.
+pub(crate) const MIN_ENTRIES: usize = 1 << 16;
+
+type Numeric = std::result::Result<(), LltError>;
+const NONE: usize = usize::MAX;
+
+/// Whether this machine has faer's update kernel (x86-64 with AVX2 and FMA); elsewhere faer's own
+/// numeric factorisation is used.
+pub(super) fn available() -> bool {
+    instr_set().is_some()
+}
+
+#[cfg(target_arch = "x86_64")]
+fn instr_set() -> Option<private_gemm_x86::InstrSet> {
+    use private_gemm_x86::InstrSet;
+    if std::arch::is_x86_feature_detected!("avx512f") {
+        Some(InstrSet::Avx512)
+    } else if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        Some(InstrSet::Avx256)
+    } else {
+        None
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+fn instr_set() -> Option<()> {
+    None
+}
+
+/// L's values, written by several threads, each supernode's block by one only.
+struct Values(*mut f64, usize);
+// SAFETY: blocks are handed out by `block_mut` to one thread each, and read by `block` only once written
+// (a supernode reads its descendants', finished before it starts: same thread, or joined threads).
+unsafe impl Sync for Values {}
+
+impl Values {
+    /// # Safety
+    /// No other thread writes `a..b` while the slice lives.
+    unsafe fn block(&self, a: usize, b: usize) -> &[f64] {
+        assert!(a <= b && b <= self.1);
+        std::slice::from_raw_parts(self.0.add(a), b - a)
+    }
+
+    /// # Safety
+    /// No other thread reads or writes `a..b` while the slice lives.
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn block_mut(&self, a: usize, b: usize) -> &mut [f64] {
+        assert!(a <= b && b <= self.1);
+        std::slice::from_raw_parts_mut(self.0.add(a), b - a)
+    }
+}
+
+/// What every supernode's computation reads.
+struct Ctx<'a> {
+    symbolic: &'a SymbolicSupernodalCholesky<usize>,
+    a: SparseColMatRef<'a, usize, f64>,
+    values: Values,
+    /// The supernodes that update supernode s, increasing: `updaters[update_ptr[s]..update_ptr[s + 1]]`.
+    update_ptr: Vec<usize>,
+    updaters: Vec<usize>,
+}
+
+/// L's values of the lower triangle `a` (permuted) with `threads` threads (≥ 2), as faer's
+/// `factorize_supernodal_numeric_llt` with default parameters computes them. `values` must be zeros.
+/// In rounds: the subtrees of [`plan`] on threads of their own, then the same for the supernodes above
+/// them, until the subtrees would hold less than a quarter of what is left or one thread would do
+/// most of their work; the rest in order, with faer's parallel dense kernels.
+pub(super) fn factorize(
+    values: &mut [f64],
+    a: SparseColMatRef<'_, usize, f64>,
+    symbolic: &SymbolicSupernodalCholesky<usize>,
+    threads: usize,
+) -> Numeric {
+    let (parent, update_ptr, updaters) = tree(symbolic);
+    let own = own_work(symbolic);
+    let ctx = Ctx { symbolic, a, values: Values(values.as_mut_ptr(), values.len()), update_ptr, updaters };
+    let mut members: Vec<usize> = (0..parent.len()).collect();
+    loop {
+        let (groups, top) = plan(&own, &parent, &members, threads);
+        let sum = |list: &[usize]| list.iter().map(|&s| own[s]).sum::<f64>();
+        let mut loads: Vec<f64> = groups.iter().map(|g| sum(g)).collect();
+        loads.sort_by(|a, b| b.total_cmp(a));
+        let left = sum(&members);
+        // little left for the subtrees, or one thread with most of it: the rest with parallel dense kernels
+        if left - sum(&top) < 0.25 * left || loads[1] < 0.25 * loads[0] {
+            return run(&ctx, &members, Par::rayon(threads));
+        }
+        let done: Vec<Numeric> = std::thread::scope(|sc| {
+            let ctx = &ctx;
+            let h: Vec<_> = groups.iter().map(|g| sc.spawn(move || run(ctx, g, Par::Seq))).collect();
+            h.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
+        });
+        // the failure of the first supernode in order among those computed
+        if let Some(e) =
+            done.into_iter().filter_map(|r| r.err()).min_by_key(|LltError::NonPositivePivot { index }| *index)
+        {
+            return Err(e);
+        }
+        if top.is_empty() {
+            return Ok(());
+        }
+        members = top;
+    }
+}
+
+/// The work of each supernode's own columns, Σ c² over them (c a column's entries, diagonal included).
+fn own_work(symbolic: &SymbolicSupernodalCholesky<usize>) -> Vec<f64> {
+    (0..symbolic.n_supernodes())
+        .map(|s| {
+            let (w, below) = (width(symbolic, s), symbolic.nnz_per_super()[s]);
+            (0..w).map(|j| ((w - j + below) as f64).powi(2)).sum::<f64>()
+        })
+        .collect()
+}
+
+/// The supernodal elimination tree (parent of each supernode, `NONE` at roots) and, for each supernode s,
+/// the supernodes whose columns update it (those with a row in s's columns), increasing.
+fn tree(symbolic: &SymbolicSupernodalCholesky<usize>) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let ns = symbolic.n_supernodes();
+    let mut of_col = vec![0; symbolic.nrows()];
+    for s in 0..ns {
+        of_col[symbolic.supernode_begin()[s]..symbolic.supernode_end()[s]].fill(s);
+    }
+    let mut parent = vec![NONE; ns];
+    let mut pairs = Vec::new();
+    for d in 0..ns {
+        let mut last = NONE;
+        for &r in pattern(symbolic, d) {
+            let s = of_col[r];
+            if s != last {
+                pairs.push((s, d));
+                last = s;
+            }
+        }
+        parent[d] = pattern(symbolic, d).first().map_or(NONE, |&r| of_col[r]);
+    }
+    let mut ptr = vec![0; ns + 1];
+    pairs.iter().for_each(|&(s, _)| ptr[s + 1] += 1);
+    (0..ns).for_each(|s| ptr[s + 1] += ptr[s]);
+    let mut next = ptr.clone();
+    let mut updaters = vec![0; pairs.len()];
+    for (s, d) in pairs {
+        updaters[next[s]] = d;
+        next[s] += 1;
+    }
+    (parent, ptr, updaters)
+}
+
+fn pattern(symbolic: &SymbolicSupernodalCholesky<usize>, s: usize) -> &[usize] {
+    &symbolic.row_idx()[symbolic.col_ptr_for_row_idx()[s]..][..symbolic.nnz_per_super()[s]]
+}
+
+/// The supernodes of `members` (increasing, closed under parents) for each thread (whole subtrees of
+/// theirs, increasing), and those above the subtrees (increasing). The largest subtree is split (its root
+/// goes above, its children become subtrees) until none holds more than 1/(4·threads) of the subtrees'
+/// work (`own`); the subtrees then go to the least loaded thread, largest first.
+fn plan(own: &[f64], parent: &[usize], members: &[usize], threads: usize) -> (Vec<Vec<usize>>, Vec<usize>) {
+    let ns = parent.len();
+    let mut work = vec![0.0f64; ns];
+    let mut children = vec![Vec::new(); ns];
+    for &s in members {
+        work[s] += own[s];
+        if parent[s] != NONE {
+            work[parent[s]] += work[s];
+            children[parent[s]].push(s);
+        }
+    }
+    let mut owner = vec![NONE; ns];
+    let above = threads;
+    let mut roots: Vec<usize> = members.iter().copied().filter(|&s| parent[s] == NONE).collect();
+    loop {
+        let total: f64 = roots.iter().map(|&r| work[r]).sum();
+        let Some(i) = (0..roots.len()).max_by(|&i, &j| work[roots[i]].total_cmp(&work[roots[j]])) else { break };
+        let r = roots[i];
+        if work[r] <= total / (4 * threads) as f64 || children[r].is_empty() {
+            break;
+        }
+        owner[r] = above;
+        roots.swap_remove(i);
+        roots.extend_from_slice(&children[r]);
+    }
+    roots.sort_by(|&a, &b| work[b].total_cmp(&work[a]).then(a.cmp(&b)));
+    let mut load = vec![0.0f64; threads];
+    for r in roots {
+        let t = (0..threads).min_by(|&i, &j| load[i].total_cmp(&load[j])).unwrap_or(0);
+        load[t] += work[r];
+        owner[r] = t;
+    }
+    for &s in members.iter().rev() {
+        if owner[s] == NONE {
+            owner[s] = owner[parent[s]];
+        }
+    }
+    let mut groups = vec![Vec::new(); threads + 1];
+    members.iter().for_each(|&s| groups[owner[s]].push(s));
+    let top = groups.pop().unwrap_or_default();
+    (groups, top)
+}
+
+/// The supernodes `list`, in order, with the parallelism `par` in their dense work.
+fn run(ctx: &Ctx, list: &[usize], par: Par) -> Numeric {
+    let n = ctx.symbolic.nrows();
+    let widest = list.iter().map(|&s| width(ctx.symbolic, s)).max().unwrap_or(0);
+    let mut g2l = vec![NONE; n];
+    let mut idx = (Vec::new(), Vec::new());
+    let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(widest, par, Default::default()));
+    for &s in list {
+        supernode(ctx, s, &mut g2l, &mut idx, par, MemStack::new(&mut mem))?;
+    }
+    Ok(())
+}
+
+fn width(symbolic: &SymbolicSupernodalCholesky<usize>, s: usize) -> usize {
+    symbolic.supernode_end()[s] - symbolic.supernode_begin()[s]
+}
+
+/// Supernode s of L, as faer's kernel computes it: K's columns, the updates of the supernodes below, the
+/// dense Cholesky factor of the diagonal block and the solve of the block below it.
+fn supernode(
+    ctx: &Ctx,
+    s: usize,
+    g2l: &mut [usize],
+    (row_idx, col_idx): &mut (Vec<usize>, Vec<usize>),
+    par: Par,
+    stack: &mut MemStack,
+) -> Numeric {
+    let sym = ctx.symbolic;
+    let cpv = sym.col_ptr_for_val();
+    let (s_start, s_end) = (sym.supernode_begin()[s], sym.supernode_end()[s]);
+    let s_pattern = pattern(sym, s);
+    let s_ncols = s_end - s_start;
+    for (i, &row) in s_pattern.iter().enumerate() {
+        g2l[row] = i + s_ncols;
+    }
+    // SAFETY: supernode s is computed by this thread only
+    let block = unsafe { ctx.values.block_mut(cpv[s], cpv[s + 1]) };
+    let mut ls = MatMut::from_column_major_slice_mut(block, s_pattern.len() + s_ncols, s_ncols);
+    for j in s_start..s_end {
+        for (i, &v) in ctx.a.row_idx_of_col(j).zip(ctx.a.val_of_col(j)) {
+            if i >= j {
+                ls[(if i >= s_end { g2l[i] } else { i - s_start }, j - s_start)] += v;
+            }
+        }
+    }
+    for &d in &ctx.updaters[ctx.update_ptr[s]..ctx.update_ptr[s + 1]] {
+        let d_pattern = pattern(sym, d);
+        let d_ncols = width(sym, d);
+        // SAFETY: d is below s in the tree: finished before s started, and no longer written
+        let ld = unsafe { ctx.values.block(cpv[d], cpv[d + 1]) };
+        let ld = MatRef::from_column_major_slice(ld, d_pattern.len() + d_ncols, d_ncols);
+        let lo = d_pattern.partition_point(|&r| r < s_start);
+        let mid = d_pattern[lo..].partition_point(|&r| r < s_end);
+        let ld_mid_bot = ld.subrows(d_ncols + lo, d_pattern.len() - lo);
+        row_idx.clear();
+        row_idx.extend(d_pattern[lo..].iter().enumerate().map(|(i, &r)| if i < mid { r - s_start } else { g2l[r] }));
+        col_idx.clear();
+        col_idx.extend(d_pattern[lo..lo + mid].iter().map(|&r| r - s_start));
+        update(ls.rb_mut(), row_idx, col_idx, ld_mid_bot, ld_mid_bot.subrows(0, mid).transpose(), par);
+    }
+    let (mut top, mut bot) = ls.split_at_row_mut(s_ncols);
+    cholesky_in_place(top.rb_mut(), Default::default(), par, stack, Default::default())
+        .map_err(|LltError::NonPositivePivot { index }| LltError::NonPositivePivot { index: index + s_start })?;
+    solve_lower_triangular_in_place(top.rb().conjugate(), bot.rb_mut().transpose_mut(), par);
+    s_pattern.iter().for_each(|&row| g2l[row] = NONE);
+    Ok(())
+}
+
+/// C[row_idx, col_idx] −= A Bᵀ on the lower triangle of C (B given transposed), as faer's supernodal
+/// kernel calls its update kernel (`spicy_matmul`): sequential below 32³ multiply-adds.
+#[cfg(target_arch = "x86_64")]
+fn update(c: MatMut<'_, f64>, row_idx: &[usize], col_idx: &[usize], a: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) {
+    use private_gemm_x86::{gemm, Accum, DType, DstKind, IType};
+    let (nrows, ncols, depth) = (a.nrows(), b.ncols(), a.ncols());
+    assert!(row_idx.len() == nrows && col_idx.len() == ncols && b.nrows() == depth);
+    assert!(row_idx.iter().all(|&i| i < c.nrows()) && col_idx.iter().all(|&j| j < c.ncols()));
+    if nrows == 0 || ncols == 0 {
+        return;
+    }
+    let Some(instr) = instr_set() else { unreachable!("subtrees::factorize is used only where available()") };
+    let par = if (nrows * ncols).saturating_mul(depth) > 32 * 32 * 32 { par } else { Par::Seq };
+    let alpha = -1.0f64;
+    // SAFETY: the shapes, strides and indices are those checked above, as faer's spicy_matmul passes them
+    unsafe {
+        gemm(
+            DType::F64,
+            IType::U64,
+            instr,
+            nrows,
+            ncols,
+            depth,
+            c.as_ptr_mut() as _,
+            c.row_stride(),
+            c.col_stride(),
+            row_idx.as_ptr() as _,
+            col_idx.as_ptr() as _,
+            DstKind::Lower,
+            Accum::Add,
+            a.as_ptr() as _,
+            a.row_stride(),
+            a.col_stride(),
+            false,
+            std::ptr::null(),
+            0,
+            b.as_ptr() as _,
+            b.row_stride(),
+            b.col_stride(),
+            true,
+            &raw const alpha as _,
+            par.degree(),
+        );
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+fn update(_: MatMut<'_, f64>, _: &[usize], _: &[usize], _: MatRef<'_, f64>, _: MatRef<'_, f64>, _: Par) {
+    unreachable!("subtrees::factorize is used only where available()")
+}

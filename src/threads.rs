@@ -1,0 +1,97 @@
+//! How many threads a run uses: the cores available to the process (its CPU affinity and cgroup quota,
+//! `std::thread::available_parallelism`), unless `--threads N` or the environment variable
+//! `TRESCA_THREADS` says otherwise. The count sizes rayon's pool (the expression evaluation of
+//! [`crate::parallel`]) and the parallel kernels of the factorisation and of the large solves
+//! (`solve::cholesky::factor`); results files record it (`/tresca@threads`).
+//!
+//! The factor, and so every result, is the same bit for bit run after run and for every count: the
+//! factorisation by subtrees computes each supernode as faer's sequential kernel does
+//! (`solve::cholesky::subtrees`), and faer's parallel dense kernels split their work by output blocks, each computed
+//! as the sequential kernel computes it (docs/model.md, "Threads"; tested in `solve::cholesky::factor`).
+
+use crate::error::{Error, Result};
+use faer::Par;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// The environment variable that sets the thread count when `--threads` is not given.
+pub const ENV: &str = "TRESCA_THREADS";
+
+/// The count in force; 0 until [`set`] or the first [`count`].
+static COUNT: AtomicUsize = AtomicUsize::new(0);
+
+/// The cores available to this process (at least 1).
+pub fn available() -> usize {
+    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+}
+
+/// The count asked for: `flag`, else `TRESCA_THREADS`, else [`available`]. Zero and text that is not a
+/// count are refused.
+pub fn requested(flag: Option<usize>) -> Result<usize> {
+    let n = match (flag, std::env::var(ENV)) {
+        (Some(n), _) => n,
+        (None, Ok(v)) => v.trim().parse().map_err(|_| bad(&v))?,
+        (None, Err(_)) => available(),
+    };
+    if n == 0 {
+        return Err(bad("0"));
+    }
+    Ok(n)
+}
+
+fn bad(v: &str) -> Error {
+    Error::Threads(v.into())
+}
+
+/// Use `n` threads from now on: the count of [`count`] and, on its first call, the size of rayon's
+/// global pool (later calls change the count only; the pool keeps its size).
+pub fn set(n: usize) {
+    let n = n.max(1);
+    COUNT.store(n, Ordering::Relaxed);
+    let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
+}
+
+/// The thread count in force: the last [`set`], else `TRESCA_THREADS` or the available cores.
+pub fn count() -> usize {
+    match COUNT.load(Ordering::Relaxed) {
+        0 => {
+            let n = requested(None).unwrap_or_else(|_| available());
+            COUNT.store(n, Ordering::Relaxed);
+            n
+        }
+        n => n,
+    }
+}
+
+/// faer's parallelism for the thread count in force: sequential for one thread.
+pub fn par() -> Par {
+    match count() {
+        1 => Par::Seq,
+        n => Par::rayon(n),
+    }
+}
+
+/// [`par`] when the work, `flops` floating-point operations, is large enough to gain from threads
+/// (handing work to the pool costs tens of µs), else sequential.
+pub fn par_for(flops: f64) -> Par {
+    if flops >= MIN_PARALLEL_FLOPS {
+        par()
+    } else {
+        Par::Seq
+    }
+}
+
+/// Below this many floating-point operations a kernel runs sequentially (see [`par_for`]).
+pub const MIN_PARALLEL_FLOPS: f64 = 4.0e6;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The system shall take the thread count from `--threads`, refusing zero.
+    #[test]
+    fn the_flag_sets_the_count_and_zero_is_refused() {
+        assert_eq!(requested(Some(3)).unwrap(), 3);
+        assert!(requested(Some(0)).is_err());
+        assert!(available() >= 1);
+    }
+}
