@@ -19,7 +19,8 @@ everything else (integers, flags, strings, shapes) must still be equal; the larg
 of every file are printed. Like is compared with like: files written with different thread counts
 (``/tresca@threads``; 1 in files of versions before it) differ unless ``--rel`` is given, which notes the
 counts (``run --threads N`` passes ``--threads N`` to the binary). ``scene_path`` (where the scene file
-was) is not compared; a dataset added by a later version (``tresca/steps/checksum``) is compared only when both files hold it.
+was) is not compared; a dataset added by a later version (``tresca/steps/checksum``) is compared only
+when both files hold it.
 """
 import argparse
 import glob
