@@ -4,7 +4,8 @@
 //! Built from a [`RawMesh`] (points, triangles, tagged boundary edges) produced by the structured
 //! generator or the Gmsh reader, after optional red refinement. [`Mesh::build`] rejects degenerate and
 //! overlapping triangles, non-manifold edges and tags on interior edges; [`Mesh::bind_parts`] checks
-//! that every boundary edge belongs to exactly one declared part. [`bisect`] refines locally.
+//! that every boundary edge belongs to exactly one declared part. [`bisect`] refines locally;
+//! [`Mesh::boundary_points`] finds the corners and changes of part, where a solution may be singular.
 
 pub mod bisect;
 mod build;
