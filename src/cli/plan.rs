@@ -69,6 +69,31 @@ pub fn run(
         }
         return Ok(if chosen { 0 } else { REFUSED });
     }
+    print_table(&p);
+    let b = &p.best[0];
+    say!(
+        "\nrun it: tresca-cr run {} --refine {} --steps {} --solver {} --tol {:e}",
+        scene.file,
+        b.refine,
+        b.steps,
+        p.solver,
+        p.tol
+    );
+    if execute {
+        if let Some(Ok(a)) = adaptive.as_ref().filter(|_| adaptive_chosen(&adaptive)) {
+            summarise(&p, None, &adaptive)?;
+            super::out::report_written(csv.as_deref())?;
+            return super::plan_adaptive::execute(&scene, a, &p);
+        }
+    }
+    let achieved = if execute { Some(execute_plan(&scene, &p, b)?) } else { None };
+    summarise(&p, achieved, &adaptive)?;
+    super::out::report_written(csv.as_deref())?;
+    Ok(0)
+}
+
+/// The plan and its runners-up, one line each.
+fn print_table(p: &Plan) {
     say!(
         "\n{:>8} {:>6} {:>7} {:>10} {:>6} {:>8} {:>11} {:>11} {:>11} {:>11} {:>9}",
         "",
@@ -99,62 +124,48 @@ pub fn run(
             c.memory >> 20
         );
     }
-    let b = &p.best[0];
-    say!(
-        "\nrun it: tresca-cr run {} --refine {} --steps {} --solver {} --tol {:e}",
-        scene.file,
-        b.refine,
-        b.steps,
-        p.solver,
-        p.tol
-    );
-    if execute {
-        if let Some(Ok(a)) = adaptive.as_ref().filter(|_| adaptive_chosen(&adaptive)) {
-            summarise(&p, None, &adaptive)?;
-            super::out::report_written(csv.as_deref())?;
-            return super::plan_adaptive::execute(&scene, a, &p);
-        }
-    }
-    let achieved = if execute { Some(execute_plan(&scene, &p, b)?) } else { None };
-    summarise(&p, achieved, &adaptive)?;
-    super::out::report_written(csv.as_deref())?;
-    Ok(0)
 }
 
+/// The pilot runs of one sequence (time or space) with their estimated errors and verdicts.
+fn print_sequence(name: &str, study: &Study, fit: &tresca_cr::plan::pilot::Fit) {
+    say!("  {name} sequence, sizes {}:", fit.size);
+    say!(
+        "  {:>6} {:>7} {:>9} {:>10} {:>9} {:>9} {:>7} {:>11}  verdict",
+        "refine",
+        "steps",
+        "h",
+        "unknowns",
+        "set-up",
+        "wall",
+        "it/step",
+        "est error"
+    );
+    for (i, r) in study.levels.iter().enumerate() {
+        let est = fit.errors.get(i).map_or("-".into(), |e| format!("{e:.4e}"));
+        let verdict = fit.verdicts.get(i).map_or(String::new(), |v| v.text());
+        say!(
+            "  {:>6} {:>7} {:>9.3e} {:>10} {:>9.4} {:>9.4} {:>7.2} {:>11}  {}",
+            r.refine,
+            r.steps,
+            r.h,
+            r.dofs,
+            r.setup,
+            r.wall,
+            r.iterations as f64 / r.steps as f64,
+            est,
+            verdict
+        );
+    }
+    if let Some(why) = &fit.refused {
+        say!("  no estimate: {why}");
+    }
+}
+
+/// The pilot runs, the fitted error model and the cost model.
 fn print_evidence(p: &Plan) {
     say!("\nPilot runs (the scene without [exact]; wall = set-up + steps, seconds):");
     for (name, study, fit) in [("time", &p.time, &p.time_fit), ("space", &p.space, &p.space_fit)] {
-        say!("  {name} sequence, sizes {}:", fit.size);
-        say!(
-            "  {:>6} {:>7} {:>9} {:>10} {:>9} {:>9} {:>7} {:>11}  verdict",
-            "refine",
-            "steps",
-            "h",
-            "unknowns",
-            "set-up",
-            "wall",
-            "it/step",
-            "est error"
-        );
-        for (i, r) in study.levels.iter().enumerate() {
-            let est = fit.errors.get(i).map_or("-".into(), |e| format!("{e:.4e}"));
-            let verdict = fit.verdicts.get(i).map_or(String::new(), |v| v.text());
-            say!(
-                "  {:>6} {:>7} {:>9.3e} {:>10} {:>9.4} {:>9.4} {:>7.2} {:>11}  {}",
-                r.refine,
-                r.steps,
-                r.h,
-                r.dofs,
-                r.setup,
-                r.wall,
-                r.iterations as f64 / r.steps as f64,
-                est,
-                verdict
-            );
-        }
-        if let Some(why) = &fit.refused {
-            say!("  no estimate: {why}");
-        }
+        print_sequence(name, study, fit);
     }
     say!("Pilot cost: {:.3} s (pilot budget {:.3} s)", p.pilot_wall, p.options.pilot_budget);
     let orders = |f: &tresca_cr::plan::pilot::Fit| {

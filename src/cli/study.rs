@@ -79,7 +79,6 @@ pub fn study(
     json: Option<PathBuf>,
 ) -> Result<()> {
     let start = std::time::Instant::now();
-    use tresca_cr::study::orders::observed_order;
     use tresca_cr::study::run_study;
     check_levels(levels, reference)?;
     if let Some(p) = &csv {
@@ -105,36 +104,7 @@ pub fn study(
     );
     let mut prev: Option<LevelResult> = None;
     let study = run_study(&scene, levels, reference, differences.as_deref(), |r| {
-        let o = |f: &dyn Fn(&LevelResult) -> Option<f64>| match (&prev, f(r)) {
-            // orders against h, or against k when only the time step changes
-            (Some(p), Some(b)) => {
-                let (xa, xb) = if (p.h - r.h).abs() <= 1e-12 * r.h { (p.k, r.k) } else { (p.h, r.h) };
-                f(p).map(|a| format!("{:.3}", observed_order(a, b, xa, xb))).unwrap_or_default()
-            }
-            _ => String::new(),
-        };
-        let v = |x: Option<f64>| x.map(|x| format!("{x:.4e}")).unwrap_or_else(|| "-".into());
-        let en = |r: &LevelResult| r.max_err.map(|e| e.energy);
-        let l2 = |r: &LevelResult| r.max_err.map(|e| e.l2);
-        let co = |r: &LevelResult| r.consecutive.map(|e| e[1]);
-        let rf = |r: &LevelResult| r.reference.map(|e| e[1]);
-        say!(
-            "{:>3} {:>6} {:>9.3e} {:>9.3e} {:>8} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>8.3}",
-            r.refine,
-            r.steps,
-            r.h,
-            r.k,
-            r.paper_dofs,
-            v(en(r)),
-            o(&en),
-            v(l2(r)),
-            o(&l2),
-            v(co(r)),
-            o(&co),
-            v(rf(r)),
-            o(&rf),
-            r.wall
-        );
+        print_row(prev.as_ref(), r);
         prev = Some(r.clone());
     })?;
     say!("(energy, L2: true errors, max over each level's own time nodes)");
@@ -152,6 +122,41 @@ pub fn study(
         super::summary::write(j, &summary)?;
     }
     super::out::report_written(csv.as_deref())
+}
+
+/// The table row of level `r`, with its observed orders against the level before it (`prev`).
+fn print_row(prev: Option<&LevelResult>, r: &LevelResult) {
+    use tresca_cr::study::orders::observed_order;
+    let o = |f: &dyn Fn(&LevelResult) -> Option<f64>| match (prev, f(r)) {
+        // orders against h, or against k when only the time step changes
+        (Some(p), Some(b)) => {
+            let (xa, xb) = if (p.h - r.h).abs() <= 1e-12 * r.h { (p.k, r.k) } else { (p.h, r.h) };
+            f(p).map(|a| format!("{:.3}", observed_order(a, b, xa, xb))).unwrap_or_default()
+        }
+        _ => String::new(),
+    };
+    let v = |x: Option<f64>| x.map(|x| format!("{x:.4e}")).unwrap_or_else(|| "-".into());
+    let en = |r: &LevelResult| r.max_err.map(|e| e.energy);
+    let l2 = |r: &LevelResult| r.max_err.map(|e| e.l2);
+    let co = |r: &LevelResult| r.consecutive.map(|e| e[1]);
+    let rf = |r: &LevelResult| r.reference.map(|e| e[1]);
+    say!(
+        "{:>3} {:>6} {:>9.3e} {:>9.3e} {:>8} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>8.3}",
+        r.refine,
+        r.steps,
+        r.h,
+        r.k,
+        r.paper_dofs,
+        v(en(r)),
+        o(&en),
+        v(l2(r)),
+        o(&l2),
+        v(co(r)),
+        o(&co),
+        v(rf(r)),
+        o(&rf),
+        r.wall
+    );
 }
 
 /// The estimates: energy norm per level, then every scalar output.

@@ -83,11 +83,39 @@ pub fn step_checksums(series: &[&[u8]], k: usize) -> Vec<u64> {
 
 const SCALARS: [&str; 6] = ["times", "energy", "steps/iterations", "steps/residual", "steps/n_stick", "steps/n_slip"];
 
+/// The attributes of the `/tresca` group of a new file: the scene, the build, the solver and the sizes.
+fn attributes(g: &Group, p: &Run) -> hdf5::Result<()> {
+    let (s, mesh, space, loc) = (p.scene, p.mesh, p.space, &**g);
+    attr_str(loc, "scene", &s.text)?;
+    attr_str(loc, "scene_path", &s.file)?;
+    attr_str(loc, "title", &s.title)?;
+    attr_str(loc, "version", p.meta.version)?;
+    attr_str(loc, "git_commit", p.meta.commit)?;
+    attr(loc, "threads", crate::threads::count() as i64)?;
+    attr_str(loc, "solver", s.solver.method.name())?;
+    attr(loc, "tol", s.solver.tol)?;
+    attr(loc, "max_iter", s.solver.max_iter() as i64)?;
+    attr(loc, "uzawa_step", s.solver.uzawa_step)?;
+    attr(loc, "rho", s.rho)?;
+    attr(loc, "E", s.material.e)?;
+    attr(loc, "nu", s.material.nu)?;
+    attr(loc, "steps", p.n_steps() as i64)?;
+    attr(loc, "n_edges", mesh.edges.len() as i64)?;
+    attr(loc, "n_contact", space.contact.len() as i64)?;
+    attr(loc, "n_dofs", space.n_dofs as i64)?;
+    attr(loc, "paper_dofs", space.paper_dofs() as i64)?;
+    attr(loc, "h", mesh.h_max())?;
+    attr_vec(loc, "setup_times", &p.meta.setup.as_array())?;
+    attr_str(loc, "setup_times_meaning", "mesh+space, assembly, factorisation, load superposition, condensation (s)")?;
+    attr_str(loc, "status", "running")?;
+    Ok(())
+}
+
 impl Tresca {
     /// Create the group with static data, attributes and empty series.
     pub fn create(file: &File, p: &Run) -> hdf5::Result<Tresca> {
         let g = file.create_group("tresca")?;
-        let (mesh, space, s) = (p.mesh, p.space, p.scene);
+        let (mesh, space) = (p.mesh, p.space);
         let mg = g.create_group("mesh")?;
         let pts: Vec<f64> = mesh.points.iter().flatten().copied().collect();
         put(&mg, "points", &[mesh.points.len(), 2], &pts)?;
@@ -128,33 +156,7 @@ impl Tresca {
         } else {
             None
         };
-        let loc = &*g;
-        attr_str(loc, "scene", &s.text)?;
-        attr_str(loc, "scene_path", &s.file)?;
-        attr_str(loc, "title", &s.title)?;
-        attr_str(loc, "version", p.meta.version)?;
-        attr_str(loc, "git_commit", p.meta.commit)?;
-        attr(loc, "threads", crate::threads::count() as i64)?;
-        attr_str(loc, "solver", s.solver.method.name())?;
-        attr(loc, "tol", s.solver.tol)?;
-        attr(loc, "max_iter", s.solver.max_iter() as i64)?;
-        attr(loc, "uzawa_step", s.solver.uzawa_step)?;
-        attr(loc, "rho", s.rho)?;
-        attr(loc, "E", s.material.e)?;
-        attr(loc, "nu", s.material.nu)?;
-        attr(loc, "steps", p.n_steps() as i64)?;
-        attr(loc, "n_edges", ne as i64)?;
-        attr(loc, "n_contact", space.contact.len() as i64)?;
-        attr(loc, "n_dofs", space.n_dofs as i64)?;
-        attr(loc, "paper_dofs", space.paper_dofs() as i64)?;
-        attr(loc, "h", mesh.h_max())?;
-        attr_vec(loc, "setup_times", &p.meta.setup.as_array())?;
-        attr_str(
-            loc,
-            "setup_times_meaning",
-            "mesh+space, assembly, factorisation, load superposition, condensation (s)",
-        )?;
-        attr_str(loc, "status", "running")?;
+        attributes(&g, p)?;
         attr(&sg, "completed", 0i64)?;
         let audit = AUDIT.iter().map(|a| Series::create::<f64>(&sg, a, 1, &[], sc)).collect::<hdf5::Result<_>>()?;
         Ok(Tresca {

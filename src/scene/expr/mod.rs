@@ -17,7 +17,7 @@
 //! assert!((e.eval(2.0, 3.0, 0.5)? - (-4.0 + 0.15)).abs() < 1e-12 && Expr::parse("f", "-x^2").is_err());
 //! let (set, mut out) = (ExprSet::new(&[&e, &Expr::parse("g", "x*y")?]), Vec::new());
 //! set.eval(&[[0.0, 1.0], [2.0, 3.0]], 0.0, &mut out)?;
-//! assert_eq!(out, vec![1.0, 0.0, -3.0, 6.0]); // point-major
+//! assert_eq!(out, vec![0.0, 0.0, -4.0, 6.0]); // point-major (sin(πt) = 0 at t = 0)
 //! assert!(Expr::parse("h", "1/x")?.eval(0.0, 0.0, 0.0).is_err()); // an error, not a NaN
 //! # Ok::<(), tresca_cr::Error>(())
 //! ```
