@@ -243,3 +243,26 @@ fn study_prints_reasons_not_nan() {
     assert!(out.contains("Output max_slip at T: not extrapolated: "), "{out}");
     assert!(out.lines().filter(|l| l.contains("est          —  GCI          —")).count() >= 3, "{out}");
 }
+
+/// The system shall give the same results files, bit for bit, with 1 and with 2 threads (docs/model.md,
+/// "Threads"; refine 5's factor is computed by subtrees), record the count in `/tresca@threads`, and refuse
+/// a thread count of 0 or one that is not a number with a message.
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let scene = root("verification/cases/paper_example_5_1.toml");
+    let files = [tmp("threads_1.h5"), tmp("threads_2.h5")];
+    for (t, out) in ["1", "2"].into_iter().zip(&files) {
+        let out_s = out.to_str().unwrap();
+        let o = run(&["run", &scene, "--refine", "5", "--steps", "4", "-q", "--threads", t, "-o", out_s, "--force"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let f = hdf5::File::open(out).unwrap();
+        let n: i64 = f.group("tresca").unwrap().attr("threads").unwrap().read_scalar().unwrap();
+        assert_eq!(n.to_string(), t);
+    }
+    same_results(&files[0], &files[1]);
+    let o = run(&["check", &scene, "--threads", "0"]);
+    assert!(!o.status.success() && stderr(&o).contains("--threads"), "{}", stderr(&o));
+    let o = spawn(bin().env("TRESCA_THREADS", "two").args(["check", &scene])).wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("TRESCA_THREADS"), "{}", stderr(&o));
+}

@@ -81,6 +81,15 @@ struct Ctx<'a> {
     updaters: Vec<usize>,
 }
 
+/// Bytes [`factorize`] allocates with `threads` threads beside L and faer's scratch, at most: a row map of
+/// n entries per thread, the tree and each supernode's updaters (at most one per row index of L's
+/// supernodal pattern, kept as pairs then as a list).
+pub(crate) fn scratch_bytes(symbolic: &SymbolicSupernodalCholesky<usize>, threads: usize) -> u64 {
+    let word = std::mem::size_of::<usize>() as u64;
+    let (n, ns, rows) = (symbolic.nrows() as u64, symbolic.n_supernodes() as u64, symbolic.row_idx().len() as u64);
+    word * (threads as u64 * n + 3 * rows + 12 * ns)
+}
+
 /// L's values of the lower triangle `a` (permuted) with `threads` threads (≥ 2), as faer's
 /// `factorize_supernodal_numeric_llt` with default parameters computes them. `values` must be zeros.
 /// In rounds: the subtrees of [`plan`] on threads of their own, then the same for the supernodes above

@@ -75,10 +75,19 @@ impl Symbolic {
         Symbolic { ordering, ..self }
     }
 
-    /// Bytes the numeric factorisation allocates: L's values and its scratch.
+    /// Bytes the numeric factorisation allocates: L's values and its scratch (with several threads, that
+    /// of the factorisation by subtrees too).
     fn need_of(symbolic: &SymbolicSupernodalCholesky<usize>, pattern_nnz: usize) -> u64 {
         let scratch = numeric_scratch(symbolic, pattern_nnz, crate::threads::par());
-        (symbolic.len_val() as u64).saturating_mul(8).saturating_add(scratch.unaligned_bytes_required() as u64)
+        let threads = crate::threads::count();
+        let subtrees = if threads > 1 && symbolic.len_val() >= super::subtrees::MIN_ENTRIES {
+            super::subtrees::scratch_bytes(symbolic, threads)
+        } else {
+            0
+        };
+        (symbolic.len_val() as u64)
+            .saturating_mul(8)
+            .saturating_add(scratch.unaligned_bytes_required() as u64 + subtrees)
     }
 
     /// Whether the numeric factorisation, and `more` bytes the caller will allocate beside it, fit in the
