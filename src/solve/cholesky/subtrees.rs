@@ -151,7 +151,7 @@ fn tree(symbolic: &SymbolicSupernodalCholesky<usize>) -> (Vec<usize>, Vec<usize>
     for s in 0..ns {
         of_col[symbolic.supernode_begin()[s]..symbolic.supernode_end()[s]].fill(s);
     }
-    let mut parent = vec![NONE; ns];
+    let parent: Vec<usize> = (0..ns).map(|d| pattern(symbolic, d).first().map_or(NONE, |&r| of_col[r])).collect();
     let mut pairs = Vec::new();
     for d in 0..ns {
         let mut last = NONE;
@@ -162,7 +162,6 @@ fn tree(symbolic: &SymbolicSupernodalCholesky<usize>) -> (Vec<usize>, Vec<usize>
                 last = s;
             }
         }
-        parent[d] = pattern(symbolic, d).first().map_or(NONE, |&r| of_col[r]);
     }
     let mut ptr = vec![0; ns + 1];
     pairs.iter().for_each(|&(s, _)| ptr[s + 1] += 1);
