@@ -50,6 +50,19 @@ fn summary_round_trips_through_json() {
         setup,
         memory: 1 << 20,
         disk: 4096,
+        singular: Singular {
+            points: vec![SingularPoint {
+                x: 1.0,
+                y: 1.0,
+                angle: 1.5 * std::f64::consts::PI,
+                parts: ["notch".into(), "ledge".into()],
+                sides: ["free".into(), "free".into()],
+                alpha: Some(0.5445),
+                alpha_imag: Some(0.0),
+            }],
+            uniform_order: 0.5445,
+            adaptive_order: 0.5,
+        },
     });
     let step = Step { n: 1, t: 0.5, iterations: 3, residual: 1e-13, stick: 2, slip: 1, errors: Some(errors(1e-3)) };
     s.run = Some(RunSummary {
