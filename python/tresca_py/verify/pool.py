@@ -44,9 +44,6 @@ def owns(study, rel):
     return any(fnmatch.fnmatch(rel, pattern) for pattern in study.writes)
 
 
-_TABLE = {}   # name → Study, set by run() before the workers fork
-
-
 def _captured(fd_file, fn):
     """Run ``fn()`` with file descriptors 1 and 2, and ``sys.stdout``/``sys.stderr`` (line-buffered on them),
     sent to ``fd_file``."""
@@ -68,10 +65,10 @@ def _captured(fd_file, fn):
             os.close(saved)
 
 
-def run_one(name, out):
-    """In a worker: run the study ``name`` into a fresh harness on ``out``; returns (results, output text,
-    changed .h5 files relative to ``out``, seconds)."""
-    study = _TABLE[name]
+def run_one(study, out):
+    """In a worker: run ``study`` into a fresh harness on ``out``; returns (results, output text, changed .h5
+    files relative to ``out``, seconds)."""
+    name = study.name
     hs = Harness(out=out)
     before = audits.snapshot(out)
     t0 = time.time()
@@ -103,9 +100,10 @@ def segments(studies):
     return runs + ([current] if current else [])
 
 
-def _child(name, out, path):
-    """A worker process: :func:`run_one`, its result pickled to ``path``."""
-    result = run_one(name, out)
+def _child(study, out, path):
+    """A worker process (forked: ``study`` is inherited, not pickled): :func:`run_one`, its result pickled
+    to ``path``."""
+    result = run_one(study, out)
     with open(path, "wb") as f:
         pickle.dump(result, f)
 
@@ -129,7 +127,7 @@ def _segment(ctx, seg, out, jobs, tmp):
             while queue and len(running) < jobs:
                 nxt = queue.pop(0)
                 path = os.path.join(tmp, f"{nxt.name}.pickle")
-                running[nxt.name] = (ctx.Process(target=_child, args=(nxt.name, out, path)), path)
+                running[nxt.name] = (ctx.Process(target=_child, args=(nxt, out, path)), path)
                 running[nxt.name][0].start()
             ready = mp_wait([p.sentinel for p, _ in running.values()])
             for name, (p, path) in list(running.items()):
@@ -143,11 +141,9 @@ def _segment(ctx, seg, out, jobs, tmp):
 def execute(studies, out, jobs):
     """Run ``studies`` with at most ``jobs`` at a time; yields (study, result of :func:`run_one`) in the
     table's order, each as soon as it and the ones before it are done."""
-    _TABLE.clear()
-    _TABLE.update({s.name: s for s in studies})
     if jobs <= 1:
         for s in studies:
-            yield s, run_one(s.name, out)
+            yield s, run_one(s, out)
         return
     ctx = multiprocessing.get_context("fork")
     with tempfile.TemporaryDirectory() as tmp:
