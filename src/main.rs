@@ -288,14 +288,8 @@ pub(crate) fn hand_back_memory() {
 fn main() {
     tune_malloc();
     let cli = Cli::parse();
-    match tresca_cr::threads::requested(cli.threads) {
-        Ok(n) => tresca_cr::threads::set(n),
-        Err(e) => {
-            note!("error: {e}");
-            std::process::exit(1);
-        }
-    }
-    let result = match cli.cmd {
+    let threads = tresca_cr::threads::requested(cli.threads).map(tresca_cr::threads::set);
+    let result = threads.map_err(anyhow::Error::from).and_then(|()| match cli.cmd {
         Cmd::Check { scene, grid, limits, json } => check(&scene, grid, limits, json),
         Cmd::Run { scene, overrides, out, verbose, quiet, limits, json } => {
             run(&scene, overrides, out, (verbose, quiet), limits, json)
@@ -310,7 +304,7 @@ fn main() {
         }
         cmd @ Cmd::Adapt { .. } => adapt(cmd),
         cmd @ Cmd::Plan { .. } => plan(cmd),
-    };
+    });
     if let Err(e) = result {
         note!("error: {e:#}");
         std::process::exit(1);

@@ -70,19 +70,6 @@ pub fn par() -> Par {
     }
 }
 
-/// [`par`] when the work, `flops` floating-point operations, is large enough to gain from threads
-/// (handing work to the pool costs tens of µs), else sequential.
-pub fn par_for(flops: f64) -> Par {
-    if flops >= MIN_PARALLEL_FLOPS {
-        par()
-    } else {
-        Par::Seq
-    }
-}
-
-/// Below this many floating-point operations a kernel runs sequentially (see [`par_for`]).
-pub const MIN_PARALLEL_FLOPS: f64 = 4.0e6;
-
 #[cfg(test)]
 mod tests {
     use super::*;
