@@ -1,0 +1,96 @@
+"""The per-step contact problem of a scene with normal unknowns (a unilateral or a Coulomb part, issue 40): every
+Γ_C edge e carries the tangential unknown s_e and the normal unknown r_e = u_n(m_e), and the contact force on the
+body is −μ_e τ_e − P_e n_e (μ_e the friction force, P_e = |e| p_e the normal force). With B injecting both
+(tangential ones first), C = Bᵀ K_r⁻¹ B and
+
+    d = (s_free − s^{n−1}, r_free − ḡ),   λ = (μ, P),   Δ = d − C λ = (Δs, r − ḡ),
+
+a step solves the dual problem min ½λᵀCλ − dᵀλ over μ_e ∈ [−w_e, w_e] (Tresca, w_e = |e| ḡa_e, on every Γ_C edge,
+also where separated), P_e ∈ [0, ∞) (unilateral: P ≥ 0, r ≤ ḡ, P (r − ḡ) = 0) or (−∞, ∞) (bilateral: r = ḡ),
+exactly, by the primal active-set method (``friction.bound_qp``). Coulomb replaces w_e by F̄_e |P_e|: a fixed
+point over Tresca thresholds, each solved exactly, iterated until P changes by ≤ 1e-14 of its size; the
+natural residual with the bounds of the final P is reported (and must be ≤ 1e-12).
+
+ḡ_e is the edge mean (3-point Gauss) of the gap at tₙ. An edge is *separated* when P_e = 0 and its gap is open,
+r_e − ḡ_e < −1e-9 · max|d| (the rule of the Rust solver); status 0 stick, 1 slip, 2 separated.
+"""
+import numpy as np
+
+from tresca_py.quadrature import GAUSS3_W
+from tresca_py.skfem_cr.friction import StepSolver, bound_qp, classify, natural_residual
+
+SEPARATED = 2
+COULOMB_TOL, COULOMB_MAX_ITER = 1e-14, 500
+
+
+class Normal:
+    """Bounds, Coulomb coefficients and gaps of the normal unknowns of a ``Discretisation``."""
+
+    def __init__(self, disc):
+        self.disc = disc
+        self.lo = np.where(disc.unilateral, 0.0, -np.inf)
+        self.coulomb = ~np.isnan(disc.coulomb)
+        self.gaps = []                                      # (gap expression, positions in disc.contact)
+        for ip, b in enumerate(disc.scene.boundaries):
+            if b.kind == "contact" and b.gap is not None:
+                self.gaps.append((b.gap, np.flatnonzero(disc.part_of_edge[disc.contact] == ip)))
+
+    def gap(self, t):
+        """ḡ_e(t) of every Γ_C edge (zero without a gap)."""
+        g = np.zeros(len(self.disc.contact))
+        for expr, pos in self.gaps:
+            xq, yq = self.disc.edge_points(self.disc.contact[pos])
+            g[pos] = expr(xq, yq, t) @ GAUSS3_W
+        return g
+
+    def bounds(self, P):
+        """(lo, hi) of λ = (μ, P) for the normal forces P: thresholds w_e or F̄_e |P_e|."""
+        w = np.where(self.coulomb, np.nan_to_num(self.disc.coulomb) * np.abs(P), self.disc.weight)
+        return np.concatenate([-w, self.lo]), np.concatenate([w, np.full(len(w), np.inf)])
+
+
+def solve_contact(C, d, normal, lam0):
+    """λ = (μ, P) of one step (module docstring); returns (λ, iterations, natural residual / force scale)."""
+    nc = len(d) // 2
+    lam, its = lam0.copy(), 0
+    for _ in range(COULOMB_MAX_ITER if normal.coulomb.any() else 1):
+        lo, hi = normal.bounds(lam[nc:])
+        new, k = bound_qp(C, d, lo, hi, lam)
+        its += k
+        change = np.max(np.abs(new[nc:] - lam[nc:]))
+        lam = new
+        if not normal.coulomb.any() or change <= COULOMB_TOL * max(np.max(np.abs(lam[nc:])), 1e-300):
+            break
+    else:
+        raise RuntimeError(f"Coulomb fixed point: no convergence in {COULOMB_MAX_ITER} Tresca solves "
+                           f"(last change of P {change:.3e})")
+    lo, hi = normal.bounds(lam[nc:])
+    scale = max(np.max(np.abs(lam)), np.max(np.abs(d)), 1e-300)
+    return lam, its, natural_residual(C, d, lo, hi, lam) / scale
+
+
+class UnilateralStepSolver(StepSolver):
+    """``StepSolver`` with the normal unknowns: the same factorisation, the step of the module docstring."""
+
+    def __init__(self, disc, K):
+        super().__init__(disc, K)
+        self.normal = Normal(disc)
+        self.mu = np.zeros(len(self.ic))
+
+    def step(self, l_full, u_prev_full, t):
+        """One backward Euler step at time t; returns (u_full, info dict)."""
+        disc, nc = self.disc, len(self.disc.contact)
+        r_free = self._solve(self.P.T @ l_full)
+        s_old = np.sum(u_prev_full.reshape(-1, 2)[disc.contact] * disc.tangent, axis=1)
+        gbar = self.normal.gap(t)
+        d = r_free[self.ic] - np.concatenate([s_old, gbar])
+        lam, its, residual = solve_contact(self.C, d, self.normal, self.mu)
+        self.mu = lam.copy()
+        r = r_free - self.Z @ lam
+        delta = d - self.C @ lam
+        state = classify(lam[:nc], delta[:nc], d[:nc], np.abs(self.normal.bounds(lam[nc:])[1][:nc])).astype(np.int8)
+        opening = delta[nc:]                                 # r_e - ḡ_e
+        state[(lam[nc:] == 0) & (opening < -1e-9 * np.max(np.abs(d)))] = SEPARATED
+        return self.P @ r, dict(iterations=its, residual=residual, mu=lam[:nc], d=d[:nc], ds=delta[:nc],
+                                dof=r[self.ic[:nc]], pressure=lam[nc:] / disc.lengths[disc.contact], gap=opening,
+                                state=state)
