@@ -105,6 +105,15 @@ def test_the_system_shall_refuse_unilateral_scenes_in_the_bilateral_solvers(tmp_
         s.refuse_contact_extensions("dolfinx_cr")
 
 
+def test_the_system_shall_refuse_an_initial_state_that_penetrates(tmp_path):
+    """The system shall refuse u0 with u0.n > g on a unilateral part, naming the part and the point, exit 2."""
+    scene = write(tmp_path, bottom='law = "unilateral"\ng_a = "0.1"\ngap = "0.001"')
+    scene.write_text(scene.read_text() + '[initial]\nu0 = ["0", "(0.002-0.002*x)*(1-y)"]\n')
+    p, _ = run([PY, "scripts/skfem_solve.py", scene, "-o", tmp_path / "out.h5", "-q"], check=False)
+    assert p.returncode == 2 and "penetrates the unilateral part 'bottom' at (1.750000, 0.000000)" in p.stderr
+    assert not (tmp_path / "out.h5").exists()
+
+
 def test_the_system_shall_solve_a_symmetry_part_as_frictionless_bilateral_contact(tmp_path):
     """The system shall give a symmetry part exactly the solution of a frictionless bilateral contact part."""
     a = solve(tmp_path, write(tmp_path, bottom='g_a = "0"', right="symmetry", name="sym.toml"))

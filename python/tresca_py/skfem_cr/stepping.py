@@ -9,7 +9,7 @@ from tresca_py.common import git_commit
 from tresca_py.errors import InputError
 from tresca_py.skfem_cr.cr import Discretisation
 from tresca_py.skfem_cr.friction import StepSolver, classify
-from tresca_py.skfem_cr.unilateral import UnilateralStepSolver
+from tresca_py.skfem_cr.unilateral import UnilateralStepSolver, initial_state
 
 
 def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
@@ -40,6 +40,8 @@ def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
     u = disc.interpolate(scene.u0, times[0])
     if lifting is not None:
         u = u + lifting.lift(times[0])
+    if disc.normal_unknowns:
+        res["gap"][0], res["state"][0] = initial_state(disc, u, times[0])
     for n, t in enumerate(times):
         tic = time.perf_counter()
         if n > 0:

@@ -11,11 +11,14 @@ exactly, by the primal active-set method (``friction.bound_qp``). Coulomb replac
 point over Tresca thresholds, each solved exactly, iterated until P changes by ≤ 1e-14 of its size; the
 natural residual with the bounds of the final P is reported (and must be ≤ 1e-12).
 
-ḡ_e is the edge mean (3-point Gauss) of the gap at tₙ. An edge is *separated* when P_e = 0 and its gap is open,
-r_e − ḡ_e < −1e-9 · max|d| (the rule of the Rust solver); status 0 stick, 1 slip, 2 separated.
+ḡ_e is the edge mean (3-point Gauss) of the gap at tₙ. An edge is *separated* when it is unilateral, P_e = 0 and
+its gap is open, r_e − ḡ_e < −1e-9 · max(|Δ|, |d|) (the rule of the Rust solver; stick and slip by
+``friction.classify`` with the scale max(|Δs|, |d|)); status 0 stick, 1 slip, 2 separated. Step 0 has P = 0, the gap of u⁰ and "separated"
+where it is open; an initial state that penetrates a unilateral part is refused, naming the part and the point.
 """
 import numpy as np
 
+from tresca_py.errors import InputError
 from tresca_py.quadrature import GAUSS3_W
 from tresca_py.skfem_cr.friction import StepSolver, bound_qp, classify, natural_residual
 
@@ -69,6 +72,27 @@ def solve_contact(C, d, normal, lam0):
     return lam, its, natural_residual(C, d, lo, hi, lam) / scale
 
 
+PENETRATION_TOL = 1e-9
+
+
+def initial_state(disc, u0, t0):
+    """(gap, state) of step 0 for the CR interpolant ``u0`` (canonical vector); InputError where it penetrates a
+    unilateral part by more than 1e-9 of max(|u0·n|, |ḡ|) (edge means; the Rust solver's rule)."""
+    un = np.sum(u0.reshape(-1, 2)[disc.contact] * disc.normal, axis=1)
+    gbar = Normal(disc).gap(t0)
+    gap = un - gbar
+    over = disc.unilateral & (gap > PENETRATION_TOL * np.maximum(np.abs(un), np.abs(gbar)))
+    if over.any():
+        k = int(np.flatnonzero(over)[0])
+        e = disc.contact[k]
+        part = disc.scene.boundaries[disc.part_of_edge[e]].name
+        m = disc.midpoints[e]
+        raise InputError(f"[initial] u0: the initial state penetrates the unilateral part '{part}' at "
+                         f"({m[0]:.6f}, {m[1]:.6f}): u0·n = {un[k]:e} > gap {un[k] - gap[k]:e} at t0 = {t0} "
+                         "(edge means)")
+    return gap, np.where(gap < 0, SEPARATED, 0).astype(np.int8)
+
+
 class UnilateralStepSolver(StepSolver):
     """``StepSolver`` with the normal unknowns: the same factorisation, the step of the module docstring."""
 
@@ -88,9 +112,10 @@ class UnilateralStepSolver(StepSolver):
         self.mu = lam.copy()
         r = r_free - self.Z @ lam
         delta = d - self.C @ lam
-        state = classify(lam[:nc], delta[:nc], d[:nc], np.abs(self.normal.bounds(lam[nc:])[1][:nc])).astype(np.int8)
+        state = classify(lam[:nc], delta[:nc], d, self.normal.bounds(lam[nc:])[1][:nc]).astype(np.int8)
         opening = delta[nc:]                                 # r_e - ḡ_e
-        state[(lam[nc:] == 0) & (opening < -1e-9 * np.max(np.abs(d)))] = SEPARATED
+        scale = max(np.max(np.abs(delta)), np.max(np.abs(d)))
+        state[(self.normal.lo == 0) & (lam[nc:] <= 0) & (opening < -1e-9 * scale)] = SEPARATED
         return self.P @ r, dict(iterations=its, residual=residual, mu=lam[:nc], d=d[:nc], ds=delta[:nc],
                                 dof=r[self.ic[:nc]], pressure=lam[nc:] / disc.lengths[disc.contact], gap=opening,
                                 state=state)
