@@ -11,10 +11,11 @@ exactly, by the primal active-set method (``friction.bound_qp``). Coulomb replac
 point over Tresca thresholds, each solved exactly, iterated until P changes by ≤ 1e-14 of its size; the
 natural residual with the bounds of the final P is reported (and must be ≤ 1e-12).
 
-ḡ_e is the edge mean (3-point Gauss) of the gap at tₙ. An edge is *separated* when it is unilateral, P_e = 0 and
-its gap is open, r_e − ḡ_e < −1e-9 · max(|Δ|, |d|) (the rule of the Rust solver; stick and slip by
-``friction.classify`` with the scale max(|Δs|, |d|)); status 0 stick, 1 slip, 2 separated. Step 0 has P = 0, the gap of u⁰ and "separated"
-where it is open; an initial state that penetrates a unilateral part is refused, naming the part and the point.
+ḡ_e is the edge mean (3-point Gauss) of the gap at tₙ. An edge is *separated* when it is unilateral, P_e = 0
+and its gap is open, r_e − ḡ_e < −1e-9 · max(|Δ|, |d|) (the rule of the Rust solver; stick and slip by
+``friction.classify`` with the scale max(|Δs|, |d|)); status 0 stick, 1 slip, 2 separated. Step 0 has P = 0,
+the gap of u⁰ and "separated" where it is open; an initial state that penetrates a unilateral part is refused,
+naming the part and the point.
 """
 import numpy as np
 
