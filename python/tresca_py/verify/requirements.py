@@ -113,7 +113,8 @@ REQUIREMENTS = (
     ),
     Requirement(
         'U2-skfem-signorini-incompressible',
-        '… the same, free of locking, near-incompressible (λ/μ = 10⁴, `mms_signorini_incompressible`)',
+        '… the same, free of locking, near-incompressible (λ/μ = 10⁴, `mms_signorini_incompressible`, refine 1..5: '
+        'its L² error is pre-asymptotic at refine 0)',
         '.venv/bin/python scripts/skfem_solve.py verification/cases/mms_signorini_incompressible.toml --refine k '
         '--steps 8',
         'reference/h_skfem_mms_signorini_incompressible.md',
