@@ -66,8 +66,9 @@ def _case(name, title, header, E, nu, u, reaction, friction):
     """The case dict of tresca_py.mms.derive plus the contact data: ``reaction`` = (p, lt) (sympy), ``friction``
     = ("g_a", expr) or ("coulomb", expr)."""
     kind, law = friction
-    return dict(name=name, title=title, header=header + DERIVATION, E=E, nu=nu, corners=UNIT_SQUARE, cells=[4, 4],
-                diagonal="first", kinds=KINDS, u=u, g_a=law if kind == "g_a" else None, T=1, steps=8,
+    measured = f"\nMeasured errors and orders (scikit-fem): reference/h_skfem_{name}.md (make verify regenerates it)."
+    return dict(name=name, title=title, header=header + DERIVATION + measured, E=E, nu=nu, corners=UNIT_SQUARE,
+                cells=[4, 4], diagonal="first", kinds=KINDS, u=u, g_a=law if kind == "g_a" else None, T=1, steps=8,
                 contact=dict(law="unilateral", friction=kind, bound=law, gap=GAP, pressure=reaction[0],
                              lt=reaction[1]),
                 expect={"stick_to_slip": True, "slip_to_stick": False, "contact_to_separation": False,
