@@ -68,7 +68,7 @@ def study(hs, quick=False):
     for rid, name, what, first in CASES:
         levels = range(first, first + (4 if quick else 5))
         rows, (ok_e, m_e), (ok_l, m_l), cmd = convergence(name, levels)
-        cmd = cmdline(cmd).replace(f"--refine {levels[-1]}", "--refine k")
+        cmd = cmdline(cmd[:7]).replace(f"--refine {levels[-1]}", "--refine k")     # without -o OUT -q
         ref = f"h_skfem_{name}"
         md = table_md(ref, f"{name}: scikit-fem, true errors (max over the time nodes), N = {STEPS}", rows,
                       ["energy_max", "h1_max", "l2_max"])
