@@ -9,12 +9,12 @@ from tresca_py.common import CASES
 from tresca_py.mms.derive import CheckFailed
 from tresca_py.mms.scene_toml import scene_text
 from tresca_py.mms.signorini import SIGNORINI_CASES
-from tresca_py.mms.signorini_checks import derive_signorini, mutants, run_checks
+from tresca_py.mms.signorini_checks import UNILATERAL_CASES, derive_signorini, mutants, run_checks
 
 QUIET = dict(log=lambda msg: None)
 
 
-@pytest.mark.parametrize("make", SIGNORINI_CASES, ids=lambda m: m.__name__)
+@pytest.mark.parametrize("make", UNILATERAL_CASES, ids=lambda m: m.__name__)
 def test_the_system_shall_regenerate_the_committed_unilateral_scenes_byte_for_byte(make):
     """The system shall write verification/cases/mms_signorini_*.toml exactly as derived from the case."""
     d = derive_signorini(make())
@@ -22,7 +22,7 @@ def test_the_system_shall_regenerate_the_committed_unilateral_scenes_byte_for_by
         assert scene_text(d) == fh.read()
 
 
-@pytest.mark.parametrize("make", SIGNORINI_CASES, ids=lambda m: m.__name__)
+@pytest.mark.parametrize("make", UNILATERAL_CASES, ids=lambda m: m.__name__)
 def test_the_system_shall_derive_unilateral_cases_that_satisfy_signorini_and_friction(make):
     """The system shall derive data whose contact reaction satisfies p >= 0, u.n <= g, p (u.n - g) = 0 and the
     friction law (Tresca or Coulomb) at every sample, with both transition points inside Gamma_C."""

@@ -16,7 +16,7 @@ from tresca_py.mms.lshape import check_toml as check_lshape_toml
 from tresca_py.mms.lshape import run_checks as run_lshape_checks
 from tresca_py.mms.lshape import scene_text as lshape_text
 from tresca_py.mms.scene_toml import check_toml, scene_text
-from tresca_py.mms.signorini import SIGNORINI_CASES
+from tresca_py.mms.signorini_checks import UNILATERAL_CASES
 from tresca_py.mms.signorini_checks import run_checks as run_signorini_checks
 from tresca_py.mms.signorini_checks import selftest as signorini_selftest
 
@@ -74,7 +74,7 @@ def derive_all(exmex):
     print("== mms_lshape: the L-shape with the re-entrant corner's singularity (tresca_py/mms/lshape.py)")
     lshape = run_lshape_checks(case_lshape(), lambda msg: print("   " + msg))
     text = lshape_text(lshape)
-    unilateral = derive_each(SIGNORINI_CASES, run_signorini_checks)
+    unilateral = derive_each(UNILATERAL_CASES, run_signorini_checks)
     return [scene_of(d, scene_text(d)) for d in derived] + [
         ("mms_lshape.toml", text, lambda path: check_lshape_toml(path.read_text(), lshape))] + [
         scene_of(d, scene_text(d)) for d in unilateral]

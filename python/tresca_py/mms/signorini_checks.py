@@ -7,11 +7,15 @@ friction traction, a Coulomb threshold off the exact pressure) must each be reje
 import numpy as np
 import sympy as sp
 
-from tresca_py.mms.checks import check_derivatives, check_roundtrip
+from tresca_py.mms.checks import check_derivatives, check_roundtrip, sample_times
 from tresca_py.mms.derive import CheckFailed, derive, printed
 from tresca_py.mms.elasticity import side_normal_exact
-from tresca_py.mms.signorini import R, case_coulomb, case_signorini_moving, x
+from tresca_py.mms.signorini import SIGNORINI_CASES, R, case_coulomb, case_signorini_moving, x
 from tresca_py.mms.signorini_law import check_signorini_law
+from tresca_py.mms.signorini_stop import case_signorini_stop
+
+#: every unilateral case that verification/mms/derive.py writes
+UNILATERAL_CASES = SIGNORINI_CASES + [case_signorini_stop]
 
 
 def derive_signorini(case):
@@ -39,7 +43,7 @@ def run_checks(case, log=print):
     d = derive_signorini(case)
     check_roundtrip(d, rng, log)
     check_derivatives(d, rng, log)
-    times = np.linspace(0, float(d["T"]), 401)
+    times = sample_times(d, 401)
     for side in [s for s, k in d["kinds"].items() if k == "contact"]:
         check_signorini_law(d, side, np.linspace(0, 1, 1001), times, log=log)
     return d
@@ -64,6 +68,7 @@ def mutants():
         "Coulomb F 1% too small": lambda: _mutant(case_coulomb, bound=cm["bound"] * R(99, 100)),
         "Coulomb threshold off the pressure": lambda: _mutant(case_coulomb, lt=cm["lt"] * (1 + x / 10)),
         "Coulomb: friction traction where separated": lambda: _mutant(case_coulomb, lt=cm["lt"] - R(1, 100)),
+        "slip continues after the traction leaves the bound": lambda: case_signorini_stop(stops=False),
     }
 
 

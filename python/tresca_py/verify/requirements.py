@@ -126,6 +126,13 @@ REQUIREMENTS = (
         'reference/h_skfem_mms_signorini_coulomb.md',
     ),
     Requirement(
+        'U4-skfem-signorini-k',
+        'converge with order 1 ± 0.1 in k when the slip stops abruptly on a unilateral contact part (time error at '
+        'refine 2 against N = 4096 on the same mesh, N = 4, 16, 64, 256, `mms_signorini_stop`, scikit-fem)',
+        '.venv/bin/python scripts/skfem_solve.py verification/cases/mms_signorini_stop.toml --refine 2 --steps N',
+        'reference/k_skfem_mms_signorini_stop.md',
+    ),
+    Requirement(
         'P1-paper-orders',
         "rest on the paper's Table 5.1 as printed (a data check): its orders recomputed from its errors are 0.8577, "
         "0.9671, 0.9015, 0.866",
