@@ -27,7 +27,7 @@ def test_the_system_shall_derive_unilateral_cases_that_satisfy_signorini_and_fri
     """The system shall derive data whose contact reaction satisfies p >= 0, u.n <= g, p (u.n - g) = 0 and the
     friction law (Tresca or Coulomb) at every sample, with both transition points inside Gamma_C."""
     d = run_checks(make(), **QUIET)
-    assert d["expect"]["separation_to_contact"] and d["expect"]["stick_to_slip"]
+    assert d["expect"]["separation_to_contact"] and (d["expect"]["stick_to_slip"] or d["expect"]["slip_to_stick"])
 
 
 @pytest.mark.parametrize("what", sorted(mutants()))
