@@ -105,6 +105,15 @@ def test_the_system_shall_refuse_unilateral_scenes_in_the_bilateral_solvers(tmp_
         s.refuse_contact_extensions("dolfinx_cr")
 
 
+@pytest.mark.parametrize("coulomb,message", [("x-1", "coulomb = -0.9"), ("sqrt(x-5)", "has the value nan")])
+def test_the_system_shall_refuse_a_negative_or_infinite_coulomb_coefficient(tmp_path, coulomb, message):
+    """The system shall refuse F < 0 or F not finite, naming the part and a point, with exit status 2."""
+    scene = write(tmp_path, bottom=f'law = "unilateral"\ncoulomb = "{coulomb}"')
+    p, _ = run([PY, "scripts/skfem_solve.py", scene, "--refine", 1, "-o", tmp_path / "out.h5", "-q"], check=False)
+    assert p.returncode == 2 and "boundary 'bottom'" in p.stderr and message in p.stderr
+    assert not (tmp_path / "out.h5").exists()
+
+
 def test_the_system_shall_refuse_an_initial_state_that_penetrates(tmp_path):
     """The system shall refuse u0 with u0.n > g on a unilateral part, naming the part and the point, exit 2."""
     scene = write(tmp_path, bottom='law = "unilateral"\ng_a = "0.1"\ngap = "0.001"')

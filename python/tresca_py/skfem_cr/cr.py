@@ -117,8 +117,10 @@ class Discretisation:
             xq, yq = self.edge_points(c[sel])
             law, key = (b.g_a, "g_a") if b.coulomb is None else (b.coulomb, "coulomb")
             g = law(xq, yq, 0.0)
-            if np.any(g < 0):
-                raise SceneError(f"boundary '{b.name}': {key} is negative somewhere")
+            if np.any(g < 0):                                   # (not finite: refused by the expression)
+                bad = np.flatnonzero(g < 0)[0]
+                raise SceneError(f"boundary '{b.name}': {key} = {g.flat[bad]:.6g} at ({xq.flat[bad]:.6g}, "
+                                 f"{yq.flat[bad]:.6g}) is negative")
             if b.coulomb is None:
                 self.gbar[sel] = g @ GAUSS3_W
             else:
