@@ -9,7 +9,7 @@ import numpy as np
 # The order of the series in a step's checksum (src/output/tresca.rs module doc).
 SERIES = ("times", "u", "energy", "steps/iterations", "steps/residual", "steps/n_stick", "steps/n_slip",
           "steps/wall_time", "contact/slip", "contact/sigma_t", "contact/state", "contact/mu", "contact/dof",
-          "contact/pressure", "contact/gap", "errors/energy", "errors/h1", "errors/l2")
+          "errors/energy", "errors/h1", "errors/l2")
 
 _P = [np.uint64(v) for v in (0x9E3779B185EBCA87, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9, 0x85EBCA77C2B2AE63,
                              0x27D4EB2F165667C5)]

@@ -37,11 +37,12 @@ def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
         res["errors"] = {k: np.zeros(N + 1) for k in ("energy", "h1", "l2")}
     if disc.normal_unknowns:
         res["pressure"], res["gap"] = np.zeros((N + 1, C)), np.zeros((N + 1, C))
+        res["status"] = np.zeros((N + 1, C), dtype=np.uint8)
     u = disc.interpolate(scene.u0, times[0])
     if lifting is not None:
         u = u + lifting.lift(times[0])
     if disc.normal_unknowns:
-        res["gap"][0], res["state"][0] = initial_state(disc, u, times[0])
+        res["gap"][0], res["status"][0] = initial_state(disc, u, times[0])
     for n, t in enumerate(times):
         tic = time.perf_counter()
         if n > 0:
@@ -53,8 +54,8 @@ def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
         res["slip"][n] = np.sum(u.reshape(-1, 2)[disc.contact] * disc.tangent, axis=1)
         if n == 0:
             res["dof"][n] = res["slip"][n]          # u^0 = I_CR u0 holds s_e tau_e on contact edges
-        res["n_slip"][n] = int(np.sum(res["state"][n] == 1))
-        res["n_stick"][n] = int(np.sum(res["state"][n] == 0))
+        res["n_slip"][n] = int(res["state"][n].sum())
+        res["n_stick"][n] = C - res["n_slip"][n]
         res["energy"][n] = float(u @ (K @ u)) if lifting is None else lifting.energy(K, u, t)
         if errors is not None:
             for key, e2 in zip(("energy", "h1", "l2"), errors(t, u), strict=True):
@@ -73,7 +74,7 @@ def _step(stepper, disc, K, load_t, u_prev, lifting, t, res, n):
         u_l = 0.0 if lifting is None else lifting.lift(t)
         w, info = stepper.step(load_t if lifting is None else load_t + lifting.rhs(t) - K @ u_l, u_prev, t)
         u = w + u_l
-        res["pressure"][n], res["gap"][n] = info["pressure"], info["gap"]
+        res["pressure"][n], res["gap"][n], res["status"][n] = info["pressure"], info["gap"], info["status"]
     elif lifting is None:
         u, info = stepper.step(load_t, u_prev)
     else:
@@ -102,7 +103,8 @@ def write_results(path, disc: Discretisation, res, solver_name, extra_attrs=None
     contact = None
     if len(disc.contact):
         contact = results.Contact(disc.contact, disc.normal, disc.tangent, disc.gbar, res["slip"], res["sigma_t"],
-                                  res["state"], res["mu"], res["dof"], res.get("pressure"), res.get("gap"))
+                                  res["state"], res["mu"], res["dof"], res.get("pressure"), res.get("gap"),
+                                  res.get("status"))
     r = results.Results(
         mesh=results.Mesh(disc.points, disc.triangles, disc.edges, disc.midpoints), times=scene.times,
         u=res["u"], energy=res["energy"], steps={k: res[k] for k in results.STEP_FIELDS}, contact=contact,

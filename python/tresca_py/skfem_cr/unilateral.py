@@ -13,9 +13,10 @@ the current P is ≤ 1e-13 of the force scale; that residual is reported.
 
 ḡ_e is the edge mean (3-point Gauss) of the gap at tₙ. An edge is *separated* when it is unilateral, P_e = 0
 and its gap is open, r_e − ḡ_e < −1e-9 · max(|Δ|, |d|) (the rule of the Rust solver; stick and slip by
-``friction.classify`` with the scale max(|Δs|, |d|)); status 0 stick, 1 slip, 2 separated. Step 0 has P = 0,
-the gap of u⁰ and "separated" where it is open; an initial state that penetrates a unilateral part is refused,
-naming the part and the point.
+``friction.classify`` with the scale max(|Δs|, |d|)). ``status`` is 0 stick, 1 slip, 2 separated; ``state`` keeps
+stick/slip. Step 0 has P = 0, the gap of u⁰ and status "separated" where it is open by more
+than 1e-9 of max(|u⁰·n|, |ḡ|) over Γ_C (rounding of the interpolant is not a gap); an initial state that
+penetrates a unilateral part is refused, naming the part and the point.
 """
 import numpy as np
 
@@ -77,7 +78,7 @@ PENETRATION_TOL = 1e-9
 
 
 def initial_state(disc, u0, t0):
-    """(gap, state) of step 0 for the CR interpolant ``u0`` (canonical vector); InputError where it penetrates a
+    """(gap, status) of step 0 for the CR interpolant ``u0`` (canonical vector); InputError where it penetrates a
     unilateral part by more than 1e-9 of max(|u0·n|, |ḡ|) (edge means; the Rust solver's rule)."""
     un = np.sum(u0.reshape(-1, 2)[disc.contact] * disc.normal, axis=1)
     gbar = Normal(disc).gap(t0)
@@ -91,7 +92,8 @@ def initial_state(disc, u0, t0):
         raise InputError(f"[initial] u0: the initial state penetrates the unilateral part '{part}' at "
                          f"({m[0]:.6f}, {m[1]:.6f}): u0·n = {un[k]:e} > gap {un[k] - gap[k]:e} at t0 = {t0} "
                          "(edge means)")
-    return gap, np.where(gap < 0, SEPARATED, 0).astype(np.int8)
+    scale = max(np.max(np.abs(un)), np.max(np.abs(gbar)))
+    return gap, np.where(gap < -PENETRATION_TOL * scale, SEPARATED, 0).astype(np.uint8)
 
 
 class UnilateralStepSolver(StepSolver):
@@ -116,7 +118,8 @@ class UnilateralStepSolver(StepSolver):
         state = classify(lam[:nc], delta[:nc], d, self.normal.bounds(lam[nc:])[1][:nc]).astype(np.int8)
         opening = delta[nc:]                                 # r_e - ḡ_e
         scale = max(np.max(np.abs(delta)), np.max(np.abs(d)))
-        state[(self.normal.lo == 0) & (lam[nc:] <= 0) & (opening < -1e-9 * scale)] = SEPARATED
+        status = state.copy()
+        status[(self.normal.lo == 0) & (lam[nc:] <= 0) & (opening < -1e-9 * scale)] = SEPARATED
         return self.P @ r, dict(iterations=its, residual=residual, mu=lam[:nc], d=d[:nc], ds=delta[:nc],
                                 dof=r[self.ic[:nc]], pressure=lam[nc:] / disc.lengths[disc.contact], gap=opening,
-                                state=state)
+                                state=state, status=status)

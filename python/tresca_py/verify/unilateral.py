@@ -50,7 +50,7 @@ def level(name, refine, steps=STEPS):
     return dict(refine=refine, steps=steps, h=h, k=float(r.times[1] - r.times[0]), paper_dofs=2 * len(m.edges),
                 energy_max=float(np.max(r.errors["energy"])), h1_max=float(np.max(r.errors["h1"])),
                 l2_max=float(np.max(r.errors["l2"])), residual=float(np.max(r.steps["residual"])),
-                signorini=discrete_signorini(r), states=np.bincount(r.contact.state[-1], minlength=3).tolist()), cmd
+                signorini=discrete_signorini(r), states=np.bincount(r.contact.status[-1], minlength=3).tolist()), cmd
 
 
 def convergence(name, levels):
