@@ -53,11 +53,14 @@ def output_path(args, scene):
     return paths.output_file(out, "results file")
 
 
-def open_scene(args, discretise, report=True):
+def open_scene(args, discretise, report=True, unilateral=False):
     """Scene, the solver's own discretisation ``discretise(scene)`` and the checked output path; bad input exits
-    with one error line."""
+    with one error line. Unless ``unilateral``, a scene with a unilateral, Coulomb or loaded contact part is
+    refused (``Scene.refuse_contact_extensions``)."""
     with exit_on_failure(report):
         scene = load_scene(args.scene, refine=args.refine, steps=args.steps)
+        if not unilateral:
+            scene.refuse_contact_extensions(discretise.__module__.split(".")[1])
         out = output_path(args, scene)
         disc = discretise(scene)
     return scene, disc, out

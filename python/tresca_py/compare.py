@@ -8,8 +8,10 @@ files may number vertices and edges differently.  For every time node n it repor
     du     = |u_A^n - u_B^n| / |u_A^n|            (Euclidean norm of the whole DOF vector;
                                                   absolute when |u_A^n| = 0)
     dE     = |E_A^n - E_B^n| / |E_A^n|            (E = tresca/energy = a_h(u^n,u^n), when both have it)
-    dsig   = |sigma_t,A - sigma_t,B|_inf / max_e gbar_e      (tangential traction on Gamma_C)
-    flags  = number of contact edges whose stick/slip state differs
+    dsig   = |sigma_t,A - sigma_t,B|_inf / max_e gbar_e      (tangential traction on Gamma_C; with normal
+             unknowns, unilateral or Coulomb, max(|d sigma_t|_inf, |p_A - p_B|_inf) / max(gbar, |sigma_t,A|, p_A))
+    flags  = number of contact edges whose stick/slip state differs (with normal unknowns in both files: whose
+             stick/slip/separated status differs)
     derr_* = relative difference of the true errors (energy, h1, l2), when both files have them
              (0 when both are below --err-floor, as in patch tests)
 
@@ -42,7 +44,8 @@ def load(path):
     out = {"times": r.times, "u": r.u, "mid": r.mesh.midpoints, "energy": r.energy, "solver": str(r.attrs["solver"])}
     if r.contact is not None:
         c = r.contact
-        out.update(cmid=r.mesh.midpoints[c.edges], sigma_t=c.sigma_t, state=c.state, slip=c.slip, g=c.g)
+        out.update(cmid=r.mesh.midpoints[c.edges], sigma_t=c.sigma_t, state=c.state, slip=c.slip, g=c.g,
+                   pressure=c.pressure, status=c.status)
     if r.errors is not None:
         out["errors"] = dict(r.errors)
     return out
@@ -86,9 +89,16 @@ def compare_files(path_a, path_b, err_floor=1e-12):
         cperm = match(A["cmid"], B["cmid"], "contact edges")
         sB = np.empty_like(A["sigma_t"])
         sB[:, cperm] = B["sigma_t"]
-        stB = np.empty_like(A["state"])
-        stB[:, cperm] = B["state"]
+        flag = "status" if A["status"] is not None and B["status"] is not None else "state"   # status: + separated
+        stB = np.empty_like(A[flag])
+        stB[:, cperm] = B[flag]
         gscale = max(float(np.max(A["g"])), 1e-300)
+        if (A["pressure"] is None) != (B["pressure"] is None):
+            raise CompareError("one file has contact pressures (normal unknowns), the other has none")
+        if A["pressure"] is not None:
+            pB = np.empty_like(A["pressure"])
+            pB[:, cperm] = B["pressure"]
+            gscale = max(gscale, float(np.max(np.abs(A["sigma_t"]))), float(np.max(np.abs(A["pressure"]))))
     errs = sorted(set(A.get("errors", {})) & set(B.get("errors", {})))
     worst = dict(du=0.0, dE=0.0, dsig=0.0, derr=0.0)
     nflags = 0
@@ -98,7 +108,9 @@ def compare_files(path_a, path_b, err_floor=1e-12):
         dE = (abs(A["energy"][n] - B["energy"][n]) / abs(A["energy"][n]) if abs(A["energy"][n]) > 0
               else abs(B["energy"][n])) if "energy" in A and "energy" in B else 0.0
         dsig = float(np.max(np.abs(A["sigma_t"][n] - sB[n]))) / gscale if has_c else 0.0
-        fl = int(np.sum(A["state"][n] != stB[n])) if has_c else 0
+        if has_c and A["pressure"] is not None:
+            dsig = max(dsig, float(np.max(np.abs(A["pressure"][n] - pB[n]))) / gscale)
+        fl = int(np.sum(A[flag][n] != stB[n])) if has_c else 0
         de = [abs(A["errors"][k][n] - B["errors"][k][n]) / max(abs(A["errors"][k][n]), abs(B["errors"][k][n]))
               if max(abs(A["errors"][k][n]), abs(B["errors"][k][n])) > err_floor else 0.0 for k in errs]
         # np.maximum propagates NaN (Python's max(0.0, nan) is 0.0, which would pass a NaN difference)

@@ -44,6 +44,9 @@ DATASETS = (
     ("contact/state", U1, ("R", "C"), "0 stick, 1 slip"),
     ("contact/mu", F8, ("R", "C"), "friction force μ_e, exact"),
     ("contact/dof", F8, ("R", "C"), "the contact unknown"),
+    ("contact/pressure", F8, ("R", "C"), "contact pressure p_e = P_e/|e| (scenes with normal unknowns only)"),
+    ("contact/gap", F8, ("R", "C"), "u_n(m_e) − ḡ_e (scenes with normal unknowns only)"),
+    ("contact/status", U1, ("R", "C"), "0 stick, 1 slip, 2 separated (scenes with normal unknowns only)"),
     ("errors/energy", F8, ("R",), "true energy error"),
     ("errors/h1", F8, ("R",), "true broken H1 error"),
     ("errors/l2", F8, ("R",), "true L2 error"),
@@ -51,7 +54,10 @@ DATASETS = (
 SPEC = {name: (dtype, shape) for name, dtype, shape, _ in DATASETS}
 STEP_FIELDS = ("iterations", "residual", "n_stick", "n_slip", "wall_time")
 CONTACT_STATIC = ("edges", "normal", "tangent", "g")
-CONTACT_SERIES = ("slip", "sigma_t", "state", "mu", "dof")
+CONTACT_SERIES = ("slip", "sigma_t", "state", "mu", "dof", "pressure", "gap", "status")
+# Written only by a run whose Γ_C edges carry normal unknowns (a unilateral or Coulomb part; issue 40); not part
+# of the step checksums (tresca_py.checksum.SERIES), as src/output/tresca.rs writes them.
+NORMAL_SERIES = ("contact/pressure", "contact/gap", "contact/status")
 ERRORS = ("energy", "h1", "l2")
 
 # /tresca attributes as the Rust binary writes them: name -> type ("floats": a 1-D float array)
@@ -106,6 +112,9 @@ class Contact:
     state: np.ndarray
     mu: np.ndarray | None
     dof: np.ndarray | None
+    pressure: np.ndarray | None = None
+    gap: np.ndarray | None = None
+    status: np.ndarray | None = None
 
 
 @dataclass(eq=False)
@@ -181,7 +190,8 @@ def _check_array(where, name, shape, dtype, sizes):
     if tuple(shape) != want:
         raise ResultsError(f"{where}: tresca/{name} has shape {tuple(shape)}, the layout wants {want} "
                            f"({', '.join(map(str, sym))})")
-    kinds = {"contact/state": "iub", "steps/checksum": "u"}.get(name, "f" if SPEC[name][0].kind == "f" else "iu")
+    kinds = {"contact/state": "iub", "contact/status": "iub", "steps/checksum": "u"}.get(
+        name, "f" if SPEC[name][0].kind == "f" else "iu")
     if np.dtype(dtype).kind not in kinds:
         raise ResultsError(f"{where}: tresca/{name} holds {np.dtype(dtype)}, the layout wants {SPEC[name][0]}")
 
@@ -218,6 +228,9 @@ def validate(r, where="results"):
             raise ResultsError(f"{where}: tresca/contact/edges lists an edge twice")
         if np.any((c.state != 0) & (c.state != 1)):
             raise ResultsError(f"{where}: tresca/contact/state holds values other than 0 (stick) and 1 (slip)")
+        if c.status is not None and np.any(~np.isin(c.status, (0, 1, 2))):
+            raise ResultsError(f"{where}: tresca/contact/status holds values other than 0 (stick), 1 (slip) and 2 "
+                               "(separated)")
     E, nu = r.attrs.get("E", 1.0), r.attrs.get("nu", 0.0)
     if not (np.isfinite(E) and E > 0 and np.isfinite(nu) and -1 < nu < 0.5):  # as src/scene/mod.rs requires
         raise ResultsError(f"{where}: attributes E = {E}, nu = {nu}: not a plane-strain material (E > 0, "
@@ -308,7 +321,7 @@ def _read_group(f, where, verify):
     parts = {"contact": has_contact, "errors": "errors" in g}
     wanted = [n for n, *_ in DATASETS if parts.get(n.split("/")[0], True)]
     for name in wanted:
-        optional = name == "steps/checksum" or (legacy and name in LEGACY_MISSING)
+        optional = name == "steps/checksum" or name in NORMAL_SERIES or (legacy and name in LEGACY_MISSING)
         if optional and name not in g:
             continue
         ds[name] = _dataset(where, g, name)

@@ -26,7 +26,7 @@ _SCHEMA = {
     "title": None,
     "mesh": {"corners", "cells", "diagonal", "refine", "file"},
     "material": {"E", "nu"},
-    "boundary": {"name", "kind", "traction", "g_a", "u", "gap"},
+    "boundary": {"name", "kind", "traction", "g_a", "u", "gap", "law", "coulomb"},
     "loads": {"f"},
     "initial": {"u0"},
     "time": {"T", "steps", "times"},
@@ -42,11 +42,14 @@ _SCHEMA = {
 @dataclass
 class Boundary:
     name: str
-    kind: str                    # "dirichlet" | "neumann" | "contact"
-    traction: VecExpr | None = None
-    g_a: Expr | None = None
+    kind: str                    # "dirichlet" | "neumann" | "contact" (a symmetry part is a contact part)
+    traction: VecExpr | None = None   # Neumann traction, or the given surface load on Γ_C (None: none)
+    g_a: Expr | None = None      # Tresca's bound (None with coulomb)
     u: VecExpr | None = None     # Dirichlet data u_D(x, y, t); None: clamped (absent or the constant 0)
-    gap: Expr | None = None      # imposed normal displacement g_n(x, y, t) on Γ_C; None: g_n = 0
+    gap: Expr | None = None      # imposed normal displacement g_n(x, y, t) on Γ_C, or the gap; None: 0
+    law: str = "bilateral"       # contact law: "bilateral" (u.n = g_n) or "unilateral" (u.n <= g)
+    coulomb: Expr | None = None  # Coulomb's coefficient F(x, y): threshold F p
+    symmetry: bool = False       # written kind = "symmetry": frictionless bilateral, u.n = 0
 
     @property
     def has_data(self):
@@ -73,9 +76,23 @@ class Scene:
     output: str | None = None
 
     @property
+    def normal_unknowns(self):
+        """True if every Γ_C edge carries a normal unknown: the scene has a unilateral or a Coulomb part."""
+        return any(b.kind == "contact" and (b.law == "unilateral" or b.coulomb is not None) for b in self.boundaries)
+
+    def refuse_contact_extensions(self, solver):
+        """SceneError naming the part if the scene uses what ``solver`` does not model (issue 40: a unilateral
+        law, Coulomb friction, a surface load on Γ_C)."""
+        for b in self.boundaries:
+            if b.kind == "contact" and (b.law == "unilateral" or b.coulomb is not None or b.traction is not None):
+                raise SceneError(f"boundary '{b.name}': the {solver} solver models bilateral Tresca contact only "
+                                 "(no law = \"unilateral\", coulomb or contact traction)")
+
+    @property
     def has_boundary_data(self):
-        """True if a part imposes nonzero boundary data (docs/scene.md: `u`, `gap`)."""
-        return any(b.has_data for b in self.boundaries)
+        """True if a part imposes nonzero boundary data that the lifting carries (docs/scene.md: `u`, and `gap`
+        without normal unknowns)."""
+        return any(b.u is not None or (b.gap is not None and not self.normal_unknowns) for b in self.boundaries)
 
     @property
     def lam(self):
@@ -187,39 +204,66 @@ def _read_boundaries(doc):
         if name in seen:
             raise SceneError(f"[{where}] boundary part '{name}' is declared twice")
         seen.add(name)
-        if kind not in ("dirichlet", "neumann", "contact"):
-            raise SceneError(f"[{where}] ('{name}') kind must be dirichlet, neumann or contact, got {kind!r}")
-        if "traction" in b and kind != "neumann":
-            raise SceneError(f"[{where}] ('{name}') 'traction' is only allowed for kind = \"neumann\"")
-        if "g_a" in b and kind != "contact":
-            raise SceneError(f"[{where}] ('{name}') 'g_a' is only allowed for kind = \"contact\"")
-        if "u" in b and kind != "dirichlet":
-            raise SceneError(f"[{where}] ('{name}') 'u' is only allowed for kind = \"dirichlet\"")
-        if "gap" in b and kind != "contact":
-            raise SceneError(f"[{where}] ('{name}') 'gap' is only allowed for kind = \"contact\"")
+        if kind not in ("dirichlet", "neumann", "contact", "symmetry"):
+            raise SceneError(f"[{where}] ('{name}') kind must be dirichlet, neumann, contact or symmetry, "
+                             f"got {kind!r}")
+        _refuse_foreign_keys(where, name, kind, b)
         bd = Boundary(name, kind)
         if kind == "dirichlet" and "u" in b:
             u = VecExpr(b["u"], f"boundary '{name}' u")
             bd.u = None if u.is_zero else u
-        if kind == "contact" and "gap" in b:
-            if not isinstance(b["gap"], str):
-                raise SceneError(f"[{where}] ('{name}') 'gap' must be one expression string, got {b['gap']!r}")
-            gap = Expr(b["gap"], f"boundary '{name}' gap")
-            bd.gap = None if gap.is_zero else gap
         if kind == "neumann":
             bd.traction = VecExpr(b.get("traction", ["0", "0"]), f"boundary '{name}' traction")
         if kind == "contact":
-            if "g_a" not in b:
-                raise SceneError(f"[{where}] ('{name}') contact needs 'g_a' (the friction bound)")
-            bd.g_a = Expr(b["g_a"], f"boundary '{name}' g_a")
-            if bd.g_a.depends_on_t:
-                raise SceneError(f"boundary '{name}' g_a must not depend on t")
+            _read_contact(where, name, b, bd)
+        if kind == "symmetry":
+            bd.kind, bd.g_a, bd.symmetry = "contact", Expr("0", f"boundary '{name}' (symmetry)"), True
         bnds.append(bd)
     if not any(b.kind == "dirichlet" for b in bnds):
         # a_h (even with the jump term) is singular on rigid motions unless a Dirichlet part fixes them
         raise SceneError("[boundary] no dirichlet part: rigid motions are not fixed "
                          "(the paper requires meas(Gamma_D) > 0)")
     return bnds
+
+
+_KEYS_OF = {"traction": ("neumann", "contact"), "g_a": ("contact",), "u": ("dirichlet",), "gap": ("contact",),
+            "law": ("contact",), "coulomb": ("contact",)}
+
+
+def _refuse_foreign_keys(where, name, kind, b):
+    """A key that the part's kind does not take, refused naming the part."""
+    for key, kinds in _KEYS_OF.items():
+        if key in b and kind not in kinds:
+            raise SceneError(f"[{where}] ('{name}') '{key}' is only allowed for kind = "
+                             + " or ".join(f'"{k}"' for k in kinds))
+
+
+def _read_contact(where, name, b, bd):
+    """The keys of a contact part: law, g_a or coulomb (not both), gap, traction."""
+    if "gap" in b:
+        if not isinstance(b["gap"], str):
+            raise SceneError(f"[{where}] ('{name}') 'gap' must be one expression string, got {b['gap']!r}")
+        gap = Expr(b["gap"], f"boundary '{name}' gap")
+        bd.gap = None if gap.is_zero else gap
+    bd.law = b.get("law", "bilateral")
+    if bd.law not in ("bilateral", "unilateral"):
+        raise SceneError(f"[{where}] ('{name}') unknown contact law {bd.law!r} (expected \"bilateral\" or "
+                         "\"unilateral\")")
+    if "traction" in b:
+        traction = VecExpr(b["traction"], f"boundary '{name}' traction")
+        bd.traction = None if traction.is_zero else traction
+    if "g_a" in b and "coulomb" in b:
+        raise SceneError(f"[{where}] ('{name}') takes either 'g_a' (Tresca) or 'coulomb' (Coulomb), not both")
+    if "g_a" not in b and "coulomb" not in b:
+        raise SceneError(f"[{where}] ('{name}') contact needs 'g_a' (the friction bound) or 'coulomb'")
+    key = "g_a" if "g_a" in b else "coulomb"
+    bound = Expr(b[key], f"boundary '{name}' {key}")
+    if bound.depends_on_t:
+        raise SceneError(f"boundary '{name}' {key} must not depend on t")
+    if key == "g_a":
+        bd.g_a = bound
+    else:
+        bd.coulomb = bound
 
 
 def _read_times(path, doc, steps):

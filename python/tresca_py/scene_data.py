@@ -48,6 +48,8 @@ def _edge_rows(scene, a, b, part):
         sel = part == ip
         if not np.any(sel) or bd.kind == "neumann" or (not bd.has_data and scene.u0.is_zero):
             continue
+        if bd.kind == "contact" and scene.normal_unknowns:      # the gap is a constraint there, not u0's value
+            continue
         x, y = q[sel, :, 0], q[sel, :, 1]
         u0 = scene.u0(x, y, t0)
         if bd.kind == "dirichlet":

@@ -135,12 +135,17 @@ def check_sides(d):
 def check_contact(d, log):
     """Pointwise Tresca conditions on every contact side (u.n = 0 there) on a fine space-time grid, with the
     times of ``d["t_special"]`` and either side of them (tresca_py.mms.tresca_law)."""
-    times = set(np.linspace(0, float(d["T"]), 601).tolist())
-    for ts in d.get("t_special", []):
-        times |= {float(ts) - 1e-9, float(ts), float(ts) + 1e-9}
-    times = np.array(sorted(times))
+    times = sample_times(d, 601)
     for side in [s for s, k in d["kinds"].items() if k == "contact"]:
         check_tresca_law(d, side, np.linspace(0, 1, 2001), times, log=log)
+
+
+def sample_times(d, n):
+    """``n`` equidistant times of [0, T] plus the times of ``d["t_special"]`` and either side of them."""
+    times = set(np.linspace(0, float(d["T"]), n).tolist())
+    for ts in d.get("t_special", []):
+        times |= {float(ts) - 1e-9, float(ts), float(ts) + 1e-9}
+    return np.array(sorted(times))
 
 
 def run_checks(case, exmex_bin=None, log=print):

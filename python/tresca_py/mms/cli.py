@@ -6,7 +6,8 @@ import pathlib
 import sys
 
 from tresca_py.common import CASES as CASES_DIR
-from tresca_py.mms.cases import CASES, selftest
+from tresca_py.mms.cases import CASES
+from tresca_py.mms.cases import selftest as tresca_selftest
 from tresca_py.mms.checks import run_checks
 from tresca_py.mms.derive import CheckFailed
 from tresca_py.mms.exmex import NotPrintable
@@ -15,6 +16,9 @@ from tresca_py.mms.lshape import check_toml as check_lshape_toml
 from tresca_py.mms.lshape import run_checks as run_lshape_checks
 from tresca_py.mms.lshape import scene_text as lshape_text
 from tresca_py.mms.scene_toml import check_toml, scene_text
+from tresca_py.mms.signorini_checks import UNILATERAL_CASES
+from tresca_py.mms.signorini_checks import run_checks as run_signorini_checks
+from tresca_py.mms.signorini_checks import selftest as signorini_selftest
 
 
 def derive_each(makers, run):
@@ -60,7 +64,8 @@ def scene_of(d, text):
 
 
 def derive_all(exmex):
-    """Every case of tresca_py.mms.cases and the L-shape, derived and checked: their scenes."""
+    """Every case of tresca_py.mms.cases, the L-shape and the unilateral cases of tresca_py.mms.signorini, derived
+    and checked: their scenes."""
     def run(case, log):
         d = run_checks(case, exmex, log)
         log("longest printed expression: %d characters" % max(len(v) for v in d["str"].values()))
@@ -69,8 +74,16 @@ def derive_all(exmex):
     print("== mms_lshape: the L-shape with the re-entrant corner's singularity (tresca_py/mms/lshape.py)")
     lshape = run_lshape_checks(case_lshape(), lambda msg: print("   " + msg))
     text = lshape_text(lshape)
+    unilateral = derive_each(UNILATERAL_CASES, run_signorini_checks)
     return [scene_of(d, scene_text(d)) for d in derived] + [
-        ("mms_lshape.toml", text, lambda path: check_lshape_toml(path.read_text(), lshape))]
+        ("mms_lshape.toml", text, lambda path: check_lshape_toml(path.read_text(), lshape))] + [
+        scene_of(d, scene_text(d)) for d in unilateral]
+
+
+def selftest():
+    """The self-tests of the Tresca cases and of the unilateral ones."""
+    tresca_selftest()
+    signorini_selftest()
 
 
 def main():

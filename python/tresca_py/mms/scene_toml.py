@@ -35,7 +35,7 @@ def scene_text(d):
         if kind == "neumann":
             L.append('traction = ["%s", "%s"]' % (st["g_%s_1" % side], st["g_%s_2" % side]))
         if kind == "contact":
-            L.append('g_a  = "%s"' % st["g_a"])
+            L += contact_lines(d, side)
     L += ["", "[loads]", 'f = ["%s", "%s"]' % (st["f1"], st["f2"]),
           "", "[initial]", 'u0 = ["%s", "%s"]' % (st["u0_1"], st["u0_2"]),
           "", "[time]", "T = %s" % toml_float(d["T"]), "steps = %d" % d["steps"],
@@ -48,6 +48,18 @@ def scene_text(d):
     return "\n".join(L)
 
 
+def contact_lines(d, side):
+    """The keys of contact part ``side``: g_a alone for a bilateral case; for a unilateral one (``d["contact"]``,
+    tresca_py.mms.signorini) the law, g_a or coulomb, the gap and the surface load on Gamma_C."""
+    st = d["str"]
+    c = d.get("contact")
+    if c is None:
+        return ['g_a  = "%s"' % st["g_a"]]
+    return ['law = "%s"' % c["law"], '%s = "%s"' % (c["friction"], st[c["friction"]]),
+            'gap = "%s"' % st["gap_%s" % side],
+            'traction = ["%s", "%s"]' % (st["ct_%s_1" % side], st["ct_%s_2" % side])]
+
+
 def check_toml(path, d):
     """The written file parses as TOML and carries exactly the derived strings."""
     import tomllib
@@ -57,3 +69,8 @@ def check_toml(path, d):
     require(doc["loads"]["f"] == [st["f1"], st["f2"]], "%s: TOML f mismatch" % path)
     require(doc["exact"]["grad"] == [[st["grad11"], st["grad12"]], [st["grad21"], st["grad22"]]],
             "%s: TOML grad mismatch" % path)
+    for b in doc["boundary"]:
+        if b["kind"] == "contact" and d.get("contact") is not None:
+            side = b["name"]
+            require(b["gap"] == st["gap_%s" % side] and b["traction"] == [st["ct_%s_1" % side], st["ct_%s_2" % side]],
+                    "%s: TOML contact data mismatch on %s" % (path, side))

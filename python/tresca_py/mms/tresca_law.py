@@ -77,23 +77,10 @@ def check_tresca_law(d, side, s, times, gap=None, log=print):
     require(np.min(ga) > 0 or static and np.min(ga) >= 0, "%s: g_a must be positive" % name)
     require(np.all(ga == ga[:, :1]), "%s: g_a depends on t" % name)
     vt1, vt2, _ = tangential(*velocity(d, PX, PY, TT), n)
-    vt_abs = np.hypot(vt1, vt2)
     ttol = 1e-11 * np.max(ga)
-    vtol = 1e-11 * max(1e-3, np.max(vt_abs))
-    require(np.max(st_abs - ga) <= ttol, "%s: |sigma_t| exceeds g_a by %.2e" % (name, np.max(st_abs - ga)))
-    # stick: |sigma_t| < g_a strictly  =>  u_t' = 0
-    stick = st_abs < ga - ttol
-    bad = np.max(vt_abs[stick]) if stick.any() else 0.0
-    require(bad <= vtol, "%s: stick point with slip velocity %.2e" % (name, bad))
-    # slip: u_t' != 0  =>  |sigma_t| = g_a and u_t' = -theta sigma_t, theta >= 0
-    slip = vt_abs > vtol
-    require(slip.mean() > 0.05, "%s: (almost) no slip samples" % name)
-    off = np.max(np.abs(st_abs[slip] - ga[slip]))
-    require(off <= ttol, "%s: slipping point with |sigma_t| != g_a (%.2e)" % (name, off))
-    theta = -(vt1 * st1 + vt2 * st2)[slip] / st_abs[slip] ** 2
-    require(np.min(theta) >= 0, "%s: slip velocity not opposite to sigma_t" % name)
-    res = np.max(np.hypot(vt1[slip] + theta * st1[slip], vt2[slip] + theta * st2[slip]))
-    require(res <= vtol, "%s: u_t' not parallel to sigma_t (%.2e)" % (name, res))
+    vtol = 1e-11 * max(1e-3, np.max(np.hypot(vt1, vt2)))
+    stick, slip = friction_law(name, (st1, st2), (vt1, vt2), ga, ttol, vtol)
+    vt_abs = np.hypot(vt1, vt2)
     n_ss, n_sk = (0, 0) if static else check_in_time(d, stick, slip, st_abs - ga, times, ttol)
     st_tau = st1 * tau[0] + st2 * tau[1]
     log("Tresca on %s (%d x %d samples): u.n = gap, |sig_t|<=g_a, stick, slip dir, u0   ok"
@@ -102,6 +89,34 @@ def check_tresca_law(d, side, s, times, gap=None, log=print):
         "sigma_t.tau in [%.3g, %.3g], g_a in [%.3g, %.3g], max|slip rate| %.3g, max|u.n| %.3g"
         % (100 * stick.mean(), 100 * slip.mean(), n_ss, n_sk, st_tau.min(), st_tau.max(),
            ga.min(), ga.max(), vt_abs.max(), np.max(np.abs(un))))
+
+
+def friction_law(name, st, vt, bound, ttol, vtol):
+    """The friction law at samples: tangential traction ``st`` = (st1, st2), slip velocity ``vt``, threshold
+    ``bound`` (g_a, or F p for Coulomb), tolerances ``ttol`` (traction) and ``vtol`` (velocity):
+    |sigma_t| <= bound; |sigma_t| < bound => u_t' = 0; u_t' != 0 => |sigma_t| = bound and u_t' = -theta sigma_t,
+    theta >= 0 (where the bound is positive: a zero bound leaves the slip free). Returns the boolean arrays
+    (stick, slip); raises CheckFailed on the first violation."""
+    st1, st2 = st
+    vt1, vt2 = vt
+    st_abs, vt_abs = np.hypot(st1, st2), np.hypot(vt1, vt2)
+    over = np.max(st_abs - bound)
+    require(over <= ttol, "%s: |sigma_t| exceeds the threshold (g_a or F p) by %.2e" % (name, over))
+    # stick: |sigma_t| < g_a strictly  =>  u_t' = 0
+    stick = st_abs < bound - ttol
+    bad = np.max(vt_abs[stick]) if stick.any() else 0.0
+    require(bad <= vtol, "%s: stick point with slip velocity %.2e" % (name, bad))
+    # slip: u_t' != 0  =>  |sigma_t| = g_a and u_t' = -theta sigma_t, theta >= 0
+    slip = vt_abs > vtol
+    require(slip.mean() > 0.05, "%s: (almost) no slip samples" % name)
+    off = np.max(np.abs(st_abs[slip] - bound[slip]))
+    require(off <= ttol, "%s: slipping point with |sigma_t| != the threshold (%.2e)" % (name, off))
+    held = slip & (bound > ttol)
+    theta = -(vt1 * st1 + vt2 * st2)[held] / st_abs[held] ** 2
+    require(np.min(theta) >= 0, "%s: slip velocity not opposite to sigma_t" % name)
+    res = np.max(np.hypot(vt1[held] + theta * st1[held], vt2[held] + theta * st2[held]))
+    require(res <= vtol, "%s: u_t' not parallel to sigma_t (%.2e)" % (name, res))
+    return stick, slip
 
 
 def check_in_time(d, stick, slip, excess, times, ttol):

@@ -2,7 +2,8 @@
 
 Modules: ``cr`` (edges, boundary parts, contact data, CR interpolant, reduction), ``assemble`` (a_h, its
 jump part, loads and true errors with scikit-fem), ``lifting`` (boundary data u_D and g_n: u = w + u_L),
-``friction`` (the exact per-step friction solver), ``stepping`` (backward Euler and the results file), ``main``
+``friction`` (the exact per-step friction solver), ``unilateral`` (the step with normal unknowns: Signorini,
+Coulomb), ``stepping`` (backward Euler and the results file), ``main``
 (the command line, scripts/skfem_solve.py). It imports nothing from the dolfinx re-implementation.
 
 The mathematics

@@ -67,9 +67,13 @@ class SkfemProblem:
 
         # loads
         self.neumann = []
-        for b in scene.boundaries:
+        for ip, b in enumerate(scene.boundaries):
             if b.kind == "neumann" and not b.traction.is_zero:
                 edges = disc.neumann[b.name]
+                if len(edges):
+                    self.neumann.append((b.traction, FacetBasis(m, e, facets=self.facet_of_edge[edges], intorder=5)))
+            if b.kind == "contact" and b.traction is not None:        # the surface load on Γ_C, as a Neumann one
+                edges = disc.contact[disc.part_of_edge[disc.contact] == ip]
                 if len(edges):
                     self.neumann.append((b.traction, FacetBasis(m, e, facets=self.facet_of_edge[edges], intorder=5)))
 

@@ -108,16 +108,26 @@ class Discretisation:
         self.tangent = dv                                       # counter-clockwise direction
         self.normal = np.stack([dv[:, 1], -dv[:, 0]], 1)        # outward: tau = (-n_y, n_x)
         self.gbar = np.zeros(len(c))
+        self.unilateral = np.zeros(len(c), bool)
+        self.coulomb = np.full(len(c), np.nan)                  # F-bar_e on Coulomb edges, NaN on Tresca ones
         for ip, b in enumerate(scene.boundaries):
             if b.kind != "contact":
                 continue
             sel = self.part_of_edge[c] == ip
             xq, yq = self.edge_points(c[sel])
-            g = b.g_a(xq, yq, 0.0)
-            if np.any(g < 0):
-                raise SceneError(f"boundary '{b.name}': g_a is negative somewhere")
-            self.gbar[sel] = g @ GAUSS3_W
+            law, key = (b.g_a, "g_a") if b.coulomb is None else (b.coulomb, "coulomb")
+            g = law(xq, yq, 0.0)
+            if np.any(g < 0):                                   # (not finite: refused by the expression)
+                bad = np.flatnonzero(g < 0)[0]
+                raise SceneError(f"boundary '{b.name}': {key} = {g.flat[bad]:.6g} at ({xq.flat[bad]:.6g}, "
+                                 f"{yq.flat[bad]:.6g}) is negative")
+            if b.coulomb is None:
+                self.gbar[sel] = g @ GAUSS3_W
+            else:
+                self.coulomb[sel] = g @ GAUSS3_W
+            self.unilateral[sel] = b.law == "unilateral"
         self.weight = self.lengths[c] * self.gbar
+        self.normal_unknowns = scene.normal_unknowns
 
     @property
     def n_dofs(self):
@@ -136,12 +146,14 @@ class Discretisation:
         vals = vexpr(xq, yq, t) @ GAUSS3_W                      # (2, E)
         u = vals.T.copy()
         u[self.dirichlet] = 0.0
-        s = np.sum(u[self.contact] * self.tangent, axis=1)
-        u[self.contact] = s[:, None] * self.tangent
+        if not self.normal_unknowns:                            # u.n = 0 (or the lifted gap) on Γ_C
+            s = np.sum(u[self.contact] * self.tangent, axis=1)
+            u[self.contact] = s[:, None] * self.tangent
         return u.ravel()
 
     def reduction(self):
-        """Sparse P (2E x nred) with u_full = P r; contact unknowns s_e are the last C entries of r."""
+        """Sparse P (2E x nred) with u_full = P r; the contact unknowns are the last entries of r: s_e (C of them),
+        then, in a scene with normal unknowns, u_n(m_e) (C more). Returns (P, positions of the contact unknowns)."""
         E = len(self.edges)
         free = np.ones(E, bool)
         free[self.dirichlet] = False
@@ -153,7 +165,11 @@ class Discretisation:
         cols = np.concatenate([2 * np.arange(len(fe)), 2 * np.arange(len(fe)) + 1,
                                nf + np.arange(C), nf + np.arange(C)])
         vals = np.concatenate([np.ones(nf), self.tangent[:, 0], self.tangent[:, 1]])
-        P = sp.csr_matrix((vals, (rows, cols)), shape=(2 * E, nf + C))
-        return P, nf + np.arange(C)
-
-
+        nc = C
+        if self.normal_unknowns:
+            rows = np.concatenate([rows, 2 * self.contact, 2 * self.contact + 1])
+            cols = np.concatenate([cols, nf + C + np.arange(C), nf + C + np.arange(C)])
+            vals = np.concatenate([vals, self.normal[:, 0], self.normal[:, 1]])
+            nc = 2 * C
+        P = sp.csr_matrix((vals, (rows, cols)), shape=(2 * E, nf + nc))
+        return P, nf + np.arange(nc)

@@ -8,21 +8,30 @@ from tresca_py.skfem_cr.cr import Discretisation
 
 
 def box_qp(C, d, w, mu0=None, max_iter=None):
-    """Exact solution of min 1/2 mu^T C mu - mu^T d subject to |mu_i| <= w_i (C SPD, small, dense).
+    """Exact solution of min 1/2 mu^T C mu - mu^T d subject to |mu_i| <= w_i (C SPD, small, dense):
+    ``bound_qp`` with the bounds -w, w. Returns (mu, iterations)."""
+    return bound_qp(C, d, -w, w, mu0, max_iter)
+
+
+def bound_qp(C, d, lo, hi, x0=None, max_iter=None):
+    """Exact solution of min 1/2 x^T C x - x^T d subject to lo <= x <= hi (C SPD, small, dense; a bound may be
+    infinite, lo_i = hi_i pins x_i).
 
     Primal active-set method: every iterate is feasible, a bound is dropped only at a minimiser of
     the current face, and the objective decreases strictly, so no face repeats (finite termination).
-    Returns (mu, iterations).
+    Returns (x, iterations).
     """
     n = len(d)
     if n == 0:
         return np.zeros(0), 0
     max_iter = max_iter or 10 * n + 50
-    mu = np.zeros(n) if mu0 is None else np.clip(mu0, -w, w)
-    upper = (mu >= w)                      # fixed at +w (w == 0 counts as fixed)
-    lower = (mu <= -w) & ~upper
+    mu = np.zeros(n) if x0 is None else np.clip(x0, lo, hi)
+    upper = (mu >= hi)                     # fixed at the upper bound (lo == hi counts as fixed)
+    lower = (mu <= lo) & ~upper
     fixed = upper | lower
-    gscale = np.max(np.abs(d)) + np.max(np.abs(C)) * np.max(w) + 1e-300
+    bounds = np.abs(np.concatenate([lo, hi]))
+    bscale = np.max(bounds[np.isfinite(bounds)], initial=0.0)
+    gscale = np.max(np.abs(d)) + np.max(np.abs(C)) * bscale + 1e-300
     for it in range(1, max_iter + 1):
         F = np.flatnonzero(~fixed)
         if len(F):
@@ -31,25 +40,25 @@ def box_qp(C, d, w, mu0=None, max_iter=None):
             p = target - mu[F]
             # ratio test against the box
             with np.errstate(divide="ignore", invalid="ignore"):
-                lim = np.where(p > 0, (w[F] - mu[F]) / p, np.where(p < 0, (-w[F] - mu[F]) / p, np.inf))
+                lim = np.where(p > 0, (hi[F] - mu[F]) / p, np.where(p < 0, (lo[F] - mu[F]) / p, np.inf))
             j = int(np.argmin(lim)) if len(lim) else -1
             if j >= 0 and lim[j] < 1.0:
                 alpha = max(lim[j], 0.0)
                 mu[F] += alpha * p
                 k = F[j]
                 if p[j] > 0:
-                    mu[k], upper[k] = w[k], True
+                    mu[k], upper[k] = hi[k], True
                 else:
-                    mu[k], lower[k] = -w[k], True
+                    mu[k], lower[k] = lo[k], True
                 fixed[k] = True
                 continue
             mu[F] = target
         # multiplier (gradient) test on the fixed set
         g = C @ mu - d
         viol = np.zeros(n)
-        viol[upper] = g[upper]              # at +w optimal iff g <= 0
-        viol[lower] = -g[lower]             # at -w optimal iff g >= 0
-        viol[w <= 0] = 0.0                  # w = 0: mu is pinned at 0
+        viol[upper] = g[upper]              # at the upper bound optimal iff g <= 0
+        viol[lower] = -g[lower]             # at the lower bound optimal iff g >= 0
+        viol[lo >= hi] = 0.0                # lo == hi (w = 0): x is pinned
         k = int(np.argmax(viol))
         if viol[k] <= 1e-14 * gscale:
             return mu, it
@@ -61,9 +70,13 @@ def kkt_residual(C, d, w, mu):
     """Natural residual |mu - P_box(mu - gamma (C mu - d))|_inf / max(w), gamma = 1/max diag C."""
     if len(mu) == 0:
         return 0.0
+    return natural_residual(C, d, -w, w, mu) / max(np.max(w), 1e-300)
+
+
+def natural_residual(C, d, lo, hi, x):
+    """|x - P_[lo,hi](x - gamma (C x - d))|_inf, gamma = 1/max diag C: zero exactly at the QP's solution."""
     gamma = 1.0 / max(np.max(np.diag(C)), 1e-300)
-    r = mu - np.clip(mu - gamma * (C @ mu - d), -w, w)
-    return float(np.max(np.abs(r)) / max(np.max(w), 1e-300))
+    return float(np.max(np.abs(x - np.clip(x - gamma * (C @ x - d), lo, hi))))
 
 
 class StepSolver:

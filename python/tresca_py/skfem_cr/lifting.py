@@ -55,7 +55,7 @@ class SkfemLifting:
                 edges = disc.dirichlet[disc.part_of_edge[disc.dirichlet] == ip]
                 fb = FacetBasis(prob.mesh, prob.elem, facets=prob.facet_of_edge[edges], intorder=5)
                 self.dirichlet.append((b.u, edges, fb))
-            if b.kind == "contact" and b.gap is not None:
+            if b.kind == "contact" and b.gap is not None and not scene.normal_unknowns:
                 self.gap.append((b.gap, np.flatnonzero(disc.part_of_edge[disc.contact] == ip)))
 
     def lift(self, t):

@@ -11,7 +11,7 @@ from tresca_py.skfem_cr.stepping import run, write_results
 
 def main(argv=None):
     args = cli("Quasi-static Tresca friction with stabilised Crouzeix-Raviart elements -- scikit-fem solver.", argv)
-    scene, disc, out = open_scene(args, Discretisation)
+    scene, disc, out = open_scene(args, Discretisation, unilateral=True)
     with exit_on_failure():
         t0 = time.perf_counter()
         prob = SkfemProblem(disc)

@@ -9,6 +9,7 @@ from tresca_py.common import git_commit
 from tresca_py.errors import InputError
 from tresca_py.skfem_cr.cr import Discretisation
 from tresca_py.skfem_cr.friction import StepSolver, classify
+from tresca_py.skfem_cr.unilateral import UnilateralStepSolver, initial_state
 
 
 def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
@@ -26,7 +27,7 @@ def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
     N = len(times) - 1
     C = len(disc.contact)
     t0 = time.perf_counter()
-    stepper = StepSolver(disc, K)
+    stepper = UnilateralStepSolver(disc, K) if disc.normal_unknowns else StepSolver(disc, K)
     res = dict(u=np.zeros((N + 1, len(disc.edges), 2)), slip=np.zeros((N + 1, C)), mu=np.zeros((N + 1, C)),
                dof=np.zeros((N + 1, C)), sigma_t=np.zeros((N + 1, C)), state=np.zeros((N + 1, C), dtype=np.int8),
                iterations=np.zeros(N + 1, dtype=np.int64), residual=np.zeros(N + 1),
@@ -34,9 +35,14 @@ def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
                wall_time=np.zeros(N + 1), energy=np.zeros(N + 1), factor_time=time.perf_counter() - t0)
     if errors is not None:
         res["errors"] = {k: np.zeros(N + 1) for k in ("energy", "h1", "l2")}
+    if disc.normal_unknowns:
+        res["pressure"], res["gap"] = np.zeros((N + 1, C)), np.zeros((N + 1, C))
+        res["status"] = np.zeros((N + 1, C), dtype=np.uint8)
     u = disc.interpolate(scene.u0, times[0])
     if lifting is not None:
         u = u + lifting.lift(times[0])
+    if disc.normal_unknowns:
+        res["gap"][0], res["status"][0] = initial_state(disc, u, times[0])
     for n, t in enumerate(times):
         tic = time.perf_counter()
         if n > 0:
@@ -64,7 +70,12 @@ def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
 
 def _step(stepper, disc, K, load_t, u_prev, lifting, t, res, n):
     """Step n: the friction step (on w = u − u_L with data), its contact data stored in ``res``; returns uⁿ."""
-    if lifting is None:
+    if disc.normal_unknowns:                        # the gap is a constraint (not lifted): u_L is zero on Γ_C
+        u_l = 0.0 if lifting is None else lifting.lift(t)
+        w, info = stepper.step(load_t if lifting is None else load_t + lifting.rhs(t) - K @ u_l, u_prev, t)
+        u = w + u_l
+        res["pressure"][n], res["gap"][n], res["status"][n] = info["pressure"], info["gap"], info["status"]
+    elif lifting is None:
         u, info = stepper.step(load_t, u_prev)
     else:
         u_l = lifting.lift(t)
@@ -74,7 +85,7 @@ def _step(stepper, disc, K, load_t, u_prev, lifting, t, res, n):
     res["sigma_t"][n] = -mu / disc.lengths[disc.contact]
     res["mu"][n] = mu
     res["dof"][n] = info["dof"]
-    res["state"][n] = classify(mu, info["ds"], info["d"], disc.weight)
+    res["state"][n] = info["state"] if "state" in info else classify(mu, info["ds"], info["d"], disc.weight)
     res["iterations"][n] = info["iterations"]
     res["residual"][n] = info["residual"]
     return u
@@ -92,7 +103,8 @@ def write_results(path, disc: Discretisation, res, solver_name, extra_attrs=None
     contact = None
     if len(disc.contact):
         contact = results.Contact(disc.contact, disc.normal, disc.tangent, disc.gbar, res["slip"], res["sigma_t"],
-                                  res["state"], res["mu"], res["dof"])
+                                  res["state"], res["mu"], res["dof"], res.get("pressure"), res.get("gap"),
+                                  res.get("status"))
     r = results.Results(
         mesh=results.Mesh(disc.points, disc.triangles, disc.edges, disc.midpoints), times=scene.times,
         u=res["u"], energy=res["energy"], steps={k: res[k] for k in results.STEP_FIELDS}, contact=contact,

@@ -104,6 +104,35 @@ REQUIREMENTS = (
         'reference/joint_mms_stop.md',
     ),
     Requirement(
+        'U1-skfem-signorini',
+        'converge with order 1 ± 0.1 (energy) and 2 ± 0.15 (L²) on a manufactured Signorini–Tresca solution whose '
+        'contact/separation and stick/slip points move (`mms_signorini_moving`, scikit-fem solver, 5 levels, N = 8; '
+        'every step to a natural residual ≤ 1e-12)',
+        '.venv/bin/python scripts/skfem_solve.py verification/cases/mms_signorini_moving.toml --refine k --steps 8',
+        'reference/h_skfem_mms_signorini_moving.md',
+    ),
+    Requirement(
+        'U2-skfem-signorini-incompressible',
+        '… the same, free of locking, near-incompressible (λ/μ = 10⁴, `mms_signorini_incompressible`, refine 1..5: '
+        'its L² error is pre-asymptotic at refine 0)',
+        '.venv/bin/python scripts/skfem_solve.py verification/cases/mms_signorini_incompressible.toml --refine k '
+        '--steps 8',
+        'reference/h_skfem_mms_signorini_incompressible.md',
+    ),
+    Requirement(
+        'U3-skfem-coulomb',
+        '… the same with Coulomb friction whose threshold is F times the exact pressure (`mms_signorini_coulomb`)',
+        '.venv/bin/python scripts/skfem_solve.py verification/cases/mms_signorini_coulomb.toml --refine k --steps 8',
+        'reference/h_skfem_mms_signorini_coulomb.md',
+    ),
+    Requirement(
+        'U4-skfem-signorini-k',
+        'converge with order 1 ± 0.1 in k when the slip stops abruptly on a unilateral contact part (time error at '
+        'refine 2 against N = 4096 on the same mesh, N = 4, 16, 64, 256, `mms_signorini_stop`, scikit-fem)',
+        '.venv/bin/python scripts/skfem_solve.py verification/cases/mms_signorini_stop.toml --refine 2 --steps N',
+        'reference/k_skfem_mms_signorini_stop.md',
+    ),
+    Requirement(
         'P1-paper-orders',
         "rest on the paper's Table 5.1 as printed (a data check): its orders recomputed from its errors are 0.8577, "
         "0.9671, 0.9015, 0.866",

@@ -59,6 +59,7 @@ def set_up(comm, args, log):
     try:
         try:
             scene = load_scene(args.scene, refine=args.refine, steps=args.steps)
+            scene.refuse_contact_extensions("distributed dolfinx")
         except InputError as e:
             raise Fail(str(e)) from None
         try:
