@@ -56,15 +56,20 @@ impl Writer {
     /// its sidecar already is. [`Writer::create_locked`] checks it; a run checks it before its set-up
     /// too, since from 1,000,000 unknowns the file is created only after the factorisation.
     pub fn refuse_existing(path: &Path, force: bool) -> Result<()> {
+        Writer::refuse_existing_for(path, force, true)
+    }
+
+    /// [`Writer::refuse_existing`] for a command that can (`resumable`, `run --resume`) or cannot
+    /// (`adapt`) continue the run an existing file holds: the refusal suggests only what the command does.
+    pub fn refuse_existing_for(path: &Path, force: bool, resumable: bool) -> Result<()> {
         if path.is_dir() {
             return Err(Error::Io { path: path.to_path_buf(), msg: "is a directory, not a results file".into() });
         }
         if path.exists() && !force {
+            let resume = if resumable { " or --resume to continue the run it holds" } else { "" };
             return Err(Error::Io {
                 path: path.to_path_buf(),
-                msg:
-                    "results file already exists; pass --force to overwrite it or --resume to continue the run it holds"
-                        .into(),
+                msg: format!("results file already exists; pass --force to overwrite it{resume}"),
             });
         }
         let side = sidecar(path);

@@ -93,9 +93,12 @@ impl Estimate {
             "{} triangles, {} unknowns, {} contact edges, {} steps",
             self.triangles, self.unknowns, self.contact, self.steps
         );
-        let (mem, mem_limit) = match max_memory {
-            Some(m) => (Some(m), "is the limit given (--max-memory)"),
-            None => (available_memory(), "is available on this machine"),
+        // a limit given is checked against the hard bounds too (address space, cgroup: `machine`), which
+        // no allocation can pass
+        let (mem, mem_limit) = match (max_memory, crate::machine::hard_memory_left()) {
+            (Some(m), Some((h, why))) if h < m => (Some(h), why),
+            (Some(m), _) => (Some(m), "is the limit given (--max-memory)"),
+            (None, _) => crate::machine::memory_left().map_or((None, ""), |(b, why)| (Some(b), why)),
         };
         let least = self.memory_metis.unwrap_or(self.memory);
         if let Some(have) = mem.filter(|&h| least > h) {
