@@ -51,7 +51,7 @@ fn address_space_left() -> Option<u64> {
         return None;
     }
     let vm = field(&std::fs::read_to_string("/proc/self/status").ok()?, "VmSize:").unwrap_or(0) * 1024;
-    Some((lim.rlim_cur as u64).saturating_sub(vm))
+    Some(lim.rlim_cur.saturating_sub(vm))
 }
 
 /// What the memory limits of the process's cgroup (its group and every ancestor, v1 or v2) leave.
