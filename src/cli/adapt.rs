@@ -108,7 +108,7 @@ pub fn run_rows(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<
         }
     }
     if let Some(path) = &csv {
-        std::fs::write(&path, csv_text(&outcome.rows, exact))
+        std::fs::write(path, csv_text(&outcome.rows, exact))
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(j) = &json {
