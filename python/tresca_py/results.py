@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import checksum, paths
+from . import checksum, paths, virtual
 
 F8, I8, U1, U8 = np.dtype("<f8"), np.dtype("<i8"), np.dtype("u1"), np.dtype("<u8")
 
@@ -278,6 +278,9 @@ def _dataset(where, g, name):
     obj = g.get(name)
     if not isinstance(obj, h5py.Dataset):
         raise ResultsError(f"{where}: tresca/{name} is missing")
+    if obj.is_virtual and (missing := virtual.missing_source(obj)):
+        raise ResultsError(f"{where}: tresca/{name} is a virtual dataset whose source {missing} is missing; HDF5 "
+                           "would read it as zeros, not data")
     return obj
 
 
