@@ -125,3 +125,89 @@ fn adapt_on_a_disk_that_fills_ends_with_an_error_not_a_signal() {
     }
     assert!(levels >= 1, "no level was written: {}", stderr(&o));
 }
+
+/// `args` run with standard output closed (`>&-`).
+fn with_stdout_closed(args: &[&str]) -> std::process::Output {
+    use std::os::unix::process::CommandExt;
+    let _g = fork_guard();
+    let mut c = bin();
+    c.args(args);
+    // SAFETY: closing descriptor 1 in the child between fork and exec.
+    unsafe {
+        c.pre_exec(|| {
+            libc::close(1);
+            Ok(())
+        });
+    }
+    c.output().unwrap()
+}
+
+/// §5: the system shall fail `adapt` whose table is lost (standard output closed or full) as `study` and
+/// `plan` fail, naming the cause, and say that --csv keeps the table.
+#[test]
+fn adapt_with_its_standard_output_lost_fails() {
+    let scene = scene40();
+    let args = ["adapt", scene.as_str(), "--levels", "2"];
+    let o = with_stdout_closed(&args);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("cannot write to standard output"), "{}", stderr(&o));
+    if Path::new("/dev/full").exists() {
+        let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+        let o = {
+            let _g = fork_guard();
+            bin().args(args).stdout(full).output().unwrap()
+        };
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        assert!(stderr(&o).contains("--csv keeps it"), "{}", stderr(&o));
+    }
+}
+
+/// §5: the system shall refuse `adapt --reference 0` (the starting mesh, not finer than any level) before
+/// any level runs, refuse a reference solve whose memory does not fit before it runs (exit code 3, the
+/// reason named), and refuse an existing level file suggesting only what adapt does (--force, not
+/// --resume).
+#[test]
+fn adapt_refuses_what_it_cannot_do_as_run_does() {
+    let scene = scene40();
+    let o = spawn(bin().args(["adapt", &scene, "--levels", "2", "--reference", "0"])).wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--reference 0") && stderr(&o).contains("not finer"), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).lines().count() <= 1, "a level ran");
+    let args = ["adapt", &scene, "--levels", "2", "--reference", "12", "--max-memory", "100M"];
+    let o = spawn(bin().args(args)).wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    assert!(stderr(&o).contains("reference solve") && stderr(&o).contains("does not fit"), "{}", stderr(&o));
+    let dir = tmp("adapt-again");
+    let _ = std::fs::remove_dir_all(&dir);
+    let args = ["adapt", &scene, "--levels", "1", "--out", s(&dir)];
+    let o = spawn(bin().args(args)).wait_with_output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = spawn(bin().args(args)).wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--force") && !stderr(&o).contains("--resume"), "{}", stderr(&o));
+}
+
+/// §5: the system shall refuse a study whose level does not fit under the process's address-space limit
+/// (`ulimit -v`) even when --max-memory allows it, naming the limit, before any level runs.
+#[test]
+fn study_max_memory_is_checked_against_the_address_space_limit() {
+    use std::os::unix::process::CommandExt;
+    let scene = scene40();
+    let o = {
+        let _g = fork_guard();
+        let mut c = bin();
+        c.args(["study", &scene, "--levels", "0:4,7:8", "--max-memory", "100G"]);
+        // SAFETY: setrlimit in the child between fork and exec (`ulimit -v 800000`, in KiB).
+        unsafe {
+            c.pre_exec(|| {
+                let lim = libc::rlimit { rlim_cur: 800_000 << 10, rlim_max: 800_000 << 10 };
+                libc::setrlimit(libc::RLIMIT_AS, &lim);
+                Ok(())
+            });
+        }
+        c.output().unwrap()
+    };
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("ulimit -v") && stderr(&o).contains("study level 7:8"), "{}", stderr(&o));
+    assert!(o.stdout.is_empty(), "a level ran");
+}
