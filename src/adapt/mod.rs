@@ -290,14 +290,6 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
     }
     if let (Some(g), Some(finest)) = (opts.reference, levels.last()) {
         let (ref_mesh, _) = overlay(finest.mesh.clone(), last_root, g)?;
-        if ref_mesh.tris.len() == finest.mesh.tris.len() {
-            let have = rows.last().map_or(0, |r| r.generation);
-            let msg = format!(
-                "--reference {g}: the finest level already has every triangle of generation {g} or more, so the \
-                 reference would be that level itself; give a generation above {have}"
-            );
-            return Err(Error::scene(&scene.file, "adapt", msg));
-        }
         match reference_refusal(scene, &ref_mesh, opts, &levels) {
             Some(why) => stopped = Some(why),
             None => {
