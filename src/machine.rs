@@ -1,15 +1,94 @@
 //! What this machine has: the memory available to a new allocation and the free space of a file system.
 //! Read by the pre-run estimate (`scene::budget`) and by the factorisation, which checks the exact size of
 //! the factor before it allocates it (`solve::cholesky`).
+//!
+//! The memory a process can have is the least of three bounds: MemAvailable of `/proc/meminfo` (the
+//! machine), what the address-space limit leaves (`ulimit -v`, RLIMIT_AS, less the process's VmSize), and
+//! what the memory limit of its cgroup leaves (v2 `memory.max`, v1 `memory.limit_in_bytes`, of its group
+//! and every ancestor, less the group's usage without its inactive file cache, which the kernel reclaims
+//! first). The last two are hard: an allocation past them fails whatever `--max-memory` says.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// MemAvailable of `/proc/meminfo`, bytes (`None` where there is no such file).
+/// What each bound is called in a refusal ("… B of memory needed, … B {what}").
+const MACHINE: &str = "is available on this machine";
+const ADDRESS_SPACE: &str = "is left under this process's address-space limit (ulimit -v)";
+const CGROUP: &str = "is left under the memory limit of this process's cgroup";
+
+/// The memory a new allocation can have, bytes: the least of the three bounds of the module doc (`None`
+/// where none is known).
 pub fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
+    memory_left().map(|(b, _)| b)
+}
+
+/// [`available_memory`] with the words that name the bound it is.
+pub fn memory_left() -> Option<(u64, &'static str)> {
+    [mem_available().map(|b| (b, MACHINE)), hard_memory_left()].into_iter().flatten().min_by_key(|&(b, _)| b)
+}
+
+/// The least of the hard bounds (address space, cgroup), with the words that name it; `None` without any.
+pub fn hard_memory_left() -> Option<(u64, &'static str)> {
+    let aspace = address_space_left().map(|b| (b, ADDRESS_SPACE));
+    [aspace, cgroup_left().map(|b| (b, CGROUP))].into_iter().flatten().min_by_key(|&(b, _)| b)
+}
+
+/// The number after `key` in a `key value` text (`/proc/meminfo`, `/proc/self/status`, `memory.stat`).
+fn field(text: &str, key: &str) -> Option<u64> {
+    let line = text.lines().find(|l| l.split_whitespace().next() == Some(key))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
+/// MemAvailable of `/proc/meminfo`, bytes.
+fn mem_available() -> Option<u64> {
+    Some(field(&std::fs::read_to_string("/proc/meminfo").ok()?, "MemAvailable:")? * 1024)
+}
+
+/// RLIMIT_AS less the process's VmSize, bytes; `None` without a limit.
+fn address_space_left() -> Option<u64> {
+    let mut lim = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+    // SAFETY: getrlimit fills the struct it is given.
+    if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) } != 0 || lim.rlim_cur == libc::RLIM_INFINITY {
+        return None;
+    }
+    let vm = field(&std::fs::read_to_string("/proc/self/status").ok()?, "VmSize:").unwrap_or(0) * 1024;
+    Some(lim.rlim_cur.saturating_sub(vm))
+}
+
+/// What the memory limits of the process's cgroup (its group and every ancestor, v1 or v2) leave.
+fn cgroup_left() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    let mut least = None::<u64>;
+    for line in text.lines() {
+        let mut parts = line.splitn(3, ':');
+        let (Some(id), Some(ctl), Some(path)) = (parts.next(), parts.next(), parts.next()) else { continue };
+        let (root, names) = if id == "0" && ctl.is_empty() {
+            ("/sys/fs/cgroup", ["memory.max", "memory.current", "inactive_file"])
+        } else if ctl.split(',').any(|c| c == "memory") {
+            ("/sys/fs/cgroup/memory", ["memory.limit_in_bytes", "memory.usage_in_bytes", "total_inactive_file"])
+        } else {
+            continue;
+        };
+        let mut dir = PathBuf::from(root).join(path.trim_start_matches('/'));
+        loop {
+            if let Some(left) = group_left(&dir, names) {
+                least = Some(least.map_or(left, |l| l.min(left)));
+            }
+            if dir.as_path() == Path::new(root) || !dir.pop() {
+                break;
+            }
+        }
+    }
+    least
+}
+
+/// limit − (usage − inactive file cache) of one cgroup directory; `None` without a limit (`max`, or v1's
+/// near 2⁶³ "unlimited").
+fn group_left(dir: &Path, [max, current, inactive]: [&str; 3]) -> Option<u64> {
+    let read = |name: &str| std::fs::read_to_string(dir.join(name)).ok();
+    let limit: u64 = read(max)?.trim().parse().ok().filter(|&l: &u64| l < 1 << 62)?;
+    let usage: u64 = read(current)?.trim().parse().ok()?;
+    let cache = read("memory.stat").and_then(|t| field(&t, inactive)).unwrap_or(0);
+    Some(limit.saturating_sub(usage.saturating_sub(cache)))
 }
 
 /// Hand the heap memory freed so far back to the system (glibc's `malloc_trim`): glibc keeps freed

@@ -329,6 +329,8 @@ fn run(
     json: cli::summary::JsonArg,
 ) -> Result<()> {
     let (given, resume) = (out.output.clone(), out.resume);
+    // an existing -o first: before the estimate, whose bounds (ulimit -v) would name another cause
+    given.iter().filter(|_| !resume).try_for_each(|p| tresca_cr::output::Writer::refuse_existing(p, out.force))?;
     let new_file = move |s: &Scene| given.or_else(|| s.output.clone()).filter(|_| !resume);
     cli::summary::check_path(json.json.as_deref())
         .and_then(|()| load(scene, overrides.grid, limits, new_file, true))

@@ -7,6 +7,7 @@ run (``--theta 1``), with DOF^(-1/2) for reference.
 import argparse
 import csv
 import glob
+import math
 import os
 import re
 import sys
@@ -37,6 +38,20 @@ def read_rows(path):
         return list(csv.DictReader(f))
 
 
+def number(path, rows, i, col):
+    """The value of column ``col`` in data row ``i`` of the CSV ``path``: a finite positive number, since a
+    log-log picture cannot draw anything else (NaN, inf, 0 or a negative value is refused naming its place)."""
+    text = rows[i].get(col)
+    try:
+        v = float(text)
+    except (TypeError, ValueError):
+        v = math.nan
+    if not (math.isfinite(v) and v > 0):
+        raise ValueError(f"{path}: line {i + 2}, column {col} = {text!r}: not a finite positive number, which "
+                         "a log-log picture cannot draw")
+    return v
+
+
 def error_column(rows):
     """The error compared: the reference distance, else the true error, else the distance to the next level."""
     for col in ("vs_reference", "error", "vs_next"):
@@ -51,14 +66,15 @@ def rates_picture(adaptive, uniform, out, title):
     for path, name, mark in ((adaptive, "adaptive", "o"), (uniform, "uniform", "s")):
         rows = read_rows(path)
         col = error_column(rows)
-        d = np.array([float(r["unknowns"]) for r in rows])
+        d = np.array([number(path, rows, i, "unknowns") for i in range(len(rows))])
         keep = [i for i, r in enumerate(rows) if r[col]]
-        e = np.array([float(rows[i][col]) for i in keep])
-        eta = np.array([float(r["estimator"]) for r in rows])
+        e = np.array([number(path, rows, i, col) for i in keep])
+        eta = np.array([number(path, rows, i, "estimator") for i in range(len(rows))])
         ax.loglog(d[keep], e, mark + "-", label=f"{name}: error ({col})")
         ax.loglog(d, eta, mark + "--", mfc="none", label=f"{name}: estimator")
-    d0 = np.array([float(r["unknowns"]) for r in read_rows(adaptive)])
-    e0 = float(read_rows(adaptive)[0][error_column(read_rows(adaptive))])
+    first = read_rows(adaptive)
+    d0 = np.array([number(adaptive, first, i, "unknowns") for i in range(len(first))])
+    e0 = number(adaptive, first, 0, error_column(first))
     ax.loglog(d0, e0 * (d0 / d0[0]) ** -0.5, "k:", label="DOF^(-1/2)")
     ax.set_xlabel("unknowns")
     ax.set_ylabel("energy norm (max over time nodes)")

@@ -24,6 +24,8 @@ Checks, each with its reason:
 import h5py
 import numpy as np
 
+from .results import ResultsError
+
 SERIES = ("external_work", "boundary_work", "stored_energy", "friction_dissipation", "euler_dissipation",
           "balance_residual")
 BALANCE_REL = 1e-9
@@ -34,12 +36,27 @@ EPS = 2.0 ** -53
 
 def read(path, completed):
     """{name: the first ``completed`` values} of the audit series, or None for a file without them (a run of
-    an older version or of the Python solvers)."""
+    an older version or of the Python solvers); ResultsError for a series that is not a 1-D numeric dataset
+    of at least ``completed`` values (a group, strings, 2-D, short)."""
     with h5py.File(path, "r") as f:
         g = f["tresca/steps"]
         if not all(k in g for k in SERIES):
             return None
-        return {k: np.asarray(g[k][:completed], dtype=float) for k in SERIES}
+        return {k: _series(path, g, k, completed) for k in SERIES}
+
+
+def _series(path, g, k, completed):
+    """The first ``completed`` values of the audit series ``k`` of the group ``g``, checked (see ``read``)."""
+    ds = g.get(k)
+    where = f"{path}: tresca/steps/{k}"
+    if not isinstance(ds, h5py.Dataset):
+        raise ResultsError(f"{where} is {type(ds).__name__.lower()}, not a dataset of the energy audit")
+    if ds.dtype.kind not in "fiu":
+        raise ResultsError(f"{where} holds {ds.dtype} values, the energy audit wants numbers (float64)")
+    if ds.ndim != 1 or ds.shape[0] < completed:
+        raise ResultsError(f"{where} has shape {ds.shape}, the energy audit wants one value for each of the "
+                           f"{completed} completed steps")
+    return np.asarray(ds[:completed], dtype=float)
 
 
 def rounding(path, scale):

@@ -102,9 +102,39 @@ def check_tresca(c, run):
             c.close(ct.sigma_t, -ct.mu / length, "sigma_t = -mu/|e|", 1e-14)
 
 
+# what each block of /VTKHDF declares, and the dataset that must hold that many rows
+DECLARED = (("NumberOfPoints", "Points"), ("NumberOfCells", "Types"), ("NumberOfConnectivityIds", "Connectivity"))
+
+
+def declared_sizes(h5):
+    """ResultsError unless every count a /VTKHDF block declares (points, cells, connectivity ids) is held by its
+    dataset and fits the file's size: the VTK reader allocates what is declared before it reads, so a count
+    of 10⁹ in a small file would take gigabytes first."""
+    import h5py
+    size = os.path.getsize(h5)
+    with h5py.File(h5, "r") as f:
+        root = f.get("VTKHDF")
+        blocks = [(k, g) for k, g in root.items() if isinstance(g, h5py.Group) and k != "Assembly"] if root else []
+        for name, g in blocks:
+            for count, held in DECLARED:
+                c, d = g.get(count), g.get(held)
+                if not (isinstance(c, h5py.Dataset) and isinstance(d, h5py.Dataset)):
+                    continue
+                n = np.asarray(c[()]).reshape(-1)
+                if n.dtype.kind not in "iu" or np.any(n < 0):
+                    raise results.ResultsError(f"{h5}: VTKHDF/{name}/{count} holds {n.dtype} {n[:4]}, not counts")
+                need = int(n.max(initial=0))
+                row = d.dtype.itemsize * int(np.prod(d.shape[1:], dtype=np.int64))
+                if need > d.shape[0] or need * row > size:
+                    raise results.ResultsError(
+                        f"{h5}: VTKHDF/{name}/{count} declares {need}, but VTKHDF/{name}/{held} holds "
+                        f"{d.shape[0]} rows and the file has {size} bytes: damaged, not read")
+
+
 def check_vtkhdf(c, run, h5):
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy as v2n
+    declared_sizes(h5)
     r = vtk.vtkHDFReader()
     r.SetFileName(h5)
     r.UpdateInformation()
@@ -202,6 +232,7 @@ def main(argv=None):
         views = has_views(r.path)
         if views or args.xdmf:
             paths.check_sidecar(r.path, xdmf)
+        budget = audit.read(r.path, r.completed)
     except (results.ResultsError, paths.PathError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
@@ -210,7 +241,6 @@ def main(argv=None):
     print(f"{args.h5}: {r.completed} steps, {len(run.frames)} frames (every {run.every}), {run.T} triangles, "
           f"{run.E} edges, {run.C} contact edges, status {r.status!r}")
     check_tresca(c, run)
-    budget = audit.read(r.path, r.completed)
     if budget is not None:
         print(audit.summary(budget))
         for m in audit.problems(budget, audit.rounding(r.path, audit.largest_work(budget))):

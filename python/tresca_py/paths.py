@@ -47,7 +47,10 @@ def input_file(path, what="results file"):
 
 
 def _superblock_eof(head):
-    """The end-of-file address a superblock records (None for versions this does not know)."""
+    """The end of file a superblock records, as a size from the file's first byte (None for versions this does
+    not know). HDF5 records it so with or without a user block before the superblock (a 512-byte user block
+    and a file of 2,640 bytes record base address 512 and end of file 2,640): the superblock's offset is
+    not added."""
     version = head[8]
     if version in (0, 1):
         size = head[13]  # size of offsets
@@ -85,8 +88,8 @@ def hdf5_file(path, what="results file"):
             raise PathError(f"{path}: is not an HDF5 file (no HDF5 signature; it starts with {start!r}: {kind}), "
                             f"not a {what}")
     eof = _superblock_eof(head)
-    if eof is not None and at + eof > size:
-        raise PathError(f"{path}: is truncated: its HDF5 superblock records at least {at + eof} bytes, the file "
+    if eof is not None and eof > size:
+        raise PathError(f"{path}: is truncated: its HDF5 superblock records at least {eof} bytes, the file "
                         f"has {size} (an interrupted copy?)")
     return path
 

@@ -150,6 +150,12 @@ def contact(d, n, out):
 def energy(d, out):
     """The energy budget over time (``tresca_py.audit``): stored energy, cumulative external and boundary work,
     cumulative frictional and backward-Euler dissipation, and the balance residual on a second axis."""
+    energy_figure(d).savefig(out, dpi=120, bbox_inches="tight")
+
+
+def energy_figure(d):
+    """The figure of ``energy``. Residuals that are exactly zero have no place on the log axis: they are marked
+    on its bottom edge and named in the legend, so the axis spans the nonzero residuals only."""
     a, t = d["audit"], d["times"]
     fig = Figure(figsize=(7, 5.6))
     a1, a2 = fig.subplots(2, 1, sharex=True)
@@ -162,12 +168,19 @@ def energy(d, out):
     a1.set_ylabel("energy [force·length]")
     a1.legend(fontsize=8)
     a1.grid(alpha=0.3)
-    a2.semilogy(t[1:], np.maximum(np.abs(a["balance_residual"][1:]), 1e-300), ".", color="tab:red")
+    r, tn = np.abs(a["balance_residual"][1:]), t[1:]
+    zero = r == 0
+    if np.any(~zero):
+        a2.semilogy(tn[~zero], r[~zero], ".", color="tab:red", label="|balance residual|")
+    if np.any(zero):
+        a2.plot(tn[zero], np.zeros(int(zero.sum())), "x", color="tab:gray", transform=a2.get_xaxis_transform(),
+                clip_on=False, label=f"exactly 0 ({int(zero.sum())} steps)")
+        a2.legend(fontsize=8)
     a2.set_ylabel("|balance residual|")
     a2.set_xlabel(f"time [{d['units']['T'].strip() or 'time'}]")
     a2.grid(alpha=0.3)
     a1.set_title(title(d, "energy budget: a_h(uⁿ,δuⁿ) + j_h(δuⁿ) = (lⁿ,δuⁿ) + W_Γⁿ per step"), fontsize=9)
-    fig.savefig(out, dpi=120, bbox_inches="tight")
+    return fig
 
 
 def positive_or_auto(text):

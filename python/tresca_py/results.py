@@ -9,14 +9,15 @@ is not an edge, time nodes not increasing, a step that does not match its checks
 
 Sizes: P points, T triangles, E edges, C contact edges (Γ_C; the ``contact`` group exists only when C > 0),
 R rows of every series (N + 1 time nodes; a killed run, status "running", has room for all N + 1 but data
-in its first ``completed`` rows only; a finished or stopped run has exactly ``completed`` rows).
+in its first ``completed`` rows only; a finished or stopped run has exactly ``completed`` rows, but a stopped
+run whose disk had no room to cut its series keeps all N + 1, as a killed run).
 """
 import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import checksum, paths
+from . import checksum, paths, virtual
 
 F8, I8, U1, U8 = np.dtype("<f8"), np.dtype("<i8"), np.dtype("u1"), np.dtype("<u8")
 
@@ -279,9 +280,10 @@ def _status_rows(where, status, completed, rows, n_steps):
     if status.startswith("running") and rows != n_steps + 1:
         raise ResultsError(f"{where}: a killed run (status {status!r}) must have room for all {n_steps + 1} "
                            f"steps; the series hold {rows} rows")
-    if status.startswith("stopped") and rows != completed:
-        raise ResultsError(f"{where}: a stopped run must be cut to its {completed} completed steps; the series "
-                           f"hold {rows} rows")
+    # a stopped run is cut to its completed steps, or left at full length when the disk had no room to cut it
+    if status.startswith("stopped") and rows not in (completed, n_steps + 1):
+        raise ResultsError(f"{where}: a stopped run must be cut to its {completed} completed steps or left at "
+                           f"all {n_steps + 1}; the series hold {rows} rows")
 
 
 def _dataset(where, g, name):
@@ -289,6 +291,9 @@ def _dataset(where, g, name):
     obj = g.get(name)
     if not isinstance(obj, h5py.Dataset):
         raise ResultsError(f"{where}: tresca/{name} is missing")
+    if obj.is_virtual and (missing := virtual.missing_source(obj)):
+        raise ResultsError(f"{where}: tresca/{name} is a virtual dataset whose source {missing} is missing; HDF5 "
+                           "would read it as zeros, not data")
     return obj
 
 

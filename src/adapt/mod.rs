@@ -218,6 +218,11 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
     if !(opts.theta > 0.0 && opts.theta <= 1.0) {
         return Err(Error::scene(&scene.file, "adapt", format!("theta = {}: must be in (0, 1]", opts.theta)));
     }
+    if opts.reference == Some(0) {
+        let msg = "--reference 0: generation 0 is the starting mesh, not finer than any level; give a generation \
+                   above the finest level's (at least 1)";
+        return Err(Error::scene(&scene.file, "adapt", msg.to_string()));
+    }
     let start = Instant::now();
     let mut mesh = initial_mesh(scene)?;
     let mut root_area: Vec<f64> = (0..mesh.tris.len()).map(|t| mesh.area(t)).collect();
@@ -235,6 +240,10 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
         let min_angle = mesh.min_angle();
         let generation = reference::generations(&mesh, &root_area).into_iter().max().unwrap_or(0);
         let out = opts.out.as_ref().map(|d| d.join(format!("level_{level}.h5")));
+        if let Some(p) = &out {
+            // before anything of the level is made; adapt does not resume, so its refusal says only --force
+            Writer::refuse_existing_for(p, opts.force, false)?;
+        }
         if let (Some(dir), true) = (&opts.out, opts.gmsh) {
             export::write_gmsh(&mesh, &dir.join(format!("level_{level}.msh")))?;
         }
@@ -281,16 +290,36 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
     }
     if let (Some(g), Some(finest)) = (opts.reference, levels.last()) {
         let (ref_mesh, _) = overlay(finest.mesh.clone(), last_root, g)?;
-        let rf = solve(scene, ref_mesh, None, false, false, false)?;
-        let law = crate::fem::elasticity::Elasticity::new(&scene.material);
-        for (row, kept) in rows.iter_mut().zip(&levels) {
-            row.vs_reference = Some(distance(&rf.kept, kept, &law, scene.rho)?);
+        match reference_refusal(scene, &ref_mesh, opts, &levels) {
+            Some(why) => stopped = Some(why),
+            None => {
+                let rf = solve(scene, ref_mesh, None, false, false, false)?;
+                let law = crate::fem::elasticity::Elasticity::new(&scene.material);
+                for (row, kept) in rows.iter_mut().zip(&levels) {
+                    row.vs_reference = Some(distance(&rf.kept, kept, &law, scene.rho)?);
+                }
+            }
         }
     }
     if stopped.is_none() && rows.last().is_some_and(|r| opts.target.is_some_and(|t| r.estimator > t)) {
         stopped = Some(format!("the target was not reached in {} levels", rows.len()));
     }
     Ok(Outcome { rows, stopped })
+}
+
+/// Why the reference solve on `mesh` is not run: its memory, beside the fields of every level kept for
+/// the comparison and its own (8 bytes a value, every time node), does not fit.
+fn reference_refusal(scene: &Scene, mesh: &Mesh, opts: &Options, levels: &[Kept]) -> Option<String> {
+    let steps = scene.times.len() - 1;
+    let sizes = (mesh.tris.len() as u64, mesh.edges.len() as u64, contact_edges(scene, mesh));
+    let mut estimate = Estimate::of_sizes(sizes, steps, false);
+    let fields = |unknowns: u64| unknowns.saturating_mul(8).saturating_mul(steps as u64 + 1);
+    let kept: u64 = levels.iter().map(|k| fields(k.space.n_dofs as u64)).sum();
+    let more = kept.saturating_add(fields(estimate.unknowns));
+    estimate.memory = estimate.memory.saturating_add(more);
+    estimate.memory_metis = estimate.memory_metis.map(|m| m.saturating_add(more));
+    let e = estimate.check(opts.max_memory, None, None).err()?;
+    Some(format!("the reference solve ({} unknowns) does not fit: {e}", estimate.unknowns))
 }
 
 /// Why level `level` on `mesh` is not run: its memory or results file does not fit, or the budget would

@@ -107,8 +107,8 @@ pub fn run_rows(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<
             );
         }
     }
-    if let Some(path) = csv {
-        std::fs::write(&path, csv_text(&outcome.rows, exact))
+    if let Some(path) = &csv {
+        std::fs::write(path, csv_text(&outcome.rows, exact))
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(j) = &json {
@@ -119,6 +119,8 @@ pub fn run_rows(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<
         summary.adapt = Some(super::summary::AdaptSummary::of(&opts, exact, &outcome.rows, outcome.stopped.clone()));
         super::summary::write(j, &summary)?;
     }
+    // the table is the result (or --csv keeps it): a closed or full standard output fails the command
+    super::out::report_written(csv.as_deref())?;
     let code = match &outcome.stopped {
         Some(why) => {
             note!("refused: {why}");

@@ -5,6 +5,7 @@ use super::fields::{Fields, StepFields};
 use super::h5::{self, io, Raw};
 use super::lock::OutputLock;
 use super::paths::{self, sidecar};
+use super::reserve;
 use super::rows::Rows;
 use super::tresca::Tresca;
 use super::vtkhdf::{FrameRows, Frames, VtkHdf};
@@ -13,6 +14,24 @@ use super::{ioerr, partial_path, Opened, Options, Pending, Run, Writer, AUTO_FRA
 use crate::error::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
+
+/// The visualisation frames of a run of `n` steps: every `--frame-every` steps, by default at most
+/// [`AUTO_FRAMES`].
+fn frames_of(n: usize, opts: &Options) -> Frames {
+    Frames { every: opts.frame_every.unwrap_or(n.div_ceil(AUTO_FRAMES - 1)).max(1), last: n }
+}
+
+/// What is reserved for a new file of `run` with `frames` frames before the library builds it: the
+/// estimate of `scene::budget::results_file` plus the metadata of a frame (8 virtual datasets and their
+/// object headers: about 13.5 KB a frame measured on an 8-triangle mesh with 2,001 frames), with an
+/// eighth more, since only a reservation that covers the whole file keeps the library from a full disk.
+fn file_bytes(run: &Run, frames: u64) -> u64 {
+    const FRAME_METADATA: u64 = 16 << 10;
+    let sizes = (run.mesh.tris.len() as u64, run.mesh.edges.len() as u64, run.space.contact.len() as u64);
+    let est = crate::scene::budget::results_file(sizes, run.n_steps() as u64, frames)
+        .saturating_add(frames.saturating_mul(FRAME_METADATA));
+    est.saturating_add(est / 8)
+}
 
 /// The file a new one replaces, held open for reading (see [`Pending`]); not through a symbolic link,
 /// and without waiting on a FIFO.
@@ -37,15 +56,20 @@ impl Writer {
     /// its sidecar already is. [`Writer::create_locked`] checks it; a run checks it before its set-up
     /// too, since from 1,000,000 unknowns the file is created only after the factorisation.
     pub fn refuse_existing(path: &Path, force: bool) -> Result<()> {
+        Writer::refuse_existing_for(path, force, true)
+    }
+
+    /// [`Writer::refuse_existing`] for a command that can (`resumable`, `run --resume`) or cannot
+    /// (`adapt`) continue the run an existing file holds: the refusal suggests only what the command does.
+    pub fn refuse_existing_for(path: &Path, force: bool, resumable: bool) -> Result<()> {
         if path.is_dir() {
             return Err(Error::Io { path: path.to_path_buf(), msg: "is a directory, not a results file".into() });
         }
         if path.exists() && !force {
+            let resume = if resumable { " or --resume to continue the run it holds" } else { "" };
             return Err(Error::Io {
                 path: path.to_path_buf(),
-                msg:
-                    "results file already exists; pass --force to overwrite it or --resume to continue the run it holds"
-                        .into(),
+                msg: format!("results file already exists; pass --force to overwrite it{resume}"),
             });
         }
         let side = sidecar(path);
@@ -75,12 +99,15 @@ impl Writer {
             .with_fapl(h5::file_access)
             .create_excl(&partial)
             .map_err(io(path, "cannot create HDF5 file"))?;
-        let opened = Writer::fill(&file, path, &partial, run, opts).inspect_err(|_| {
-            // nothing of a new file is left when it cannot be made (a full disk: the series are allocated
-            // for the whole run, so the partial file would be large)
-            let _ = std::fs::remove_file(&partial);
-        })?;
-        let (fields, tresca, vtk, xdmf, frames, raw) = opened;
+        let frames = frames_of(run.n_steps(), opts);
+        let opened = Writer::reserve_new(&partial, path, run, frames)
+            .and_then(|raw| Writer::fill(&file, path, run, frames, raw))
+            .inspect_err(|_| {
+                // nothing of a new file is left when it cannot be made (a full disk: the series are
+                // allocated for the whole run, so the partial file would be large)
+                let _ = std::fs::remove_file(&partial);
+            })?;
+        let (fields, tresca, vtk, xdmf, raw) = opened;
         let old = paths::lstat(path)?.is_some().then(|| open_old(path)).flatten();
         let pending = Some(Pending { old, partial });
         let mut w = Writer::from_opened(path, run, fields, Opened { file, raw, tresca, vtk, xdmf, frames }, 0, None);
@@ -90,29 +117,38 @@ impl Writer {
         Ok(w)
     }
 
-    /// The groups of a new file `file` (built at `partial`), with its sidecar started.
-    #[allow(clippy::type_complexity)]
+    /// The plain handle on a new file (at `partial`, for `path`), with the whole estimated file reserved
+    /// before the library writes into it (`reserve`).
+    fn reserve_new(partial: &Path, path: &Path, run: &Run, frames: Frames) -> Result<Raw> {
+        let raw = Raw::open(partial).map_err(ioerr(path, "cannot open the new file for writing"))?;
+        let need = file_bytes(run, frames.total() as u64);
+        reserve::from_start(&raw.0, need).map_err(|e| reserve::no_room(path, need, "for the results file", &e))?;
+        Ok(raw)
+    }
+
+    /// The groups of a new file `file` (for `path`), with its sidecar started; once flushed, every byte of
+    /// the file is allocated (the series of every step, `reserve`) and the rest of the reservation handed
+    /// back.
     fn fill(
         file: &hdf5::File,
         path: &Path,
-        partial: &Path,
         run: &Run,
-        opts: &Options,
-    ) -> Result<(Fields, Tresca, VtkHdf, Xdmf, Frames, Raw)> {
+        frames: Frames,
+        raw: Raw,
+    ) -> Result<(Fields, Tresca, VtkHdf, Xdmf, Raw)> {
         let fields = Fields::new(run);
         let contact = !run.space.contact.is_empty();
-        let n = run.n_steps();
-        let every = opts.frame_every.unwrap_or(n.div_ceil(AUTO_FRAMES - 1)).max(1);
-        let frames = Frames { every, last: n };
         let tresca = Tresca::create(file, run).map_err(io(path, "writing the tresca group"))?;
-        h5::attr(&tresca.group, "frame_every", every as i64).map_err(io(path, "attribute frame_every"))?;
+        h5::attr(&tresca.group, "frame_every", frames.every as i64).map_err(io(path, "attribute frame_every"))?;
         let vtk =
             VtkHdf::create(file, &fields, frames.total(), contact).map_err(io(path, "writing the VTKHDF group"))?;
         let xdmf = Xdmf::create(file, path, &fields, contact, frames.total())
             .map_err(ioerr(path, "writing the XDMF sidecar"))?;
         file.flush().map_err(io(path, "flush"))?;
-        let raw = Raw::open(partial).map_err(ioerr(path, "cannot open the new file for writing"))?;
-        Ok((fields, tresca, vtk, xdmf, frames, raw))
+        let len = raw.0.metadata().map_err(ioerr(path, "cannot inspect the new file"))?.len();
+        reserve::allocate(&raw.0).map_err(|e| reserve::no_room(path, len, "for every step of the run", &e))?;
+        reserve::trim(&raw.0).map_err(ioerr(path, "cannot hand back the space reserved beyond the new file"))?;
+        Ok((fields, tresca, vtk, xdmf, raw))
     }
 
     /// Record the set-up times of a file created before they were known ([`crate::Problem::new_beside`]).

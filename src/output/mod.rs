@@ -45,11 +45,13 @@
 //! [`Writer::finish`] records: "completed" or the error of the failed step).
 
 mod background;
+mod close;
 mod create;
 pub mod fields;
 mod h5;
 mod lock;
 mod paths;
+mod reserve;
 mod resume;
 mod rows;
 mod take;
@@ -292,6 +294,13 @@ impl Writer {
         }
         let path = self.path.clone();
         let (steps, nf) = (self.completed + self.rows.count, self.frames_done + self.frame_rows.count());
+        if nf > self.frames_done {
+            // the one commit that allocates in the file (a chunk of `Steps/Values`): its room first
+            reserve::ahead(&self.raw.0, reserve::MARGIN).map_err(|e| {
+                let what = format!("to commit steps {}..{}", self.completed, steps - 1);
+                reserve::no_room(&path, reserve::MARGIN, &what, &e)
+            })?;
+        }
         let write = || -> hdf5::Result<()> {
             self.tresca.write_rows(&self.raw, &self.rows)?;
             self.vtk.write_frames(&self.raw, &self.frame_rows)
@@ -308,78 +317,25 @@ impl Writer {
         mark().map_err(io(&path, "marking the steps complete"))?;
         self.file.flush().map_err(io(&path, "flush"))?;
         self.seconds[1] += f0.elapsed().as_secs_f64();
-        for (k, &n) in self.frame_steps.iter().enumerate() {
-            let t = self.frame_rows.times[k];
-            self.xdmf
-                .append_text(self.frames_done + k, n, t)
-                .map_err(ioerr(&self.xdmf.path.clone(), "appending to the XDMF sidecar"))?;
-        }
-        if !self.frame_steps.is_empty() {
-            self.xdmf.write_text().map_err(ioerr(&self.xdmf.path.clone(), "writing the XDMF sidecar"))?;
-        }
-        self.publish()?;
+        // the steps are in the file: the writer counts them before the sidecar is written, so a sidecar
+        // that cannot be written (a full disk) loses none of them
+        let first_frame = self.frames_done;
+        let new_frames: Vec<(usize, f64)> =
+            self.frame_steps.iter().zip(&self.frame_rows.times).map(|(&n, &t)| (n, t)).collect();
         self.completed = steps;
         self.frames_done = nf;
         self.rows.reset(steps);
         self.frame_rows.reset(nf);
         self.frame_steps.clear();
         self.last_commit = Instant::now();
-        Ok(())
-    }
-
-    /// Commit what is buffered, record why the run stopped ("completed", or the error of the failed
-    /// step) and close the file. A run that stopped early has its series cut to the completed steps.
-    /// Returns the number of steps in the file (0: no file was written, see [`Writer::publish`]).
-    pub fn finish(mut self, status: &str) -> Result<usize> {
-        self.close(status)?;
-        Ok(self.completed)
-    }
-
-    fn close(&mut self, status: &str) -> Result<()> {
-        // a last commit that fails (a full disk) does not end the closing: the file is still cut to its
-        // completed steps and records why it stopped, and a file without a step is removed
-        let committed = self.commit();
-        self.finished = true;
-        let path = self.path.clone();
-        if self.completed == 0 {
-            // nothing committed (the run failed at step 0): no results file replaces an old one
-            if let Some(Pending { partial, .. }) = self.pending.take() {
-                let _ = std::fs::remove_file(partial);
-                self.xdmf.discard();
-            }
-            return committed;
+        for (k, &(n, t)) in new_frames.iter().enumerate() {
+            self.xdmf
+                .append_text(first_frame + k, n, t)
+                .map_err(ioerr(&self.xdmf.path.clone(), "appending to the XDMF sidecar"))?;
         }
-        let status = match &committed {
-            Err(e) if !status.starts_with("stopped") => format!("stopped: {e}"),
-            _ => status.to_string(),
-        };
-        let all = self.frames.last + 1;
-        if self.completed < all || committed.is_err() {
-            // a stopped run: series of exactly the completed steps, so no reader meets unwritten rows
-            let (steps, frames) = (self.completed, self.frames_done);
-            let mut shrink = || -> hdf5::Result<()> {
-                self.tresca.set_steps(&self.raw, steps, steps)?;
-                self.vtk.set_frames(&self.raw, frames, frames)?;
-                self.xdmf.drop_frames_from(frames)
-            };
-            let shrunk = shrink().map_err(io(&path, "shrinking the series of a stopped run"));
-            let shrunk = committed.and(shrunk);
-            let marked = self.tresca.set_status(&status).map_err(io(&path, "attribute status"));
-            let flushed = self.file.flush().map_err(io(&path, "flush"));
-            return shrunk.and(marked).and(flushed).and(self.publish());
+        if !new_frames.is_empty() {
+            self.xdmf.write_text().map_err(ioerr(&self.xdmf.path.clone(), "writing the XDMF sidecar"))?;
         }
-        self.tresca.set_status(&status).map_err(io(&path, "attribute status"))?;
-        self.file.flush().map_err(io(&path, "flush"))?;
         self.publish()
-    }
-}
-
-impl Drop for Writer {
-    /// A writer dropped without [`Writer::finish`] (an error, a panic) still commits what it holds and
-    /// closes the file as a stopped run.
-    fn drop(&mut self) {
-        if !self.finished {
-            let _ = self.close("stopped: the writer was dropped before the run finished");
-        }
     }
 }

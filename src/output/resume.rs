@@ -7,6 +7,7 @@ use super::fields::Fields;
 use super::h5::{self, io, Raw};
 use super::lock::OutputLock;
 use super::paths;
+use super::reserve;
 use super::tresca::Tresca;
 use super::vtkhdf::{Frames, VtkHdf};
 use super::xdmf::Xdmf;
@@ -52,6 +53,12 @@ impl Writer {
         let frames_done = frames.before(completed);
         let frame_list: Vec<(usize, f64)> =
             (0..completed).filter(|&n| frames.is_frame(n)).map(|n| (n, times[n])).collect();
+        // a stopped run's series are given back their full length below: their room first (`reserve`)
+        let rows = tresca.group.dataset("times").map_err(io(path, "tresca/times"))?.shape()[0];
+        let len = raw.0.metadata().map_err(ioerr(path, "cannot inspect the file"))?.len();
+        let all = run.n_steps() + 1;
+        let need = (len as u128 * all.saturating_sub(rows) as u128 / rows.max(1) as u128) as u64 + reserve::MARGIN;
+        reserve::ahead(&raw.0, need).map_err(|e| reserve::no_room(path, need, "to resume the run", &e))?;
         let mut fix = || -> hdf5::Result<StepResult> {
             // a stopped run's series were cut to its completed steps: room for the whole run again
             tresca.set_steps(&raw, run.n_steps() + 1, completed)?;

@@ -333,7 +333,11 @@ impl Xdmf {
             Some(f) => f,
             None => super::paths::create_new(&self.partial)?,
         };
-        spare.write_all_at(&self.text, 0)?;
+        if let Err(e) = spare.write_all_at(&self.text, 0) {
+            // kept (and removed by drop), so the next commit writes it again instead of meeting its name
+            self.spare = Some(spare);
+            return Err(e);
+        }
         if exchange(&self.partial, &self.path)? {
             // the names are swapped: `file` now names the previous text at `partial`
             self.spare = Some(std::mem::replace(&mut self.file, spare));

@@ -82,16 +82,7 @@ impl Estimate {
             let n = unknowns as f64;
             memory.saturating_sub((8.0 * (1.0 - METIS_FILL) * FILL_ND * n * n.log2()) as u64)
         });
-        let disk = if results {
-            // per step: u (edges × 2 f64), 8 scalars, 5 contact series (4 f64 + 1 byte), 3 errors
-            let row = 16 * edges + 64 + 33 * contact + 24;
-            let frames = (steps + 1).min(FRAMES);
-            let per_frame = 100 * triangles + 40 * contact;
-            let fixed = 250 * triangles + 64 * edges + (1 << 20);
-            (steps + 1).saturating_mul(row).saturating_add(frames * per_frame).saturating_add(fixed)
-        } else {
-            0
-        };
+        let disk = if results { results_file((triangles, edges, contact), steps, (steps + 1).min(FRAMES)) } else { 0 };
         Estimate { triangles, edges, unknowns, contact, steps, memory, memory_metis, disk }
     }
 
@@ -102,9 +93,12 @@ impl Estimate {
             "{} triangles, {} unknowns, {} contact edges, {} steps",
             self.triangles, self.unknowns, self.contact, self.steps
         );
-        let (mem, mem_limit) = match max_memory {
-            Some(m) => (Some(m), "is the limit given (--max-memory)"),
-            None => (available_memory(), "is available on this machine"),
+        // a limit given is checked against the hard bounds too (address space, cgroup: `machine`), which
+        // no allocation can pass
+        let (mem, mem_limit) = match (max_memory, crate::machine::hard_memory_left()) {
+            (Some(m), Some((h, why))) if h < m => (Some(h), why),
+            (Some(m), _) => (Some(m), "is the limit given (--max-memory)"),
+            (None, _) => crate::machine::memory_left().map_or((None, ""), |(b, why)| (Some(b), why)),
         };
         let least = self.memory_metis.unwrap_or(self.memory);
         if let Some(have) = mem.filter(|&h| least > h) {
@@ -140,6 +134,16 @@ impl Estimate {
         let metis = self.memory_metis.map(|m| format!(" (~{} with METIS's ordering, the fallback)", human(m)));
         format!("memory ~{}{}{mem}; results file ~{}", human(self.memory), metis.unwrap_or_default(), human(self.disk))
     }
+}
+
+/// Bytes of a results file of a mesh of (triangles, edges, contact edges) with `steps` time steps and
+/// `frames` visualisation frames (an estimate, as [`Estimate::disk`]).
+pub fn results_file((triangles, edges, contact): (u64, u64, u64), steps: u64, frames: u64) -> u64 {
+    // per step: u (edges × 2 f64), 8 scalars, 5 contact series (4 f64 + 1 byte), 3 errors
+    let row = 16 * edges + 64 + 33 * contact + 24;
+    let per_frame = 100 * triangles + 40 * contact;
+    let fixed = 250 * triangles + 64 * edges + (1 << 20);
+    (steps + 1).saturating_mul(row).saturating_add(frames.saturating_mul(per_frame)).saturating_add(fixed)
 }
 
 /// (triangles, edges, contact edges) of the scene's mesh, without building it.
