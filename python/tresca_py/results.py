@@ -121,6 +121,7 @@ class Results:
     attrs: dict = field(default_factory=dict)
     path: str | None = None
     rows: int | None = None  # rows in the file (> completed for a killed run)
+    audit_checksummed: bool = False  # the checksums cover the energy audit series (tresca_py.checksum)
 
     @property
     def completed(self):
@@ -168,10 +169,12 @@ class Results:
             out.update({f"contact/{k}": getattr(self.contact, k) for k in CONTACT_STATIC})
         return out
 
-    def checksums(self):
-        """The checksum of every step (``tresca_py.checksum``), the series in their stored dtypes."""
+    def checksums(self, audit=()):
+        """The checksum of every step (``tresca_py.checksum``), the series in their stored dtypes, followed by the
+        ``audit`` series (f64 arrays of the committed steps) when the checksums cover them."""
         s = self.series()
-        return checksum.step_checksums([np.asarray(s[k], SPEC[k][0]) for k in checksum.SERIES if k in s])
+        return checksum.step_checksums([np.asarray(s[k], SPEC[k][0]) for k in checksum.SERIES if k in s]
+                                       + [np.asarray(a, F8) for a in audit])
 
 
 def _check_array(where, name, shape, dtype, sizes):
@@ -342,11 +345,27 @@ def _read_group(f, where, verify):
     validate(r, where)
     if verify and "steps/checksum" in ds:
         stored = load("steps/checksum")
-        bad = np.nonzero(r.checksums() != stored)[0]
+        r.audit_checksummed = checksum.covers_audit(ds["steps/checksum"])
+        audit = _audit_rows(where, g, S, sizes["R"]) if r.audit_checksummed else []
+        bad = np.nonzero(r.checksums(audit) != stored)[0]
         if len(bad):
             raise ResultsError(f"{where}: step {int(bad[0])} does not match its checksum (tresca/steps/checksum): "
                                "the file was damaged after it was written; steps before it are intact")
     return r
+
+
+def _audit_rows(where, g, S, rows):
+    """The first S rows of the audit series that the checksums cover; ResultsError if one is missing or not a
+    float series of the file's rows."""
+    import h5py
+    out = []
+    for name in checksum.AUDIT:
+        obj = g.get(name)
+        if not isinstance(obj, h5py.Dataset) or obj.shape != (rows,) or obj.dtype.kind != "f":
+            what = "missing" if obj is None else "not a float series of one value per step"
+            raise ResultsError(f"{where}: tresca/{name} is {what}, though the step checksums cover the energy audit")
+        out.append(obj[:S])
+    return out
 
 
 def read(path, verify=True):
