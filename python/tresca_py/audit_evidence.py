@@ -10,7 +10,8 @@ when its checksums were recomputed: what the file allows of ``src/stepping/audit
   Dirichlet data (no ``u`` key in the scene's dirichlet parts) they are the boundary edges off Γ_C whose ``u`` is
   exactly zero at every step, and their number is known from ``n_dofs`` = 2(E − D − C) + C: when the two agree the
   set is exactly Γ_D (every Dirichlet edge is zero, so the zero edges include it, and there are no more of them).
-  Otherwise (Dirichlet data, or a Neumann edge that stayed zero) the energy is not recomputed, and ``recompute`` says so.
+  Otherwise (Dirichlet data, or a Neumann edge that stayed zero) the energy is not recomputed, and ``recompute``
+  says so.
 
 Tolerances, each a rounding bound of the two evaluations (the file's and this one) of the same sum of
 nonnegative terms: the summation order, N ε of the sum (N terms: Higham's γ_N); each term's own rounding, a
