@@ -128,3 +128,75 @@ fn data_cancelling_by_rounding_are_accepted() {
     let e = check(&scene, &mesh, &space).err().expect("refused").to_string();
     assert!(e.contains("inconsistent boundary data") && e.contains("gap"), "{e}");
 }
+
+/// §3: the system shall refuse a friction bound whose force on an edge, |e|·ḡ_e, the friction solver and
+/// the energy audit cannot multiply (g_a = 1e308 ran with exit 0 and an audit of inf and NaN), in every
+/// command, naming the part; g_a = 1e150 (|e|ḡ = 2e150, within √(1.8e308)) still runs.
+#[test]
+fn friction_bounds_the_audit_cannot_multiply_are_refused() {
+    let huge = super::scene_with("g_a_huge.toml", "g_a = \"0.0012\"", "g_a = \"1e308\"");
+    for args in [vec!["check", huge.as_str()], vec!["run", &huge, "-q", "--steps", "4"]] {
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("(bottom).g_a") && e.contains("friction force"), "{args:?}: {e}");
+    }
+    let large = super::scene_with("g_a_large.toml", "g_a = \"0.0012\"", "g_a = \"1e150\"");
+    let out = tmp("g_a_large.h5");
+    let o = run(&["run", &large, "-q", "--steps", "4", "-o", s(&out), "--force"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let f = hdf5::File::open(&out).unwrap();
+    for k in tresca_cr::output::tresca::AUDIT {
+        let v: Vec<f64> = f.dataset(&format!("tresca/steps/{k}")).unwrap().read_raw().unwrap();
+        assert!(v.iter().all(|x| x.is_finite()), "{k}: {v:?}");
+    }
+}
+
+/// §7: the system shall blame an overflow caused by the boundary data on them, by part and key, and
+/// name only the data the scene gives (not "the loads, u₀ and g_a" of a scene without loads).
+#[test]
+fn overflow_is_blamed_on_the_data_that_cause_it() {
+    let dirichlet = two_dirichlet("1e160*t", 2, "").replace(r#"u = ["0.01*t", "0"]"#, r#"u = ["1e160*t", "0"]"#);
+    let dirichlet = dirichlet.replace(r#"traction = ["0.001*t", "0"]"#, "");
+    let gap = two_dirichlet("0", 2, "")
+        .replace(
+            "name = \"left\"\nkind = \"dirichlet\"\nu = [\"0.01*t\", \"0\"]",
+            "name = \"left\"\nkind = \"neumann\"",
+        )
+        .replace(
+            "name = \"bottom\"\nkind = \"dirichlet\"\nu = [\"0\", \"0\"]",
+            "name = \"bottom\"\nkind = \"contact\"\ng_a = \"0.1\"\ngap = \"1e160*t\"",
+        )
+        .replace("name = \"top\"\nkind = \"neumann\"", "name = \"top\"\nkind = \"dirichlet\"")
+        .replace(r#"traction = ["0.001*t", "0"]"#, "");
+    for (name, text, want) in [
+        ("u_overflows.toml", dirichlet, "part `left`'s u and part `bottom`'s u"),
+        ("gap_overflows.toml", gap, "part `bottom`'s gap"),
+    ] {
+        let p = write(name, &text);
+        let o = run(&["run", &p, "-q"]);
+        assert_eq!(o.status.code(), Some(1), "{name}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("overflows") && e.contains(want), "{name}: {e}");
+        assert!(!e.contains("the loads") && !e.contains("u₀"), "{name}: {e}");
+    }
+}
+
+/// §7: the system shall print a memory limit in a unit that shows it (`--max-memory 10M` was "0.0 GB"
+/// in plan's refusal) and refuse a mesh whose counts exceed 64 bits without wrapped sizes
+/// (`cells = [2^32, 2^32]` reported "18446744073709551615 triangles").
+#[test]
+fn sizes_are_printed_as_they_are() {
+    let ex = super::root("verification/cases/paper_example_5_1.toml");
+    let o = run(&["plan", &ex, "--target", "1e-3", "--max-memory", "10M"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("10.0 MB") && !out.contains("0.0 GB"), "{out}{}", stderr(&o));
+    let cells = super::scene_with("cells_2_32.toml", "cells = [2, 2]", "cells = [4294967296, 4294967296]");
+    for args in [vec!["check", cells.as_str()], vec!["run", &cells, "-q"], vec!["study", &cells, "--levels", "0:4,1:8"]]
+    {
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("3.689e19 triangles") && !e.contains("18446744073709551"), "{args:?}: {e}");
+    }
+}
