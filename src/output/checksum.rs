@@ -20,17 +20,3 @@ pub fn step_checksums(series: &[&[u8]], k: usize) -> Vec<u64> {
         })
         .collect()
 }
-
-/// The series a new file's checksums cover, in their order (module doc).
-pub(super) fn covered(contact: bool, errors: bool) -> String {
-    let mut v = vec!["times", "u", "energy"];
-    v.extend(["steps/iterations", "steps/residual", "steps/n_stick", "steps/n_slip", "steps/wall_time"]);
-    if contact {
-        v.extend(["contact/slip", "contact/sigma_t", "contact/state", "contact/mu", "contact/dof"]);
-    }
-    if errors {
-        v.extend(["errors/energy", "errors/h1", "errors/l2"]);
-    }
-    let audit = super::tresca::AUDIT.map(|a| format!("steps/{a}"));
-    v.into_iter().map(String::from).chain(audit).collect::<Vec<_>>().join(", ")
-}
