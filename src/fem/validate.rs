@@ -39,7 +39,9 @@ pub fn on_mesh(scene: &Scene, mesh: &Mesh) -> Result<CrSpace> {
 /// of inf and NaN). A bound that large is a bound that never binds: give the data in other units.
 pub fn friction_forces(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<()> {
     let top = f64::MAX.sqrt();
-    let Some(c) = space.contact.iter().find(|c| !(c.length * c.g_mean <= top)) else { return Ok(()) };
+    let Some(c) = space.contact.iter().find(|c| c.length * c.g_mean > top || (c.length * c.g_mean).is_nan()) else {
+        return Ok(());
+    };
     let part = space.edge_part[c.edge].map_or("?", |p| scene.parts[p].name.as_str());
     let x = mesh.midpoint(c.edge);
     Err(Error::scene(

@@ -125,7 +125,7 @@ fn data_cancelling_by_rounding_are_accepted() {
     let (scene, mesh, space) = with_gap(cancel);
     check(&scene, &mesh, &space).unwrap();
     let (scene, mesh, space) = with_gap("1e-17");
-    let e = check(&scene, &mesh, &space).err().expect("refused").to_string();
+    let e = check(&scene, &mesh, &space).expect_err("refused").to_string();
     assert!(e.contains("inconsistent boundary data") && e.contains("gap"), "{e}");
 }
 
