@@ -65,13 +65,18 @@ def forge(path, forgery):
             n = np.arange(len(g["stored_energy"]))
             g["stored_energy"][...] = g["stored_energy"][()] + d * n
             g["external_work"][...] = g["external_work"][()] + d * (n > 0)
+        elif forgery == "work moved to the boundary":
+            # W + W_Γ unchanged: the balance holds, the stored and dissipated energies are the true ones
+            d = 0.5 * float(np.max(np.abs(g["external_work"][()])))
+            g["external_work"][1:] = g["external_work"][1:] + d
+            g["boundary_work"][1:] = g["boundary_work"][1:] - d
         else:
             j, e = g["friction_dissipation"][()], g["euler_dissipation"][()]
             g["friction_dissipation"][...], g["euler_dissipation"][...] = e, j
 
 
 FORGERIES = ["times 2", "times 1e6", "zeroed", "deleted", "energy shifted, work compensated",
-             "dissipations swapped"]
+             "dissipations swapped", "work moved to the boundary"]
 
 
 @pytest.mark.parametrize("forgery", FORGERIES)

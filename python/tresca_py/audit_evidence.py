@@ -3,6 +3,8 @@ when its checksums were recomputed: what the file allows of ``src/stepping/audit
 
 * ``friction_dissipation`` j_h(δuⁿ) = Σ_{e ⊂ Γ_C} |e| ḡ_e |sⁿ_e − sⁿ⁻¹_e| from ``contact/g``, ``contact/slip`` and the
   mesh (every run with Γ_C);
+* ``boundary_work`` W_Γ: exactly 0 in a scene without boundary data (no ``u`` or ``gap`` key in its parts), where
+  the file does not hold the loads that the external work needs;
 * ``stored_energy`` Eⁿ = ½a_h(uⁿ, uⁿ) and ``euler_dissipation`` ½a_h(δuⁿ, δuⁿ) from ``u``, the mesh, E, ν and ρ:
   a_h(U, U) = Σ_T |T| σ(∇U):∇U + 2ρμ Σ_{e interior ∪ Γ_D} |J_e|²/3, where J_e is the jump of U at an end of e
   (on a Dirichlet edge the trace: the jump is linear along e and vanishes at its midpoint, so its mean square is
@@ -43,14 +45,26 @@ def friction(r):
     return j, (len(w) + TERM_ROUNDINGS) * EPS * j
 
 
+def _parts(r):
+    """The scene's ``[[boundary]]`` tables as stored in the file, or None when they cannot be read."""
+    try:
+        parts = tomllib.loads(r.attrs.get("scene", "")).get("boundary", [])
+    except tomllib.TOMLDecodeError:
+        return None
+    return [p for p in parts if isinstance(p, dict)] if isinstance(parts, list) else None
+
+
+def has_data(parts, kind, key):
+    """True if a part of ``kind`` gives ``key`` (``u`` of a dirichlet part, ``gap`` of a contact part)."""
+    return any(p.get("kind") == kind and key in p for p in parts)
+
+
 def dirichlet_edges(r):
     """The Dirichlet edges (module docstring), or a sentence saying why they cannot be told from the file."""
-    text = r.attrs.get("scene", "")
-    try:
-        parts = tomllib.loads(text).get("boundary", [])
-    except tomllib.TOMLDecodeError:
+    parts = _parts(r)
+    if parts is None:
         return "the scene stored in the file cannot be read"
-    if any(p.get("kind") == "dirichlet" and "u" in p for p in parts if isinstance(p, dict)):
+    if has_data(parts, "dirichlet", "u"):
         return "the scene imposes Dirichlet data, whose values along Γ_D the file does not hold"
     if "n_dofs" not in r.attrs:
         return "the file has no n_dofs"
@@ -128,6 +142,10 @@ def recompute(r, a):
     j = friction(r)
     if j is not None:
         compare("friction_dissipation", *j)
+    parts = _parts(r)
+    if parts is not None and not has_data(parts, "dirichlet", "u") and not has_data(parts, "contact", "gap"):
+        # without boundary data the reactions do no work: the audit adds exact zeros
+        compare("boundary_work", np.zeros(len(a["boundary_work"])), np.zeros(len(a["boundary_work"])))
     d = dirichlet_edges(r)
     if isinstance(d, str):
         notes.append(f"stored and Euler energies not recomputed: {d}")
