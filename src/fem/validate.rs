@@ -49,7 +49,7 @@ pub fn friction_forces(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<()
         format!("boundary ({part}).g_a"),
         format!(
             "the friction force |e|·ḡ_e = {:.3e} of the edge at ({:.6}, {:.6}) (ḡ_e = {:.3e}) is beyond √(1.8e308) = \
-             1.3e154: its square and its products with the slip overflow in the friction solver and the energy audit; \
+             1.3e154: its square overflows f64, as its products with the slip may in the friction solver and the audit; \
              give the data in other units (u scales with load/E)",
             c.length * c.g_mean,
             x[0],
