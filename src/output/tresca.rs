@@ -28,7 +28,7 @@
 //! edges hold the two unknowns verbatim) and `contact/dof` (the one unknown of a contact edge).
 
 use super::checksum::{step_checksums, COVERS};
-use super::h5::{attr, attr_str, attr_vec, put, Raw, Series};
+use super::h5::{attr, attr_str, attr_vec, put, read_str, Raw, Series};
 use super::rows::Rows;
 use super::Run;
 use crate::fem::norms::ErrorNorms;
@@ -344,7 +344,10 @@ impl Tresca {
     /// [`Series::set_steps`]).
     pub fn set_steps(&mut self, raw: &Raw, steps: usize, kept: usize) -> hdf5::Result<()> {
         if let Some(c) = &mut self.checksum {
+            // the rewritten dataset keeps what its attribute says it covers
+            let covers = read_str(&c.ds, COVERS).ok();
             c.set_steps(raw, steps, kept)?;
+            covers.map_or(Ok(()), |v| attr_str(&c.ds, COVERS, &v))?;
         }
         self.series(true).into_iter().try_for_each(|s| s.set_steps(raw, steps, kept))
     }
