@@ -114,3 +114,15 @@ def test_the_system_shall_check_an_audit_its_checksums_do_not_cover_and_say_so(e
 def test_the_system_shall_find_the_audit_of_a_valid_run_equal_to_its_fields(example):
     r = check_results(example)
     assert r.returncode == 0 and "not recomputed" not in r.stdout, r.stdout + r.stderr
+
+
+def test_the_system_shall_check_the_covered_audit_of_a_stopped_run(rust_bin, tmp_path):
+    """A run that stops (Uzawa's iteration limit) is cut to its completed steps: its checksum, rewritten then,
+    still covers the audit and says so."""
+    out = tmp_path / "stopped.h5"
+    p = subprocess.run([rust_bin, "run", f"{CASES}/mms_front.toml", "--solver", "uzawa", "-q", "-o", str(out)],
+                       capture_output=True, text=True)
+    assert p.returncode == 1 and "did not converge" in p.stderr, p.stderr
+    assert results.read(str(out)).audit_checksummed
+    r = check_results(out)
+    assert r.returncode == 0 and "not covered" not in r.stdout, r.stdout + r.stderr
