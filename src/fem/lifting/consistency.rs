@@ -14,9 +14,39 @@
 //! * [`ROUNDING_SAFETY`] times the rounding error bound of the two values compared
 //!   (`scene::expr::rounding`: each expression's literals and operations, and the dot product with the
 //!   normal). It is what admits data that cancel to zero at t₀ by rounding whatever they do later:
-//!   `gap = "(0.1 + t)^2 - 0.01 - 0.2*t - t^2"` is 1.7e-18 at t₀ = 0, within its bound 1.1e-17 of the
-//!   u₀·n = 0 it is compared with, and is accepted, while `gap = "1e-17"` is refused (the test
-//!   `data_cancelling_by_rounding_are_accepted` of tests/hostile/validation.rs runs both).
+//!   `gap = "(0.1 + t)^2 - 0.01 - 0.2*t - t^2"` is 1.7e-18 at t₀ = 0, within its bound (of order 1e-17) of the
+//!   u₀·n = 0 it is compared with, and is accepted, while `gap = "1e-17"` is refused (below, and the
+//!   test `data_cancelling_by_rounding_are_accepted` of tests/hostile/validation.rs):
+//!
+//! ```
+//! use tresca_cr::{fem::lifting::consistency::check, fem::space::CrSpace, mesh::Mesh, Scene};
+//! let text = r#"
+//!     mesh = { corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], cells = [2, 2] }
+//!     material = { E = 10.0, nu = 0.3 }
+//!     time = { T = 1.0, steps = 2 }
+//!     [[boundary]]
+//!     name = "top"
+//!     kind = "dirichlet"
+//!     [[boundary]]
+//!     name = "left"
+//!     kind = "neumann"
+//!     [[boundary]]
+//!     name = "right"
+//!     kind = "neumann"
+//!     [[boundary]]
+//!     name = "bottom"
+//!     kind = "contact"
+//!     g_a = "0.1"
+//!     gap = "GAP""#;
+//! let checked = |gap: &str| -> tresca_cr::Result<()> {
+//!     let scene = Scene::from_str(&text.replace("GAP", gap), "doc.toml")?;
+//!     let mesh = Mesh::from_spec(&scene.mesh)?;
+//!     check(&scene, &mesh, &CrSpace::new(&mesh, &scene.parts)?)
+//! };
+//! checked("(0.1 + t)^2 - 0.01 - 0.2*t - t^2")?; // 1.7e-18 at t₀ = 0: rounding, accepted
+//! assert!(checked("1e-17").is_err()); // a mismatch with u₀·n = 0, refused
+//! # Ok::<(), tresca_cr::Error>(())
+//! ```
 //!
 //! Only scenes with boundary data are checked: without them (u_D = 0, g_n = 0) a u₀ that does not vanish
 //! on Γ_D or whose normal part does not vanish on Γ_C is projected onto V_h (those values dropped), as
