@@ -128,6 +128,8 @@ pub struct Discretised {
     pub law: Elasticity,
     /// Whether the set-up estimates K's condition number.
     pub guard: Guard,
+    /// Private: a `Discretised` is made only by [`Discretised::new`], which validates it.
+    validated: (),
 }
 
 impl Discretised {
@@ -137,7 +139,7 @@ impl Discretised {
         let space = crate::fem::validate::on_mesh(&scene, &mesh)?;
         let data = BoundaryData::of(&mesh, &scene.parts, &space);
         let law = Elasticity::new(&scene.material);
-        Ok(Discretised { scene, mesh, space, data, law, guard })
+        Ok(Discretised { scene, mesh, space, data, law, guard, validated: () })
     }
 }
 
