@@ -119,6 +119,8 @@ pub(super) struct Factored {
 
 /// A discretised problem, what the set-up starts from: the scene, its mesh, CR space and boundary data
 /// (the lifting, added outside V_h), and the law.
+/// Outside the crate it is made only by [`Discretised::new`], which validates it (`non_exhaustive`).
+#[non_exhaustive]
 pub struct Discretised {
     pub scene: Scene,
     pub mesh: Mesh,
@@ -128,8 +130,6 @@ pub struct Discretised {
     pub law: Elasticity,
     /// Whether the set-up estimates K's condition number.
     pub guard: Guard,
-    /// Private: a `Discretised` is made only by [`Discretised::new`], which validates it.
-    validated: (),
 }
 
 impl Discretised {
@@ -139,7 +139,7 @@ impl Discretised {
         let space = crate::fem::validate::on_mesh(&scene, &mesh)?;
         let data = BoundaryData::of(&mesh, &scene.parts, &space);
         let law = Elasticity::new(&scene.material);
-        Ok(Discretised { scene, mesh, space, data, law, guard, validated: () })
+        Ok(Discretised { scene, mesh, space, data, law, guard })
     }
 }
 
