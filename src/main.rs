@@ -255,6 +255,8 @@ fn load(
     if let Some(n) = steps {
         scene.set_steps(n)?;
     }
+    // the one validation of every command, before any work (each set-up checks its own level again)
+    tresca_cr::fem::validate::scene(&scene)?;
     Ok((scene, estimate))
 }
 

@@ -219,7 +219,8 @@ fn loads_scale_over_the_f64_range() {
         let t = text
             .replace(r#"["0.02*(5-y)*t", "-0.01*t"]"#, &format!(r#"["{f:e}*0.02*(5-y)*t", "-{f:e}*0.01*t"]"#))
             .replace(r#"g_a = "0.0012""#, &format!(r#"g_a = "{f:e}*0.0012""#));
-        let p = tresca_cr::Problem::new(tresca_cr::Scene::from_str(&t, "scaled.toml").unwrap()).unwrap();
+        // a friction force beyond √(f64 range) is refused at the set-up (fem::validate), the energy at its step
+        let p = tresca_cr::Problem::new(tresca_cr::Scene::from_str(&t, "scaled.toml").unwrap())?;
         let mut us = Vec::new();
         let r = p.run(tresca_cr::RunOptions::all(), |r| {
             us.push(r.u.clone());

@@ -13,6 +13,9 @@ use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
+#[path = "hostile/validation.rs"]
+mod validation;
+
 fn tmp(name: &str) -> PathBuf {
     common::tmp_in("tresca-hostile", name)
 }

@@ -3,7 +3,9 @@
     .venv/bin/python scripts/check_results.py run.h5 [--xdmf run.xdmf]
 
 * h5py (the ``tresca`` group, ``tresca_py.results.read``): the README layout, ``completed``, status, finite
-  values, the per-step checksums, and σ_τ = −μ/|e| on Γ_C.
+  values, the per-step checksums (the energy audit's too, in files since they cover it), σ_τ = −μ/|e| on Γ_C,
+  and the energy audit: its balance (``tresca_py.audit``), its terms recomputed from the stored fields where the
+  file allows (``tresca_py.audit_evidence``), and its presence in a file of the Rust solver.
 * VTK's ``vtkHDFReader`` (the VTKHDF view: a collection of the block ``body`` and, when Γ_C exists, ``contact``):
   numbers of points, cells and frames, each block's array names, and every frame's displacement / von Mises /
   contact arrays against values recomputed from ``tresca/u`` (``tresca_py.fields``).
@@ -23,7 +25,7 @@ import sys
 
 import numpy as np
 
-from . import audit, fields, paths, results
+from . import audit, audit_evidence, fields, paths, results
 
 BODY_CELLS = ["strain", "stress", "von_mises"]
 CONTACT_CELLS = ["sigma_t", "slip", "slip_increment", "stick_slip"]
@@ -129,6 +131,27 @@ def declared_sizes(h5):
                     raise results.ResultsError(
                         f"{h5}: VTKHDF/{name}/{count} declares {need}, but VTKHDF/{name}/{held} holds "
                         f"{d.shape[0]} rows and the file has {size} bytes: damaged, not read")
+
+
+def check_audit(c, r, views, budget):
+    """The energy audit: its balance (``tresca_py.audit``) and its terms against the stored fields
+    (``tresca_py.audit_evidence``); a file of the Rust solver (it has the views) without its audit fails, and an
+    audit the step checksums do not cover is said to be so. ``budget``: ``audit.read``'s series, read in
+    ``main`` where a damaged audit is an error of the file."""
+    if budget is None:
+        c.check(not views, "energy audit: the file has none (tresca/steps/stored_energy, ...): deleted, or written "
+                           "by a version before the audit")
+        if not views:
+            print("no energy audit (the Python solvers write none)")
+        return
+    print(audit.summary(budget))
+    if not r.audit_checksummed:
+        print("note: energy audit not covered by the step checksums (a file of a version before they covered it)")
+    problems, notes = audit_evidence.recompute(r, budget)
+    for m in notes:
+        print(f"note: {m}")
+    for m in audit.problems(budget, audit.rounding(r.path, audit.largest_work(budget))) + problems:
+        c.check(False, m)
 
 
 def check_vtkhdf(c, run, h5):
@@ -241,10 +264,7 @@ def main(argv=None):
     print(f"{args.h5}: {r.completed} steps, {len(run.frames)} frames (every {run.every}), {run.T} triangles, "
           f"{run.E} edges, {run.C} contact edges, status {r.status!r}")
     check_tresca(c, run)
-    if budget is not None:
-        print(audit.summary(budget))
-        for m in audit.problems(budget, audit.rounding(r.path, audit.largest_work(budget))):
-            c.check(False, m)
+    check_audit(c, r, views, budget)
     readers = (("VTKHDF (vtkHDFReader)", check_vtkhdf, r.path), ("XDMF (meshio)", check_meshio, os.path.abspath(xdmf)),
                ("XDMF (vtkXdmfReader)", check_vtkxdmf, os.path.abspath(xdmf)))
     if not views:

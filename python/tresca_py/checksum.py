@@ -1,6 +1,7 @@
 """The per-step checksums of ``tresca/steps/checksum``: XXH64 (seed 0) of each step's rows of every series,
-concatenated in the order of ``SERIES`` (those present), as little-endian bytes. The Rust writer computes the
-same (``src/output/tresca.rs``, ``step_checksums``); ``--resume`` and the readers verify it.
+concatenated in the order of ``SERIES`` (those present), then ``AUDIT`` where the checksum covers it
+(``covers_audit``), as little-endian bytes. The Rust writer computes the
+same (``src/output/checksum.rs``, ``step_checksums``); ``--resume`` and the readers verify it.
 
 XXH64 is evaluated here with numpy, vectorised over the steps (one row of bytes per step).
 """
@@ -10,6 +11,20 @@ import numpy as np
 SERIES = ("times", "u", "energy", "steps/iterations", "steps/residual", "steps/n_stick", "steps/n_slip",
           "steps/wall_time", "contact/slip", "contact/sigma_t", "contact/state", "contact/mu", "contact/dof",
           "errors/energy", "errors/h1", "errors/l2")
+
+#: The energy audit's series: last in a step's checksum in files whose checksum names them in its attribute
+#: ``COVERS`` (files written before then have no such attribute, and their checksums end with ``SERIES``).
+AUDIT = tuple(f"steps/{k}" for k in ("external_work", "boundary_work", "stored_energy", "friction_dissipation",
+                                     "euler_dissipation", "balance_residual"))
+COVERS = "series"
+
+
+def covers_audit(dataset):
+    """True if the checksum ``dataset`` (h5py) names the audit series in its ``COVERS`` attribute."""
+    v = dataset.attrs.get(COVERS)
+    v = v.decode() if isinstance(v, bytes) else v
+    return isinstance(v, str) and set(AUDIT) <= set(v.split(", "))
+
 
 _P = [np.uint64(v) for v in (0x9E3779B185EBCA87, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9, 0x85EBCA77C2B2AE63,
                              0x27D4EB2F165667C5)]

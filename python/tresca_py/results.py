@@ -131,6 +131,7 @@ class Results:
     attrs: dict = field(default_factory=dict)
     path: str | None = None
     rows: int | None = None  # rows in the file (> completed for a killed run)
+    audit: dict | None = None  # {name: series} of the energy audit when the step checksums cover it
 
     @property
     def completed(self):
@@ -178,10 +179,17 @@ class Results:
             out.update({f"contact/{k}": getattr(self.contact, k) for k in CONTACT_STATIC})
         return out
 
+    @property
+    def audit_checksummed(self):
+        """True if the step checksums cover the energy audit (``tresca_py.checksum.covers_audit``)."""
+        return self.audit is not None
+
     def checksums(self):
-        """The checksum of every step (``tresca_py.checksum``), the series in their stored dtypes."""
+        """The checksum of every step (``tresca_py.checksum``), the series in their stored dtypes, the audit's last
+        when they cover it."""
         s = self.series()
-        return checksum.step_checksums([np.asarray(s[k], SPEC[k][0]) for k in checksum.SERIES if k in s])
+        audit = [np.asarray(self.audit[k], F8) for k in checksum.AUDIT] if self.audit is not None else []
+        return checksum.step_checksums([np.asarray(s[k], SPEC[k][0]) for k in checksum.SERIES if k in s] + audit)
 
 
 def _check_array(where, name, shape, dtype, sizes):
@@ -358,6 +366,8 @@ def _read_group(f, where, verify):
                 steps={k: load(f"steps/{k}") for k in STEP_FIELDS}, contact=contact, errors=errors,
                 attrs=attrs, path=where, rows=sizes["R"])
     validate(r, where)
+    if "steps/checksum" in ds and checksum.covers_audit(ds["steps/checksum"]):
+        r.audit = _audit_rows(where, g, S, sizes["R"])
     if verify and "steps/checksum" in ds:
         stored = load("steps/checksum")
         bad = np.nonzero(r.checksums() != stored)[0]
@@ -365,6 +375,20 @@ def _read_group(f, where, verify):
             raise ResultsError(f"{where}: step {int(bad[0])} does not match its checksum (tresca/steps/checksum): "
                                "the file was damaged after it was written; steps before it are intact")
     return r
+
+
+def _audit_rows(where, g, S, rows):
+    """{name: the first S rows} of the audit series that the checksums cover; ResultsError if one is missing or
+    not a float series of the file's rows."""
+    import h5py
+    out = {}
+    for name in checksum.AUDIT:
+        obj = g.get(name)
+        if not isinstance(obj, h5py.Dataset) or obj.shape != (rows,) or obj.dtype.kind != "f":
+            what = "missing" if obj is None else "not a float series of one value per step"
+            raise ResultsError(f"{where}: tresca/{name} is {what}, though the step checksums cover the energy audit")
+        out[name] = obj[:S].astype(F8, copy=False)
+    return out
 
 
 def read(path, verify=True):
@@ -408,7 +432,12 @@ def write(path, r, extra_attrs=None):
             g = f.create_group("tresca")
             for name, a in {**r.static(), **r.series()}.items():
                 g.create_dataset(name, data=np.asarray(a, SPEC[name][0]))
-            g.create_dataset("steps/checksum", data=r.checksums())
+            sums = g.create_dataset("steps/checksum", data=r.checksums())
+            if r.audit is not None:
+                for k in checksum.AUDIT:
+                    g.create_dataset(k, data=np.asarray(r.audit[k], F8))
+                sums.attrs[checksum.COVERS] = ", ".join([k for k in checksum.SERIES if k in r.series()]
+                                                       + list(checksum.AUDIT))
             for k, v in attrs.items():
                 g.attrs[k] = v
             g["steps"].attrs["completed"] = np.int64(r.completed)

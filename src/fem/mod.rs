@@ -7,7 +7,8 @@
 //! * [`assemble`]: the stiffness K of a_h; [`loads`]: the load functional lⁿ;
 //! * [`exact`]: the exact solution at quadrature points; [`norms`]: true-error norms;
 //! * [`forms`]: the energy audit's forms on full midpoint fields;
-//! * [`prolong`]: the prolongation between nested meshes.
+//! * [`prolong`]: the prolongation between nested meshes;
+//! * [`validate`]: the validation of a scene's boundary parts and data that every command runs first.
 
 pub mod assemble;
 pub mod elasticity;
@@ -20,4 +21,5 @@ pub mod prolong;
 pub mod quadrature;
 pub mod singular;
 pub mod space;
+pub mod validate;
 pub mod williams;

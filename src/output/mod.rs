@@ -45,6 +45,7 @@
 //! [`Writer::finish`] records: "completed" or the error of the failed step).
 
 mod background;
+pub mod checksum;
 mod close;
 mod create;
 pub mod fields;

@@ -37,7 +37,7 @@ fn underflows(path: &Path, n: usize, mid: &[[f64; 2]]) -> Result<()> {
             msg: format!(
                 "step {n}: the displacement (largest |u| = {largest:.3e}) is below the single-precision range (1.2e-38) \
                  of the VTKHDF/XDMF views, which would show zeros; the step was not written (u is linear in the \
-                 loads, u₀ and g_a: scale them up)"
+                 scene's data together, the loads, u₀, g_a and the parts' u and gap: scale them up)"
             ),
         });
     }
@@ -125,7 +125,8 @@ impl Writer {
                         path: path.to_path_buf(),
                         msg: format!(
                             "step {n}: {what}[{k}] exceeds the single-precision range (3.4e38) of the VTKHDF/XDMF \
-                             views; the step was not written (u is linear in the loads, u₀ and g_a: scale them down)"
+                             views; the step was not written (u is linear in the scene's data together, the loads, u₀, g_a and \
+                             the parts' u and gap: scale them down)"
                         ),
                     });
                 }

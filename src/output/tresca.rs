@@ -12,20 +12,23 @@
 //! euler_dissipation, balance_residual}`: (lⁿ,δuⁿ); the work of the reactions on Γ_D and of Γ_C's
 //! imposed normal displacement (0 without boundary data); Eⁿ = ½a_h(uⁿ,uⁿ) (Dirichlet jump against
 //! u_D); j_h(δuⁿ); ½a_h(δuⁿ,δuⁿ); and a_h(uⁿ,δuⁿ) + j_h(δuⁿ) − (lⁿ,δuⁿ) − boundary_work, which vanishes
-//! up to rounding and the friction solver's tolerance (NaN where a step had no audit). The audit series
-//! are not part of the checksum below (files before them have none).
+//! up to rounding and the friction solver's tolerance (NaN where a step had no audit).
 //!
 //! `u` is the displacement at the edge midpoints, the lifting of the boundary data included
 //! (`fem::lifting`); `energy` is a_h(uⁿ,uⁿ) with the Dirichlet jump measured against u_D.
 //! `tresca/steps` carries the attribute `completed` (number of complete steps), written after every
 //! other dataset of a step. `tresca/steps/checksum` (u64) holds per step the XXH64 (seed 0) of the step's
 //! rows of every series above, in the order `times, u, energy, steps/{iterations, residual, n_stick, n_slip,
-//! wall_time}, contact/{slip, sigma_t, state, mu, dof}, errors/{energy, h1, l2}` (those present), as
-//! little-endian bytes; it is written with the rows, before `completed`, and checked by `--resume` and by
-//! `scripts/check_results.py` ([`step_checksums`]). The unknown vector of the last step is rebuilt exactly from `u` (free
+//! wall_time}, contact/{slip, sigma_t, state, mu, dof}, errors/{energy, h1, l2}` (those present), then the
+//! audit series in [`AUDIT`]'s order, as little-endian bytes; it is written with the rows, before
+//! `completed`, and checked by `--resume` and by `scripts/check_results.py` (`output::checksum`). Its
+//! attribute `series` (`output::checksum::COVERS`) names the series it covers: a file written before the audit was covered has
+//! no such attribute (and its checksums cover the series before the audit), and is read and resumed with
+//! that layout. The unknown vector of the last step is rebuilt exactly from `u` (free
 //! edges hold the two unknowns verbatim) and `contact/dof` (the one unknown of a contact edge).
 
-use super::h5::{attr, attr_str, attr_vec, put, Raw, Series};
+use super::checksum::{step_checksums, COVERS};
+use super::h5::{attr, attr_str, attr_vec, put, read_str, Raw, Series};
 use super::rows::Rows;
 use super::Run;
 use crate::fem::norms::ErrorNorms;
@@ -54,6 +57,8 @@ pub struct Tresca {
     checksum: Option<Series>,
     /// The energy audit, [`AUDIT`] (`None` in files of versions before it).
     audit: Option<Vec<Series>>,
+    /// True if the checksums cover the audit series (attribute [`COVERS`] of the checksum).
+    audit_checksummed: bool,
 }
 
 /// The audit's series under `steps`, in `stepping::Audit::as_array`'s order.
@@ -66,19 +71,18 @@ pub const AUDIT: [&str; 6] = [
     "balance_residual",
 ];
 
-/// The XXH64 of each of `k` steps whose rows are the k equal consecutive parts of every slice of
-/// `series` (the bytes of consecutive steps of each series, in the order of the module doc).
-pub fn step_checksums(series: &[&[u8]], k: usize) -> Vec<u64> {
-    (0..k)
-        .map(|i| {
-            let mut h = xxhash_rust::xxh64::Xxh64::new(0);
-            for s in series {
-                let row = s.len() / k;
-                h.update(&s[i * row..(i + 1) * row]);
-            }
-            h.digest()
-        })
-        .collect()
+/// The series a new file's checksums cover, in their order (module doc).
+fn covered(contact: bool, errors: bool) -> String {
+    let mut v = vec!["times", "u", "energy"];
+    v.extend(["steps/iterations", "steps/residual", "steps/n_stick", "steps/n_slip", "steps/wall_time"]);
+    if contact {
+        v.extend(["contact/slip", "contact/sigma_t", "contact/state", "contact/mu", "contact/dof"]);
+    }
+    if errors {
+        v.extend(["errors/energy", "errors/h1", "errors/l2"]);
+    }
+    let audit = AUDIT.map(|a| format!("steps/{a}"));
+    v.into_iter().map(String::from).chain(audit).collect::<Vec<_>>().join(", ")
 }
 
 const SCALARS: [&str; 6] = ["times", "energy", "steps/iterations", "steps/residual", "steps/n_stick", "steps/n_slip"];
@@ -159,9 +163,12 @@ impl Tresca {
         attributes(&g, p)?;
         attr(&sg, "completed", 0i64)?;
         let audit = AUDIT.iter().map(|a| Series::create::<f64>(&sg, a, 1, &[], sc)).collect::<hdf5::Result<_>>()?;
+        let checksum = Series::create::<u64>(&sg, "checksum", 1, &[], sc)?;
+        attr_str(&checksum.ds, COVERS, &covered(contact.is_some(), errors.is_some()))?;
         Ok(Tresca {
             audit: Some(audit),
-            checksum: Some(Series::create::<u64>(&sg, "checksum", 1, &[], sc)?),
+            audit_checksummed: true,
+            checksum: Some(checksum),
             times: Series::create::<f64>(&g, "times", 1, &[], sc)?,
             u: Series::create::<f64>(&g, "u", 1, &[ne, 2], sc)?,
             energy: Series::create::<f64>(&g, "energy", 1, &[], sc)?,
@@ -195,9 +202,11 @@ impl Tresca {
             Ok(eg) => Some([Series::open(&eg, "energy", 1)?, Series::open(&eg, "h1", 1)?, Series::open(&eg, "l2", 1)?]),
             Err(_) => None,
         };
+        let checksum = Series::open(&sg, "checksum", 1).ok();
         Ok(Tresca {
             audit: AUDIT.iter().map(|a| Series::open(&sg, a, 1)).collect::<hdf5::Result<_>>().ok(),
-            checksum: Series::open(&sg, "checksum", 1).ok(),
+            audit_checksummed: checksum.as_ref().is_some_and(|c| c.ds.attr(COVERS).is_ok()),
+            checksum,
             times: Series::open(&g, SCALARS[0], 1)?,
             u: Series::open(&g, "u", 1)?,
             energy: Series::open(&g, SCALARS[1], 1)?,
@@ -213,7 +222,8 @@ impl Tresca {
         })
     }
 
-    fn all(&mut self) -> Vec<&mut Series> {
+    /// Every series in the checksum's order, the audit's last when `audit`.
+    fn series(&mut self, audit: bool) -> Vec<&mut Series> {
         let mut v = vec![
             &mut self.times,
             &mut self.u,
@@ -226,6 +236,9 @@ impl Tresca {
         ];
         v.extend(self.contact.iter_mut().flatten());
         v.extend(self.errors.iter_mut().flatten());
+        if audit {
+            v.extend(self.audit.iter_mut().flatten());
+        }
         v
     }
 
@@ -248,6 +261,9 @@ impl Tresca {
         if self.errors.is_some() {
             v.extend(b.errors.iter().map(|e| c(e)));
         }
+        if self.audit_checksummed {
+            v.extend(b.audit.iter().map(|a| c(a)));
+        }
         step_checksums(&v, b.count)
     }
 
@@ -258,8 +274,14 @@ impl Tresca {
             Some(c) => c.read_steps::<u64>(0, completed)?,
             None => return Err(hdf5::Error::from("the file has no step checksums (written before they were added)")),
         };
+        if self.audit_checksummed && self.audit.is_none() {
+            return Err(hdf5::Error::from("its energy audit series are missing, though its checksums cover them"));
+        }
+        if self.audit_checksummed && self.audit.is_none() {
+            return Err(hdf5::Error::from("its energy audit series are missing, though its checksums cover them"));
+        }
         // blocks of steps of about 64 MB, so that a file larger than memory is verified too
-        let series = self.all();
+        let series = self.series(self.audit_checksummed);
         let per_step = series.iter().map(|s| s.step_bytes()).sum::<usize>().max(1);
         let block = ((64 << 20) / per_step).max(1);
         for first in (0..completed).step_by(block) {
@@ -322,12 +344,12 @@ impl Tresca {
     /// [`Series::set_steps`]).
     pub fn set_steps(&mut self, raw: &Raw, steps: usize, kept: usize) -> hdf5::Result<()> {
         if let Some(c) = &mut self.checksum {
+            // the rewritten dataset keeps what its attribute says it covers
+            let covers = read_str(&c.ds, COVERS).ok();
             c.set_steps(raw, steps, kept)?;
+            covers.map_or(Ok(()), |v| attr_str(&c.ds, COVERS, &v))?;
         }
-        for a in self.audit.iter_mut().flatten() {
-            a.set_steps(raw, steps, kept)?;
-        }
-        self.all().into_iter().try_for_each(|s| s.set_steps(raw, steps, kept))
+        self.series(true).into_iter().try_for_each(|s| s.set_steps(raw, steps, kept))
     }
 
     /// Rebuild the StepResult of stored step n (exact unknowns, μ, slip, state, statistics).

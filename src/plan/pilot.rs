@@ -203,11 +203,11 @@ impl<'a> Runner<'a> {
         let need = crate::scene::budget::Estimate::of(&s, level.steps, false)?.memory.saturating_mul(3) / 2;
         if let Some(m) = crate::scene::budget::available_memory().filter(|&m| need > m) {
             return Ok(Some(format!(
-                "pilot level {}:{} would need ~{:.1} GB with the two levels kept, {:.1} GB are available",
+                "pilot level {}:{} would need ~{} with the two levels kept, {} are available",
                 level.refine,
                 level.steps,
-                need as f64 / 1e9,
-                m as f64 / 1e9
+                crate::error::human(need),
+                crate::error::human(m)
             )));
         }
         let r = self.seq.push(level)?;

@@ -191,14 +191,14 @@ fn choose(plan: &mut Plan, all: Vec<Candidate>, mut notes: Vec<String>) {
         plan.refused = Some(match &over_budget {
             Some(c) => format!(
                 "the target is out of reach within the budget of {:.0} s and {} of memory: the cheapest configuration \
-                 predicted to meet it (refine {}, {} steps, {} unknowns) would take {:.3e} s and {:.1} GB",
+                 predicted to meet it (refine {}, {} steps, {} unknowns) would take {:.3e} s and {}",
                 options.budget,
-                memory_limit.map_or("any amount".into(), |m| format!("{:.1} GB", m as f64 / 1e9)),
+                memory_limit.map_or("any amount".into(), crate::error::human),
                 c.refine,
                 c.steps,
                 c.unknowns,
                 c.wall,
-                c.memory as f64 / 1e9
+                crate::error::human(c.memory)
             ),
             None => format!(
                 "the target is out of reach: no configuration up to refine {MAX_REFINE} and {MAX_STEPS} steps is predicted to meet it"

@@ -146,8 +146,39 @@ pub fn results_file((triangles, edges, contact): (u64, u64, u64), steps: u64, fr
     (steps + 1).saturating_mul(row).saturating_add(frames.saturating_mul(per_frame)).saturating_add(fixed)
 }
 
-/// (triangles, edges, contact edges) of the scene's mesh, without building it.
+/// The most triangles a mesh may count (2⁴⁸ = 2.8e14, beyond any machine's memory by a factor of a
+/// thousand): below it every size and byte count of [`Estimate::of_sizes`] is exact in 64-bit integers
+/// (the largest, the frames' 51 × 100 bytes a triangle, stays below 2⁶¹), so none wraps around.
+const MAX_TRIANGLES: f64 = (1u64 << 48) as f64;
+
+/// (triangles, edges, contact edges) of the scene's mesh, without building it; refused when the
+/// triangles exceed [`MAX_TRIANGLES`], with their number computed in floating point.
 fn sizes(scene: &Scene) -> Result<(u64, u64, u64)> {
+    let (what, triangles) = match &scene.mesh {
+        MeshSpec::Structured { cells, refine, .. } => {
+            let f = f64::from(1u32 << refine);
+            (
+                format!("cells = [{}, {}] at refine {refine}", cells[0], cells[1]),
+                2.0 * cells[0] as f64 * cells[1] as f64 * f * f,
+            )
+        }
+        MeshSpec::Gmsh { .. } => (String::new(), 0.0),
+    };
+    if triangles > MAX_TRIANGLES {
+        return Err(Error::scene(
+            &scene.file,
+            "mesh.cells",
+            format!(
+                "{what} makes {triangles:.3e} triangles, far beyond any machine's memory (at most {MAX_TRIANGLES:.1e} \
+                 are counted)"
+            ),
+        ));
+    }
+    counts(scene)
+}
+
+/// [`sizes`] once the triangles are known to be countable.
+fn counts(scene: &Scene) -> Result<(u64, u64, u64)> {
     let contact_parts: Vec<&str> =
         scene.parts.iter().filter(|p| matches!(p.kind, PartKind::Contact(..))).map(|p| p.name.as_str()).collect();
     match &scene.mesh {
@@ -168,6 +199,13 @@ fn sizes(scene: &Scene) -> Result<(u64, u64, u64)> {
             let raw = crate::mesh::parse_gmsh(&text, &path.display().to_string())?;
             let f = 1u64 << (2 * refine);
             let tris = (raw.tris.len() as u64).saturating_mul(f);
+            if tris as f64 > MAX_TRIANGLES {
+                return Err(Error::scene(
+                    &scene.file,
+                    "mesh.refine",
+                    format!("{} triangles at refine {refine} are far beyond any machine's memory", tris as f64),
+                ));
+            }
             let contact = raw
                 .tagged
                 .iter()

@@ -8,6 +8,7 @@
 use crate::error::{Error, Result};
 use crate::names::named_enum;
 use expr::{Expr, Vec2Expr};
+mod blame;
 pub mod budget;
 pub mod expr;
 mod parts;

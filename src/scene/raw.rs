@@ -135,6 +135,7 @@ pub(super) struct RawBoundary {
     pub(super) traction: Option<[String; 2]>,
     pub(super) g_a: Option<String>,
     /// Dirichlet data u_D(x, y, t) of a dirichlet part (default 0).
+    #[serde(default, deserialize_with = "opt_exactly")]
     pub(super) u: Option<[String; 2]>,
     /// Imposed normal displacement g_n(x, y, t) of a contact part (default 0).
     pub(super) gap: Option<String>,

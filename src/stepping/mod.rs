@@ -314,7 +314,7 @@ fn initial_state(
 
 /// Finiteness check and true errors (when the scene gives `[exact]`).
 fn finish(r: StepResult, d: Parts<'_>, errors: Option<&ErrorEvaluator>) -> Result<StepResult> {
-    let mut r = checked(r)?;
+    let mut r = checked(r, d.scene)?;
     if let (Some(ev), Some(ex), true) = (errors, &d.scene.exact, has_u(d.space, &r)) {
         let mid = lifting::displacement(d.space, d.data, &r.u, r.t)?;
         r.errors = Some(ev.errors(d.mesh, ex, &mid, r.t)?);
@@ -336,8 +336,8 @@ fn has_u(space: &CrSpace, r: &StepResult) -> bool {
     !r.u.is_empty() || space.n_dofs == 0
 }
 
-/// The finiteness checks of a step result.
-fn checked(r: StepResult) -> Result<StepResult> {
+/// The finiteness checks of a step result of `scene`.
+fn checked(r: StepResult, scene: &Scene) -> Result<StepResult> {
     if r.u.iter().any(|v| !v.is_finite()) {
         return Err(Error::Linear(format!(
             "step {}: the solution is not finite (singular or ill-conditioned system)",
@@ -347,9 +347,10 @@ fn checked(r: StepResult) -> Result<StepResult> {
     if !r.u.is_empty() && !r.energy.is_finite() {
         let umax = r.u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         return Err(Error::Linear(format!(
-            "step {}: the energy a_h(u, u) overflows f64 (max |u| = {umax:.3e}): the loads are too large for \
-             the answer to be representable; u is linear in the loads, u₀ and g_a together, so scale them down",
-            r.n
+            "step {}: the energy a_h(u, u) overflows f64 (max |u| = {umax:.3e}): the data are too large for \
+             the answer to be representable; {}",
+            r.n,
+            scene.scale_data("down")
         )));
     }
     Ok(r)

@@ -78,7 +78,7 @@ impl Problem {
         }
         let mut norms = norms.into_iter();
         for r in done {
-            let mut r = checked(r)?;
+            let mut r = checked(r, &self.scene)?;
             if self.errors.is_some() && self.scene.exact.is_some() && self.has_u(&r) {
                 match norms.next() {
                     Some(e) => r.errors = Some(e),

@@ -73,12 +73,8 @@ impl Problem {
         beside: Option<impl FnOnce(&Discretised) -> R + Send>,
     ) -> WithBeside<R> {
         let t0 = Instant::now();
-        let space = CrSpace::new(&mesh, &scene.parts).map_err(|e| (e, None))?;
-        let data = BoundaryData::of(&mesh, &scene.parts, &space);
-        crate::fem::lifting::consistency::check(&scene, &mesh, &space).map_err(|e| (e, None))?;
+        let p0 = Discretised::new(scene, mesh, guard).map_err(|e| (e, None))?;
         let t1 = Instant::now();
-        let law = Elasticity::new(&scene.material);
-        let p0 = Discretised { scene, mesh, space, data, law, guard };
         let (rest, r) = p0.set_up(beside);
         let Discretised { scene, mesh, space, data, law, .. } = p0;
         let rest = match rest {
@@ -123,6 +119,8 @@ pub(super) struct Factored {
 
 /// A discretised problem, what the set-up starts from: the scene, its mesh, CR space and boundary data
 /// (the lifting, added outside V_h), and the law.
+/// Outside the crate it is made only by [`Discretised::new`], which validates it (`non_exhaustive`).
+#[non_exhaustive]
 pub struct Discretised {
     pub scene: Scene,
     pub mesh: Mesh,
@@ -132,6 +130,17 @@ pub struct Discretised {
     pub law: Elasticity,
     /// Whether the set-up estimates K's condition number.
     pub guard: Guard,
+}
+
+impl Discretised {
+    /// The scene on `mesh`: its parts bound and its boundary data checked (`fem::validate::on_mesh`, which
+    /// every set-up passes through here, so that no command can skip it), the data's lifting and the law.
+    pub fn new(scene: Scene, mesh: Mesh, guard: Guard) -> Result<Discretised> {
+        let space = crate::fem::validate::on_mesh(&scene, &mesh)?;
+        let data = BoundaryData::of(&mesh, &scene.parts, &space);
+        let law = Elasticity::new(&scene.material);
+        Ok(Discretised { scene, mesh, space, data, law, guard })
+    }
 }
 
 /// The instants the set-up's phases ended at (the space's end and these give [`SetupTimes`]).

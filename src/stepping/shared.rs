@@ -31,6 +31,8 @@ impl Problem {
         if scene.times.first() != m.t0.as_ref() {
             return Err(Error::Linear("internal: a shared set-up used with another initial time".into()));
         }
+        // the shared set-up checked the data at its own scene's time nodes: this one's are checked here
+        crate::fem::lifting::consistency::check(&scene, &m.mesh, &m.space)?;
         let t3 = Instant::now();
         let mut assembled = Vec::new();
         let basis = LoadBasis::build(&m.loads, &scene.times, &m.factor, &mut assembled)?;
@@ -91,11 +93,8 @@ impl MeshSetUp {
     pub fn new(scene: &Scene, guard: Guard) -> Result<MeshSetUp> {
         let t0 = Instant::now();
         let mesh = Mesh::from_spec(&scene.mesh)?;
-        let space = CrSpace::new(&mesh, &scene.parts)?;
-        let data = BoundaryData::of(&mesh, &scene.parts, &space);
+        let p0 = Discretised::new(scene.clone(), mesh, guard)?;
         let t1 = Instant::now();
-        let law = Elasticity::new(&scene.material);
-        let p0 = Discretised { scene: scene.clone(), mesh, space, data, law, guard };
         let (stiffness, loads, symbolic) = p0.assemble()?;
         let t2 = Instant::now();
         let f = p0.factor(&stiffness, symbolic)?;

@@ -26,6 +26,7 @@ mod eval;
 mod lint;
 pub mod program;
 mod regroup;
+pub mod rounding;
 mod separate;
 pub use separate::factor_slot;
 pub mod sym;
@@ -120,6 +121,11 @@ impl Expr {
     /// An error about this expression (its scene key and text).
     pub fn error(&self, msg: String) -> Error {
         Error::Expr { key: self.key.clone(), expr: self.text.clone(), msg }
+    }
+
+    /// A bound on the rounding error of the value at (x, y, t) ([`rounding`]).
+    pub fn rounding(&self, x: f64, y: f64, t: f64) -> f64 {
+        rounding::value_and_bound(&self.tree, [x, y, t]).1
     }
 
     /// Evaluate at (x, y, t); a non-finite value is an error.
@@ -293,6 +299,10 @@ impl Vec2Expr {
     /// Evaluate both components.
     pub fn eval(&self, x: f64, y: f64, t: f64) -> Result<[f64; 2]> {
         Ok([self.0[0].eval(x, y, t)?, self.0[1].eval(x, y, t)?])
+    }
+    /// The rounding bounds of both components ([`Expr::rounding`]).
+    pub fn rounding(&self, x: f64, y: f64, t: f64) -> [f64; 2] {
+        [self.0[0].rounding(x, y, t), self.0[1].rounding(x, y, t)]
     }
     /// True if both components are the constant zero.
     pub fn is_zero(&self) -> bool {
