@@ -47,6 +47,7 @@
 mod background;
 mod create;
 pub mod fields;
+pub mod guard;
 mod h5;
 mod lock;
 mod paths;
