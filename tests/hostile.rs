@@ -5,6 +5,8 @@
 //! inputs that are scenes are also in `tests/fuzz_corpus/` (replayed by `tests/fuzz.rs`).
 
 mod common;
+#[path = "hostile/outputs.rs"]
+mod outputs;
 use common::{bin, root, spawn, stderr};
 use std::os::unix::fs::FileTypeExt;
 use std::os::unix::process::CommandExt;
