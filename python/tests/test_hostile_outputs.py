@@ -57,13 +57,13 @@ def test_solver_output_that_is_an_input_is_refused(tmp_path, target):
 
 
 def test_solver_output_links_fifos_and_existing_files(tmp_path):
-    """The system shall refuse a solver's -o that is a symbolic link (even with --force), a FIFO (at once) or an
+    """The system shall refuse a solver's -o that is a symbolic link, a FIFO (at once, even with --force) or an
     existing file without --force, naming it and leaving it as it was."""
     scene, _ = lshape(tmp_path)
     v = victim(tmp_path)
     link = tmp_path / "link.h5"
     link.symlink_to(v)
-    rc, _, err = tool("skfem_solve.py", scene, "-q", "-o", link, "--force")
+    rc, _, err = tool("skfem_solve.py", scene, "-q", "-o", link)
     refused(rc, err, "symbolic link")
     assert link.is_symlink() and v.read_text() == "V\n"
     fifo = tmp_path / "fifo.h5"
@@ -95,14 +95,14 @@ def pictures(runs, tmp_path_factory):
 
 @pytest.mark.parametrize("which", ["first", "last"])
 def test_render_never_draws_through_a_link(runs, pictures, tmp_path, which):
-    """The system shall refuse render.py's pictures through a symbolic link planted under one of their names, even
-    with --force, before drawing any, the link's target unchanged."""
+    """The system shall refuse render.py's pictures through a symbolic link planted under one of their names before
+    drawing any, the link's target unchanged."""
     v = victim(tmp_path)
     out = tmp_path / "pictures"
     out.mkdir()
     name = pictures[0] if which == "first" else pictures[-1]
     (out / name).symlink_to(v)
-    rc, _, err = tool("render.py", runs["contact"], "-o", out, "--force")
+    rc, _, err = tool("render.py", runs["contact"], "-o", out)
     refused(rc, err, "symbolic link")
     assert v.read_text() == "V\n" and os.listdir(out) == [name]
 
@@ -145,7 +145,7 @@ def test_adapt_plot_pictures_under_the_rule(adapted, tmp_path):
     out = tmp_path / "meshes"
     out.mkdir()
     (out / "mesh_1.png").symlink_to(v)
-    rc, _, err = tool("adapt_plot.py", "meshes", levels, "-o", out, "--force")
+    rc, _, err = tool("adapt_plot.py", "meshes", levels, "-o", out)
     refused(rc, err, "symbolic link")
     assert v.read_text() == "V\n" and os.listdir(out) == ["mesh_1.png"]
     fifo = tmp_path / "rates.png"

@@ -13,18 +13,14 @@
 //!   `FILE`: a rename replaces the name, never what a link points to, and a failed write leaves the old
 //!   file as it was.
 
-use super::paths::{clear_stale, create_new, lstat, sidecar};
-use crate::error::{Error, Result};
+use super::paths::{clear_stale, create_new, lstat, refuse, sidecar};
+use crate::error::Result;
 use crate::input::kind_of;
 use crate::scene::{MeshSpec, Scene};
 use std::ffi::OsString;
 use std::io::Write;
 use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
-
-fn refuse(path: &Path, msg: String) -> Error {
-    Error::Io { path: path.to_path_buf(), msg }
-}
 
 /// How an output of [`Outputs`] is checked.
 #[derive(Clone, Copy, PartialEq)]
