@@ -8,12 +8,9 @@ own Python (``pvpython``, without the venv) runs them too (``tresca_py.paraview`
 * ``output_file`` / ``output_dir``: the path is not a directory (or is one), its directory exists or can be
   made, and a file can be created in it (tried, so read-only directories and file systems are found even
   for root, whom the permission bits do not stop).
-* ``new_output`` / ``distinct`` / ``write_new``: the rule of every file a tool writes (docs/results.md, "Every
-  output, one rule"), as ``src/output/guard.rs`` states it for the Rust commands: before any work, an output is
-  absent or, with ``--force``, a regular file with a single link (a symbolic link, hard link, device, FIFO, socket
-  or directory is refused by name, found with ``lstat``, so nothing is opened and a FIFO never blocks), and it is
-  never an input or another output, compared by ``(st_dev, st_ino)``; the file is then built in ``FILE.tmp``,
-  created exclusively without following links, and renamed over ``FILE``.
+* ``new_output`` / ``distinct`` / ``write_new``: the rule of every file a tool writes, stated in docs/results.md
+  ("Every output, one rule"; ``src/output/guard.rs`` for the Rust commands): checked before any work with
+  ``lstat`` (never opened), compared with the inputs by ``(st_dev, st_ino)``, written through ``FILE.tmp``.
 * ``sidecar_targets`` / ``check_sidecar``: the HDF5 files an XDMF sidecar references, and that it references
   the results file being opened (a ``run.h5`` copied with its ``run.xdmf`` keeps pointing at the original).
 """
