@@ -98,7 +98,7 @@ pub struct Reports {
     /// Write a machine-readable summary (JSON; fields in src/cli/summary.rs) to FILE.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
-    /// Replace the files this command writes (--json, --csv, --differences' files) where they exist.
+    /// Replace the files this command writes (--json; study and plan: --csv; study: --differences' files).
     #[arg(long)]
     pub force: bool,
 }
