@@ -85,7 +85,7 @@ pub fn study(
     let (json, force) = (reports.json, reports.force);
     check_levels(levels, reference)?;
     let diffs: Vec<PathBuf> =
-        differences.iter().flat_map(|d| levels[1..].iter().map(|l| file_of(d, l.refine, l.steps))).collect();
+        differences.iter().flat_map(|d| levels.iter().skip(1).map(|l| file_of(d, l.refine, l.steps))).collect();
     Outputs::new(force)
         .inputs_of(&scene)
         .dirs(differences.as_deref(), "--differences directory")

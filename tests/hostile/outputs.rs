@@ -189,30 +189,38 @@ fn outputs_that_are_inputs_or_each_other_are_refused() {
     assert_eq!(std::fs::read(&mesh).unwrap(), before);
 }
 
-/// §1: the system shall not write `--gmsh`'s level meshes or `--differences`' files through a symbolic
-/// link planted under their names, refusing before the first level, and shall refuse a
-/// `--differences` path that is not a directory.
+/// §1: the system shall not write `--gmsh`'s level meshes, `adapt --out`'s level files or `--differences`'
+/// files through a symbolic link planted under their names, nor open a FIFO there (it would block),
+/// refusing before the first level, and shall refuse a `--differences` path that is not a directory.
 #[test]
-fn links_under_level_and_difference_names_are_refused_before_any_level() {
+fn links_and_fifos_under_level_and_difference_names_are_refused_before_any_level() {
     let scene = base();
-    let levels = tmp("linked_levels");
-    let _ = std::fs::remove_dir_all(&levels);
-    std::fs::create_dir_all(&levels).unwrap();
-    let v = victim("gmsh");
-    std::os::unix::fs::symlink(&v, levels.join("level_1.msh")).unwrap();
-    let o = within(&["adapt", &scene, "--levels", "2", "--out", s(&levels), "--gmsh", "--force"]);
-    refused(&o, "--gmsh", "symbolic link");
-    assert_eq!(std::fs::read(&v).unwrap(), b"V\n");
-    assert!(!levels.join("level_0.h5").exists() && !levels.join("level_0.msh").exists(), "level 0 was written");
-    let diffs = tmp("linked_diffs");
-    let _ = std::fs::remove_dir_all(&diffs);
-    std::fs::create_dir_all(&diffs).unwrap();
-    let v = victim("diffs");
-    std::os::unix::fs::symlink(&v, diffs.join("difference_2_16.xdmf")).unwrap();
-    let o = within(&["study", &scene, "--levels", "0:4,1:8,2:16", "--differences", s(&diffs), "--force"]);
-    refused(&o, "--differences", "symbolic link");
-    assert_eq!(std::fs::read(&v).unwrap(), b"V\n");
-    assert!(!diffs.join("difference_1_8.xdmf").exists(), "a level's file was written");
+    for (kind, want) in [("link", "symbolic link"), ("fifo", "FIFO")] {
+        let plant = |p: &Path, v: &Path| match kind {
+            "link" => std::os::unix::fs::symlink(v, p).unwrap(),
+            _ => mkfifo(p),
+        };
+        for name in ["level_1.msh", "level_1.h5", "level_1.xdmf"] {
+            let levels = tmp(&format!("planted_levels_{kind}"));
+            let _ = std::fs::remove_dir_all(&levels);
+            std::fs::create_dir_all(&levels).unwrap();
+            let v = victim(&format!("levels_{kind}"));
+            plant(&levels.join(name), &v);
+            let o = within(&["adapt", &scene, "--levels", "2", "--out", s(&levels), "--gmsh", "--force"]);
+            refused(&o, &format!("--out with {kind} {name}"), want);
+            assert_eq!(std::fs::read(&v).unwrap(), b"V\n");
+            assert!(!levels.join("level_0.h5").exists() && !levels.join("level_0.msh").exists(), "level 0 written");
+        }
+        let diffs = tmp(&format!("planted_diffs_{kind}"));
+        let _ = std::fs::remove_dir_all(&diffs);
+        std::fs::create_dir_all(&diffs).unwrap();
+        let v = victim(&format!("diffs_{kind}"));
+        plant(&diffs.join("difference_2_16.xdmf"), &v);
+        let o = within(&["study", &scene, "--levels", "0:4,1:8,2:16", "--differences", s(&diffs), "--force"]);
+        refused(&o, &format!("--differences with {kind}"), want);
+        assert_eq!(std::fs::read(&v).unwrap(), b"V\n");
+        assert!(!diffs.join("difference_1_8.xdmf").exists(), "a level's file was written");
+    }
     let file = victim("diffs_file");
     let o = within(&["study", &scene, "--levels", "0:4,1:8", "--differences", s(&file)]);
     refused(&o, "--differences FILE", "not a directory");
