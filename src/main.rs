@@ -32,7 +32,7 @@ enum Cmd {
         #[command(flatten)]
         limits: Limits,
         #[command(flatten)]
-        json: cli::summary::JsonArg,
+        json: cli::summary::Reports,
     },
     /// Run a scene.
     Run {
@@ -73,7 +73,7 @@ enum Cmd {
         #[arg(long, allow_hyphen_values = true, value_parser = cli::args::size)]
         max_memory: Option<u64>,
         #[command(flatten)]
-        json: cli::summary::JsonArg,
+        json: cli::summary::Reports,
     },
     /// Adaptive meshes: solve, estimate the error per triangle, mark (Dörfler) and bisect, level by
     /// level, each level a whole run; a table per level (exit code 3 when stopped before the goal).
@@ -145,7 +145,7 @@ enum Cmd {
         #[arg(long)]
         uniform_only: bool,
         #[command(flatten)]
-        json: cli::summary::JsonArg,
+        json: cli::summary::Reports,
     },
 }
 
@@ -301,7 +301,7 @@ fn main() {
                 .and_then(|()| load(&scene, Grid::default(), Limits::none(), |_| None, false))
                 .and_then(|(mut s, _)| {
                     solver.apply(&mut s)?;
-                    cli::study::study(s, &levels, reference, csv, differences, max_memory, json.json)
+                    cli::study::study(s, &levels, reference, csv, differences, max_memory, json)
                 })
         }
         cmd @ Cmd::Adapt { .. } => adapt(cmd),
@@ -314,11 +314,11 @@ fn main() {
 }
 
 /// `check`: the estimate of the results file is for the scene's [output] path, else the current directory.
-fn check(scene: &Path, grid: Grid, limits: Limits, json: cli::summary::JsonArg) -> Result<()> {
+fn check(scene: &Path, grid: Grid, limits: Limits, json: cli::summary::Reports) -> Result<()> {
     let out = |s: &Scene| Some(s.output.clone().unwrap_or_else(|| PathBuf::from("run.h5")));
     cli::summary::check_path(json.json.as_deref())
         .and_then(|()| load(scene, grid, limits, out, false))
-        .and_then(|(s, e)| cli::check::check(s, e, json.json))
+        .and_then(|(s, e)| cli::check::check(s, e, json))
 }
 
 /// `run`: a resumed run's file already holds its disk space, so only memory is checked then.
@@ -389,7 +389,7 @@ fn plan(cmd: Cmd) -> Result<()> {
     };
     let (s, _) = cli::summary::check_path(json.json.as_deref())
         .and_then(|()| load(&scene, Grid::default(), Limits::none(), |_| None, false))?;
-    exit_unless_zero(cli::plan::run(s, options, csv, run, !uniform_only, json.json)?);
+    exit_unless_zero(cli::plan::run(s, options, csv, run, !uniform_only, json)?);
     Ok(())
 }
 

@@ -7,6 +7,8 @@
 mod common;
 #[path = "hostile/faults.rs"]
 mod faults;
+#[path = "hostile/outputs.rs"]
+mod outputs;
 use common::{bin, root, spawn, stderr};
 use std::os::unix::fs::FileTypeExt;
 use std::os::unix::process::CommandExt;

@@ -18,7 +18,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from tresca_py import results  # noqa: E402
+from tresca_py import paths, results  # noqa: E402
 
 
 def mesh_picture(path, out, title):
@@ -29,7 +29,7 @@ def mesh_picture(path, out, title):
     ax.set_aspect("equal")
     ax.set_title(f"{title}: {len(m.triangles)} triangles")
     ax.set_axis_off()
-    fig.savefig(out, dpi=130, bbox_inches="tight")
+    paths.save_figure(fig, out, dpi=130, bbox_inches="tight")
     plt.close(fig)
 
 
@@ -80,8 +80,15 @@ def rates_picture(adaptive, uniform, out, title):
     ax.set_ylabel("energy norm (max over time nodes)")
     ax.set_title(title)
     ax.legend(fontsize=7)
-    fig.savefig(out, dpi=130, bbox_inches="tight")
+    paths.save_figure(fig, out, dpi=130, bbox_inches="tight")
     plt.close(fig)
+
+
+def check_outputs(pictures, inputs, force):
+    """The rule of every output (``tresca_py.paths``) for all ``pictures`` before the first is drawn."""
+    paths.distinct([(p, "picture") for p in pictures], [(p, "input") for p in inputs])
+    for p in pictures:
+        paths.new_output(p, "picture", force)
 
 
 def main(argv=None):
@@ -97,21 +104,29 @@ def main(argv=None):
     r.add_argument("uniform")
     r.add_argument("-o", "--out", required=True)
     r.add_argument("--title", default="")
+    for p in (m, r):
+        p.add_argument("--force", action="store_true", help="replace existing pictures")
     a = ap.parse_args(argv)
     try:
         if a.cmd == "meshes":
-            os.makedirs(a.out, exist_ok=True)
             files = {int(re.search(r"level_(\d+)\.h5$", p).group(1)): p
                      for p in glob.glob(os.path.join(a.dir, "level_*.h5"))}
             if not files:
                 raise ValueError(f"{a.dir}: no level_<k>.h5 files")
-            for k in a.levels if a.levels else sorted(files):
-                if k not in files:
-                    raise ValueError(f"{a.dir}: no level_{k}.h5")
-                mesh_picture(files[k], os.path.join(a.out, f"mesh_{k}.png"), f"{a.title} {k}")
+            levels = a.levels if a.levels else sorted(files)
+            missing = [k for k in levels if k not in files]
+            if missing:
+                raise ValueError(f"{a.dir}: no level_{missing[0]}.h5")
+            out = paths.output_dir(a.out, "pictures directory")
+            pictures = [(k, os.path.join(out, f"mesh_{k}.png")) for k in levels]
+            check_outputs([p for _, p in pictures], [files[k] for k in levels], a.force)
+            for k, p in pictures:
+                mesh_picture(files[k], p, f"{a.title} {k}")
         else:
+            check_outputs([a.out], [a.adaptive, a.uniform], a.force)
+            paths.output_file(a.out, "picture")
             rates_picture(a.adaptive, a.uniform, a.out, a.title)
-    except (OSError, ValueError, results.ResultsError) as e:
+    except (OSError, ValueError, results.ResultsError, paths.PathError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     return 0

@@ -21,6 +21,7 @@ def cli(description, argv=None):
     ap.add_argument("--refine", type=int, default=None, help="override [mesh] refine")
     ap.add_argument("--steps", type=int, default=None, help="override the number of uniform time steps")
     ap.add_argument("-q", "--quiet", action="store_true", help="no per-step log")
+    ap.add_argument("--force", action="store_true", help="replace an existing results file")
     args = ap.parse_args(argv)
     return args
 
@@ -45,11 +46,15 @@ def exit_on_failure(report=True):
 
 
 def output_path(args, scene):
-    """The results path (``-o`` or the scene's ``[output] path``), made absolute, checked before any work:
-    not a directory or other non-regular file, in a directory where files can be created."""
+    """The results path (``-o`` or the scene's ``[output] path``), made absolute, checked before any work under
+    the rule of every output (``paths.new_output``: an existing file replaced only with ``--force``; never the
+    scene or its mesh), in a directory where files can be created."""
     out = args.output or scene.output
     if not out:
         raise SceneError("no output path: give -o OUT.h5 or [output] path in the scene")
+    inputs = [(args.scene, "scene")] + ([(scene.mesh["file"], "mesh")] if "file" in scene.mesh else [])
+    paths.distinct([(out, "results file")], inputs)
+    paths.new_output(out, "results file", args.force)
     return paths.output_file(out, "results file")
 
 

@@ -8,12 +8,18 @@ own Python (``pvpython``, without the venv) runs them too (``tresca_py.paraview`
 * ``output_file`` / ``output_dir``: the path is not a directory (or is one), its directory exists or can be
   made, and a file can be created in it (tried, so read-only directories and file systems are found even
   for root, whom the permission bits do not stop).
+* ``new_output`` / ``distinct`` / ``write_new``: the rule of every file a tool writes, stated in docs/results.md
+  ("Every output, one rule"; ``src/output/guard.rs`` for the Rust commands): checked before any work with
+  ``lstat`` (never opened), compared with the inputs by ``(st_dev, st_ino)``, written through ``FILE.tmp``.
 * ``sidecar_targets`` / ``check_sidecar``: the HDF5 files an XDMF sidecar references, and that it references
   the results file being opened (a ``run.h5`` copied with its ``run.xdmf`` keeps pointing at the original).
 """
 import os
 import stat
 import xml.etree.ElementTree as ET
+
+KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISLNK, "a symbolic link"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+         (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 # a sidecar of the largest runs is a few MB; anything far larger is not one
@@ -135,6 +141,100 @@ def _probe(directory, what):
         raise PathError(f"{directory}: cannot create files in the {what}: {err.strerror}") from None
     os.close(fd)
     os.unlink(probe)
+
+
+def kind_of(mode):
+    """What a file system object of ``st_mode`` ``mode`` is, for messages."""
+    return next((name for test, name in KINDS if test(mode)), "not a regular file")
+
+
+def new_output(path, what="output file", force=False):
+    """``path`` made absolute, if the rule of every output (module doc) lets a tool write it: absent, or with
+    ``force`` a regular file with a single link; else PathError naming what is there."""
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        return os.path.abspath(path)
+    except OSError as err:
+        raise PathError(f"{path}: cannot inspect the path for the {what}: {err.strerror}") from None
+    if not stat.S_ISREG(st.st_mode):
+        hint = "; give the path the link points to, or remove the link" if stat.S_ISLNK(st.st_mode) else ""
+        raise PathError(f"{path}: the {what} would go here, but the path is {kind_of(st.st_mode)} (not a regular "
+                        f"file){hint}")
+    if st.st_nlink > 1:
+        raise PathError(f"{path}: the {what} would go here, but the file there has {st.st_nlink} hard links "
+                        "(replacing it would leave the other names as they are); remove it or give another path")
+    if not force:
+        raise PathError(f"{path}: the {what} already exists; pass --force to replace it")
+    return os.path.abspath(path)
+
+
+def _identity(path, follow):
+    """``(st_dev, st_ino)`` of the file at ``path``, else of its directory with the name, else the absolute path."""
+    try:
+        st = os.stat(path) if follow else os.lstat(path)
+        return st.st_dev, st.st_ino
+    except OSError:
+        pass
+    try:
+        st = os.stat(os.path.dirname(os.path.abspath(path)))
+        return st.st_dev, st.st_ino, os.path.basename(path)
+    except OSError:
+        return os.path.abspath(path)
+
+
+def distinct(outputs, inputs=()):
+    """Refuse (PathError) an output that is the same file as an input or as another output, compared by
+    ``(st_dev, st_ino)`` (a link or another name of a file counts). ``outputs``, ``inputs``: (path, what) pairs."""
+    ids = [_identity(p, False) for p, _ in outputs]
+    for p, what in inputs:
+        i = _identity(p, True)
+        if i in ids:
+            out, owhat = outputs[ids.index(i)]
+            raise PathError(f"{out}: the {owhat} would overwrite the input ({what} {p}); choose another path")
+    for k, i in enumerate(ids):
+        if i in ids[:k]:
+            (a, awhat), (b, bwhat) = outputs[ids.index(i)], outputs[k]
+            raise PathError(f"{b}: the {bwhat} and the {awhat} ({a}) are the same file: one would overwrite the "
+                            "other; give them different paths")
+
+
+def write_new(path, write, what="output file", force=False):
+    """Write the file ``path`` under the rule of every output: ``new_output`` again, then ``write(f)`` into
+    ``FILE.tmp``, a binary file created exclusively without following links (a stale regular one is removed
+    first), renamed over ``path``. A failure leaves no temporary and an old file as it was."""
+    path = new_output(path, what, force)
+    tmp = path + ".tmp"
+    try:
+        st = os.lstat(tmp)
+    except FileNotFoundError:
+        st = None
+    if st is not None:
+        if not stat.S_ISREG(st.st_mode) or st.st_nlink > 1:
+            there = kind_of(st.st_mode) if not stat.S_ISREG(st.st_mode) else f"a file with {st.st_nlink} hard links"
+            raise PathError(f"{tmp}: the temporary of the {what} would be created here, but the path is {there} "
+                            "(not one this program left); remove it")
+        os.unlink(tmp)
+    try:
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
+    except OSError as err:
+        raise PathError(f"{tmp}: cannot create the temporary of the {what}: {err.strerror}") from None
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.lexists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def save_figure(fig, path, **kw):
+    """``fig.savefig`` to ``path`` through ``write_new`` (whether an existing picture may be replaced was decided
+    with the tool's other outputs before its work), in the format of its extension."""
+    fmt = os.path.splitext(path)[1].lstrip(".").lower() or "png"
+    return write_new(path, lambda f: fig.savefig(f, format=fmt, **kw), "picture", force=True)
 
 
 def sidecar_targets(xdmf):

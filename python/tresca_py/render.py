@@ -105,7 +105,7 @@ def deformed(d, n, field, scale, out):
     ax.set_ylabel(f"y [{u_['L']}]")
     ax.set_title(title(d, f"t = {d['times'][n]:.4g}{u_['T']}, step {n}: deformed ×{s:.3g} (grey: reference). "
                     "Gaps between triangles: the CR field is continuous only at edge midpoints"), fontsize=9)
-    fig.savefig(out, dpi=120, bbox_inches="tight")
+    paths.save_figure(fig, out, dpi=120, bbox_inches="tight")
 
 
 def contact(d, n, out):
@@ -144,13 +144,13 @@ def contact(d, n, out):
     a1.set_title(title(d, f"Γ_C at t = {times[n]:.4g}{u_['T']} (step {n}); "
                           f"shaded: slip ({nslip} of {len(state)} edges)"),
                  fontsize=9)
-    fig.savefig(out, dpi=120, bbox_inches="tight")
+    paths.save_figure(fig, out, dpi=120, bbox_inches="tight")
 
 
 def energy(d, out):
     """The energy budget over time (``tresca_py.audit``): stored energy, cumulative external and boundary work,
     cumulative frictional and backward-Euler dissipation, and the balance residual on a second axis."""
-    energy_figure(d).savefig(out, dpi=120, bbox_inches="tight")
+    paths.save_figure(energy_figure(d), out, dpi=120, bbox_inches="tight")
 
 
 def energy_figure(d):
@@ -206,27 +206,40 @@ def main(argv=None):
     ap.add_argument("--field", choices=["vm", "u"], default="vm", help="colour: von Mises or |u|")
     ap.add_argument("--scale", type=positive_or_auto, default=0.0,
                     help="displacement magnification (default 0: automatic)")
+    ap.add_argument("--force", action="store_true", help="replace existing pictures")
     args = ap.parse_args(argv)
     try:
         d = load(args.h5)
         out = paths.output_dir(args.out)
+        pictures = planned(d, args.times, out)
+        # the rule of every output, for all pictures before the first is drawn (tresca_py.paths)
+        paths.distinct([(p, "picture") for _, _, p in pictures], [(args.h5, "results file")])
+        for _, _, p in pictures:
+            paths.new_output(p, "picture", args.force)
     except (results.ResultsError, paths.PathError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
     t = d["times"]
     if d["note"]:
         print(f"note: {args.h5}: {d['note']}; drawing committed steps only (t ≤ {t[-1]:.4g})")
-    want = args.times if args.times else [t[0] + q * (t[-1] - t[0]) for q in (0.25, 0.5, 1.0)]
-    for n in dict.fromkeys(int(np.argmin(np.abs(t - w))) for w in want):
-        p = os.path.join(out, f"deformed_{n:06d}.png")
-        deformed(d, n, args.field, args.scale, p)
-        print(p)
-        if "c_edges" in d:
-            p = os.path.join(out, f"contact_{n:06d}.png")
-            contact(d, n, p)
-            print(p)
-    if d["audit"] is not None and len(t) > 1:
-        p = os.path.join(out, "energy.png")
-        energy(d, p)
+    draw = {"deformed": lambda n, p: deformed(d, n, args.field, args.scale, p),
+            "contact": lambda n, p: contact(d, n, p), "energy": lambda n, p: energy(d, p)}
+    for kind, n, p in pictures:
+        draw[kind](n, p)
         print(p)
     return 0
+
+
+def planned(d, times, out):
+    """The pictures to draw, (kind, step, path): the deformed body (and Γ_C) at the steps nearest ``times`` (default
+    a quarter, half and all of the run), and the energy budget when the file has its audit."""
+    t = d["times"]
+    want = times if times else [t[0] + q * (t[-1] - t[0]) for q in (0.25, 0.5, 1.0)]
+    pictures = []
+    for n in dict.fromkeys(int(np.argmin(np.abs(t - w))) for w in want):
+        pictures.append(("deformed", n, os.path.join(out, f"deformed_{n:06d}.png")))
+        if "c_edges" in d:
+            pictures.append(("contact", n, os.path.join(out, f"contact_{n:06d}.png")))
+    if d["audit"] is not None and len(t) > 1:
+        pictures.append(("energy", len(t) - 1, os.path.join(out, "energy.png")))
+    return pictures

@@ -421,7 +421,9 @@ def write(path, r, extra_attrs=None):
     import h5py
     validate(r, "results to write")
     try:
-        out = paths.output_file(path, "results file")
+        # the rule of every output (paths.new_output); whether an existing file may be replaced (--force) was
+        # decided by the solver's command line before its work
+        out = paths.output_file(paths.new_output(path, "results file", force=True), "results file")
     except paths.PathError as err:
         raise ResultsError(str(err)) from None
     attrs = {"status": "completed", "steps": r.completed - 1, **r.attrs, **(extra_attrs or {}),

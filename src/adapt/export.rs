@@ -4,7 +4,7 @@
 //! triangles, and per boundary part one curve entity of a physical group of the part's name holding
 //! its edges. Coordinates are written with the shortest representation that reads back to the same f64.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::mesh::Mesh;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -61,7 +61,8 @@ pub fn gmsh_text(mesh: &Mesh) -> String {
     s
 }
 
-/// Write `mesh` to `path` as Gmsh 4.1 ASCII.
-pub fn write_gmsh(mesh: &Mesh, path: &Path) -> Result<()> {
-    std::fs::write(path, gmsh_text(mesh)).map_err(|e| Error::Io { path: path.to_path_buf(), msg: e.to_string() })
+/// Write `mesh` to `path` as Gmsh 4.1 ASCII, under the rule of every output (`output::guard`: an existing
+/// file replaced only when `force`).
+pub fn write_gmsh(mesh: &Mesh, path: &Path, force: bool) -> Result<()> {
+    crate::output::guard::write_new(path, "Gmsh mesh of the level", gmsh_text(mesh).as_bytes(), force)
 }

@@ -16,6 +16,7 @@
 
 pub mod estimator;
 pub mod export;
+pub mod files;
 pub mod reference;
 pub mod time;
 
@@ -239,13 +240,9 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
         let t0 = Instant::now();
         let min_angle = mesh.min_angle();
         let generation = reference::generations(&mesh, &root_area).into_iter().max().unwrap_or(0);
-        let out = opts.out.as_ref().map(|d| d.join(format!("level_{level}.h5")));
-        if let Some(p) = &out {
-            // before anything of the level is made; adapt does not resume, so its refusal says only --force
-            Writer::refuse_existing_for(p, opts.force, false)?;
-        }
+        let out = opts.out.as_ref().map(|d| files::level_results(d, level));
         if let (Some(dir), true) = (&opts.out, opts.gmsh) {
-            export::write_gmsh(&mesh, &dir.join(format!("level_{level}.msh")))?;
+            export::write_gmsh(&mesh, &files::level_mesh(dir, level), opts.force)?;
         }
         let solved = solve(scene, mesh, out, opts.force, !opts.lean, opts.lean)?;
         let marked = dorfler(&solved.acc.eta2, opts.theta);

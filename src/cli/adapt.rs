@@ -4,9 +4,11 @@
 use super::out::{note, say};
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use tresca_cr::adapt::estimator::TERMS;
+use tresca_cr::adapt::files::{level_mesh, level_results, levels_to_check};
 use tresca_cr::adapt::{adapt, Options, Row};
+use tresca_cr::output::guard::{write_new, Outputs};
 use tresca_cr::Scene;
 
 /// The CSV of the rows: one line per level.
@@ -48,6 +50,23 @@ pub fn csv_text(rows: &[Row], exact: bool) -> String {
     s
 }
 
+/// Refuse, before the first level, outputs that break the rule of every output (`output::guard`): the
+/// level files (each level a loop may write, `adapt::files`), `--csv` and `--json`.
+fn check_outputs(scene: &Scene, opts: &Options, csv: Option<&Path>, json: Option<&Path>) -> Result<()> {
+    let mut outputs = Outputs::new(opts.force).inputs_of(scene).files(csv, "--csv file").files(json, "--json file");
+    if let Some(dir) = &opts.out {
+        outputs = outputs.dirs(Some(dir.as_path()), "--out directory");
+        let others: Vec<&Path> = csv.into_iter().chain(json).collect();
+        for k in levels_to_check(dir, opts.levels, &others) {
+            outputs = outputs.results(&level_results(dir, k), &format!("level file of level {k}"), false);
+            if opts.gmsh {
+                outputs = outputs.file(&level_mesh(dir, k), &format!("Gmsh mesh of level {k}"));
+            }
+        }
+    }
+    Ok(outputs.check()?)
+}
+
 /// Run the loop and report; returns the exit code (3: stopped before the goal, with the reason).
 pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<PathBuf>) -> Result<i32> {
     run_rows(scene, opts, csv, json).map(|(code, _)| code)
@@ -56,6 +75,7 @@ pub fn run(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<PathB
 /// [`run`], also returning the levels' rows (for `plan --run`).
 pub fn run_rows(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<PathBuf>) -> Result<(i32, Vec<Row>)> {
     let start = std::time::Instant::now();
+    check_outputs(&scene, &opts, csv.as_deref(), json.as_deref())?;
     if let Some(dir) = &opts.out {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
@@ -107,9 +127,8 @@ pub fn run_rows(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<
             );
         }
     }
-    if let Some(path) = &csv {
-        std::fs::write(path, csv_text(&outcome.rows, exact))
-            .with_context(|| format!("cannot write {}", path.display()))?;
+    if let Some(path) = csv {
+        write_new(&path, "--csv file", csv_text(&outcome.rows, exact).as_bytes(), opts.force)?;
     }
     if let Some(j) = &json {
         let mut summary = super::summary::Summary::new("adapt", &scene.file, start.elapsed().as_secs_f64());
@@ -117,7 +136,7 @@ pub fn run_rows(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<
             summary.status = format!("refused: {why}");
         }
         summary.adapt = Some(super::summary::AdaptSummary::of(&opts, exact, &outcome.rows, outcome.stopped.clone()));
-        super::summary::write(j, &summary)?;
+        super::summary::write(j, &summary, opts.force)?;
     }
     // the table is the result (or --csv keeps it): a closed or full standard output fails the command
     super::out::report_written(csv.as_deref())?;

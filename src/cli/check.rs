@@ -6,6 +6,7 @@
 
 use super::out::say;
 use anyhow::Result;
+use tresca_cr::output::guard::Outputs;
 use tresca_cr::scene::budget::Estimate;
 use tresca_cr::scene::PartKind;
 use tresca_cr::{Problem, Scene};
@@ -42,8 +43,10 @@ fn refined(mut v: u64, mut t: u64, mut e: u64, k: u32) -> (u64, u64, u64) {
     (v, t, e)
 }
 
-pub fn check(scene: Scene, estimate: Estimate, json: Option<std::path::PathBuf>) -> Result<()> {
+pub fn check(scene: Scene, estimate: Estimate, reports: super::summary::Reports) -> Result<()> {
     let start = std::time::Instant::now();
+    let (json, force) = (reports.json, reports.force);
+    Outputs::new(force).inputs_of(&scene).files(json.as_deref(), "--json file").check()?;
     let level = scene.mesh_level();
     let (at, built) = assembled_level(&scene)?;
     let k = level - at;
@@ -94,7 +97,7 @@ pub fn check(scene: Scene, estimate: Estimate, json: Option<std::path::PathBuf>)
     let (lines, singular) = super::corners::describe(&points, &s.parts);
     lines.iter().for_each(|l| say!("{l}"));
     if let Some(j) = &json {
-        write_json(j, &problem, s, &estimate, singular, start.elapsed().as_secs_f64())?;
+        write_json(j, &problem, s, &estimate, singular, (start.elapsed().as_secs_f64(), force))?;
     }
     match super::out::stdout_error() {
         Some(e) => anyhow::bail!("cannot write to standard output: {e}"),
@@ -141,7 +144,7 @@ fn write_json(
     s: &Scene,
     estimate: &Estimate,
     singular: super::summary::Singular,
-    wall: f64,
+    (wall, force): (f64, bool),
 ) -> Result<()> {
     let (m, sp) = (&problem.mesh, &problem.space);
     let mut summary = super::summary::Summary::new("check", &s.file, wall);
@@ -163,6 +166,6 @@ fn write_json(
         disk: estimate.disk,
         singular,
     });
-    super::summary::write(j, &summary)?;
+    super::summary::write(j, &summary, force)?;
     Ok(())
 }

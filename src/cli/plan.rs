@@ -4,8 +4,9 @@
 //! report the achieved error estimate (and the true error when the scene has `[exact]`).
 
 use super::out::{note, say};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use std::path::PathBuf;
+use tresca_cr::output::guard::Outputs;
 use tresca_cr::plan::model::{Combine, TimeError};
 use tresca_cr::plan::pilot::{fit, Quantity};
 use tresca_cr::plan::{plan, Candidate, Options, Plan};
@@ -30,9 +31,12 @@ pub fn run(
     csv: Option<PathBuf>,
     execute: bool,
     weigh_adaptive: bool,
-    json: Option<PathBuf>,
+    reports: super::summary::Reports,
 ) -> Result<i32> {
     let start = std::time::Instant::now();
+    let (json, force) = (reports.json, reports.force);
+    let outputs = Outputs::new(force).inputs_of(&scene);
+    outputs.files(csv.as_deref(), "--csv file").files(json.as_deref(), "--json file").check()?;
     let summarise = |p: &Plan, achieved, adaptive: &Option<Weighed>| -> Result<()> {
         let Some(j) = &json else { return Ok(()) };
         let mut s = super::summary::Summary::new("plan", &scene.file, start.elapsed().as_secs_f64());
@@ -44,16 +48,13 @@ pub fn run(
                 s.status = format!("refused: {why}");
             }
         }
-        super::summary::write(j, &s)
+        super::summary::write(j, &s, force)
     };
-    if let Some(path) = &csv {
-        super::run::not_an_input(std::slice::from_ref(path), &scene, "--csv")?;
-    }
     say!("Planning {} for the {} ≤ {:e}", scene.file, options.quantity.describe(), options.target);
     let p = plan(&scene, &options)?;
     print_evidence(&p);
     if let Some(path) = &csv {
-        std::fs::write(path, csv_text(&p)).with_context(|| format!("cannot write {}", path.display()))?;
+        tresca_cr::output::guard::write_new(path, "--csv file", csv_text(&p).as_bytes(), force)?;
     }
     for n in &p.notes {
         say!("note: {n}");

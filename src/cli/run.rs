@@ -3,29 +3,8 @@
 use super::out::{note, say};
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
+use tresca_cr::output::guard::Outputs;
 use tresca_cr::{Problem, RunOptions, Scene};
-
-/// Refuse output paths (`what`: the option) that are the scene or its mesh, as files (a link or another
-/// name of them counts): writing them would overwrite the run's own input.
-pub fn not_an_input(outs: &[PathBuf], scene: &Scene, what: &str) -> Result<()> {
-    use std::os::unix::fs::MetadataExt;
-    let id = |p: &Path| std::fs::metadata(p).ok().map(|m| (m.dev(), m.ino()));
-    let mut inputs = vec![PathBuf::from(&scene.file)];
-    if let tresca_cr::scene::MeshSpec::Gmsh { path, .. } = &scene.mesh {
-        inputs.push(path.clone());
-    }
-    for out in outs {
-        let Some(o) = id(out) else { continue };
-        if let Some(i) = inputs.iter().find(|i| id(i) == Some(o)) {
-            anyhow::bail!(
-                "{}: {what} would overwrite the run's input {}; choose another path",
-                out.display(),
-                i.display()
-            );
-        }
-    }
-    Ok(())
-}
 
 /// Where and how results are written.
 #[derive(clap::Args)]
@@ -51,7 +30,7 @@ pub struct OutputArgs {
 pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool, json: Option<PathBuf>) -> Result<()> {
     let start = std::time::Instant::now();
     let path = out.output.clone().or_else(|| scene.output.clone());
-    check_output_args(&out, path.as_deref(), &scene)?;
+    check_output_args(&out, path.as_deref(), json.as_deref(), &scene)?;
     let (problem, writer, first) = set_up(scene, &out, path.as_deref())?;
     let mut writer = writer.map(tresca_cr::output::Background::spawn).transpose()?;
     let n = problem.n_steps();
@@ -104,7 +83,7 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool, json: Opti
     }
     if let Some(j) = &json {
         summary.wall = start.elapsed().as_secs_f64();
-        super::summary::write(j, &summary)?;
+        super::summary::write(j, &summary, out.force)?;
     }
     result.with_context(|| "run stopped")?;
     bar.finish_and_clear();
@@ -118,22 +97,25 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool, json: Opti
     Ok(())
 }
 
-/// The output options that are refused before anything is done, and the note for a run without a file.
-fn check_output_args(out: &OutputArgs, path: Option<&Path>, scene: &Scene) -> Result<()> {
+/// The output options that are refused before anything is done (every output under `output::guard`'s
+/// rule), and the note for a run without a file.
+fn check_output_args(out: &OutputArgs, path: Option<&Path>, json: Option<&Path>, scene: &Scene) -> Result<()> {
     anyhow::ensure!(!(out.resume && path.is_none()), "--resume needs a results file: give -o FILE");
     anyhow::ensure!(out.frame_every != Some(0), "--frame-every must be at least 1");
     anyhow::ensure!(
         out.commit_interval.is_finite() && out.commit_interval >= 0.0,
         "--commit-interval must be a non-negative number of seconds"
     );
+    if let Some(p) = path.filter(|_| !out.resume) {
+        tresca_cr::output::Writer::refuse_existing(p, out.force)?;
+    }
+    let outputs = Outputs::new(out.force).inputs_of(scene).files(json, "--json file");
     match path {
-        Some(p) => {
-            not_an_input(&[p.to_path_buf(), tresca_cr::output::sidecar(p)], scene, "the output")?;
-            if !out.resume {
-                tresca_cr::output::Writer::refuse_existing(p, out.force)?;
-            }
+        Some(p) => outputs.results(p, "results file", out.resume).check()?,
+        None => {
+            outputs.check()?;
+            note!("note: no results file (give -o FILE or an [output] path): the steps are solved and only this summary is kept")
         }
-        None => note!("note: no results file (give -o FILE or an [output] path): the steps are solved and only this summary is kept"),
     }
     Ok(())
 }

@@ -4,7 +4,9 @@
 use super::out::say;
 use anyhow::{Context, Result};
 use std::path::PathBuf;
+use tresca_cr::output::guard::{write_new, Outputs};
 use tresca_cr::scene::budget::Estimate;
+use tresca_cr::study::differences::file_of;
 use tresca_cr::study::richardson::Verdict;
 use tresca_cr::study::{Axis, Level, LevelResult, Study};
 use tresca_cr::Scene;
@@ -76,14 +78,21 @@ pub fn study(
     csv: Option<PathBuf>,
     differences: Option<PathBuf>,
     max_memory: Option<u64>,
-    json: Option<PathBuf>,
+    reports: super::summary::Reports,
 ) -> Result<()> {
     let start = std::time::Instant::now();
     use tresca_cr::study::run_study;
+    let (json, force) = (reports.json, reports.force);
     check_levels(levels, reference)?;
-    if let Some(p) = &csv {
-        super::run::not_an_input(std::slice::from_ref(p), &scene, "--csv")?;
-    }
+    let diffs: Vec<PathBuf> =
+        differences.iter().flat_map(|d| levels.iter().skip(1).map(|l| file_of(d, l.refine, l.steps))).collect();
+    Outputs::new(force)
+        .inputs_of(&scene)
+        .dirs(differences.as_deref(), "--differences directory")
+        .files(csv.as_deref(), "--csv file")
+        .files(json.as_deref(), "--json file")
+        .files(diffs.iter().map(PathBuf::as_path), "--differences file")
+        .check()?;
     check_memory(&scene, levels, reference, max_memory)?;
     say!(
         "{:>3} {:>6} {:>9} {:>9} {:>8} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>11} {:>6} {:>8}",
@@ -113,13 +122,12 @@ pub fn study(
         say!("wrote {}", f.display());
     }
     if let Some(path) = &csv {
-        std::fs::write(path, tresca_cr::study::csv::text(&study))
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        write_new(path, "--csv file", tresca_cr::study::csv::text(&study).as_bytes(), force)?;
     }
     if let Some(j) = &json {
         let mut summary = super::summary::Summary::new("study", &scene.file, start.elapsed().as_secs_f64());
         summary.study = Some(super::summary::StudySummary::of(&study, reference));
-        super::summary::write(j, &summary)?;
+        super::summary::write(j, &summary, force)?;
     }
     super::out::report_written(csv.as_deref())
 }

@@ -92,6 +92,17 @@ pub struct JsonArg {
     pub json: Option<PathBuf>,
 }
 
+/// `--json FILE` and `--force` of `check`, `study` and `plan` (`run` and `adapt` have a `--force` of their own).
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct Reports {
+    /// Write a machine-readable summary (JSON; fields in src/cli/summary.rs) to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Replace the files this command writes (--json; study and plan: --csv; study: --differences' files).
+    #[arg(long)]
+    pub force: bool,
+}
+
 /// The summary of one subcommand (see the module doc).
 #[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
 pub struct Summary {
@@ -142,14 +153,11 @@ pub fn check_path(path: Option<&Path>) -> Result<()> {
     Ok(())
 }
 
-/// Write `s` to `path` (a temporary file beside it, then renamed: never half written).
-pub fn write(path: &Path, s: &Summary) -> Result<()> {
+/// Write `s` to `path` under the rule of every output (`output::guard::write_new`: built in `FILE.tmp`,
+/// then renamed, never half written; an existing file replaced only when `force`).
+pub fn write(path: &Path, s: &Summary, force: bool) -> Result<()> {
     let text = serde_json::to_string_pretty(s).context("cannot serialise the summary")?;
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, text + "\n").with_context(|| format!("cannot write {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))
+    Ok(tresca_cr::output::guard::write_new(path, "--json file", (text + "\n").as_bytes(), force)?)
 }
 
 /// The set-up's wall times.

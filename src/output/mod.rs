@@ -49,6 +49,7 @@ pub mod checksum;
 mod close;
 mod create;
 pub mod fields;
+pub mod guard;
 mod h5;
 mod lock;
 mod paths;

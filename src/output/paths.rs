@@ -14,7 +14,7 @@ use std::fs::{File, Metadata, OpenOptions};
 use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
 use std::path::{Path, PathBuf};
 
-fn refuse(path: &Path, msg: String) -> Error {
+pub(super) fn refuse(path: &Path, msg: String) -> Error {
     Error::Io { path: path.to_path_buf(), msg }
 }
 

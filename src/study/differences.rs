@@ -64,7 +64,14 @@ pub fn write(dir: &Path, fine: &Kept, coarse: &Kept) -> Result<std::path::PathBu
     }
     x += "</Grid>\n</Domain>\n</Xdmf>\n";
     std::fs::create_dir_all(dir).map_err(|e| Error::Io { path: dir.to_path_buf(), msg: e.to_string() })?;
-    let path = dir.join(format!("difference_{}_{}.xdmf", fp.scene.mesh_level(), fp.scene.times.len() - 1));
-    std::fs::write(&path, x).map_err(|e| Error::Io { path: path.clone(), msg: e.to_string() })?;
+    let path = file_of(dir, fp.scene.mesh_level(), fp.scene.times.len() - 1);
+    // under the rule of every output; whether an existing file may be replaced (--force) was decided
+    // with the command's other outputs before its first level
+    crate::output::guard::write_new(&path, "--differences file", x.as_bytes(), true)?;
     Ok(path)
+}
+
+/// The file of the level (`refine`, `steps`) in `dir`.
+pub fn file_of(dir: &Path, refine: u32, steps: usize) -> std::path::PathBuf {
+    dir.join(format!("difference_{refine}_{steps}.xdmf"))
 }

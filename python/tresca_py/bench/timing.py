@@ -32,6 +32,7 @@ def timed(cmd, env=None, mem=False, summary=False, check=True):
     if summary:
         fd, js = tempfile.mkstemp(prefix="tresca-bench-", suffix=".json")
         os.close(fd)
+        os.remove(js)  # a name no other process takes (mkstemp); the command creates the file itself
         cmd = list(cmd) + ["--json", js]
     if mem:
         cmd = [TIME, "-f", "MAXRSS %M"] + cmd  # our own format for /usr/bin/time's report on stderr
@@ -48,6 +49,7 @@ def timed(cmd, env=None, mem=False, summary=False, check=True):
         rss = int(m.group(1)) if m else None
     s = None
     if js:
-        s = cli_summary.load(js) if os.path.getsize(js) else None
-        os.remove(js)
+        s = cli_summary.load(js) if os.path.exists(js) and os.path.getsize(js) else None
+        if os.path.exists(js):
+            os.remove(js)
     return Timed(wall, cpu, rss, s)

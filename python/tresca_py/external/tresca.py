@@ -105,7 +105,7 @@ def run_level(binary, scene, refine, steps, out_dir, probes, pen_scale):
 def study_csv(binary, scene, levels, steps, csv_path):
     """``tresca-cr study … --csv`` over the same levels (its own Richardson estimates, kept as a reference file)."""
     lv = ",".join(f"{r}:{steps}" for r in levels)
-    cmd = [str(binary), "study", str(scene), "--levels", lv, "--csv", str(csv_path)]
+    cmd = [str(binary), "study", str(scene), "--levels", lv, "--csv", str(csv_path), "--force"]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({proc.returncode}): {proc.stderr.strip()[-400:]}")

@@ -57,7 +57,7 @@ def solve_all(scene, work, codes=CODES):
         out[code] = os.path.join(work, f"{code}.h5")
         if os.path.exists(out[code]):
             os.remove(out[code])
-        run([PY, os.path.join(SCRIPTS, f"{code}_solve.py"), scene, "-q", "-o", out[code]])
+        run([PY, os.path.join(SCRIPTS, f"{code}_solve.py"), scene, "-q", "-o", out[code], "--force"])
     return out
 
 

@@ -54,11 +54,11 @@ def adapt(hs, scene, name, levels, theta, reference=None, out=None, gmsh=False):
     there, with ``gmsh`` their meshes as Gmsh too); returns (rows, command). Rows: numbers as floats, empty
     fields None."""
     path = staged(hs, f"{name}.csv")
-    cmd = [BIN, "adapt", scene, "--levels", str(levels), "--theta", str(theta), "--csv", path]
+    cmd = [BIN, "adapt", scene, "--levels", str(levels), "--theta", str(theta), "--csv", path, "--force"]
     if reference is not None:
         cmd += ["--reference", str(reference)]
     if out is not None:
-        cmd += ["--out", out, "--force"] + (["--gmsh"] if gmsh else [])
+        cmd += ["--out", out] + (["--gmsh"] if gmsh else [])
     run(cmd)
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))

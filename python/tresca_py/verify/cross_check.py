@@ -152,7 +152,7 @@ def run_code(code, scene, out, refine, steps, mpi=0):
         cmd = [BIN, "run", scene, "-o", out, "--force", "-q"] + extra
     else:
         cmd = ([MPIRUN, "-n", str(mpi)] if mpi else []) + \
-              [PY, os.path.join(ROOT, "scripts", f"{code}_solve.py"), scene, "-o", out, "-q"] + extra
+              [PY, os.path.join(ROOT, "scripts", f"{code}_solve.py"), scene, "-o", out, "-q", "--force"] + extra
     if os.path.exists(out) and code != "rust":
         os.remove(out)
     t0 = time.perf_counter()

@@ -25,7 +25,8 @@ def study(hs, scene, levels, name, reference=None, solver=None, extra=()):
     """Run `tresca-cr study`, keep its CSV as reference/NAME.csv (staged by the harness `hs`), return (rows, command).
     Numbers become floats, empty fields None, text fields (verdicts, size) stay strings."""
     out = hs.path(f"{name}.csv")
-    cmd = [BIN, "study", scene, "--levels", ",".join(f"{r}:{n}" for r, n in levels), "--csv", out]
+    cmd = [BIN, "study", scene, "--levels", ",".join(f"{r}:{n}" for r, n in levels), "--csv", out,
+           "--force"]
     if reference:
         cmd += ["--reference", f"{reference[0]}:{reference[1]}"]
     if solver:

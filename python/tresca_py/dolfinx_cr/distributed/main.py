@@ -32,6 +32,7 @@ def parse_args(argv=None):
     ap.add_argument("--refine", type=int, default=None, help="override [mesh] refine")
     ap.add_argument("--steps", type=int, default=None, help="override the number of uniform time steps")
     ap.add_argument("-q", "--quiet", action="store_true", help="no per-step log")
+    ap.add_argument("--force", action="store_true", help="replace an existing results file")
     ap.add_argument("--ksp", choices=("mumps", "cg-gamg"), default="mumps",
                     help="linear solver for K_r: MUMPS Cholesky (default) or CG + GAMG (rtol 1e-13)")
     ap.add_argument("--mumps-analysis", choices=("sequential", "parallel"), default="sequential",
