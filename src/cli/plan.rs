@@ -168,6 +168,7 @@ fn print_evidence(p: &Plan) {
         print_sequence(name, study, fit);
     }
     say!("Pilot cost: {:.3} s (pilot budget {:.3} s)", p.pilot_wall, p.options.pilot_budget);
+    say!("Order bound: min(1, α_min) = {:.4} in h (the scene's corners, `tresca-cr check`)", p.order_limit);
     let orders = |f: &tresca_cr::plan::pilot::Fit| {
         if f.errors.len() < 2 {
             return String::new();
@@ -262,7 +263,7 @@ fn execute_plan(scene: &Scene, p: &Plan, b: &Candidate) -> Result<super::summary
     let study: Study = run_study(&s, &levels, None, None, |r| {
         say!("  refine {} steps {}: {:.3} s", r.refine, r.steps, r.wall);
     })?;
-    let f = fit(&study, &p.options.quantity)?;
+    let f = fit(&study, &p.options.quantity, Some(p.order_limit))?;
     let model = p.error.expect("a plan has an error model");
     let space = match (f.errors.last(), f.not_in_range()) {
         (Some(&e), None) => e,

@@ -13,7 +13,8 @@
 use super::model::TimeError;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
-use crate::study::richardson::Verdict;
+use crate::study::estimate::level_errors;
+use crate::study::richardson::{asymptotic, NormModel, Verdict};
 use crate::study::{estimate, Axis, Level, LevelResult, Sequence, SetupCache, Study};
 
 /// The error the planner is asked to bound.
@@ -67,6 +68,9 @@ pub struct Fit {
     /// Distance of each level to the one before (max over the common nodes; |ΔQ| for an output; 0 for
     /// the first level).
     pub distances: Vec<f64>,
+    /// Why the estimates are bounds: the observed order exceeded the scene's order bound, which replaced it
+    /// ([`fit`]).
+    pub bounded: Option<String>,
 }
 
 impl Fit {
@@ -74,6 +78,9 @@ impl Fit {
     pub fn not_in_range(&self) -> Option<String> {
         if let Some(why) = &self.refused {
             return Some(why.clone());
+        }
+        if self.bounded.is_some() {
+            return None;
         }
         match self.verdicts.last() {
             Some(Verdict::InRange) => None,
@@ -83,8 +90,11 @@ impl Fit {
     }
 }
 
-/// The quantity's estimates in a finished study.
-pub fn fit(study: &Study, q: &Quantity) -> Result<Fit> {
+/// The quantity's estimates in a finished study. `limit`: the energy-norm order a space sequence can
+/// reach, min(1, α_min) from the scene's singular exponents (`fem::singular`); its levels are then judged
+/// against it (the band of `study::richardson::asymptotic` around it, not around CR's 1), and an observed
+/// order above it, still falling towards it, is replaced by it ([`bound_order`]).
+pub fn fit(study: &Study, q: &Quantity, limit: Option<f64>) -> Result<Fit> {
     let (size, x) = estimate::sizes(&study.levels);
     match q {
         Quantity::Energy => {
@@ -94,7 +104,7 @@ pub fn fit(study: &Study, q: &Quantity) -> Result<Fit> {
                 .iter()
                 .map(|r| r.increment.as_ref().map_or(0.0, |v| v.iter().copied().fold(0.0, f64::max)))
                 .collect();
-            Ok(Fit {
+            let mut f = Fit {
                 size,
                 x,
                 errors: e.levels.iter().map(|l| l.error[0]).collect(),
@@ -103,7 +113,12 @@ pub fn fit(study: &Study, q: &Quantity) -> Result<Fit> {
                 beta: e.model.map(|m| m.beta),
                 refused: e.refused.clone(),
                 distances,
-            })
+                bounded: None,
+            };
+            if let (Some(limit), Some(model), Axis::H) = (limit, e.model, size) {
+                bound_order(&mut f, study, model, limit);
+            }
+            Ok(f)
         }
         Quantity::Output(name) => {
             let i = study.output_names.iter().position(|n| n == name).ok_or_else(|| {
@@ -127,9 +142,33 @@ pub fn fit(study: &Study, q: &Quantity) -> Result<Fit> {
                 beta: None,
                 refused,
                 distances,
+                bounded: None,
             })
         }
     }
+}
+
+/// Judge a space sequence against the order bound `limit` = min(1, α_min). An observed order p above it is
+/// pre-asymptotic: the smooth part of the solution dominates the coarse levels and the order falls towards
+/// the singular one as h → 0. The levels are then re-estimated with p = `limit` and β ≤ 1, and the model
+/// extrapolates with `limit`: with Galerkin orthogonality (β = 1) the finest level's error is the sum of
+/// the increments still to come, |e_L|² = Σ_{j>L} d_j², and increments decaying at least like h^limit give
+/// |e_L| ≤ d_L/√(r^{2·limit} − 1), the estimate at p = `limit` (a smaller β only raises it); beyond the
+/// finest level the error decays at least like h^limit. So the prediction is a bound, not a hope.
+fn bound_order(f: &mut Fit, study: &Study, model: NormModel, limit: f64) {
+    f.verdicts = asymptotic(&f.x, model.p, &f.errors, limit);
+    if model.p <= limit {
+        return;
+    }
+    let bounded = NormModel { p: limit, beta: model.beta.min(1.0), ..model };
+    f.errors = level_errors(&study.levels, &bounded).iter().map(|e| e[0]).collect();
+    f.bounded = Some(format!(
+        "the observed space order {:.3} is above min(1, α_min) = {limit:.3}, the order the scene's corners allow \
+         (`tresca-cr check`): still falling towards it, so the finest pilot level is re-estimated and the error \
+         extrapolated with {limit:.3} (a bound)",
+        model.p
+    ));
+    f.p = limit;
 }
 
 /// The scene the pilots run: without `[exact]`, with the quantity among its outputs.
@@ -279,7 +318,7 @@ pub fn time_pilot(
         }
         spent += run.spent;
         let study = run.study();
-        let f = fit(&study, q)?;
+        let f = fit(&study, q, None)?;
         let run_steps: Vec<usize> = study.levels.iter().map(|l| l.steps).collect();
         let done = f.not_in_range().is_none() || f.time_bound(&run_steps, steps, ratio).at(0.0) <= enough;
         last = Some((study, ratio));

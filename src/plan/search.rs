@@ -19,13 +19,16 @@ pub(super) struct Pilots<'a> {
     pub(super) time: &'a Study,
     pub(super) time_fit: &'a Fit,
     pub(super) time_ratio: usize,
+    /// min(1, α_min) of the scene ([`super::Plan::order_limit`]).
+    pub(super) order_limit: f64,
     pub(super) wall: f64,
 }
 
 /// Fit the models to the pilots and search (module doc).
 pub(super) fn decide(s: &Scene, options: &Options, pilots: &Pilots, mut notes: Vec<String>) -> Result<Plan> {
-    let Pilots { space, time, time_fit, time_ratio, wall } = *pilots;
-    let space_fit = fit(space, &options.quantity)?;
+    let Pilots { space, time, time_fit, time_ratio, order_limit, wall } = *pilots;
+    let space_fit = fit(space, &options.quantity, Some(order_limit))?;
+    notes.extend(space_fit.bounded.clone());
     let cost = CostModel::fit(&space_samples(&space.levels), &samples(&time.levels));
     let mut plan = Plan {
         options: options.clone(),
@@ -33,6 +36,7 @@ pub(super) fn decide(s: &Scene, options: &Options, pilots: &Pilots, mut notes: V
         space_fit: space_fit.clone(),
         time: time.clone(),
         time_fit: time_fit.clone(),
+        order_limit,
         time_ratio,
         scene_steps: s.times.len() - 1,
         error: None,
