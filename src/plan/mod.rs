@@ -238,7 +238,10 @@ fn space_pilot(
             let extend = match draft.best.first() {
                 _ if draft.space_fit.not_in_range().is_some() => true, // not yet in the asymptotic range
                 Some(b) => b.refine > r - 1 + MAX_EXTRAPOLATION && predicted(r) <= EXTENSION_SHARE * b.wall,
-                None => false,
+                // refused for the budget: a pilot level closer to the configuration may bring it within
+                None => draft.over_budget.as_ref().is_some_and(|b| {
+                    b.refine > r - 1 + MAX_EXTRAPOLATION && predicted(r) <= EXTENSION_SHARE * options.budget
+                }),
             };
             if !extend || r > r0 + MAX_REFINE {
                 let mut done = draft;

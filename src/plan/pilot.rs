@@ -14,7 +14,7 @@ use super::model::TimeError;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 use crate::study::estimate::level_errors;
-use crate::study::richardson::{asymptotic, NormModel, Verdict};
+use crate::study::richardson::{asymptotic, NormModel, Verdict, ORDER_TOL};
 use crate::study::{estimate, Axis, Level, LevelResult, Sequence, SetupCache, Study};
 
 /// The error the planner is asked to bound.
@@ -148,25 +148,41 @@ pub fn fit(study: &Study, q: &Quantity, limit: Option<f64>) -> Result<Fit> {
     }
 }
 
-/// Judge a space sequence against the order bound `limit` = min(1, α_min). An observed order p above it is
-/// pre-asymptotic: the smooth part of the solution dominates the coarse levels and the order falls towards
-/// the singular one as h → 0. The levels are then re-estimated with p = `limit` and β ≤ 1, and the model
-/// extrapolates with `limit`: with Galerkin orthogonality (β = 1) the finest level's error is the sum of
-/// the increments still to come, |e_L|² = Σ_{j>L} d_j², and increments decaying at least like h^limit give
-/// |e_L| ≤ d_L/√(r^{2·limit} − 1), the estimate at p = `limit` (a smaller β only raises it); beyond the
-/// finest level the error decays at least like h^limit. So the prediction is a bound, not a hope.
+/// Judge a space sequence against the order bound `limit` = min(1, α_min). An observed order p at or below
+/// it is judged in the band around `limit` (`study::richardson::asymptotic`). An order above it is
+/// accepted but never extrapolated with: the model uses `limit` (a smooth part of the solution may dominate
+/// the coarse levels; the singular part's order takes over as h → 0). Where the order is still falling —
+/// the finest increment's order is more than `ORDER_TOL` below p — or the estimates are not consistent
+/// with p (the GCI test around CR's order 1), the levels are also re-estimated with p = `limit` and β ≤ 1:
+/// with Galerkin orthogonality (β = 1) the finest level's error is the sum of the increments still to
+/// come, |e_L|² = Σ_{j>L} d_j², and increments decaying at least like h^limit give
+/// |e_L| ≤ d_L/√(r^{2·limit} − 1), the estimate at p = `limit` (a smaller β only raises it). So the
+/// prediction is a bound, not a hope.
 fn bound_order(f: &mut Fit, study: &Study, model: NormModel, limit: f64) {
-    f.verdicts = asymptotic(&f.x, model.p, &f.errors, limit);
     if model.p <= limit {
+        f.verdicts = asymptotic(&f.x, model.p, &f.errors, limit);
         return;
     }
-    let bounded = NormModel { p: limit, beta: model.beta.min(1.0), ..model };
-    f.errors = level_errors(&study.levels, &bounded).iter().map(|e| e[0]).collect();
+    let n = f.x.len();
+    let finest = (n >= 3 && f.distances[n - 1] > 0.0)
+        .then(|| (f.distances[n - 2] / f.distances[n - 1]).ln() / (f.x[n - 2] / f.x[n - 1]).ln());
+    let falling = finest.is_some_and(|o| o < model.p - ORDER_TOL);
+    let consistent = matches!(f.verdicts.last(), Some(Verdict::InRange));
+    let how = if falling || !consistent {
+        let bounded = NormModel { p: limit, beta: model.beta.min(1.0), ..model };
+        f.errors = level_errors(&study.levels, &bounded).iter().map(|e| e[0]).collect();
+        format!(
+            "{}: the finest pilot level is re-estimated with {limit:.3}",
+            if falling { "still falling towards it" } else { "its estimates are not yet consistent" }
+        )
+    } else {
+        "the finest pilot level's estimate stands".to_string()
+    };
     f.bounded = Some(format!(
-        "the observed space order {:.3} is above min(1, α_min) = {limit:.3}, the order the scene's corners allow \
-         (`tresca-cr check`): still falling towards it, so the finest pilot level is re-estimated and the error \
-         extrapolated with {limit:.3} (a bound)",
-        model.p
+        "the observed space order {:.3} (finest increment {}) is above min(1, α_min) = {limit:.3}, the order the \
+         scene's corners allow (`tresca-cr check`); {how}, and the error is extrapolated with {limit:.3} (a bound)",
+        model.p,
+        finest.map_or("-".into(), |o| format!("{o:.3}"))
     ));
     f.p = limit;
 }
