@@ -33,11 +33,15 @@ pub fn run(
     json: Option<PathBuf>,
 ) -> Result<i32> {
     let start = std::time::Instant::now();
-    let summarise = |p: &Plan, achieved, adaptive: &Option<Weighed>| -> Result<()> {
+    let exact = scene.exact.is_some();
+    let summarise = |p: &Plan, achieved, adaptive: &Option<Weighed>, ran: &[tresca_cr::adapt::Row]| -> Result<()> {
         let Some(j) = &json else { return Ok(()) };
         let mut s = super::summary::Summary::new("plan", &scene.file, start.elapsed().as_secs_f64());
         let mut ps = super::summary::PlanSummary::of(p, &p.options.quantity.describe(), achieved);
-        ps.adaptive = adaptive.as_ref().map(|w| super::summary::AdaptiveRoute::of(w, scene.exact.is_some()));
+        ps.adaptive = adaptive.as_ref().map(|w| super::summary::AdaptiveRoute::of(w, exact));
+        if let Some(a) = ps.adaptive.as_mut() {
+            a.run = ran.iter().map(|r| super::summary::AdaptLevel::of(r, exact)).collect();
+        }
         s.plan = Some(ps);
         if let Some(why) = &p.refused {
             if !adaptive_chosen(adaptive) {
@@ -62,11 +66,14 @@ pub fn run(
     if let Some(why) = &p.refused {
         let chosen = adaptive_chosen(&adaptive);
         say!("\n{}: {why}", if chosen { "No uniform plan (the adaptive route above is)" } else { "No plan" });
-        summarise(&p, None, &adaptive)?;
-        super::out::report_written(csv.as_deref())?;
         if let (true, Some(Ok(a))) = (chosen && execute, &adaptive) {
-            return super::plan_adaptive::execute(&scene, a, &p);
+            let (code, rows) = super::plan_adaptive::execute(&scene, a, &p)?;
+            summarise(&p, None, &adaptive, &rows)?;
+            super::out::report_written(csv.as_deref())?;
+            return Ok(code);
         }
+        summarise(&p, None, &adaptive, &[])?;
+        super::out::report_written(csv.as_deref())?;
         return Ok(if chosen { 0 } else { REFUSED });
     }
     print_table(&p);
@@ -81,13 +88,14 @@ pub fn run(
     );
     if execute {
         if let Some(Ok(a)) = adaptive.as_ref().filter(|_| adaptive_chosen(&adaptive)) {
-            summarise(&p, None, &adaptive)?;
+            let (code, rows) = super::plan_adaptive::execute(&scene, a, &p)?;
+            summarise(&p, None, &adaptive, &rows)?;
             super::out::report_written(csv.as_deref())?;
-            return super::plan_adaptive::execute(&scene, a, &p);
+            return Ok(code);
         }
     }
     let achieved = if execute { Some(execute_plan(&scene, &p, b)?) } else { None };
-    summarise(&p, achieved, &adaptive)?;
+    summarise(&p, achieved, &adaptive, &[])?;
     super::out::report_written(csv.as_deref())?;
     Ok(0)
 }

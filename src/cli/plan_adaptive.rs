@@ -81,8 +81,8 @@ fn print(a: &AdaptivePlan, file: &str) {
 /// uniform plan's η, under the same memory and disk checks as `tresca-cr adapt` and the plan's memory limit and
 /// wall budget), printed as `adapt` prints it,
 /// then whether it reached that η and, with an exact solution, the true error against the target. Returns the
-/// exit code (3 when the loop was refused).
-pub fn execute(scene: &Scene, a: &AdaptivePlan, p: &Plan) -> Result<i32> {
+/// exit code (3 when the loop was refused) and the loop's levels.
+pub fn execute(scene: &Scene, a: &AdaptivePlan, p: &Plan) -> Result<(i32, Vec<Row>)> {
     let target = p.options.target;
     let mut s = scene.clone();
     s.set_steps(a.steps)?;
@@ -117,5 +117,5 @@ pub fn execute(scene: &Scene, a: &AdaptivePlan, p: &Plan) -> Result<i32> {
             );
         }
     }
-    Ok(code)
+    Ok((code, rows))
 }

@@ -65,7 +65,7 @@
 //! there), `adaptive_rate` (r in η = c N^(−r)), `uniform_rate` (`null`: no uniform pilot), `uniform_unknowns`,
 //! `uniform_wall`, `uniform_memory`, `adaptive_unknowns`, `adaptive_levels`, `adaptive_wall` (the whole
 //! sequence), `adaptive_memory` (its last level), `pilot_wall`, `adaptive_pilot` (its levels, as `adapt`'s),
-//! `uniform_pilot` (empty).
+//! `uniform_pilot` (empty), `run` (with `--run` where the route was recommended: the levels of its `adapt` loop).
 //!
 //! `adapt` ([`AdaptSummary`]): `theta`, `levels_asked`, `target`, `reference_generation` (the flags;
 //! `null` when not given), `exact` (the errors are true ones), `stopped` (why the loop stopped before its
@@ -280,7 +280,7 @@ pub struct RunSummary {
 mod adapt;
 mod plan;
 mod study;
-pub use adapt::{AdaptSummary, AdaptiveRoute};
+pub use adapt::{AdaptLevel, AdaptSummary, AdaptiveRoute};
 pub use plan::{Achieved, PlanSummary};
 pub use study::{Level, StudySummary};
 

@@ -122,6 +122,9 @@ pub struct AdaptiveRoute {
     pub steps: Option<usize>,
     pub adaptive_pilot: Vec<AdaptLevel>,
     pub uniform_pilot: Vec<AdaptLevel>,
+    /// With `--run` where the route was recommended: the levels of its `adapt` loop.
+    #[serde(default)]
+    pub run: Vec<AdaptLevel>,
 }
 
 impl AdaptiveRoute {
@@ -148,6 +151,7 @@ impl AdaptiveRoute {
             steps: None,
             adaptive_pilot: vec![],
             uniform_pilot: vec![],
+            run: vec![],
         };
         let w = match w {
             Ok(w) => w,
