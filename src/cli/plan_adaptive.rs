@@ -15,17 +15,18 @@ const OPTIMAL_ORDER: f64 = 1.0;
 const ORDER_SCATTER: f64 = 0.05;
 
 /// Weigh and print; `None` for targets the indicator does not bound (outputs other than the energy norm),
-/// when the uniform plan has no error model, or when its space order is already optimal (then the
+/// when the uniform plan has no error model, or when its observed space order is already optimal (then the
 /// adaptive pilots would only add to the planner's cost, which is to stay within 5 % of the plan).
 pub fn weigh(scene: &Scene, p: &Plan) -> Result<Option<std::result::Result<AdaptivePlan, String>>> {
     let Some(model) = p.error.as_ref().filter(|_| p.options.quantity == Quantity::Energy) else {
         return Ok(None);
     };
-    if model.space.p >= OPTIMAL_ORDER - ORDER_SCATTER {
+    // the order the pilot observed, not the model's (which the scene's corners may bound below it)
+    let observed = p.space.estimates.model.map_or(model.space.p, |m| m.p);
+    if observed >= OPTIMAL_ORDER - ORDER_SCATTER {
         say!(
-            "\nAdaptive route not weighed: the uniform space order {:.3} is optimal for CR (≥ {}), so adaptive \
+            "\nAdaptive route not weighed: the uniform space order {observed:.3} is optimal for CR (≥ {}), so adaptive \
              refinement cannot reach the target with fewer unknowns by more than its overhead",
-            model.space.p,
             OPTIMAL_ORDER - ORDER_SCATTER
         );
         return Ok(None);
