@@ -133,6 +133,11 @@ class Runner:
         self.full = case(name)
         self.bare = os.path.join(tmp, f"{name}_noexact.toml")
         open(self.bare, "w").write(strip_exact(open(self.full).read()))
+        # a mesh file the scene names resolves beside the copy too (mms_lshape's lshape_sides.msh)
+        here = os.path.dirname(self.full)
+        for f in os.listdir(here):
+            if f.endswith(".msh") and not os.path.exists(os.path.join(tmp, f)):
+                os.symlink(os.path.join(here, f), os.path.join(tmp, f))
         self.cache, self.costs = cache, costs
 
     def config(self, r, n, tol=None):
