@@ -357,6 +357,7 @@ fn adapt(cmd: Cmd) -> Result<()> {
         levels,
         target,
         until_unknowns: None,
+        target_estimate: None,
         theta,
         out,
         gmsh,

@@ -38,6 +38,30 @@ fn plan_meets_its_target_in_truth() {
     assert!(p.best.windows(2).all(|w| w[0].wall <= w[1].wall) && p.best.iter().all(|c| c.error <= target));
 }
 
+/// Requirement (issue 42): on the corner-singular mms_lshape (re-entrant corner, α = 0.5445: the observed
+/// order 0.84 over the pilots still falls towards it) the system shall judge and extrapolate the space
+/// pilot with min(1, α_min), never with the observed order, say so in a note, and so predict an error that
+/// bounds the truth: at 0.1 the planned configuration, run with the scene's exact solution, has a true error
+/// at most the prediction and the target.
+#[test]
+fn corner_exponent_bounds_the_extrapolation() {
+    let s = scene("verification/cases/mms_lshape.toml");
+    let target = 0.1;
+    let p = plan(&s, &options(target)).unwrap();
+    assert!(p.refused.is_none(), "{:?}", p.refused);
+    let model = p.error.unwrap();
+    assert!((p.order_limit - 0.544_483_736_782_464).abs() < 1e-6, "{}", p.order_limit);
+    assert_eq!(model.space.p, p.order_limit, "extrapolated with the bound");
+    assert!(p.notes.iter().any(|n| n.contains("above min(1, α_min)")), "{:?}", p.notes);
+    let b = &p.best[0];
+    let mut c = s.clone();
+    c.set_refine(b.refine).unwrap();
+    c.set_steps(b.steps).unwrap();
+    c.solver.tol = p.tol;
+    let (truth, _) = max_errors(&run(c).1);
+    assert!(truth <= b.error && truth <= target, "refine {}: true {truth:e}, predicted {:e}", b.refine, b.error);
+}
+
 /// Requirement: a scene whose slip only passes from stick to slip needs no more steps than it asks for:
 /// the planner says so (a time-error bound far below the target) and plans the scene's own steps.
 #[test]

@@ -12,8 +12,10 @@
 //! built mesh and refused when they do not fit, as `run` does; with a wall-time budget a level is
 //! refused when the time so far plus the last level's time scaled by the growth in unknowns exceeds it.
 //! Beside η each level reports the time indicator η_k ([`time`]), a bound on the error of the time
-//! stepping (the steps are the scene's; the loop refines space only).
+//! stepping (the steps are the scene's; the loop refines space only), and from level 1 on the error
+//! estimate ([`estimate`]: η calibrated against a Richardson estimate along the sequence in N).
 
+pub mod estimate;
 pub mod estimator;
 pub mod export;
 pub mod files;
@@ -28,7 +30,7 @@ use crate::scene::budget::Estimate;
 use crate::scene::Scene;
 use crate::stepping::{Problem, StepResult};
 use estimator::{Accumulated, Estimator};
-use reference::{distance, overlay, Kept};
+use reference::{distance, increments, overlay, Kept};
 use std::path::PathBuf;
 use std::time::Instant;
 use time::TimeIndicator;
@@ -42,6 +44,8 @@ pub struct Options {
     pub target: Option<f64>,
     /// Stop once a level has at least this many unknowns.
     pub until_unknowns: Option<usize>,
+    /// Stop once the error estimate ([`estimate`]) is at most this (from level `estimate::TRUSTED_FROM` on).
+    pub target_estimate: Option<f64>,
     /// Dörfler's θ in (0, 1].
     pub theta: f64,
     /// Write `level_<k>.h5` here.
@@ -56,9 +60,9 @@ pub struct Options {
     /// Measure every level against a reference: the finest level's mesh refined to at least this
     /// generation ([`reference::overlay`]).
     pub reference: Option<u32>,
-    /// A planner's pilot (`plan::adaptive`): only η and the unknowns are read, so no energy audit, no
-    /// time indicator, no distance between levels and no condition estimate (the uniform pilots made it)
-    /// are computed (those fields of the rows stay 0 and `None`, and the levels' fields are not kept).
+    /// A planner's pilot (`plan::adaptive`): only η, the error estimate and the unknowns are read, so no
+    /// energy audit, no time indicator and no condition estimate (the uniform pilots made it) are computed
+    /// (those fields of the rows stay 0).
     pub lean: bool,
 }
 
@@ -69,6 +73,7 @@ impl Options {
             levels: Some(levels),
             target: None,
             until_unknowns: None,
+            target_estimate: None,
             theta,
             out: None,
             gmsh: false,
@@ -111,6 +116,10 @@ pub struct Row {
     pub time_estimator: f64,
     pub time_dissipation: f64,
     pub time_load: f64,
+    /// R_k, the Richardson estimate along the sequence from this level and the one before, and E_k, the
+    /// error estimate: η calibrated against the R of the last levels ([`estimate`]); from level 1 on.
+    pub richardson: Option<f64>,
+    pub estimate: Option<f64>,
 }
 
 impl Row {
@@ -182,10 +191,8 @@ fn solve(scene: &Scene, mesh: Mesh, out: Option<PathBuf>, force: bool, timed: bo
         if let Some(w) = writer.as_mut() {
             w.write_step(r)?;
         }
-        if !lean {
-            u.push(r.u.clone());
-            t.push(r.t);
-        }
+        u.push(r.u.clone());
+        t.push(r.t);
         Ok(())
     };
     let options = crate::stepping::RunOptions { audit: !lean, ..crate::stepping::RunOptions::all() };
@@ -265,18 +272,26 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
             ..Row::default()
         };
         let law = crate::fem::elasticity::Elasticity::new(&scene.material);
-        if let (Some(pv), Some(last), false) = (levels.last(), rows.last_mut(), opts.lean) {
-            last.vs_next = Some(distance(&solved.kept, pv, &law, scene.rho)?);
+        if let (Some(pv), Some(last)) = (levels.last(), rows.last_mut()) {
+            let inc = increments(&solved.kept, pv, &law, scene.rho, true)?;
+            last.vs_next = Some(reference::max_distance(&inc));
+            let parts: Vec<(f64, f64)> = inc.iter().map(|p| (p.gradient, p.fine_jumps)).collect();
+            row.richardson = estimate::richardson(&parts, last.unknowns, row.unknowns);
         }
         let (raw, parent) = bisect(&solved.kept.mesh, &marked);
         let next_root = parent.iter().map(|&p| root_area[p]).collect();
         last_root = std::mem::replace(&mut root_area, next_root);
         mesh = Mesh::build(raw)?;
         row.wall = t0.elapsed().as_secs_f64();
-        report(&row);
-        let done =
-            opts.target.is_some_and(|t| row.estimator <= t) || opts.until_unknowns.is_some_and(|n| row.unknowns >= n);
         rows.push(row);
+        let e = estimate::calibrated(&rows);
+        let row = rows.last_mut().expect("pushed");
+        row.estimate = e;
+        report(row);
+        let done = opts.target.is_some_and(|t| row.estimator <= t)
+            || opts.until_unknowns.is_some_and(|n| row.unknowns >= n)
+            || (row.level >= estimate::TRUSTED_FROM
+                && opts.target_estimate.zip(row.estimate).is_some_and(|(t, e)| e <= t));
         if opts.reference.is_none() {
             levels.clear();
         }

@@ -55,23 +55,48 @@ pub fn overlay(mut mesh: Mesh, mut root_area: Vec<f64>, g: u32) -> Result<(Mesh,
 
 /// max over the time nodes of |||u_fine − u_coarse||| on nested meshes (module doc).
 pub fn distance(fine: &Kept, coarse: &Kept, law: &Elasticity, rho: f64) -> Result<f64> {
+    Ok(max_distance(&increments(fine, coarse, law, rho, false)?))
+}
+
+/// max over the time nodes of the distance √(G² + J_coarse) of [`increments`].
+pub fn max_distance(parts: &[Increment]) -> f64 {
+    parts.iter().fold(0.0f64, |m, p| m.max((p.gradient + p.coarse_jumps).max(0.0).sqrt()))
+}
+
+/// The parts of the distance of two nested levels at one time node (squared): the broken energy of the
+/// gradient difference, the coarse level's jump energy (against u_D), and, when asked, the fine level's.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Increment {
+    pub gradient: f64,
+    pub coarse_jumps: f64,
+    pub fine_jumps: f64,
+}
+
+/// [`Increment`] at every common time node; `fine_jumps` only with `with_fine` (else 0).
+pub fn increments(fine: &Kept, coarse: &Kept, law: &Elasticity, rho: f64, with_fine: bool) -> Result<Vec<Increment>> {
     let parent = parent_triangles(&coarse.mesh, &fine.mesh)?;
     let fe: Vec<Element> = (0..fine.mesh.tris.len()).map(|t| Element::new(&fine.mesh, t)).collect();
     let ce: Vec<Element> = (0..coarse.mesh.tris.len()).map(|t| Element::new(&coarse.mesh, t)).collect();
     let has_data = coarse.data.is_some();
     let jumps = ErrorEvaluator::new(&coarse.mesh, &coarse.space, has_data, law, rho);
-    let mut worst = 0.0f64;
+    let fine_eval = with_fine.then(|| ErrorEvaluator::new(&fine.mesh, &fine.space, has_data, law, rho));
+    let mut out = Vec::with_capacity(fine.u.len());
     for (i, (uf, uc)) in fine.u.iter().zip(&coarse.u).enumerate() {
         let mf = displacement(&fine.space, fine.data.as_ref(), uf, fine.t[i])?;
         let mc = displacement(&coarse.space, coarse.data.as_ref(), uc, coarse.t[i])?;
-        let mut sum = jumps.jump_energy_at(&mc, &coarse.space, has_data, &coarse.parts, coarse.t[i])?;
+        let coarse_jumps = jumps.jump_energy_at(&mc, &coarse.space, has_data, &coarse.parts, coarse.t[i])?;
+        let fine_jumps = match &fine_eval {
+            Some(f) => f.jump_energy_at(&mf, &fine.space, has_data, &fine.parts, fine.t[i])?,
+            None => 0.0,
+        };
+        let mut gradient = 0.0;
         for (t, &p) in parent.iter().enumerate() {
             let gf = fe[t].gradient(fine.mesh.tri_edges[t].map(|e| mf[e]));
             let gc = ce[p].gradient(coarse.mesh.tri_edges[p].map(|e| mc[e]));
             let d = [[gf[0][0] - gc[0][0], gf[0][1] - gc[0][1]], [gf[1][0] - gc[1][0], gf[1][1] - gc[1][1]]];
-            sum += fine.mesh.area(t) * law.energy_density(d);
+            gradient += fine.mesh.area(t) * law.energy_density(d);
         }
-        worst = worst.max(sum.max(0.0).sqrt());
+        out.push(Increment { gradient, coarse_jumps, fine_jumps });
     }
-    Ok(worst)
+    Ok(out)
 }

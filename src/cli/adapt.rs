@@ -19,7 +19,7 @@ pub fn csv_text(rows: &[Row], exact: bool) -> String {
     for t in TERMS {
         let _ = write!(s, ",eta_{t}");
     }
-    s.push_str(",time_estimator,time_dissipation,time_load\n");
+    s.push_str(",time_estimator,time_dissipation,time_load,estimate,richardson\n");
     for r in rows {
         let e = r.error_or_estimate();
         let f = |x: Option<f64>| x.map(|v| format!("{v:.6e}")).unwrap_or_default();
@@ -45,7 +45,8 @@ pub fn csv_text(rows: &[Row], exact: bool) -> String {
         for v in r.terms {
             let _ = write!(s, ",{:.6e}", v.max(0.0).sqrt());
         }
-        let _ = writeln!(s, ",{:.6e},{:.6e},{:.6e}", r.time_estimator, r.time_dissipation, r.time_load);
+        let _ = write!(s, ",{:.6e},{:.6e},{:.6e}", r.time_estimator, r.time_dissipation, r.time_load);
+        let _ = writeln!(s, ",{},{}", f(r.estimate), f(r.richardson));
     }
     s
 }
@@ -81,7 +82,7 @@ pub fn run_rows(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<
     }
     let exact = scene.exact.is_some();
     say!(
-        "{:>5} {:>9} {:>9} {:>11} {:>11} {:>11} {:>6} {:>8} {:>7} {:>8}",
+        "{:>5} {:>9} {:>9} {:>11} {:>11} {:>11} {:>6} {:>8} {:>7} {:>8} {:>11}",
         "level",
         "triangles",
         "unknowns",
@@ -91,13 +92,15 @@ pub fn run_rows(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<
         "eff",
         "min ang",
         "marked",
-        "wall s"
+        "wall s",
+        "estimate"
     );
     let outcome = adapt(&scene, &opts, |r| {
         let e = r.error.map(|e| format!("{e:.4e}")).unwrap_or_else(|| "-".into());
         let eff = r.error.map(|e| format!("{:.3}", r.estimator / e)).unwrap_or_default();
+        let est = r.estimate.map(|e| format!("{e:.4e}")).unwrap_or_else(|| "-".into());
         say!(
-            "{:>5} {:>9} {:>9} {:>11.4e} {:>11.4e} {:>11} {:>6} {:>8.3} {:>7} {:>8.3}",
+            "{:>5} {:>9} {:>9} {:>11.4e} {:>11.4e} {:>11} {:>6} {:>8.3} {:>7} {:>8.3} {:>11}",
             r.level,
             r.triangles,
             r.unknowns,
@@ -107,7 +110,8 @@ pub fn run_rows(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<
             eff,
             r.min_angle,
             r.marked,
-            r.wall
+            r.wall,
+            est
         );
     })?;
     if !exact {
@@ -127,8 +131,8 @@ pub fn run_rows(scene: Scene, opts: Options, csv: Option<PathBuf>, json: Option<
             );
         }
     }
-    if let Some(path) = csv {
-        write_new(&path, "--csv file", csv_text(&outcome.rows, exact).as_bytes(), opts.force)?;
+    if let Some(path) = &csv {
+        write_new(path, "--csv file", csv_text(&outcome.rows, exact).as_bytes(), opts.force)?;
     }
     if let Some(j) = &json {
         let mut summary = super::summary::Summary::new("adapt", &scene.file, start.elapsed().as_secs_f64());

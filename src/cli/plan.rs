@@ -37,11 +37,15 @@ pub fn run(
     let (json, force) = (reports.json, reports.force);
     let outputs = Outputs::new(force).inputs_of(&scene);
     outputs.files(csv.as_deref(), "--csv file").files(json.as_deref(), "--json file").check()?;
-    let summarise = |p: &Plan, achieved, adaptive: &Option<Weighed>| -> Result<()> {
+    let exact = scene.exact.is_some();
+    let summarise = |p: &Plan, achieved, adaptive: &Option<Weighed>, ran: &[tresca_cr::adapt::Row]| -> Result<()> {
         let Some(j) = &json else { return Ok(()) };
         let mut s = super::summary::Summary::new("plan", &scene.file, start.elapsed().as_secs_f64());
         let mut ps = super::summary::PlanSummary::of(p, &p.options.quantity.describe(), achieved);
-        ps.adaptive = adaptive.as_ref().map(|w| super::summary::AdaptiveRoute::of(w, scene.exact.is_some()));
+        ps.adaptive = adaptive.as_ref().map(|w| super::summary::AdaptiveRoute::of(w, exact));
+        if let Some(a) = ps.adaptive.as_mut() {
+            a.run = ran.iter().map(|r| super::summary::AdaptLevel::of(r, exact)).collect();
+        }
         s.plan = Some(ps);
         if let Some(why) = &p.refused {
             if !adaptive_chosen(adaptive) {
@@ -63,11 +67,14 @@ pub fn run(
     if let Some(why) = &p.refused {
         let chosen = adaptive_chosen(&adaptive);
         say!("\n{}: {why}", if chosen { "No uniform plan (the adaptive route above is)" } else { "No plan" });
-        summarise(&p, None, &adaptive)?;
-        super::out::report_written(csv.as_deref())?;
         if let (true, Some(Ok(a))) = (chosen && execute, &adaptive) {
-            return super::plan_adaptive::execute(&scene, a, &p);
+            let (code, rows) = super::plan_adaptive::execute(&scene, a, &p)?;
+            summarise(&p, None, &adaptive, &rows)?;
+            super::out::report_written(csv.as_deref())?;
+            return Ok(code);
         }
+        summarise(&p, None, &adaptive, &[])?;
+        super::out::report_written(csv.as_deref())?;
         return Ok(if chosen { 0 } else { REFUSED });
     }
     print_table(&p);
@@ -82,13 +89,14 @@ pub fn run(
     );
     if execute {
         if let Some(Ok(a)) = adaptive.as_ref().filter(|_| adaptive_chosen(&adaptive)) {
-            summarise(&p, None, &adaptive)?;
+            let (code, rows) = super::plan_adaptive::execute(&scene, a, &p)?;
+            summarise(&p, None, &adaptive, &rows)?;
             super::out::report_written(csv.as_deref())?;
-            return super::plan_adaptive::execute(&scene, a, &p);
+            return Ok(code);
         }
     }
     let achieved = if execute { Some(execute_plan(&scene, &p, b)?) } else { None };
-    summarise(&p, achieved, &adaptive)?;
+    summarise(&p, achieved, &adaptive, &[])?;
     super::out::report_written(csv.as_deref())?;
     Ok(0)
 }
@@ -169,6 +177,7 @@ fn print_evidence(p: &Plan) {
         print_sequence(name, study, fit);
     }
     say!("Pilot cost: {:.3} s (pilot budget {:.3} s)", p.pilot_wall, p.options.pilot_budget);
+    say!("Order bound: min(1, α_min) = {:.4} in h (the scene's corners, `tresca-cr check`)", p.order_limit);
     let orders = |f: &tresca_cr::plan::pilot::Fit| {
         if f.errors.len() < 2 {
             return String::new();
@@ -263,7 +272,7 @@ fn execute_plan(scene: &Scene, p: &Plan, b: &Candidate) -> Result<super::summary
     let study: Study = run_study(&s, &levels, None, None, |r| {
         say!("  refine {} steps {}: {:.3} s", r.refine, r.steps, r.wall);
     })?;
-    let f = fit(&study, &p.options.quantity)?;
+    let f = fit(&study, &p.options.quantity, Some(p.order_limit))?;
     let model = p.error.expect("a plan has an error model");
     let space = match (f.errors.last(), f.not_in_range()) {
         (Some(&e), None) => e,

@@ -15,22 +15,23 @@ const OPTIMAL_ORDER: f64 = 1.0;
 const ORDER_SCATTER: f64 = 0.05;
 
 /// Weigh and print; `None` for targets the indicator does not bound (outputs other than the energy norm),
-/// when the uniform plan has no error model, or when its space order is already optimal (then the
+/// when the uniform plan has no error model, or when its observed space order is already optimal (then the
 /// adaptive pilots would only add to the planner's cost, which is to stay within 5 % of the plan).
 pub fn weigh(scene: &Scene, p: &Plan) -> Result<Option<std::result::Result<AdaptivePlan, String>>> {
     let Some(model) = p.error.as_ref().filter(|_| p.options.quantity == Quantity::Energy) else {
         return Ok(None);
     };
-    if model.space.p >= OPTIMAL_ORDER - ORDER_SCATTER {
+    // the order the pilot observed, not the model's (which the scene's corners may bound below it)
+    let observed = p.space.estimates.model.map_or(model.space.p, |m| m.p);
+    if observed >= OPTIMAL_ORDER - ORDER_SCATTER {
         say!(
-            "\nAdaptive route not weighed: the uniform space order {:.3} is optimal for CR (≥ {}), so adaptive \
+            "\nAdaptive route not weighed: the uniform space order {observed:.3} is optimal for CR (≥ {}), so adaptive \
              refinement cannot reach the target with fewer unknowns by more than its overhead",
-            model.space.p,
             OPTIMAL_ORDER - ORDER_SCATTER
         );
         return Ok(None);
     }
-    say!("\nAdaptive route (θ = {}), weighed through the error indicator η:", tresca_cr::plan::adaptive::THETA);
+    say!("\nAdaptive route (θ = {}), weighed through its error estimate:", tresca_cr::plan::adaptive::THETA);
     let w = weigh_routes(scene, p)?;
     match &w {
         Err(why) => say!("  not weighed: {why}"),
@@ -45,14 +46,15 @@ fn print(a: &AdaptivePlan, file: &str) {
         say!("  {name} pilot (unknowns:η): {}", n.join(" "));
     };
     line("adaptive", &a.adaptive_pilot);
-    line("uniform", &a.uniform_pilot);
     say!(
-        "  η ∝ N^(−{:.3}) adaptive, N^(−{:.3}) uniform; pilots {:.3} s on {} steps; the uniform plan's {:.0} unknowns mean η = {:.3e}",
+        "  η ∝ N^(−{:.3}); estimate = {:.3} η (its last level); pilot {:.3} s on {} steps; the route stops at an estimate \
+         of {:.3e} ({} of the target), predicted at η = {:.3e}",
         -a.adaptive_law.p,
-        -a.uniform_law.p,
+        a.calibration,
         a.pilot_wall,
         a.pilot_steps,
-        a.uniform_unknowns,
+        a.estimate_target,
+        tresca_cr::plan::adaptive::ESTIMATE_SHARE,
         a.eta
     );
     say!("  {:>9} {:>12} {:>7} {:>11} {:>9}", "route", "unknowns", "levels", "pred wall", "memory");
@@ -80,28 +82,34 @@ fn print(a: &AdaptivePlan, file: &str) {
 /// uniform plan's η, under the same memory and disk checks as `tresca-cr adapt` and the plan's memory limit and
 /// wall budget), printed as `adapt` prints it,
 /// then whether it reached that η and, with an exact solution, the true error against the target. Returns the
-/// exit code (3 when the loop was refused).
-pub fn execute(scene: &Scene, a: &AdaptivePlan, p: &Plan) -> Result<i32> {
+/// exit code (3 when the loop was refused) and the loop's levels.
+pub fn execute(scene: &Scene, a: &AdaptivePlan, p: &Plan) -> Result<(i32, Vec<Row>)> {
     let target = p.options.target;
     let mut s = scene.clone();
     s.set_steps(a.steps)?;
     let opts = tresca_cr::adapt::Options {
-        target: Some(a.eta),
+        target: None,
+        target_estimate: Some(a.estimate_target),
         levels: None,
         max_memory: p.options.max_memory,
         budget: Some(p.options.budget),
         ..tresca_cr::adapt::Options::levels(0, tresca_cr::plan::adaptive::THETA)
     };
-    say!("\nRunning the adaptive route (θ = {}, {} steps, until η ≤ {:.3e}):", opts.theta, a.steps, a.eta);
+    say!(
+        "\nRunning the adaptive route (θ = {}, {} steps, until the error estimate ≤ {:.3e}):",
+        opts.theta,
+        a.steps,
+        a.estimate_target
+    );
     let (code, rows) = super::adapt::run_rows(s, opts, None, None)?;
     if let Some(last) = rows.last() {
-        let reached = last.estimator <= a.eta;
+        let estimate = last.estimate.unwrap_or(f64::INFINITY);
         say!(
-            "reached η = {:.4e} with {} unknowns against the uniform plan's η = {:.3e}: {}",
+            "reached the error estimate {estimate:.4e} (η = {:.4e}) with {} unknowns against {:.3e}: {}",
             last.estimator,
             last.unknowns,
-            a.eta,
-            if reached { "met" } else { "NOT met" }
+            a.estimate_target,
+            if estimate <= a.estimate_target { "met" } else { "NOT met" }
         );
         if let Some(e) = last.error {
             say!(
@@ -110,5 +118,5 @@ pub fn execute(scene: &Scene, a: &AdaptivePlan, p: &Plan) -> Result<i32> {
             );
         }
     }
-    Ok(code)
+    Ok((code, rows))
 }

@@ -60,10 +60,12 @@
 //! `refused`; `achieved` (with `--run`, [`Achieved`]: `estimate`, `space`, `time`, `true_error`, `met`,
 //! `levels`); `adaptive` ([`AdaptiveRoute`], energy-norm targets only; absent in older summaries): the
 //! adaptive route weighed against the uniform plan (`src/plan/adaptive.rs`): `choice` (`uniform`,
-//! `adaptive`, `neither`), `reason`, `refused` (why not weighed), `eta` (the indicator value to reach),
-//! `adaptive_rate`, `uniform_rate` (r in η = c N^(−r)), `uniform_unknowns`, `uniform_wall`, `uniform_memory`,
-//! `adaptive_unknowns`, `adaptive_levels`, `adaptive_wall` (the whole sequence), `adaptive_memory` (its last
-//! level), `pilot_wall`, `adaptive_pilot`, `uniform_pilot` (their levels, as `adapt`'s).
+//! `adaptive`, `neither`), `reason`, `refused` (why not weighed), `estimate_target` (the error estimate
+//! the route must reach), `calibration` (E/η of the pilot's last level), `eta` (the indicator predicted
+//! there), `adaptive_rate` (r in η = c N^(−r)), `uniform_rate` (`null`: no uniform pilot), `uniform_unknowns`,
+//! `uniform_wall`, `uniform_memory`, `adaptive_unknowns`, `adaptive_levels`, `adaptive_wall` (the whole
+//! sequence), `adaptive_memory` (its last level), `pilot_wall`, `adaptive_pilot` (its levels, as `adapt`'s),
+//! `uniform_pilot` (empty), `run` (with `--run` where the route was recommended: the levels of its `adapt` loop).
 //!
 //! `adapt` ([`AdaptSummary`]): `theta`, `levels_asked`, `target`, `reference_generation` (the flags;
 //! `null` when not given), `exact` (the errors are true ones), `stopped` (why the loop stopped before its
@@ -73,7 +75,9 @@
 //! is known) with `error_kind` (`true`, `vs_reference`, `vs_next`) and `effectivity` (η / error),
 //! `vs_next`, `vs_reference`, `min_angle` (degrees), `marked` (triangles marked for bisection), `wall`,
 //! `worst_step` (the node of the largest η), `terms` (η's terms at that node, by name), `time_estimator`
-//! (the time indicator η_k = D^{1/2} + 3L, `src/adapt/time.rs`), `time_dissipation` (D^{1/2}), `time_load` (L).
+//! (the time indicator η_k = D^{1/2} + 3L, `src/adapt/time.rs`), `time_dissipation` (D^{1/2}), `time_load` (L),
+//! `estimate` (the error estimate: η calibrated along the sequence, `src/adapt/estimate.rs`; `null` on level
+//! 0) and `richardson` (the Richardson estimate R it is calibrated against).
 
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
@@ -284,7 +288,7 @@ pub struct RunSummary {
 mod adapt;
 mod plan;
 mod study;
-pub use adapt::{AdaptSummary, AdaptiveRoute};
+pub use adapt::{AdaptLevel, AdaptSummary, AdaptiveRoute};
 pub use plan::{Achieved, PlanSummary};
 pub use study::{Level, StudySummary};
 

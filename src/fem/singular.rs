@@ -7,9 +7,11 @@
 //! that do not change the exponent): its bound is the smaller of the two. Adaptive refinement that
 //! resolves the singularities reaches N^(−1/2) in the number of unknowns N whatever α.
 
+use super::space::CrSpace;
 use super::williams::{leading_exponent, Side};
+use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::scene::{Part, PartKind};
+use crate::scene::{Part, PartKind, Scene};
 use nalgebra::Complex;
 
 /// One boundary point with its leading exponent.
@@ -74,4 +76,14 @@ fn worst(can: [&[Side]; 2], angle: f64, nu: f64) -> ([Side; 2], Option<Complex<f
 /// min(1, min Re α) over the points: the energy-norm order in h of uniform refinement (1 without any).
 pub fn uniform_order(points: &[Singularity]) -> f64 {
     points.iter().map(Singularity::uniform_order).fold(1.0, f64::min)
+}
+
+/// The singular points of a scene, found on its mesh before any refinement (refinement adds no corner and
+/// no change of condition): what `check` lists, for the planner's order bound.
+pub fn of_scene(scene: &Scene) -> Result<Vec<Singularity>> {
+    let mut s = scene.clone();
+    s.set_refine(0)?;
+    let mesh = Mesh::from_spec(&s.mesh)?;
+    let space = CrSpace::new(&mesh, &s.parts)?;
+    Ok(singularities(&mesh, &space.edge_part, &s.parts, s.material.nu))
 }

@@ -5,22 +5,21 @@
 //! unknowns are computed (no energy audit, time indicator or distance between levels). So they cost a
 //! few per cent of the plan (the planner's own cost is to stay within 5 % of it).
 //!
-//! Both routes are compared through the same error indicator η (`adapt::estimator`, an upper bound of
-//! the energy-norm error up to a constant): a few levels of each — adaptive, and uniform as the θ = 1
-//! sequence (every triangle bisected once per level) — give the laws η_a = C_a N^{−r_a} and
-//! η_u = C_u N^{−r_u} in the unknowns N (least squares over the pilots' finer halves). The uniform plan
-//! meets the target with N_u unknowns (its best candidate, else the cheapest over the budget), with the
-//! predicted error e_u ≤ target (whole refinements overshoot); the adaptive route, which can stop at
-//! any level, needs the N_a at which η_a equals η_u(N_u)·target/e_u — the indicator value of the target
-//! on the uniform route, hence about the same error: the indicator's effectivity is about the same on both routes
-//! (Example 5.1: 2.0–3.2 adaptive, 2.1–2.7 uniform, `reference/adaptive.md`), which is this comparison's
-//! assumption. Its cost: every level of the sequence is a whole run at the plan's steps — the pilot's
+//! The adaptive route is predicted through its own error estimate (`adapt::estimate`: the indicator η
+//! calibrated along the sequence against a Richardson estimate in N), not through an assumed equal
+//! effectivity of η on both routes (they differ: on mms_lshape η/error is 6 → 3 uniform, 5–6 adaptive). The
+//! pilot gives the law η_a = C_a N^{−r_a} in the unknowns N (least squares over its finer half) and the
+//! calibration c = E/η of its last level, so the route's estimate at N is c·η_a(N). The route stops where
+//! its estimate reaches [`ESTIMATE_SHARE`] of the target: the estimate's effectivity (estimate / true
+//! error) is held to [0.8, 1.25] (`make verify`, `reference/adaptive.md`), so an estimate at 0.8 T means a
+//! true error of at most T. Its unknowns N_a solve c·η_a(N_a) = 0.8 T. Its cost: every level of the sequence
+//! is a whole run at the plan's steps — the pilot's
 //! levels again and the predicted ones, N growing by the pilot's mean factor q per level up to N_a —
 //! each priced by the plan's cost model at the plan's steps and scaled by κ, the pilot's measured ratio
 //! of adaptive level wall to the model at the pilot's steps (the median over its finer half, at least 1:
-//! estimation, marking and bisection included; like the uniform route's price, without the energy
-//! audit). Its memory: the pre-run estimate of the last level. The cheaper route that fits the budget
-//! and memory is recommended.
+//! estimation, marking, bisection and the distances between levels included; like the uniform route's
+//! price, without the energy audit). Its memory: the pre-run estimate of the last level. The cheaper route
+//! that fits the budget and memory is recommended.
 
 use super::model::PowerLaw;
 use super::{Candidate, Plan};
@@ -33,13 +32,15 @@ use crate::scene::Scene;
 pub const THETA: f64 = 0.5;
 /// Most adaptive pilot levels (with θ = ½ the unknowns grow by about 1.3 per level).
 pub const ADAPTIVE_LEVELS: usize = 20;
-/// Most uniform pilot levels (bisection generations: two are one uniform refinement).
-pub const UNIFORM_LEVELS: usize = 9;
-/// Each pilot refines until this share of the uniform plan's unknowns (three and a half uniform
-/// refinements below it): deep enough for the laws' rates (Example 5.1 at 1e-4: 0.481 adaptive to 3,885
-/// unknowns against 0.482 to 7,267 and 0.488 to 18,106; 0.421 uniform to 3,088 against 0.415 to 6,176:
-/// N_a 117,223 against 106,811 with 1/64), cheap enough for the planner's 5 % of the plan.
+/// The share of the target the route's error estimate must reach (the lower end of its effectivity band).
+pub const ESTIMATE_SHARE: f64 = 0.8;
+/// The pilot refines until this share of the uniform plan's unknowns (three and a half uniform
+/// refinements below it): deep enough for the law's rate (Example 5.1 at 1e-4: 0.481 adaptive to 3,885
+/// unknowns against 0.482 to 7,267 and 0.488 to 18,106), cheap enough for the planner's 5 % of the plan.
 pub const PILOT_UNKNOWNS: f64 = 1.0 / 128.0;
+/// The pilot grows the unknowns at least this much: about 8 levels at θ = ½ (×1.3 per level), so that
+/// its last levels are past the first four, from which the error estimate is trusted.
+pub const MIN_GROWTH: f64 = 8.0;
 /// Fewest levels a law is fitted to.
 pub const FIT_LEVELS: usize = 4;
 
@@ -65,19 +66,21 @@ impl Route {
 /// The adaptive route's prediction beside the uniform plan.
 #[derive(Clone, Debug)]
 pub struct AdaptivePlan {
-    /// The pilot sequences (adaptive θ = ½, uniform θ = 1) and their laws η = c N^p (p < 0).
+    /// The pilot sequence (θ = ½) and its law η = c N^p (p < 0).
     pub adaptive_pilot: Vec<Row>,
-    pub uniform_pilot: Vec<Row>,
     pub adaptive_law: PowerLaw,
-    pub uniform_law: PowerLaw,
-    /// Seconds the two pilots took, and the time steps they ran (the space pilot's).
+    /// The calibration E/η of the pilot's last level (`adapt::estimate`).
+    pub calibration: f64,
+    /// Seconds the pilot took, and the time steps it ran (the space pilot's).
     pub pilot_wall: f64,
     pub pilot_steps: usize,
     /// The uniform route: unknowns, steps, predicted wall and memory (from the plan).
     pub uniform_unknowns: f64,
     pub uniform_wall: f64,
     pub uniform_memory: u64,
-    /// η_u(N_u): the indicator value both routes must reach.
+    /// The estimate the route must reach ([`ESTIMATE_SHARE`] of the target), and the indicator η predicted
+    /// there.
+    pub estimate_target: f64,
     pub eta: f64,
     /// The adaptive route: its time steps (the plan's), unknowns of its last level, levels in all, wall
     /// (the whole sequence), memory.
@@ -104,7 +107,7 @@ fn law(rows: &[Row]) -> Option<PowerLaw> {
 }
 
 /// The pilot: up to `levels` levels of `adapt` with θ, until a level has `unknowns` unknowns or the
-/// pilot would take more than `budget` seconds; lean (only η and the unknowns are read).
+/// pilot would take more than `budget` seconds; lean (only η, the estimate and the unknowns are read).
 fn pilot(scene: &Scene, theta: f64, levels: usize, unknowns: usize, budget: f64) -> Result<Vec<Row>> {
     let opts =
         Options { budget: Some(budget), until_unknowns: Some(unknowns), lean: true, ..Options::levels(levels, theta) };
@@ -124,27 +127,31 @@ pub fn weigh(scene: &Scene, p: &Plan) -> Result<std::result::Result<AdaptivePlan
     };
     let Some(cost) = p.cost else { return Ok(Err("no cost model".into())) };
     let start = std::time::Instant::now();
-    // each pilot refines until PILOT_UNKNOWNS of the uniform plan's unknowns, within half the pilot budget
-    let (until, share) = ((PILOT_UNKNOWNS * u.unknowns as f64).ceil() as usize, p.options.pilot_budget / 2.0);
+    // the pilot refines until PILOT_UNKNOWNS of the uniform plan's unknowns, within half the pilot budget
+    // (and at least past the levels the estimate is trusted from, adapt::estimate::TRUSTED_FROM)
+    let n0 = Estimate::of(scene, 1, false)?.unknowns as f64;
+    let at_least = n0 * MIN_GROWTH;
+    let until = (PILOT_UNKNOWNS * u.unknowns as f64).max(at_least).ceil() as usize;
+    let share = p.options.pilot_budget / 2.0;
     // on the space pilot's time grid, where the plan's spatial error was sampled (`super::plan`)
     let nh = p.space.levels.first().map_or(scene.times.len() - 1, |l| l.steps);
     let mut s = super::pilot::pilot_scene(scene, &super::pilot::Quantity::Energy)?;
     s.set_steps(nh)?;
     let adaptive_pilot = pilot(&s, THETA, ADAPTIVE_LEVELS, until, share)?;
-    let uniform_pilot = pilot(&s, 1.0, UNIFORM_LEVELS, until, share)?;
     let pilot_wall = start.elapsed().as_secs_f64();
     let half = |rows: &[Row]| rows.len().saturating_sub((rows.len() / 2).max(FIT_LEVELS)).min(rows.len());
-    let (Some(a), Some(un)) =
-        (law(&adaptive_pilot[half(&adaptive_pilot)..]), law(&uniform_pilot[half(&uniform_pilot)..]))
-    else {
+    let (Some(a), Some(calibration)) = (
+        law(&adaptive_pilot[half(&adaptive_pilot)..]),
+        adaptive_pilot.last().and_then(|r| r.estimate.map(|e| e / r.estimator)).filter(|c| c.is_finite() && *c > 0.0),
+    ) else {
         return Ok(Err(format!(
-            "the pilots ({} adaptive, {} uniform levels) are too short or their indicator does not decrease",
-            adaptive_pilot.len(),
-            uniform_pilot.len()
+            "the pilot ({} adaptive levels) is too short, its indicator does not decrease or it has no error estimate",
+            adaptive_pilot.len()
         )));
     };
-    // the uniform candidate overshoots the target (whole refinements); the adaptive route stops at it
-    let eta = un.at(u.unknowns as f64) * (p.options.target / u.error).max(1.0);
+    // the route stops where its estimate reaches ESTIMATE_SHARE of the target: c η_a(N_a) = 0.8 T
+    let estimate_target = ESTIMATE_SHARE * p.options.target;
+    let eta = estimate_target / calibration;
     let unknowns = a.solve(eta).max(1.0);
     let last = adaptive_pilot.last().expect("levels");
     let first = &adaptive_pilot[half(&adaptive_pilot)];
@@ -173,14 +180,14 @@ pub fn weigh(scene: &Scene, p: &Plan) -> Result<std::result::Result<AdaptivePlan
     let (choice, reason) = choose(fa, fu, wall, u.wall);
     Ok(Ok(AdaptivePlan {
         adaptive_pilot,
-        uniform_pilot,
         adaptive_law: a,
-        uniform_law: un,
+        calibration,
         pilot_wall,
         pilot_steps: nh,
         uniform_unknowns: u.unknowns as f64,
         uniform_wall: u.wall,
         uniform_memory: u.memory,
+        estimate_target,
         eta,
         steps: u.steps,
         unknowns,

@@ -94,6 +94,9 @@ pub struct Plan {
     pub space_fit: Fit,
     pub time: Study,
     pub time_fit: Fit,
+    /// min(1, α_min): the energy-norm order in h the scene's corners allow (`fem::singular`), against
+    /// which the space sequence is judged and beyond which it is never extrapolated.
+    pub order_limit: f64,
     /// Steps grow by this factor in the time pilot and in the search.
     pub time_ratio: usize,
     /// The scene's steps: the fewest a plan offers.
@@ -141,6 +144,7 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         return Err(Error::scene(&scene.file, "--target", format!("{target}: must be a positive number")));
     }
     let s = pilot_scene(scene, &options.quantity)?;
+    let limit = crate::fem::singular::uniform_order(&crate::fem::singular::of_scene(&s)?);
     // the guard against a nearly singular K on the time pilot's mesh, the first made
     cache.guard_first_mesh_only();
     let (r0, n0) = (s.mesh_level(), s.times.len() - 1);
@@ -155,7 +159,7 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         cache,
     )?;
     let (time, _, spent) = &time_pilot_run;
-    let time_fit = fit(time, q)?;
+    let time_fit = fit(time, q, None)?;
     let mesh = time.levels[0].refine;
     let on_mesh = |p: &Plan| {
         p.space.levels.iter().position(|l| l.refine == mesh).and_then(|i| p.space_fit.errors.get(i).copied())
@@ -165,7 +169,7 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         // inside a step is partly missed on coarse grids, and so is its spatial error). The space pilot
         // runs on the coarsest grid of the law's family whose time error is at most LAW_SAMPLING_SHARE of
         // the spatial error on the time pilot's mesh (first found with the scene's steps).
-        let first = space_pilot(&s, options, &time_pilot_run, &time_fit, n0, *spent, cache)?;
+        let first = space_pilot(&s, options, (&time_pilot_run, limit), &time_fit, n0, *spent, cache)?;
         let (Some(e), Some(TimeError::Law(law))) = (on_mesh(&first), first.error.map(|m| m.time)) else {
             return Ok(first);
         };
@@ -177,7 +181,7 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         if n == n0 {
             return Ok(first);
         }
-        let mut p = space_pilot(&s, options, &time_pilot_run, &time_fit, n, first.pilot_wall, cache)?;
+        let mut p = space_pilot(&s, options, (&time_pilot_run, limit), &time_fit, n, first.pilot_wall, cache)?;
         p.notes.insert(
             0,
             format!(
@@ -188,14 +192,14 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         );
         return Ok(p);
     }
-    let coarse = space_pilot(&s, options, &time_pilot_run, &time_fit, nt, *spent, cache)?;
+    let coarse = space_pilot(&s, options, (&time_pilot_run, limit), &time_fit, nt, *spent, cache)?;
     // sampling time on nt steps is sound when the time grids change the solution on the time pilot's
     // mesh by at most SAMPLING_SHARE of that mesh's spatial error
     let moved = time_fit.distances.iter().copied().fold(0.0, f64::max);
     match on_mesh(&coarse).as_ref() {
         Some(&e) if moved <= SAMPLING_SHARE * e => Ok(coarse),
         _ => {
-            let mut p = space_pilot(&s, options, &time_pilot_run, &time_fit, n0, coarse.pilot_wall, cache)?;
+            let mut p = space_pilot(&s, options, (&time_pilot_run, limit), &time_fit, n0, coarse.pilot_wall, cache)?;
             p.notes.insert(
                 0,
                 format!(
@@ -213,7 +217,7 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
 fn space_pilot(
     s: &Scene,
     options: &Options,
-    (time, time_ratio, _): &(Study, usize, f64),
+    ((time, time_ratio, _), order_limit): (&(Study, usize, f64), f64),
     time_fit: &Fit,
     nh: usize,
     mut spent: f64,
@@ -228,12 +232,16 @@ fn space_pilot(
         let predicted = |r: u32| cost.map_or(0.0, |c| c.predict(unknowns(s, r).unwrap_or(0) as f64, nh));
         if run.levels().len() as u32 >= SPACE_LEVELS {
             let study = run.study();
-            let pilots = Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, wall: spent + run.spent };
+            let pilots =
+                Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, order_limit, wall: spent + run.spent };
             let draft = decide(s, options, &pilots, vec![])?;
             let extend = match draft.best.first() {
                 _ if draft.space_fit.not_in_range().is_some() => true, // not yet in the asymptotic range
                 Some(b) => b.refine > r - 1 + MAX_EXTRAPOLATION && predicted(r) <= EXTENSION_SHARE * b.wall,
-                None => false,
+                // refused for the budget: a pilot level closer to the configuration may bring it within
+                None => draft.over_budget.as_ref().is_some_and(|b| {
+                    b.refine > r - 1 + MAX_EXTRAPOLATION && predicted(r) <= EXTENSION_SHARE * options.budget
+                }),
             };
             if !extend || r > r0 + MAX_REFINE {
                 let mut done = draft;
@@ -245,7 +253,7 @@ fn space_pilot(
             notes.push(why);
             spent += run.spent;
             let study = run.study();
-            let pilots = Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, wall: spent };
+            let pilots = Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, order_limit, wall: spent };
             let mut done = decide(s, options, &pilots, notes)?;
             if done.refused.is_none() && (run.levels().len() as u32) < SPACE_LEVELS {
                 done.refused = Some("fewer than four space levels: no asymptotic-range check".into());

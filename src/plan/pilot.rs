@@ -13,7 +13,8 @@
 use super::model::TimeError;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
-use crate::study::richardson::Verdict;
+use crate::study::estimate::level_errors;
+use crate::study::richardson::{asymptotic, NormModel, Verdict, ORDER_TOL};
 use crate::study::{estimate, Axis, Level, LevelResult, Sequence, SetupCache, Study};
 
 /// The error the planner is asked to bound.
@@ -67,6 +68,9 @@ pub struct Fit {
     /// Distance of each level to the one before (max over the common nodes; |ΔQ| for an output; 0 for
     /// the first level).
     pub distances: Vec<f64>,
+    /// Why the estimates are bounds: the observed order exceeded the scene's order bound, which replaced it
+    /// ([`fit`]).
+    pub bounded: Option<String>,
 }
 
 impl Fit {
@@ -74,6 +78,9 @@ impl Fit {
     pub fn not_in_range(&self) -> Option<String> {
         if let Some(why) = &self.refused {
             return Some(why.clone());
+        }
+        if self.bounded.is_some() {
+            return None;
         }
         match self.verdicts.last() {
             Some(Verdict::InRange) => None,
@@ -83,8 +90,11 @@ impl Fit {
     }
 }
 
-/// The quantity's estimates in a finished study.
-pub fn fit(study: &Study, q: &Quantity) -> Result<Fit> {
+/// The quantity's estimates in a finished study. `limit`: the energy-norm order a space sequence can
+/// reach, min(1, α_min) from the scene's singular exponents (`fem::singular`); its levels are then judged
+/// against it (the band of `study::richardson::asymptotic` around it, not around CR's 1), and an observed
+/// order above it, still falling towards it, is replaced by it ([`bound_order`]).
+pub fn fit(study: &Study, q: &Quantity, limit: Option<f64>) -> Result<Fit> {
     let (size, x) = estimate::sizes(&study.levels);
     match q {
         Quantity::Energy => {
@@ -94,7 +104,7 @@ pub fn fit(study: &Study, q: &Quantity) -> Result<Fit> {
                 .iter()
                 .map(|r| r.increment.as_ref().map_or(0.0, |v| v.iter().copied().fold(0.0, f64::max)))
                 .collect();
-            Ok(Fit {
+            let mut f = Fit {
                 size,
                 x,
                 errors: e.levels.iter().map(|l| l.error[0]).collect(),
@@ -103,7 +113,12 @@ pub fn fit(study: &Study, q: &Quantity) -> Result<Fit> {
                 beta: e.model.map(|m| m.beta),
                 refused: e.refused.clone(),
                 distances,
-            })
+                bounded: None,
+            };
+            if let (Some(limit), Some(model), Axis::H) = (limit, e.model, size) {
+                bound_order(&mut f, study, model, limit);
+            }
+            Ok(f)
         }
         Quantity::Output(name) => {
             let i = study.output_names.iter().position(|n| n == name).ok_or_else(|| {
@@ -127,9 +142,49 @@ pub fn fit(study: &Study, q: &Quantity) -> Result<Fit> {
                 beta: None,
                 refused,
                 distances,
+                bounded: None,
             })
         }
     }
+}
+
+/// Judge a space sequence against the order bound `limit` = min(1, α_min). An observed order p at or below
+/// it is judged in the band around `limit` (`study::richardson::asymptotic`). An order above it is
+/// accepted but never extrapolated with: the model uses `limit` (a smooth part of the solution may dominate
+/// the coarse levels; the singular part's order takes over as h → 0). Where the order is still falling —
+/// the finest increment's order is more than `ORDER_TOL` below p — or the estimates are not consistent
+/// with p (the GCI test around CR's order 1), the levels are also re-estimated with p = `limit` and β ≤ 1:
+/// with Galerkin orthogonality (β = 1) the finest level's error is the sum of the increments still to
+/// come, |e_L|² = Σ_{j>L} d_j², and increments decaying at least like h^limit give
+/// |e_L| ≤ d_L/√(r^{2·limit} − 1), the estimate at p = `limit` (a smaller β only raises it). So the
+/// prediction is a bound, not a hope.
+fn bound_order(f: &mut Fit, study: &Study, model: NormModel, limit: f64) {
+    if model.p <= limit {
+        f.verdicts = asymptotic(&f.x, model.p, &f.errors, limit);
+        return;
+    }
+    let n = f.x.len();
+    let finest = (n >= 3 && f.distances[n - 1] > 0.0)
+        .then(|| (f.distances[n - 2] / f.distances[n - 1]).ln() / (f.x[n - 2] / f.x[n - 1]).ln());
+    let falling = finest.is_some_and(|o| o < model.p - ORDER_TOL);
+    let consistent = matches!(f.verdicts.last(), Some(Verdict::InRange));
+    let how = if falling || !consistent {
+        let bounded = NormModel { p: limit, beta: model.beta.min(1.0), ..model };
+        f.errors = level_errors(&study.levels, &bounded).iter().map(|e| e[0]).collect();
+        format!(
+            "{}: the finest pilot level is re-estimated with {limit:.3}",
+            if falling { "still falling towards it" } else { "its estimates are not yet consistent" }
+        )
+    } else {
+        "the finest pilot level's estimate stands".to_string()
+    };
+    f.bounded = Some(format!(
+        "the observed space order {:.3} (finest increment {}) is above min(1, α_min) = {limit:.3}, the order the \
+         scene's corners allow (`tresca-cr check`); {how}, and the error is extrapolated with {limit:.3} (a bound)",
+        model.p,
+        finest.map_or("-".into(), |o| format!("{o:.3}"))
+    ));
+    f.p = limit;
 }
 
 /// The scene the pilots run: without `[exact]`, with the quantity among its outputs.
@@ -279,7 +334,7 @@ pub fn time_pilot(
         }
         spent += run.spent;
         let study = run.study();
-        let f = fit(&study, q)?;
+        let f = fit(&study, q, None)?;
         let run_steps: Vec<usize> = study.levels.iter().map(|l| l.steps).collect();
         let done = f.not_in_range().is_none() || f.time_bound(&run_steps, steps, ratio).at(0.0) <= enough;
         last = Some((study, ratio));

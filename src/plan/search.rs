@@ -19,13 +19,16 @@ pub(super) struct Pilots<'a> {
     pub(super) time: &'a Study,
     pub(super) time_fit: &'a Fit,
     pub(super) time_ratio: usize,
+    /// min(1, α_min) of the scene ([`super::Plan::order_limit`]).
+    pub(super) order_limit: f64,
     pub(super) wall: f64,
 }
 
 /// Fit the models to the pilots and search (module doc).
 pub(super) fn decide(s: &Scene, options: &Options, pilots: &Pilots, mut notes: Vec<String>) -> Result<Plan> {
-    let Pilots { space, time, time_fit, time_ratio, wall } = *pilots;
-    let space_fit = fit(space, &options.quantity)?;
+    let Pilots { space, time, time_fit, time_ratio, order_limit, wall } = *pilots;
+    let space_fit = fit(space, &options.quantity, Some(order_limit))?;
+    notes.extend(space_fit.bounded.clone());
     let cost = CostModel::fit(&space_samples(&space.levels), &samples(&time.levels));
     let mut plan = Plan {
         options: options.clone(),
@@ -33,6 +36,7 @@ pub(super) fn decide(s: &Scene, options: &Options, pilots: &Pilots, mut notes: V
         space_fit: space_fit.clone(),
         time: time.clone(),
         time_fit: time_fit.clone(),
+        order_limit,
         time_ratio,
         scene_steps: s.times.len() - 1,
         error: None,
@@ -69,7 +73,10 @@ pub(super) fn decide(s: &Scene, options: &Options, pilots: &Pilots, mut notes: V
         plan.refused = Some("no pilot run to fit the cost model to".into());
         return Ok(plan);
     };
-    let all = candidates(s, options.target, pilots, &error, &cost)?;
+    // at a pilot's own refinement its estimate stands where it is above the model (an order bound below
+    // the observed one would extrapolate backwards below the coarser levels' errors)
+    let floor: Vec<(u32, f64)> = space.levels.iter().map(|l| l.refine).zip(space_fit.errors.iter().copied()).collect();
+    let all = candidates(s, options.target, pilots, (&error, &floor), &cost)?;
     choose(&mut plan, all, notes);
     Ok(plan)
 }
@@ -126,15 +133,26 @@ fn time_error(
 }
 
 /// Per mesh from the scene's up to [`MAX_REFINE`], the fewest steps on the time law's grids predicted to
-/// meet `target`, with its predicted cost and memory.
-fn candidates(s: &Scene, target: f64, pilots: &Pilots, error: &ErrorModel, cost: &CostModel) -> Result<Vec<Candidate>> {
+/// meet `target`, with its predicted cost and memory; the space error at a pilot's refinement is at least
+/// that pilot level's estimate (`floor`: refinement, estimate).
+fn candidates(
+    s: &Scene,
+    target: f64,
+    pilots: &Pilots,
+    (model, floor): (&ErrorModel, &[(u32, f64)]),
+    cost: &CostModel,
+) -> Result<Vec<Candidate>> {
     let (finest, time) = (pilots.space.levels.last().expect("levels"), pilots.time);
     let n0 = s.times.len() - 1;
     let t_total = s.times[n0] - s.times[0];
-    let ratio = if matches!(error.time, TimeError::Law(_)) { pilots.time_ratio } else { 1 };
+    let ratio = if matches!(model.time, TimeError::Law(_)) { pilots.time_ratio } else { 1 };
     let mut all = Vec::new();
     for r in s.mesh_level()..=MAX_REFINE {
         let h = finest.h * 0.5f64.powi(r as i32 - finest.refine as i32);
+        let error = &match floor.iter().find(|&&(q, e)| q == r && e > model.space_error(h)) {
+            Some(&(_, e)) => ErrorModel { space: PowerLaw::through(h, e, model.space.p), ..*model },
+            None => *model,
+        };
         if error.space_error(h) >= target {
             continue;
         }

@@ -84,6 +84,18 @@ pub fn estimate(r: &[LevelResult]) -> Estimates {
         };
         return refuse(why);
     };
+    let errs = level_errors(r, &model);
+    let verdicts = asymptotic(&x, model.p, &errs.iter().map(|e| e[0]).collect::<Vec<_>>(), THEORETICAL_ORDER);
+    let levels =
+        errs.iter().zip(verdicts).map(|(e, v)| LevelEstimate { error: *e, gci: FS_THREE * e[0], verdict: v }).collect();
+    Estimates { size, model: Some(model), levels, refused: None }
+}
+
+/// The estimate (max over the common nodes, at T) of every level of `r` under `model` (module doc; at
+/// least two levels, with their increments).
+pub fn level_errors(r: &[LevelResult], model: &NormModel) -> Vec<[f64; 2]> {
+    let (n, (_, x)) = (r.len(), sizes(r));
+    let inc = |l: usize| r[l].increment.as_deref().unwrap_or(&[]);
     let spread = !one_mesh(r);
     let per_node = |l: usize| -> Vec<f64> {
         let g: Vec<f64> = if l + 1 < n {
@@ -93,11 +105,7 @@ pub fn estimate(r: &[LevelResult]) -> Estimates {
         };
         g.iter().zip(&r[l].jumps).map(|(g, j)| if spread { (g * g + j).sqrt() } else { *g }).collect()
     };
-    let errs: Vec<[f64; 2]> = (0..n).map(|l| super::measure::max_last(&per_node(l))).collect();
-    let verdicts = asymptotic(&x, model.p, &errs.iter().map(|e| e[0]).collect::<Vec<_>>(), THEORETICAL_ORDER);
-    let levels =
-        errs.iter().zip(verdicts).map(|(e, v)| LevelEstimate { error: *e, gci: FS_THREE * e[0], verdict: v }).collect();
-    Estimates { size, model: Some(model), levels, refused: None }
+    (0..n).map(|l| super::measure::max_last(&per_node(l))).collect()
 }
 
 #[cfg(test)]

@@ -28,6 +28,12 @@ pub struct AdaptLevel {
     pub time_estimator: f64,
     pub time_dissipation: f64,
     pub time_load: f64,
+    /// The error estimate (η calibrated along the sequence, `adapt::estimate`) and the Richardson
+    /// estimate R it is calibrated against; from level 1 on.
+    #[serde(default)]
+    pub estimate: Option<f64>,
+    #[serde(default)]
+    pub richardson: Option<f64>,
 }
 
 impl AdaptLevel {
@@ -54,6 +60,8 @@ impl AdaptLevel {
             time_estimator: r.time_estimator,
             time_dissipation: r.time_dissipation,
             time_load: r.time_load,
+            estimate: r.estimate,
+            richardson: r.richardson,
         }
     }
 }
@@ -90,9 +98,15 @@ pub struct AdaptiveRoute {
     pub choice: Option<String>,
     pub reason: Option<String>,
     pub refused: Option<String>,
-    /// η_u(N_u), the indicator value both routes must reach.
+    /// The indicator η predicted where the route's estimate reaches `estimate_target`.
     pub eta: Option<f64>,
-    /// The laws' orders r in η = c N^(−r).
+    /// The error estimate the route must reach (`plan::adaptive::ESTIMATE_SHARE` of the target) and the
+    /// pilot's calibration E/η (`adapt::estimate`).
+    #[serde(default)]
+    pub estimate_target: Option<f64>,
+    #[serde(default)]
+    pub calibration: Option<f64>,
+    /// The laws' orders r in η = c N^(−r) (the uniform pilot is no longer run: `null`).
     pub adaptive_rate: Option<f64>,
     pub uniform_rate: Option<f64>,
     pub uniform_unknowns: Option<f64>,
@@ -108,6 +122,9 @@ pub struct AdaptiveRoute {
     pub steps: Option<usize>,
     pub adaptive_pilot: Vec<AdaptLevel>,
     pub uniform_pilot: Vec<AdaptLevel>,
+    /// With `--run` where the route was recommended: the levels of its `adapt` loop.
+    #[serde(default)]
+    pub run: Vec<AdaptLevel>,
 }
 
 impl AdaptiveRoute {
@@ -118,6 +135,8 @@ impl AdaptiveRoute {
             reason: None,
             refused: None,
             eta: None,
+            estimate_target: None,
+            calibration: None,
             adaptive_rate: None,
             uniform_rate: None,
             uniform_unknowns: None,
@@ -132,6 +151,7 @@ impl AdaptiveRoute {
             steps: None,
             adaptive_pilot: vec![],
             uniform_pilot: vec![],
+            run: vec![],
         };
         let w = match w {
             Ok(w) => w,
@@ -142,8 +162,9 @@ impl AdaptiveRoute {
             choice: Some(w.choice.name().into()),
             reason: Some(w.reason.clone()),
             eta: Some(w.eta),
+            estimate_target: Some(w.estimate_target),
+            calibration: Some(w.calibration),
             adaptive_rate: Some(-w.adaptive_law.p),
-            uniform_rate: Some(-w.uniform_law.p),
             uniform_unknowns: Some(w.uniform_unknowns),
             uniform_wall: Some(w.uniform_wall),
             uniform_memory: Some(w.uniform_memory),
@@ -155,7 +176,6 @@ impl AdaptiveRoute {
             pilot_steps: Some(w.pilot_steps),
             steps: Some(w.steps),
             adaptive_pilot: rows(&w.adaptive_pilot),
-            uniform_pilot: rows(&w.uniform_pilot),
             ..none
         }
     }

@@ -139,6 +139,8 @@ fn adapt_summary_round_trips_and_old_summaries_still_read() {
         time_estimator: 3e-3,
         time_dissipation: 1e-3,
         time_load: 2e-3 / 3.0,
+        richardson: Some(4.5e-3),
+        estimate: Some(4.4e-3),
     };
     let opts = tresca_cr::adapt::Options { reference: Some(12), ..tresca_cr::adapt::Options::levels(4, 0.5) };
     let mut s = Summary::new("adapt", "verification/cases/lshape_adapt.toml", 2.0);
