@@ -111,8 +111,7 @@ fn describe(kind: &PartKind) -> String {
         }
         PartKind::Neumann(None) => "neumann, traction free (nothing assembled)".to_string(),
         PartKind::Neumann(Some(g)) => format!("neumann, g = ({}, {})", short(g.0[0].text()), short(g.0[1].text())),
-        PartKind::Contact(g, None) => format!("contact u.n = 0, Tresca g_a = {}", short(g.text())),
-        PartKind::Contact(g, Some(n)) => format!("contact u.n = {}, Tresca g_a = {}", short(n.text()), short(g.text())),
+        PartKind::Contact(c) => c.describe(short),
     }
 }
 

@@ -195,7 +195,7 @@ impl Discretised {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         let pattern = EdgePattern::new(mesh);
         // contact unknowns last: the condensation then comes from the factor (solve::condense)
-        let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
+        let contact: Vec<usize> = space.contact_dofs();
         // The ordering needs only the graph of the edges, so the second thread starts on it before K's
         // pattern (of the unknowns) is made, which it needs only for the symbolic factorisation: that
         // thread is the longer one and ends phase 1.
@@ -305,7 +305,7 @@ impl Discretised {
 
     /// C = EᵀK⁻¹E and W from the factor (`None` without Γ_C).
     pub(super) fn condense(&self, factor: &Factor) -> Result<Option<Condensation>> {
-        let contact: Vec<usize> = self.space.contact.iter().map(|c| c.dof).collect();
+        let contact: Vec<usize> = self.space.contact_dofs();
         (!contact.is_empty()).then(|| condense(&contact, factor)).transpose()
     }
 }

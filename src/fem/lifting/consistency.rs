@@ -67,7 +67,13 @@ pub fn check(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<()> {
                     }
                 }
             }
-            PartKind::Contact(_, g) => {
+            PartKind::Contact(c) => {
+                // with normal unknowns the gap is not lifted: a unilateral initial state is checked for
+                // penetration instead (`fem::gap`)
+                if c.normal_unknown {
+                    continue;
+                }
+                let g = &c.gap;
                 if g.is_none() && scene.u0.is_none() {
                     continue;
                 }
@@ -140,7 +146,8 @@ fn shared_vertices(scene: &Scene, mesh: &Mesh, space: &CrSpace, cmp: &mut Vec<Mi
                                 cmp.push((format!("{what} (u[{c}], t = {t})"), x, va[c], vb[c]));
                             }
                         }
-                        (PartKind::Dirichlet(u), PartKind::Contact(_, g)) => {
+                        (PartKind::Dirichlet(u), PartKind::Contact(c)) if !c.normal_unknown => {
+                            let g = &c.gap;
                             cmp.push((
                                 format!("{what} (u·n against gap, t = {t})"),
                                 x,
@@ -148,7 +155,8 @@ fn shared_vertices(scene: &Scene, mesh: &Mesh, space: &CrSpace, cmp: &mut Vec<Mi
                                 gap_at(g, x, t)?,
                             ));
                         }
-                        (PartKind::Contact(_, g), PartKind::Dirichlet(u)) => {
+                        (PartKind::Contact(c), PartKind::Dirichlet(u)) if !c.normal_unknown => {
+                            let g = &c.gap;
                             cmp.push((
                                 format!("{what} (gap against u·n, t = {t})"),
                                 x,
@@ -175,7 +183,7 @@ fn data_size(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<f64> {
             for &t in &scene.times {
                 let v = match kind {
                     PartKind::Dirichlet(u @ Some(_)) => vec_at(u, x, t).unwrap_or([0.0; 2]),
-                    PartKind::Contact(_, g @ Some(_)) => [gap_at(g, x, t).unwrap_or(0.0), 0.0],
+                    PartKind::Contact(c) if c.lifted_gap().is_some() => [gap_at(&c.gap, x, t).unwrap_or(0.0), 0.0],
                     _ => break,
                 };
                 size = v.iter().filter(|c| c.is_finite()).fold(size, |m, c| m.max(c.abs()));
