@@ -74,7 +74,14 @@ impl Unknowns {
         check_finite(path, n, "u", &r.u)?;
         crate::fem::lifting::displacement_into(space, data, &r.u, r.t, &mut mid)?;
         let dof = space.contact.iter().map(|c| r.u[c.dof]).collect();
-        let r = StepResult { u: Vec::new(), mu: r.mu.clone(), slip: r.slip.clone(), state: r.state.clone(), ..*r };
+        let r = StepResult {
+            u: Vec::new(),
+            mu: r.mu.clone(),
+            slip: r.slip.clone(),
+            state: r.state.clone(),
+            normal: r.normal.clone(),
+            ..*r
+        };
         Ok(Unknowns { r, mid, dof })
     }
 

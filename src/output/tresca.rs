@@ -373,6 +373,7 @@ impl Tresca {
             errors,
             wall: self.wall.read::<f64>(n)?[0],
             audit: None,
+            normal: Default::default(),
         })
     }
 

@@ -111,6 +111,19 @@ pub struct StepResult {
     /// The step's energy audit (`None` for a step without u, or not run through [`Problem::run`]'s
     /// family).
     pub audit: Option<Audit>,
+    /// The normal condition per Γ_C edge (empty without normal unknowns).
+    pub normal: NormalState,
+}
+
+/// The normal condition of a step on the Γ_C edges with normal unknowns (`friction::normal`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NormalState {
+    /// Normal force P_e = |e| p_e (p the contact pressure; the reaction of u·n = g on a bilateral edge).
+    pub force: Vec<f64>,
+    /// u_n(m_e) − ḡ_e.
+    pub gap: Vec<f64>,
+    /// Separated (P_e = 0, open gap).
+    pub separated: Vec<bool>,
 }
 
 impl StepResult {
@@ -119,6 +132,14 @@ impl StepResult {
     }
     pub fn n_stick(&self) -> usize {
         self.state.len() - self.n_slip()
+    }
+
+    /// The contact forces λ = (μ, P) in the order of the condensed problem (μ alone without normal
+    /// unknowns).
+    pub fn forces(&self) -> Vec<f64> {
+        let mut f = self.mu.clone();
+        f.extend_from_slice(&self.normal.force);
+        f
     }
 }
 
@@ -225,22 +246,36 @@ impl Problem {
                 errors: None,
                 wall: start.elapsed().as_secs_f64(),
                 audit: None,
+                normal: NormalState::default(),
             };
             return self.finish(r);
         };
         let (sol, slip) = contact(friction, &free.trace, prev, n, t)?;
-        let (mut u, mut energy) = (Vec::new(), f64::NAN);
+        let mut r = contact_result(n, t, sol, slip, Vec::new(), f64::NAN, 0.0);
         if want_u {
-            u = self.free.with_friction(free, &sol.mu)?;
-            // a_h(u, u) = (l, u) − Σ_e μ_e s_e, since K u = l − Eμ
-            energy = dot(load, &u) - dot(&sol.mu, &slip);
+            r.u = self.free.with_friction(free, &r.forces())?;
+            r.energy = self.energy_of(load, &r);
         }
-        self.finish(contact_result(n, t, sol, slip, u, energy, start.elapsed().as_secs_f64()))
+        r.wall = start.elapsed().as_secs_f64();
+        self.finish(r)
+    }
+}
+
+impl Problem {
+    /// a_h(u, u) of a step with u: (l, u) − Σ_e μ_e s_e, since K u = l − Eμ; with normal unknowns
+    /// (l, u) − λ·Eᵀu (λ = (μ, P), Eᵀu the contact unknowns of u).
+    fn energy_of(&self, load: &[f64], r: &StepResult) -> f64 {
+        if r.normal.force.is_empty() {
+            return dot(load, &r.u) - dot(&r.mu, &r.slip);
+        }
+        let trace: Vec<f64> = self.space.contact_dofs().iter().map(|&k| r.u[k]).collect();
+        dot(load, &r.u) - dot(&r.forces(), &trace)
     }
 }
 
 /// The friction problem of step n for the free trace s_f: its solution and the slip
-/// sⁿ = sⁿ⁻¹ + Δs (with d = s_f − sⁿ⁻¹ and Δs = d − Cμ).
+/// sⁿ = sⁿ⁻¹ + Δs (with d = s_f − sⁿ⁻¹ and Δs = d − Cμ; with normal unknowns d also holds
+/// r_f − ḡ(tₙ), `friction::normal`).
 fn contact(
     friction: &Friction,
     trace: &[f64],
@@ -248,8 +283,16 @@ fn contact(
     n: usize,
     t: f64,
 ) -> Result<(FrictionSolution, Vec<f64>)> {
-    let d: Vec<f64> = trace.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
-    let sol = friction.solve(&d, &prev.mu, n, t)?;
+    let mut d: Vec<f64> = trace.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
+    let sol = match friction.normal() {
+        None => friction.solve(&d, &prev.mu, n, t)?,
+        Some(nm) => {
+            let nc = prev.slip.len();
+            d.truncate(nc);
+            d.extend(trace[nc..].iter().zip(nm.gaps(t)?).map(|(r, g)| r - g));
+            friction.solve(&d, &prev.forces(), n, t)?
+        }
+    };
     let slip = prev.slip.iter().zip(&sol.slip_increment).map(|(a, b)| a + b).collect();
     Ok((sol, slip))
 }
@@ -277,6 +320,7 @@ fn contact_result(
         errors: None,
         wall,
         audit: None,
+        normal: NormalState { force: sol.normal, gap: sol.gap, separated: sol.separated },
     }
 }
 
@@ -295,6 +339,7 @@ fn initial_state(
     let nc = space.contact.len();
     let slip = space.contact.iter().map(|c| u[c.dof]).collect();
     let energy = symmetric_energy(stiffness, &u);
+    let normal = initial_normal(d, &u)?;
     let r = StepResult {
         n: 0,
         t,
@@ -308,8 +353,23 @@ fn initial_state(
         errors: None,
         wall: 0.0,
         audit: None,
+        normal,
     };
     finish(r, d, errors)
+}
+
+/// The normal state of step 0: no force, the gap of u⁰ (refused where it penetrates a unilateral part,
+/// `fem::gap::check_initial`); empty without normal unknowns.
+fn initial_normal(d: Parts<'_>, u: &[f64]) -> Result<NormalState> {
+    let normal = d.space.normal_edges();
+    if normal.is_empty() {
+        return Ok(NormalState::default());
+    }
+    crate::fem::gap::check_initial(d.scene, d.mesh, d.space, u)?;
+    let g = crate::fem::gap::GapMeans::new(d.scene, d.mesh, d.space).at(d.scene.times[0])?;
+    let gap: Vec<f64> = normal.iter().zip(&g).map(|(&j, g)| u[d.space.contact[j].normal_dof.expect("normal")] - g).collect();
+    let separated = gap.iter().map(|&g| g < 0.0).collect();
+    Ok(NormalState { force: vec![0.0; normal.len()], gap, separated })
 }
 
 /// Finiteness check and true errors (when the scene gives `[exact]`).

@@ -267,7 +267,7 @@ impl Discretised {
         let condensation = self.condense(&factor)?;
         let t5 = Instant::now();
         let (free, c) = FreeResponse::new(factor, loads, basis, assembled, condensation, space);
-        let friction = c.map(|c| Friction::new(space, c, scene.solver));
+        let friction = c.map(|c| Friction::new(scene, &self.mesh, space, c)).transpose()?;
         let ends = PhaseEnds { assembly: t2, factorisation: t3, superposition: t4, condensation: t5 };
         Ok(Operators { stiffness, free, friction, errors, conditioning, step0, ends })
     }
