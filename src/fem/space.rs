@@ -94,9 +94,16 @@ impl Element {
 pub enum EdgeDof {
     Fixed,
     Free([usize; 2]),
-    Tangential { dof: usize, tau: [f64; 2] },
+    Tangential {
+        dof: usize,
+        tau: [f64; 2],
+    },
     /// A contact edge with a normal unknown: `dofs` = [tangential, normal] along (τ, n).
-    Frame { dofs: [usize; 2], tau: [f64; 2], normal: [f64; 2] },
+    Frame {
+        dofs: [usize; 2],
+        tau: [f64; 2],
+        normal: [f64; 2],
+    },
 }
 
 impl EdgeDof {
@@ -175,7 +182,17 @@ impl CrSpace {
                     let length = mesh.edge_length(e);
                     let unilateral = c.law == ContactLaw::Unilateral;
                     let normal_dof = c.normal_unknown.then_some(n + 1);
-                    contact.push(ContactEdge { edge: e, dof: n, normal, tangent, length, g_mean, normal_dof, unilateral, coulomb });
+                    contact.push(ContactEdge {
+                        edge: e,
+                        dof: n,
+                        normal,
+                        tangent,
+                        length,
+                        g_mean,
+                        normal_dof,
+                        unilateral,
+                        coulomb,
+                    });
                     match normal_dof {
                         None => {
                             n += 1;

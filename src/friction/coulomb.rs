@@ -36,7 +36,8 @@ pub fn solve(qp: &Qp, nm: &Normal, w: &[f64], lam0: &[f64], tol: f64, max_iter: 
         if !seen.insert(set.clone()) {
             return Err(stalled("coulomb ssn (cycling: an active set repeated)", it, res));
         }
-        lam = newton_step(qp, nm, w, &set, &sigma_p).ok_or_else(|| stalled("coulomb ssn (singular system)", it, res))?;
+        lam =
+            newton_step(qp, nm, w, &set, &sigma_p).ok_or_else(|| stalled("coulomb ssn (singular system)", it, res))?;
     }
     unreachable!("the loop returns at it == max_iter")
 }

@@ -73,7 +73,7 @@ impl Normal {
             fr.zeroed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         }
         let lo: Vec<f64> = w.iter().map(|w| -w).chain(self.lo.iter().copied()).collect();
-        let hi: Vec<f64> = w.iter().copied().chain(std::iter::repeat(f64::INFINITY).take(nc)).collect();
+        let hi: Vec<f64> = w.iter().copied().chain(std::iter::repeat_n(f64::INFINITY, nc)).collect();
         let qp = Qp { c: &fr.c, d: &d, lo: &lo, hi: &hi };
         let s = &fr.settings;
         let sol = if self.has_coulomb() {
@@ -88,7 +88,8 @@ impl Normal {
         let thr: Vec<f64> = (0..nc).map(|e| self.threshold(&w, e, lam[nc + e])).collect();
         let state = classify_with(&thr, &d, &lam[..nc], &ds[..nc]);
         let scale = ds.iter().chain(&d).fold(0.0f64, |a, v| a.max(v.abs()));
-        let separated = (0..nc).map(|e| self.lo[e] == 0.0 && lam[nc + e] <= 0.0 && ds[nc + e] < -1e-9 * scale).collect();
+        let separated =
+            (0..nc).map(|e| self.lo[e] == 0.0 && lam[nc + e] <= 0.0 && ds[nc + e] < -1e-9 * scale).collect();
         let back = |v: &[f64]| -> Vec<f64> { v.iter().map(|&x| if k == 0 { x } else { pow2_scale(x, k) }).collect() };
         Ok(FrictionSolution {
             mu: back(&lam[..nc]),

@@ -36,8 +36,9 @@ pub fn auto_step(qp: &Qp, g: &[f64]) -> f64 {
 /// Uzawa from the warm start `mu0` with step `rho` (the paper's ρ̃).
 pub fn solve(qp: &Qp, g: &[f64], mu0: &[f64], rho: f64, tol: f64, max_iter: usize) -> Solved {
     let n = qp.d.len();
-    let mut lam: Vec<f64> =
-        (0..n).map(|e| if qp.half_width(e) > 0.0 { (mu0[e] / qp.half_width(e)).clamp(-1.0, 1.0) } else { 0.0 }).collect();
+    let mut lam: Vec<f64> = (0..n)
+        .map(|e| if qp.half_width(e) > 0.0 { (mu0[e] / qp.half_width(e)).clamp(-1.0, 1.0) } else { 0.0 })
+        .collect();
     let mut mu: Vec<f64> = (0..n).map(|e| qp.half_width(e) * lam[e]).collect();
     let mut diff = f64::INFINITY;
     for it in 1..=max_iter {

@@ -27,7 +27,7 @@ pub enum PartKind {
     /// Traction g(x, y, t); `None` is traction free (nothing assembled).
     Neumann(Option<Vec2Expr>),
     /// Contact (or a symmetry part): see [`ContactPart`].
-    Contact(ContactPart),
+    Contact(Box<ContactPart>),
 }
 
 /// The normal law of a contact part.
@@ -126,7 +126,7 @@ impl PartKind {
     /// The contact part, if this is one.
     pub fn contact(&self) -> Option<&ContactPart> {
         match self {
-            PartKind::Contact(c) => Some(c),
+            PartKind::Contact(c) => Some(c.as_ref()),
             _ => None,
         }
     }

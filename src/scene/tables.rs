@@ -5,8 +5,10 @@
 use super::expr::{Expr, Vec2Expr};
 use super::raw::*;
 use super::values::{positive_finite, sized, uniform_times};
-use super::{ContactLaw, ContactPart, Diagonal, Exact, FrictionBound, FrictionLaw, MeshSpec, Method, Outputs, Part, PartKind};
 use super::SolverSettings;
+use super::{
+    ContactLaw, ContactPart, Diagonal, Exact, FrictionBound, FrictionLaw, MeshSpec, Method, Outputs, Part, PartKind,
+};
 use crate::error::{Error, Result};
 
 /// `[mesh]`: a Gmsh file or a structured quadrilateral, with its refinements.
@@ -62,21 +64,20 @@ pub(super) fn parts(file: &str, boundary: &[RawBoundary]) -> Result<Vec<Part>> {
         let kind = match b.kind {
             RawKind::Dirichlet => PartKind::Dirichlet(super::parts::dirichlet_data(file, &key("u"), b.u.as_ref())?),
             RawKind::Neumann => PartKind::Neumann(traction(file, &key("traction"), b.traction.as_ref())?),
-            RawKind::Contact => PartKind::Contact(contact_part(file, b, &key)?),
-            RawKind::Symmetry => PartKind::Contact(ContactPart {
+            RawKind::Contact => PartKind::Contact(Box::new(contact_part(file, b, &key)?)),
+            RawKind::Symmetry => PartKind::Contact(Box::new(ContactPart {
                 law: ContactLaw::Bilateral,
                 friction: FrictionLaw::Tresca(FrictionBound::parse(file, &key("kind"), "0")?),
                 gap: None,
                 traction: None,
                 symmetry: true,
                 normal_unknown: false,
-            }),
+            })),
         };
         parts.push(Part { name: b.name.clone(), kind });
     }
-    let normal = parts.iter().filter_map(|p| p.kind.contact()).any(|c| {
-        c.law == ContactLaw::Unilateral || c.coulomb().is_some()
-    });
+    let normal =
+        parts.iter().filter_map(|p| p.kind.contact()).any(|c| c.law == ContactLaw::Unilateral || c.coulomb().is_some());
     for p in &mut parts {
         if let PartKind::Contact(c) = &mut p.kind {
             c.normal_unknown = normal;
@@ -104,7 +105,12 @@ pub(super) fn parts(file: &str, boundary: &[RawBoundary]) -> Result<Vec<Part>> {
 fn refuse_foreign_keys(file: &str, b: &RawBoundary, key: &dyn Fn(&str) -> String) -> Result<()> {
     let contact = b.kind == RawKind::Contact;
     let given = [
-        ("traction", b.traction.is_some(), matches!(b.kind, RawKind::Neumann | RawKind::Contact), "neumann and contact parts take a traction"),
+        (
+            "traction",
+            b.traction.is_some(),
+            matches!(b.kind, RawKind::Neumann | RawKind::Contact),
+            "neumann and contact parts take a traction",
+        ),
         ("g_a", b.g_a.is_some(), contact, "contact parts take a friction bound g_a"),
         ("u", b.u.is_some(), b.kind == RawKind::Dirichlet, "dirichlet parts take boundary values u"),
         ("gap", b.gap.is_some(), contact, "contact parts take a gap"),

@@ -367,7 +367,8 @@ fn initial_normal(d: Parts<'_>, u: &[f64]) -> Result<NormalState> {
     }
     crate::fem::gap::check_initial(d.scene, d.mesh, d.space, u)?;
     let g = crate::fem::gap::GapMeans::new(d.scene, d.mesh, d.space).at(d.scene.times[0])?;
-    let gap: Vec<f64> = normal.iter().zip(&g).map(|(&j, g)| u[d.space.contact[j].normal_dof.expect("normal")] - g).collect();
+    let gap: Vec<f64> =
+        normal.iter().zip(&g).map(|(&j, g)| u[d.space.contact[j].normal_dof.expect("normal")] - g).collect();
     let separated = gap.iter().map(|&g| g < 0.0).collect();
     Ok(NormalState { force: vec![0.0; normal.len()], gap, separated })
 }
