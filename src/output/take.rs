@@ -141,7 +141,7 @@ impl Writer {
             self.frame_rows.push(r.t, &self.buf);
             self.frame_steps.push(n);
         }
-        self.rows.push(&r, &mid, &sigma_t, &dof);
+        self.rows.push(&r, &mid, (&sigma_t, &dof), self.fields.contact_lengths());
         self.mid = mid;
         self.prev_slip = Some(r.slip);
         Ok(())

@@ -15,6 +15,10 @@
 //! up to rounding and the friction solver's tolerance (NaN where a step had no audit). The audit series
 //! are not part of the checksum below (files before them have none).
 //!
+//! With normal unknowns (a unilateral or Coulomb part, `friction::normal`) also
+//! `contact/{pressure, gap, status}` (·, C): p_e = P_e/|e|, u·n(m_e) − ḡ_e and 0 stick, 1 slip,
+//! 2 separated ([`NORMAL`]); they are not part of the checksum either (the files without them have none).
+//!
 //! `u` is the displacement at the edge midpoints, the lifting of the boundary data included
 //! (`fem::lifting`); `energy` is a_h(uⁿ,uⁿ) with the Dirichlet jump measured against u_D.
 //! `tresca/steps` carries the attribute `completed` (number of complete steps), written after every
@@ -54,7 +58,12 @@ pub struct Tresca {
     checksum: Option<Series>,
     /// The energy audit, [`AUDIT`] (`None` in files of versions before it).
     audit: Option<Vec<Series>>,
+    /// [`NORMAL`] (`None` without normal unknowns).
+    normal: Option<[Series; 3]>,
 }
+
+/// The series of the normal condition under `contact`: pressure, gap, status.
+pub const NORMAL: [&str; 3] = ["pressure", "gap", "status"];
 
 /// The audit's series under `steps`, in `stepping::Audit::as_array`'s order.
 pub const AUDIT: [&str; 6] = [
@@ -146,6 +155,17 @@ impl Tresca {
                 Series::create::<f64>(&cg, "dof", 1, &[nc], sc)?,
             ])
         };
+        let normal = match (space.normal_edges().is_empty(), g.group("contact")) {
+            (false, Ok(cg)) => {
+                let nc = space.contact.len();
+                Some([
+                    Series::create::<f64>(&cg, NORMAL[0], 1, &[nc], sc)?,
+                    Series::create::<f64>(&cg, NORMAL[1], 1, &[nc], sc)?,
+                    Series::create::<u8>(&cg, NORMAL[2], 1, &[nc], sc)?,
+                ])
+            }
+            _ => None,
+        };
         let errors = if p.meta.true_errors {
             let eg = g.create_group("errors")?;
             Some([
@@ -160,6 +180,7 @@ impl Tresca {
         attr(&sg, "completed", 0i64)?;
         let audit = AUDIT.iter().map(|a| Series::create::<f64>(&sg, a, 1, &[], sc)).collect::<hdf5::Result<_>>()?;
         Ok(Tresca {
+            normal,
             audit: Some(audit),
             checksum: Some(Series::create::<u64>(&sg, "checksum", 1, &[], sc)?),
             times: Series::create::<f64>(&g, "times", 1, &[], sc)?,
@@ -195,7 +216,12 @@ impl Tresca {
             Ok(eg) => Some([Series::open(&eg, "energy", 1)?, Series::open(&eg, "h1", 1)?, Series::open(&eg, "l2", 1)?]),
             Err(_) => None,
         };
+        let normal = g.group("contact").ok().and_then(|cg| {
+            let [a, b, c] = NORMAL.map(|k| Series::open(&cg, k, 1).ok());
+            Some([a?, b?, c?])
+        });
         Ok(Tresca {
+            normal,
             audit: AUDIT.iter().map(|a| Series::open(&sg, a, 1)).collect::<hdf5::Result<_>>().ok(),
             checksum: Series::open(&sg, "checksum", 1).ok(),
             times: Series::open(&g, SCALARS[0], 1)?,
@@ -305,6 +331,11 @@ impl Tresca {
                 s.write_steps(raw, n, k, v)?;
             }
         }
+        if let Some([p, g, st]) = &self.normal {
+            p.write_steps(raw, n, k, &b.pressure)?;
+            g.write_steps(raw, n, k, &b.gap)?;
+            st.write_steps(raw, n, k, &b.status)?;
+        }
         if let Some(a) = &self.audit {
             for (s, v) in a.iter().zip(&b.audit) {
                 s.write_steps(raw, n, k, v)?;
@@ -324,7 +355,7 @@ impl Tresca {
         if let Some(c) = &mut self.checksum {
             c.set_steps(raw, steps, kept)?;
         }
-        for a in self.audit.iter_mut().flatten() {
+        for a in self.audit.iter_mut().flatten().chain(self.normal.iter_mut().flatten()) {
             a.set_steps(raw, steps, kept)?;
         }
         self.all().into_iter().try_for_each(|s| s.set_steps(raw, steps, kept))

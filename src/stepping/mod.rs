@@ -134,6 +134,23 @@ impl StepResult {
         self.state.len() - self.n_slip()
     }
 
+    /// With normal unknowns, the lengths of Γ_C in contact (not separated), separated, and sticking
+    /// in contact (`None` without normal unknowns).
+    pub fn contact_lengths(&self, space: &CrSpace) -> Option<[f64; 3]> {
+        if self.normal.force.is_empty() {
+            return None;
+        }
+        let mut l = [0.0; 3];
+        for ((c, &sep), &st) in space.contact.iter().zip(&self.normal.separated).zip(&self.state) {
+            let k = if sep { 1 } else { 0 };
+            l[k] += c.length;
+            if !sep && st == EdgeState::Stick {
+                l[2] += c.length;
+            }
+        }
+        Some(l)
+    }
+
     /// The contact forces λ = (μ, P) in the order of the condensed problem (μ alone without normal
     /// unknowns).
     pub fn forces(&self) -> Vec<f64> {
