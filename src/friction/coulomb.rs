@@ -12,13 +12,24 @@
 //! (`Qp::residual` with the bounds of the current P) is ≤ tol; a repeated active set (the iteration
 //! cycles, as for a large F̄) or the iteration limit stops it, reported as non-convergence.
 
-use super::normal::Normal;
 use super::{stalled, Qp, Solved};
 use nalgebra::{DMatrix, DVector};
 use std::collections::HashSet;
 
-/// Solve from λ₀ = (μ₀, P₀); `w` are the Tresca bounds (used on Tresca edges).
-pub fn solve(qp: &Qp, nm: &Normal, w: &[f64], lam0: &[f64], tol: f64, max_iter: usize) -> Solved {
+/// The coefficients of the edges: F̄_e of a Coulomb edge (`None`: Tresca's bound w_e).
+pub type Coefficients<'a> = &'a [Option<f64>];
+
+/// The friction threshold of edge e for the normal force `p`: w_e (Tresca) or F̄_e |p| (Coulomb).
+pub fn threshold(f: Coefficients, w: &[f64], e: usize, p: f64) -> f64 {
+    match f[e] {
+        Some(f) => f * p.abs(),
+        None => w[e],
+    }
+}
+
+/// Solve from λ₀ = (μ₀, P₀); `w` are the Tresca bounds (used on Tresca edges), the normal forces'
+/// bounds are those of `qp` (lower bound 0: unilateral).
+pub fn solve(qp: &Qp, nm: Coefficients, w: &[f64], lam0: &[f64], tol: f64, max_iter: usize) -> Solved {
     let n = qp.d.len();
     let nc = n / 2;
     let mut lam: Vec<f64> = (0..n).map(|k| if k < nc { lam0[k] } else { lam0[k].max(qp.lo[k]) }).collect();
@@ -44,7 +55,7 @@ pub fn solve(qp: &Qp, nm: &Normal, w: &[f64], lam0: &[f64], tol: f64, max_iter: 
 
 /// Per unknown its set: tangential 0 stick, ±1 slip, 2 free (μ = 0); normal 0 closed, 1 separated. And
 /// per edge the sign s of the normal force in the threshold F̄ s P.
-fn active_sets(qp: &Qp, nm: &Normal, w: &[f64], lam: &[f64], ds: &[f64]) -> (Vec<i8>, Vec<f64>) {
+fn active_sets(qp: &Qp, nm: Coefficients, w: &[f64], lam: &[f64], ds: &[f64]) -> (Vec<i8>, Vec<f64>) {
     let n = lam.len();
     let nc = n / 2;
     let mut set = vec![0i8; n];
@@ -52,10 +63,10 @@ fn active_sets(qp: &Qp, nm: &Normal, w: &[f64], lam: &[f64], ds: &[f64]) -> (Vec
     for e in 0..nc {
         let k = nc + e;
         let yn = lam[k] + ds[k] / qp.c[(k, k)];
-        let separated = nm.lo[e] == 0.0 && yn <= 0.0;
+        let separated = qp.lo[k] == 0.0 && yn <= 0.0;
         set[k] = i8::from(separated);
         sign[e] = if yn < 0.0 { -1.0 } else { 1.0 };
-        let theta = if separated && nm.coulomb[e].is_some() { 0.0 } else { nm.threshold(w, e, yn) };
+        let theta = if separated && nm[e].is_some() { 0.0 } else { threshold(nm, w, e, yn) };
         let yt = lam[e] + ds[e] / qp.c[(e, e)];
         set[e] = if theta == 0.0 {
             2
@@ -73,7 +84,7 @@ fn active_sets(qp: &Qp, nm: &Normal, w: &[f64], lam: &[f64], ds: &[f64]) -> (Vec
 }
 
 /// The iterate of the active sets `set` (one linear solve, dense LU).
-fn newton_step(qp: &Qp, nm: &Normal, w: &[f64], set: &[i8], sign: &[f64]) -> Option<Vec<f64>> {
+fn newton_step(qp: &Qp, nm: Coefficients, w: &[f64], set: &[i8], sign: &[f64]) -> Option<Vec<f64>> {
     let n = set.len();
     let nc = n / 2;
     let mut a = DMatrix::zeros(n, n);
@@ -90,7 +101,7 @@ fn newton_step(qp: &Qp, nm: &Normal, w: &[f64], set: &[i8], sign: &[f64]) -> Opt
             1 => a[(k, k)] = 1.0,
             _ => row_of_c(&mut a, &mut b, k),
         }
-        match (set[e], nm.coulomb[e]) {
+        match (set[e], nm[e]) {
             (0, _) => row_of_c(&mut a, &mut b, e),
             (2, _) => a[(e, e)] = 1.0,
             (s, Some(f)) => {
@@ -109,7 +120,7 @@ fn newton_step(qp: &Qp, nm: &Normal, w: &[f64], set: &[i8], sign: &[f64]) -> Opt
 
 /// The natural residual of both conditions, relative to the step's force scale: max over the normal
 /// forces of |P − max(lo, P + Δ_n/C)| and over the friction forces of |μ − clamp(μ + Δs/C, ±θ(P))|.
-fn residual(qp: &Qp, nm: &Normal, w: &[f64], lam: &[f64], ds: &[f64]) -> f64 {
+fn residual(qp: &Qp, nm: Coefficients, w: &[f64], lam: &[f64], ds: &[f64]) -> f64 {
     let n = lam.len();
     let nc = n / 2;
     let mut r: f64 = 0.0;
@@ -117,11 +128,11 @@ fn residual(qp: &Qp, nm: &Normal, w: &[f64], lam: &[f64], ds: &[f64]) -> f64 {
     for e in 0..nc {
         let k = nc + e;
         r = r.max((lam[k] - qp.project(k, lam[k] + ds[k] / qp.c[(k, k)])).abs());
-        let theta = nm.threshold(w, e, lam[k]);
+        let theta = threshold(nm, w, e, lam[k]);
         r = r.max((lam[e] - (lam[e] + ds[e] / qp.c[(e, e)]).clamp(-theta, theta)).abs());
         scale = scale.max(qp.d[k].abs() / qp.c[(k, k)]);
         let t = qp.d[e].abs() / qp.c[(e, e)];
-        scale = scale.max(if nm.coulomb[e].is_some() { t } else { t.min(w[e]) });
+        scale = scale.max(if nm[e].is_some() { t } else { t.min(w[e]) });
     }
     if r == 0.0 {
         0.0

@@ -57,14 +57,6 @@ impl Normal {
         self.coulomb.iter().any(|f| f.is_some())
     }
 
-    /// The friction threshold of edge e for the normal force `p`: w_e (Tresca) or F̄_e |p| (Coulomb).
-    pub(super) fn threshold(&self, w: &[f64], e: usize, p: f64) -> f64 {
-        match self.coulomb[e] {
-            Some(f) => f * p.abs(),
-            None => w[e],
-        }
-    }
-
     /// Solve step n (time t): d and λ₀ = (μ₀, P₀) in the order of the module doc.
     pub(super) fn solve(&self, fr: &Friction, d: &[f64], mu0: &[f64], n: usize, t: f64) -> Result<FrictionSolution> {
         let nc = fr.w.len();
@@ -77,7 +69,7 @@ impl Normal {
         let qp = Qp { c: &fr.c, d: &d, lo: &lo, hi: &hi };
         let s = &fr.settings;
         let sol = if self.has_coulomb() {
-            coulomb::solve(&qp, self, &w, &mu0, s.tol, s.max_iter())
+            coulomb::solve(&qp, &self.coulomb, &w, &mu0, s.tol, s.max_iter())
         } else if s.method == Method::Pdas {
             pdas::solve(&qp, &mu0, s.tol, s.max_iter())
         } else {
@@ -85,7 +77,7 @@ impl Normal {
         };
         let (lam, iterations, residual) = sol.map_err(|e| not_converged(e, n, t, s.tol))?;
         let ds = qp.slip_increment(&lam);
-        let thr: Vec<f64> = (0..nc).map(|e| self.threshold(&w, e, lam[nc + e])).collect();
+        let thr: Vec<f64> = (0..nc).map(|e| coulomb::threshold(&self.coulomb, &w, e, lam[nc + e])).collect();
         let state = classify_with(&thr, &d, &lam[..nc], &ds[..nc]);
         let scale = ds.iter().chain(&d).fold(0.0f64, |a, v| a.max(v.abs()));
         let separated =
