@@ -55,6 +55,17 @@ impl GapMeans {
     }
 }
 
+/// Refuse a scene whose initial state u⁰ = I_CR u₀ penetrates a unilateral part ([`check_initial`]),
+/// before anything is assembled (nothing to check without normal unknowns or without u₀).
+pub fn check_scene(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<()> {
+    match &scene.u0 {
+        Some(u0) if !space.normal_edges().is_empty() => {
+            check_initial(scene, mesh, space, &space.interpolate(mesh, u0, scene.times[0])?)
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Refuse an initial state `u` (the unknowns of u⁰ = I_CR u₀) whose normal part exceeds the gap on a
 /// unilateral edge, u⁰_n(m_e) > ḡ_e(t₀), naming the part and the edge's midpoint.
 pub fn check_initial(scene: &Scene, mesh: &Mesh, space: &CrSpace, u: &[f64]) -> Result<()> {

@@ -76,6 +76,7 @@ impl Problem {
         let space = CrSpace::new(&mesh, &scene.parts).map_err(|e| (e, None))?;
         let data = BoundaryData::of(&mesh, &scene.parts, &space);
         crate::fem::lifting::consistency::check(&scene, &mesh, &space).map_err(|e| (e, None))?;
+        crate::fem::gap::check_scene(&scene, &mesh, &space).map_err(|e| (e, None))?;
         let t1 = Instant::now();
         let law = Elasticity::new(&scene.material);
         let p0 = Discretised { scene, mesh, space, data, law, guard };
