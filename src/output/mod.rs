@@ -49,6 +49,7 @@ mod create;
 pub mod fields;
 mod h5;
 mod lock;
+mod normal_series;
 mod paths;
 mod resume;
 mod rows;

@@ -62,8 +62,7 @@ pub struct Tresca {
     normal: Option<[Series; 3]>,
 }
 
-/// The series of the normal condition under `contact`: pressure, gap, status.
-pub const NORMAL: [&str; 3] = ["pressure", "gap", "status"];
+pub use super::normal_series::NORMAL;
 
 /// The audit's series under `steps`, in `stepping::Audit::as_array`'s order.
 pub const AUDIT: [&str; 6] = [
@@ -155,17 +154,7 @@ impl Tresca {
                 Series::create::<f64>(&cg, "dof", 1, &[nc], sc)?,
             ])
         };
-        let normal = match (space.normal_edges().is_empty(), g.group("contact")) {
-            (false, Ok(cg)) => {
-                let nc = space.contact.len();
-                Some([
-                    Series::create::<f64>(&cg, NORMAL[0], 1, &[nc], sc)?,
-                    Series::create::<f64>(&cg, NORMAL[1], 1, &[nc], sc)?,
-                    Series::create::<u8>(&cg, NORMAL[2], 1, &[nc], sc)?,
-                ])
-            }
-            _ => None,
-        };
+        let normal = super::normal_series::create(&g, space, sc)?;
         let errors = if p.meta.true_errors {
             let eg = g.create_group("errors")?;
             Some([
@@ -216,10 +205,7 @@ impl Tresca {
             Ok(eg) => Some([Series::open(&eg, "energy", 1)?, Series::open(&eg, "h1", 1)?, Series::open(&eg, "l2", 1)?]),
             Err(_) => None,
         };
-        let normal = g.group("contact").ok().and_then(|cg| {
-            let [a, b, c] = NORMAL.map(|k| Series::open(&cg, k, 1).ok());
-            Some([a?, b?, c?])
-        });
+        let normal = super::normal_series::open(&g);
         Ok(Tresca {
             normal,
             audit: AUDIT.iter().map(|a| Series::open(&sg, a, 1)).collect::<hdf5::Result<_>>().ok(),
