@@ -251,3 +251,27 @@ fn coulomb_with_a_large_coefficient_that_does_not_converge_says_so() {
         assert!(e.contains(n), "message `{e}` lacks `{n}`");
     }
 }
+
+/// The system shall assemble a contact part's `traction` as a surface load on Γ_C besides the contact
+/// reaction: a block lifted off its foundation (every Γ_C edge separated, no friction) with the traction
+/// on its unilateral part is the block whose bottom is a Neumann part with that traction. Tolerance: the
+/// natural residual ≤ 1e-12 of the force scale leaves the normal forces at zero up to it times cond(C)
+/// (< 1e3): 1e-9 of max |u|.
+#[test]
+fn contact_traction_is_a_surface_load_on_gamma_c() {
+    let top = r#"["0", "0.01*t"]"#;
+    let traction = "traction = [\"0.1*t\", \"-0.05*t\"]";
+    let con = common::run(block(top, &format!("law = \"unilateral\"\ng_a = \"0\"\n{traction}")));
+    let text =
+        BLOCK.replace("TOP", top).replace("kind = \"contact\"\nCONTACT", &format!("kind = \"neumann\"\n{traction}"));
+    let neu = common::run(Scene::from_str(&text, "n.toml").unwrap());
+    let last = con.1.last().unwrap();
+    assert!(last.normal.separated.iter().all(|&s| s), "{:?}", last.normal.separated);
+    let (a, b) = (con.0.displacement(&last.u, last.t).unwrap(), {
+        let r = neu.1.last().unwrap();
+        neu.0.displacement(&r.u, r.t).unwrap()
+    });
+    let scale = max_abs(b.iter().flatten().copied());
+    let d = max_abs(a.iter().zip(&b).flat_map(|(x, y)| [x[0] - y[0], x[1] - y[1]]));
+    assert!(d <= 1e-9 * scale, "|u_contact - u_neumann| = {d:e} (max |u| {scale:e})");
+}
