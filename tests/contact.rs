@@ -83,8 +83,10 @@ fn clamped_solve(p: &Problem, load: &[f64]) -> Vec<f64> {
 
 fn set_ga(s: &mut Scene, g: &str) {
     for part in &mut s.parts {
-        if let PartKind::Contact(e, _) = &mut part.kind {
-            *e = tresca_cr::scene::FrictionBound::parse("test", "g_a", g).unwrap();
+        if let PartKind::Contact(c) = &mut part.kind {
+            c.friction = tresca_cr::scene::FrictionLaw::Tresca(
+                tresca_cr::scene::FrictionBound::parse("test", "g_a", g).unwrap(),
+            );
         }
     }
 }

@@ -75,9 +75,10 @@ pub fn check(scene: Scene, estimate: Estimate, reports: super::summary::Reports)
         let n = edges_of(sp.edge_part.iter().filter(|&&q| q == Some(p)).count());
         say!("part       {:<10} {:>6} edges  {}", part.name, n, describe(&part.kind));
     }
-    // two unknowns per free edge, one per contact edge, none on Dirichlet edges
+    // two unknowns per free edge, one per contact edge (two with normal unknowns), none on Dirichlet edges
     let (dirichlet, contact) = (edges_of(sp.n_dirichlet), edges_of(sp.contact.len()));
-    let unknowns = 2 * (e - dirichlet - contact) + contact;
+    let contact = if s.has_normal_unknowns() { 2 * contact } else { contact };
+    let unknowns = 2 * (e - dirichlet) - if s.has_normal_unknowns() { 0 } else { contact };
     say!(
         "unknowns   {unknowns} (paper's count 2(edges - Dirichlet edges) = {}), {contact} contact unknowns",
         2 * (e - dirichlet)
@@ -114,8 +115,7 @@ fn describe(kind: &PartKind) -> String {
         }
         PartKind::Neumann(None) => "neumann, traction free (nothing assembled)".to_string(),
         PartKind::Neumann(Some(g)) => format!("neumann, g = ({}, {})", short(g.0[0].text()), short(g.0[1].text())),
-        PartKind::Contact(g, None) => format!("contact u.n = 0, Tresca g_a = {}", short(g.text())),
-        PartKind::Contact(g, Some(n)) => format!("contact u.n = {}, Tresca g_a = {}", short(n.text()), short(g.text())),
+        PartKind::Contact(c) => c.describe(short),
     }
 }
 
@@ -155,7 +155,7 @@ fn write_json(
         h: m.h_max(),
         unknowns: sp.n_dofs,
         paper_dofs: sp.paper_dofs(),
-        contact_unknowns: sp.contact.len(),
+        contact_unknowns: sp.contact_dofs().len(),
         steps: problem.n_steps(),
         solver: s.solver.method.name().into(),
         tol: s.solver.tol,

@@ -43,7 +43,7 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool, json: Opti
     let mut tally = Tally::default();
     let mut step_stats = Vec::new();
     let on_step = |r: &tresca_cr::StepResult| -> tresca_cr::Result<()> {
-        step_stats.push(super::summary::Step::of(r));
+        step_stats.push(super::summary::Step::of(r, &problem.space));
         if let Some(w) = writer.as_mut() {
             w.write_step(r)?;
         }

@@ -28,7 +28,8 @@
 //! was made: AMD, nested dissection by coordinates, or METIS when the factor by coordinates would not fit
 //! in memory; absent from the summaries of older versions); `step_stats`: one [`Step`] per step solved (step
 //! 0 included: `n`, `t`, `iterations`, `residual` (the solver's final KKT residual), `stick`, `slip` (contact
-//! edges), `errors` (true errors at tⁿ with `[exact]`, else `null`)); `iterations` (sum over the steps),
+//! edges), `errors` (true errors at tⁿ with `[exact]`, else `null`), and with a unilateral or Coulomb part
+//! `lengths`: `contact_length`, `separated_length`, `stick_length` of Γ_C); `iterations` (sum over the steps),
 //! `max_residual`; `max_errors`: the true errors, max over the time nodes (`null` without `[exact]`);
 //! `output`: the results file (`null` when none was written).
 //!
@@ -249,10 +250,21 @@ pub struct Step {
     pub stick: usize,
     pub slip: usize,
     pub errors: Option<Errors>,
+    /// With a unilateral or Coulomb part: the lengths of Γ_C in contact, separated, and sticking.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lengths: Option<ContactLengths>,
+}
+
+/// Lengths of Γ_C in one step (scenes with normal unknowns).
+#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq)]
+pub struct ContactLengths {
+    pub contact_length: f64,
+    pub separated_length: f64,
+    pub stick_length: f64,
 }
 
 impl Step {
-    pub fn of(r: &tresca_cr::StepResult) -> Step {
+    pub fn of(r: &tresca_cr::StepResult, space: &tresca_cr::fem::space::CrSpace) -> Step {
         Step {
             n: r.n,
             t: r.t,
@@ -261,6 +273,11 @@ impl Step {
             stick: r.n_stick(),
             slip: r.n_slip(),
             errors: r.errors.map(Errors::from),
+            lengths: r.contact_lengths(space).map(|[c, s, k]| ContactLengths {
+                contact_length: c,
+                separated_length: s,
+                stick_length: k,
+            }),
         }
     }
 }

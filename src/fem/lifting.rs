@@ -138,7 +138,8 @@ impl BoundaryData {
                     data.d_sets.push(ExprSet::new(&[&u.0[0], &u.0[1]]).bind(points));
                     data.dirichlet.extend(edges);
                 }
-                PartKind::Contact(_, Some(g)) => {
+                PartKind::Contact(c) if c.lifted_gap().is_some() => {
+                    let g = c.lifted_gap().expect("checked");
                     let idx: Vec<usize> =
                         (0..contact.len()).filter(|&j| edge_part[contact[j].edge] == Some(p)).collect();
                     let points = idx.iter().flat_map(|&j| gauss3_points(mesh, contact[j].edge)).collect();

@@ -2,6 +2,7 @@
 //!
 //! * [`space`]: the Crouzeix–Raviart element and the space V_h (zero boundary values);
 //! * [`lifting`]: nonzero boundary data u_D, g_n, added to V_h's unknowns by their lifting;
+//! * [`gap`]: the gap ḡ_e(t) of the Γ_C edges with a normal unknown (unilateral or Coulomb scenes);
 //! * [`quadrature`]: the quadrature rules on triangles and edges;
 //! * [`elasticity`]: the one elasticity law (plane strain);
 //! * [`assemble`]: the stiffness K of a_h; [`loads`]: the load functional lⁿ;
@@ -14,6 +15,7 @@ pub mod assemble;
 pub mod elasticity;
 pub mod exact;
 pub mod forms;
+pub mod gap;
 pub mod lifting;
 pub mod loads;
 pub mod norms;

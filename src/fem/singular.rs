@@ -40,7 +40,7 @@ pub fn sides_of(kind: &PartKind) -> &'static [Side] {
     match kind {
         PartKind::Dirichlet(_) => &[Side::Clamped],
         PartKind::Neumann(_) => &[Side::Free],
-        PartKind::Contact(..) => &[Side::Clamped, Side::Sliding],
+        PartKind::Contact(_) => &[Side::Clamped, Side::Sliding],
     }
 }
 

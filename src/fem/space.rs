@@ -7,6 +7,8 @@
 //! * `Fixed` (zero) on Dirichlet edges (u_D's edge mean, the lifting, is added outside V_h: `lifting`),
 //! * s_e τ_e on contact edges (τ_e = (−n_y, n_x), n_e outward: the normal part is eliminated; an imposed
 //!   normal displacement is part of the lifting), one unknown,
+//! * s_e τ_e + r_e n_e on contact edges when the scene has normal unknowns (a unilateral or a Coulomb
+//!   part, `scene::ContactPart::normal_unknown`): two unknowns, tangential then normal,
 //! * (u_x, u_y) elsewhere, two unknowns.
 //!
 //! The interpolant I_CR takes edge means (3-point Gauss), which commute with time derivatives.
@@ -28,7 +30,7 @@ use super::quadrature::{edge_point, GAUSS3};
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::scene::expr::{ExprSet, Vec2Expr};
-use crate::scene::{Part, PartKind};
+use crate::scene::{ContactLaw, FrictionBound, Part, PartKind};
 
 /// Geometry of one triangle: constant barycentric gradients.
 #[derive(Clone, Copy, Debug)]
@@ -92,7 +94,16 @@ impl Element {
 pub enum EdgeDof {
     Fixed,
     Free([usize; 2]),
-    Tangential { dof: usize, tau: [f64; 2] },
+    Tangential {
+        dof: usize,
+        tau: [f64; 2],
+    },
+    /// A contact edge with a normal unknown: `dofs` = [tangential, normal] along (τ, n).
+    Frame {
+        dofs: [usize; 2],
+        tau: [f64; 2],
+        normal: [f64; 2],
+    },
 }
 
 impl EdgeDof {
@@ -102,6 +113,7 @@ impl EdgeDof {
             EdgeDof::Fixed => [None, None],
             EdgeDof::Free([a, b]) => [Some((a, [1.0, 0.0])), Some((b, [0.0, 1.0]))],
             EdgeDof::Tangential { dof, tau } => [Some((dof, tau)), None],
+            EdgeDof::Frame { dofs: [a, b], tau, normal } => [Some((a, tau)), Some((b, normal))],
         };
         t.into_iter().flatten()
     }
@@ -115,8 +127,14 @@ pub struct ContactEdge {
     pub normal: [f64; 2],
     pub tangent: [f64; 2],
     pub length: f64,
-    /// ḡ_e, the mean of g_a over the edge.
+    /// ḡ_e, the mean of g_a over the edge (0 on a Coulomb edge).
     pub g_mean: f64,
+    /// The normal unknown r_e = u·n_e(m_e) (scenes with normal unknowns).
+    pub normal_dof: Option<usize>,
+    /// True on a unilateral edge (u·n ≤ ḡ), false on a bilateral one (u·n = ḡ).
+    pub unilateral: bool,
+    /// F̄_e, the mean of Coulomb's coefficient over the edge (`None`: Tresca).
+    pub coulomb: Option<f64>,
 }
 
 /// The discrete space V_h on a mesh with its boundary parts bound.
@@ -147,18 +165,44 @@ impl CrSpace {
                     n_dirichlet += 1;
                     EdgeDof::Fixed
                 }
-                Some(PartKind::Contact(g, _)) => {
+                Some(PartKind::Contact(c)) => {
                     let normal = mesh.outward_normal(e);
                     let tangent = [-normal[1], normal[0]];
                     let [a, b] = mesh.edges[e].map(|v| mesh.points[v]);
-                    let mut g_mean = 0.0;
-                    for (s, w) in GAUSS3 {
-                        let x = edge_point(a, b, s);
-                        g_mean += w * g.at(x[0], x[1])?;
+                    let mean = |g: &FrictionBound| -> Result<f64> {
+                        let mut m = 0.0;
+                        for (s, w) in GAUSS3 {
+                            let x = edge_point(a, b, s);
+                            m += w * g.at(x[0], x[1])?;
+                        }
+                        Ok(m)
+                    };
+                    let g_mean = c.tresca().map(mean).transpose()?.unwrap_or(0.0);
+                    let coulomb = c.coulomb().map(mean).transpose()?;
+                    let length = mesh.edge_length(e);
+                    let unilateral = c.law == ContactLaw::Unilateral;
+                    let normal_dof = c.normal_unknown.then_some(n + 1);
+                    contact.push(ContactEdge {
+                        edge: e,
+                        dof: n,
+                        normal,
+                        tangent,
+                        length,
+                        g_mean,
+                        normal_dof,
+                        unilateral,
+                        coulomb,
+                    });
+                    match normal_dof {
+                        None => {
+                            n += 1;
+                            EdgeDof::Tangential { dof: n - 1, tau: tangent }
+                        }
+                        Some(r) => {
+                            n += 2;
+                            EdgeDof::Frame { dofs: [r - 1, r], tau: tangent, normal }
+                        }
                     }
-                    contact.push(ContactEdge { edge: e, dof: n, normal, tangent, length: mesh.edge_length(e), g_mean });
-                    n += 1;
-                    EdgeDof::Tangential { dof: n - 1, tau: tangent }
                 }
                 _ => {
                     n += 2;
@@ -167,6 +211,19 @@ impl CrSpace {
             });
         }
         Ok(CrSpace { edge_dof, edge_part, n_dofs: n, contact, n_dirichlet })
+    }
+
+    /// The contact unknowns in the order of the condensed problem: the tangential unknown of every Γ_C
+    /// edge, then the normal unknowns (empty without normal unknowns: the bilateral Tresca problem).
+    pub fn contact_dofs(&self) -> Vec<usize> {
+        let t = self.contact.iter().map(|c| c.dof);
+        t.chain(self.contact.iter().filter_map(|c| c.normal_dof)).collect()
+    }
+
+    /// The Γ_C edges with a normal unknown, as indices into `contact` (in the order of their unknowns in
+    /// [`CrSpace::contact_dofs`]).
+    pub fn normal_edges(&self) -> Vec<usize> {
+        (0..self.contact.len()).filter(|&j| self.contact[j].normal_dof.is_some()).collect()
     }
 
     /// True if edge e carries the stabilisation (interior or Dirichlet).

@@ -29,6 +29,7 @@ pub fn on_mesh(scene: &Scene, mesh: &Mesh) -> Result<CrSpace> {
     let space = CrSpace::new(mesh, &scene.parts)?;
     friction_forces(scene, mesh, &space)?;
     lifting::consistency::check(scene, mesh, &space)?;
+    crate::fem::gap::check_scene(scene, mesh, &space)?;
     Ok(space)
 }
 

@@ -10,15 +10,23 @@
 //! whose KKT conditions are exactly Tresca's law on every edge. The natural residual
 //!   r(μ) = max_e |μ_e − P_e(μ_e + Δs_e / C_ee)| / F,   F = max_e min(w_e, |d_e|/C_ee),
 //! vanishes exactly at the solution and is what every solver reports.
+//!
+//! With normal unknowns (a unilateral or a Coulomb part, [`normal`]) the condensed problem has one more
+//! unknown per Γ_C edge, the normal force P_e, with its own bounds; the QP's bounds are then per unknown,
+//! [lo_e, hi_e] with hi_e = +∞ allowed (module [`normal`] states the problem).
 
+pub mod coulomb;
+pub mod normal;
 pub mod pdas;
 pub mod ssn;
 pub mod uzawa;
 
 use crate::error::{Error, Result};
 use crate::fem::space::CrSpace;
-use crate::scene::{Method, SolverSettings};
+use crate::mesh::Mesh;
+use crate::scene::{Method, Scene, SolverSettings};
 use nalgebra::DMatrix;
+use normal::Normal;
 
 /// The friction problem of a run: C, the weights and the per-step solver.
 pub struct Friction {
@@ -31,6 +39,8 @@ pub struct Friction {
     settings: SolverSettings,
     /// Steps at which the bound was treated as zero (below the rounding of the load).
     zeroed: std::sync::atomic::AtomicUsize,
+    /// The normal unknowns (`None`: the bilateral Tresca problem, tangential unknowns only).
+    normal: Option<Normal>,
 }
 
 /// What a step's friction solve produced.
@@ -43,6 +53,12 @@ pub struct FrictionSolution {
     pub state: Vec<EdgeState>,
     pub iterations: usize,
     pub residual: f64,
+    /// Normal force P_e per normal unknown (empty without normal unknowns).
+    pub normal: Vec<f64>,
+    /// u_n(m_e) − ḡ_e per normal unknown (empty without).
+    pub gap: Vec<f64>,
+    /// Separated (no pressure, open gap) per normal unknown (empty without).
+    pub separated: Vec<bool>,
 }
 
 /// Stick or slip of one contact edge.
@@ -63,21 +79,40 @@ pub struct Stalled {
 }
 
 impl Friction {
-    /// The problem on the contact edges of `space` with operator `c` (see `solve::condense`).
-    pub fn new(space: &CrSpace, c: DMatrix<f64>, settings: SolverSettings) -> Friction {
+    /// The problem of `scene` on the contact edges of `space` with operator `c` (see `solve::condense`);
+    /// with normal unknowns, `uzawa` is refused (it iterates on multipliers scaled by a finite bound).
+    pub fn new(scene: &Scene, mesh: &Mesh, space: &CrSpace, c: DMatrix<f64>) -> Result<Friction> {
         let w = space.contact.iter().map(|e| e.length * e.g_mean).collect();
         let g_mean = space.contact.iter().map(|e| e.g_mean).collect();
-        Friction::from_parts(c, w, g_mean, settings)
+        let mut f = Friction::from_parts(c, w, g_mean, scene.solver);
+        f.normal = Normal::new(scene, mesh, space);
+        if f.normal.is_some() && scene.solver.method == Method::Uzawa {
+            return Err(Error::scene(
+                &scene.file,
+                "solver.method",
+                "uzawa solves the bilateral Tresca problem only: with a unilateral or Coulomb part use ssn",
+            ));
+        }
+        Ok(f)
     }
 
     /// The problem of operator C, weights w and mean bounds ḡ (Uzawa's c_τ).
     pub(crate) fn from_parts(c: DMatrix<f64>, w: Vec<f64>, g_mean: Vec<f64>, settings: SolverSettings) -> Friction {
-        Friction { c, w, g_mean, settings, zeroed: Default::default() }
+        Friction { c, w, g_mean, settings, zeroed: Default::default(), normal: None }
+    }
+
+    /// The normal unknowns, if any.
+    pub fn normal(&self) -> Option<&Normal> {
+        self.normal.as_ref()
     }
 
     /// Solve step n (time t) with d = s_f − s_old from the warm start μ₀ with the scene's method, to
-    /// natural residual ≤ tol.
+    /// natural residual ≤ tol. With normal unknowns d and μ₀ hold the normal entries after the
+    /// tangential ones (d_n = s_f,n − ḡ, `normal`).
     pub fn solve(&self, d: &[f64], mu0: &[f64], n: usize, t: f64) -> Result<FrictionSolution> {
+        if let Some(nm) = &self.normal {
+            return nm.solve(self, d, mu0, n, t);
+        }
         let (k, zeroed, w, d, mu0) = scaled(&self.c, &self.w, d, mu0);
         if zeroed {
             self.zeroed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -87,7 +122,8 @@ impl Friction {
         } else {
             self.g_mean.clone()
         };
-        let qp = Qp { c: &self.c, d: &d, w: &w };
+        let lo: Vec<f64> = w.iter().map(|w| -w).collect();
+        let qp = Qp { c: &self.c, d: &d, lo: &lo, hi: &w };
         let s = &self.settings;
         let sol = match s.method {
             Method::Ssn => ssn::solve(&qp, &mu0, s.tol, s.max_iter()),
@@ -97,18 +133,20 @@ impl Friction {
                 uzawa::solve(&qp, &g_mean, &mu0, rho, s.tol, s.max_iter())
             }
         };
-        let (mu, iterations, residual) = sol.map_err(|e| Error::NotConverged {
-            step: n,
-            time: t,
-            solver: e.solver,
-            iterations: e.iterations,
-            residual: e.residual,
-            tol: s.tol,
-        })?;
+        let (mu, iterations, residual) = sol.map_err(|e| not_converged(e, n, t, s.tol))?;
         let slip_increment = qp.slip_increment(&mu);
         let state = classify(&qp, &mu, &slip_increment);
         let back = |v: Vec<f64>| if k == 0 { v } else { v.into_iter().map(|x| pow2_scale(x, k)).collect() };
-        Ok(FrictionSolution { mu: back(mu), slip_increment: back(slip_increment), state, iterations, residual })
+        Ok(FrictionSolution {
+            mu: back(mu),
+            slip_increment: back(slip_increment),
+            state,
+            iterations,
+            residual,
+            normal: vec![],
+            gap: vec![],
+            separated: vec![],
+        })
     }
 
     /// The diagonal C_ee of the condensed operator (the slip of edge e per unit friction force on it).
@@ -141,6 +179,11 @@ fn pow2_scale(v: f64, k: i32) -> f64 {
     v * pow2(h) * pow2(k - h)
 }
 
+/// The error of a step whose solver stalled.
+fn not_converged(e: Stalled, n: usize, t: f64, tol: f64) -> Error {
+    Error::NotConverged { step: n, time: t, solver: e.solver, iterations: e.iterations, residual: e.residual, tol }
+}
+
 /// (k, zeroed, w, d, μ₀) of the step to solve: scaled by 2^-k where the forces are beyond 2^±SAFE_EXP,
 /// and w = 0 where the friction is below the rounding of the load (see [`NEGLIGIBLE`]).
 fn scaled(c: &DMatrix<f64>, w: &[f64], d: &[f64], mu0: &[f64]) -> (i32, bool, Vec<f64>, Vec<f64>, Vec<f64>) {
@@ -161,11 +204,13 @@ fn scaled(c: &DMatrix<f64>, w: &[f64], d: &[f64], mu0: &[f64]) -> (i32, bool, Ve
 /// A solver's result: (μ, iterations, residual).
 pub type Solved = std::result::Result<(Vec<f64>, usize, f64), Stalled>;
 
-/// One step's dual QP: min ½μᵀCμ − dᵀμ, |μ_e| ≤ w_e.
+/// One step's dual QP: min ½μᵀCμ − dᵀμ, lo_e ≤ μ_e ≤ hi_e (Tresca's box: lo = −w, hi = w; a normal
+/// force: [0, +∞) unilateral, (−∞, +∞) bilateral).
 pub struct Qp<'a> {
     pub c: &'a DMatrix<f64>,
     pub d: &'a [f64],
-    pub w: &'a [f64],
+    pub lo: &'a [f64],
+    pub hi: &'a [f64],
 }
 
 impl Qp<'_> {
@@ -184,16 +229,23 @@ impl Qp<'_> {
         ds
     }
 
-    /// Projection onto [−w_e, w_e].
+    /// Projection onto [lo_e, hi_e].
     pub fn project(&self, e: usize, v: f64) -> f64 {
-        v.clamp(-self.w[e], self.w[e])
+        v.clamp(self.lo[e], self.hi[e])
     }
 
-    /// Force scale F = max_e min(w_e, |d_e|/C_ee): the size of the friction forces of this step (all-stick
-    /// forces are about |d|/C_ee, all-slip forces are w). Residuals are relative to it, so a huge bound
-    /// (g_a → ∞) does not make every iterate look converged.
+    /// Force scale F = max_e min(max(|lo_e|, hi_e), |d_e|/C_ee): the size of the forces of this step
+    /// (all-stick forces are about |d|/C_ee, all-slip forces are w; an unbounded normal force counts
+    /// with |d_e|/C_ee, the force that closes or holds its free gap alone). Residuals are relative to it,
+    /// so a huge bound (g_a → ∞) does not make every iterate look converged.
     pub fn force_scale(&self) -> f64 {
-        (0..self.d.len()).map(|e| self.w[e].min(self.d[e].abs() / self.c[(e, e)])).fold(0.0, f64::max)
+        let bound = |e: usize| self.hi[e].max(-self.lo[e]);
+        (0..self.d.len()).map(|e| bound(e).min(self.d[e].abs() / self.c[(e, e)])).fold(0.0, f64::max)
+    }
+
+    /// The half width w_e of a symmetric box [−w_e, w_e] (Uzawa's scaling; Tresca's problem only).
+    pub fn half_width(&self, e: usize) -> f64 {
+        self.hi[e]
     }
 
     /// Natural residual r(μ) = max_e |μ_e − P_e(μ_e + Δs_e/C_ee)| / F, given Δs (see module doc).
@@ -212,10 +264,15 @@ impl Qp<'_> {
 
 /// Stick or slip per edge: slip when the bound is reached and the increment is nonzero.
 pub fn classify(qp: &Qp, mu: &[f64], ds: &[f64]) -> Vec<EdgeState> {
-    let scale = ds.iter().chain(qp.d).fold(0.0f64, |a, v| a.max(v.abs()));
+    classify_with(qp.hi, qp.d, mu, ds)
+}
+
+/// [`classify`] with the bounds w of the first `mu.len()` unknowns (the tangential ones).
+pub fn classify_with(w: &[f64], d: &[f64], mu: &[f64], ds: &[f64]) -> Vec<EdgeState> {
+    let scale = ds.iter().chain(d).fold(0.0f64, |a, v| a.max(v.abs()));
     mu.iter()
         .zip(ds)
-        .zip(qp.w)
+        .zip(w)
         .map(|((m, s), w)| {
             if *w > 0.0 && m.abs() >= w * (1.0 - 1e-9) && s.abs() > 1e-9 * scale || *w == 0.0 && s.abs() > 1e-9 * scale
             {

@@ -15,7 +15,8 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Solved {
     let mut seen: HashSet<Vec<i8>> = HashSet::new();
     for it in 0..=max_iter {
         let ds = qp.slip_increment(&mu);
-        let feasible = (0..n).all(|e| mu[e].abs() <= qp.w[e] * (1.0 + 1e-14));
+        // |μ_e| ≤ w_e(1 + 1e-14) on a box; on [lo, hi] each bound widened by the same factor
+        let feasible = (0..n).all(|e| mu[e] <= qp.hi[e] * (1.0 + 1e-14) && mu[e] >= qp.lo[e] * (1.0 + 1e-14));
         let res = if feasible { qp.residual(&mu, &ds) } else { f64::INFINITY };
         if res <= tol {
             return Ok((mu, it, res));
@@ -23,9 +24,9 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Solved {
         let set: Vec<i8> = (0..n)
             .map(|e| {
                 let y = mu[e] + ds[e] / qp.c[(e, e)];
-                if y > qp.w[e] {
+                if y > qp.hi[e] {
                     1
-                } else if y < -qp.w[e] {
+                } else if y < qp.lo[e] {
                     -1
                 } else {
                     0
@@ -39,7 +40,7 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Solved {
         let stick: Vec<usize> = (0..n).filter(|&e| set[e] == 0).collect();
         for e in 0..n {
             if set[e] != 0 {
-                mu[e] = f64::from(set[e]) * qp.w[e];
+                mu[e] = if set[e] > 0 { qp.hi[e] } else { qp.lo[e] };
             }
         }
         if !stick.is_empty() {

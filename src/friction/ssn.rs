@@ -36,7 +36,9 @@ pub fn solve(qp: &Qp, mu0: &[f64], tol: f64, max_iter: usize) -> Solved {
             .min(1e-3 * fscale);
         let active: Vec<bool> = (0..n)
             .map(|e| {
-                (mu[e] >= qp.w[e] - eps && g[e] < 0.0) || (mu[e] <= -qp.w[e] + eps && g[e] > 0.0) || qp.w[e] == 0.0
+                (mu[e] >= qp.hi[e] - eps && g[e] < 0.0)
+                    || (mu[e] <= qp.lo[e] + eps && g[e] > 0.0)
+                    || qp.lo[e] == qp.hi[e]
             })
             .collect();
         let free: Vec<usize> = (0..n).filter(|&e| !active[e]).collect();

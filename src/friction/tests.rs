@@ -88,7 +88,8 @@ fn solvers_reach_the_kkt_solution() {
             let sol = got.unwrap_or_else(|e| panic!("{method:?} on {name}: {e}"));
             let err = sol.mu.iter().zip(&want).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
             assert!(err <= 1e-9, "{method:?} on {name}: μ {:?}, oracle {want:?}", sol.mu);
-            let qp = Qp { c: &c, d: &d, w: &w };
+            let lo: Vec<f64> = w.iter().map(|w| -w).collect();
+            let qp = Qp { c: &c, d: &d, lo: &lo, hi: &w };
             let ds = qp.slip_increment(&want);
             for (e, dse) in ds.iter().enumerate() {
                 let slips = dse.abs() > 1e-9;

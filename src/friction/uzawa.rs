@@ -12,7 +12,7 @@ use crate::scene::Method;
 /// ρ̃ = 1/λ_max((GW)^{1/2} C (GW)^{1/2}) by power iteration.
 pub fn auto_step(qp: &Qp, g: &[f64]) -> f64 {
     let n = qp.d.len();
-    let s: Vec<f64> = (0..n).map(|e| (g[e] * qp.w[e]).sqrt()).collect();
+    let s: Vec<f64> = (0..n).map(|e| (g[e] * qp.half_width(e)).sqrt()).collect();
     let mut v = vec![1.0 / (n as f64).sqrt(); n];
     let mut lam = 0.0;
     for _ in 0..200 {
@@ -36,9 +36,10 @@ pub fn auto_step(qp: &Qp, g: &[f64]) -> f64 {
 /// Uzawa from the warm start `mu0` with step `rho` (the paper's ρ̃).
 pub fn solve(qp: &Qp, g: &[f64], mu0: &[f64], rho: f64, tol: f64, max_iter: usize) -> Solved {
     let n = qp.d.len();
-    let mut lam: Vec<f64> =
-        (0..n).map(|e| if qp.w[e] > 0.0 { (mu0[e] / qp.w[e]).clamp(-1.0, 1.0) } else { 0.0 }).collect();
-    let mut mu: Vec<f64> = (0..n).map(|e| qp.w[e] * lam[e]).collect();
+    let mut lam: Vec<f64> = (0..n)
+        .map(|e| if qp.half_width(e) > 0.0 { (mu0[e] / qp.half_width(e)).clamp(-1.0, 1.0) } else { 0.0 })
+        .collect();
+    let mut mu: Vec<f64> = (0..n).map(|e| qp.half_width(e) * lam[e]).collect();
     let mut diff = f64::INFINITY;
     for it in 1..=max_iter {
         let ds = qp.slip_increment(&mu);
@@ -47,7 +48,7 @@ pub fn solve(qp: &Qp, g: &[f64], mu0: &[f64], rho: f64, tol: f64, max_iter: usiz
             let new = (lam[e] + rho * g[e] * ds[e]).clamp(-1.0, 1.0);
             diff = diff.max((new - lam[e]).abs());
             lam[e] = new;
-            mu[e] = qp.w[e] * new;
+            mu[e] = qp.half_width(e) * new;
         }
         if !diff.is_finite() {
             break;

@@ -103,6 +103,11 @@ impl Fields {
         self.contact_len.len()
     }
 
+    /// |e| of each contact edge.
+    pub fn contact_lengths(&self) -> &[f64] {
+        &self.contact_len
+    }
+
     /// Evaluate every array of a step into `out` (buffers are reused). `mid` are the midpoint values,
     /// `prev_slip` the previous step's slip (None at step 0).
     pub fn eval(&self, mid: &[[f64; 2]], r: &StepResult, prev_slip: Option<&[f64]>, out: &mut StepFields) {

@@ -52,6 +52,7 @@ pub mod fields;
 pub mod guard;
 mod h5;
 mod lock;
+mod normal_series;
 mod paths;
 mod reserve;
 mod resume;

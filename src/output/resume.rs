@@ -37,6 +37,14 @@ impl Writer {
             return Err(Error::Io { path: path.to_path_buf(), msg: "no results file to --resume".into() });
         }
         paths::check_target(path, true)?;
+        if !run.space.normal_edges().is_empty() {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: "--resume of a run with unilateral or Coulomb contact is not supported yet (the normal \
+                      forces are not stored for a warm start): run it again without --resume"
+                    .into(),
+            });
+        }
         let file = hdf5::File::with_options()
             .with_fapl(h5::file_access)
             .open_rw(path)

@@ -49,10 +49,15 @@ pub struct Rows {
     pub(super) errors: [Vec<f64>; 3],
     /// The energy audit (`stepping::audit`), in `Audit::as_array`'s order; NaN for a step without one.
     pub(super) audit: [Vec<f64>; 6],
+    /// The normal condition (`super::tresca::NORMAL`; empty without normal unknowns).
+    pub(super) pressure: Vec<f64>,
+    pub(super) gap: Vec<f64>,
+    pub(super) status: Vec<u8>,
 }
 
 impl Rows {
-    pub fn push(&mut self, r: &StepResult, mid: &[[f64; 2]], sigma_t: &[f64], dof: &[f64]) {
+    /// Append step `r` (`lengths`: |e| of the Γ_C edges, for the pressure P_e/|e|).
+    pub fn push(&mut self, r: &StepResult, mid: &[[f64; 2]], (sigma_t, dof): (&[f64], &[f64]), lengths: &[f64]) {
         self.count += 1;
         self.times.push(r.t);
         append(&mut self.u, mid.as_flattened());
@@ -67,6 +72,11 @@ impl Rows {
         self.state.extend(r.state.iter().map(|&s| s as u8));
         append(&mut self.mu, &r.mu);
         append(&mut self.dof, dof);
+        if !r.normal.force.is_empty() {
+            append(&mut self.pressure, &r.normal.force.iter().zip(lengths).map(|(p, l)| p / l).collect::<Vec<_>>());
+            append(&mut self.gap, &r.normal.gap);
+            self.status.extend(r.state.iter().zip(&r.normal.separated).map(|(&s, &sep)| if sep { 2 } else { s as u8 }));
+        }
         let audit = r.audit.map_or([f64::NAN; 6], |a| a.as_array());
         self.audit.iter_mut().zip(audit).for_each(|(v, a)| v.push(a));
         if let Some(e) = &r.errors {
@@ -78,7 +88,9 @@ impl Rows {
 
     /// Bytes buffered in the per-unknown and per-contact-edge rows.
     pub fn bytes(&self) -> usize {
-        bytes([&self.u, &self.slip, &self.sigma_t, &self.mu, &self.dof]) + self.state.len()
+        bytes([&self.u, &self.slip, &self.sigma_t, &self.mu, &self.dof, &self.pressure, &self.gap])
+            + self.state.len()
+            + self.status.len()
     }
 
     /// Empty the buffer, keeping its memory for the next rows; the next row is step `first`.
@@ -86,13 +98,15 @@ impl Rows {
         self.first = first;
         self.count = 0;
         let f64s = [&mut self.times, &mut self.u, &mut self.energy, &mut self.residual, &mut self.wall, &mut self.slip];
-        for v in f64s.into_iter().chain([&mut self.sigma_t, &mut self.mu, &mut self.dof]) {
+        let more = [&mut self.sigma_t, &mut self.mu, &mut self.dof, &mut self.pressure, &mut self.gap];
+        for v in f64s.into_iter().chain(more) {
             v.clear();
         }
         for v in [&mut self.iterations, &mut self.n_stick, &mut self.n_slip] {
             v.clear();
         }
         self.state.clear();
+        self.status.clear();
         self.errors.iter_mut().for_each(Vec::clear);
         self.audit.iter_mut().for_each(Vec::clear);
     }

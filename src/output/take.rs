@@ -74,7 +74,14 @@ impl Unknowns {
         check_finite(path, n, "u", &r.u)?;
         crate::fem::lifting::displacement_into(space, data, &r.u, r.t, &mut mid)?;
         let dof = space.contact.iter().map(|c| r.u[c.dof]).collect();
-        let r = StepResult { u: Vec::new(), mu: r.mu.clone(), slip: r.slip.clone(), state: r.state.clone(), ..*r };
+        let r = StepResult {
+            u: Vec::new(),
+            mu: r.mu.clone(),
+            slip: r.slip.clone(),
+            state: r.state.clone(),
+            normal: r.normal.clone(),
+            ..*r
+        };
         Ok(Unknowns { r, mid, dof })
     }
 
@@ -135,7 +142,7 @@ impl Writer {
             self.frame_rows.push(r.t, &self.buf);
             self.frame_steps.push(n);
         }
-        self.rows.push(&r, &mid, &sigma_t, &dof);
+        self.rows.push(&r, &mid, (&sigma_t, &dof), self.fields.contact_lengths());
         self.mid = mid;
         self.prev_slip = Some(r.slip);
         Ok(())

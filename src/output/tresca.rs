@@ -14,6 +14,10 @@
 //! u_D); j_h(δuⁿ); ½a_h(δuⁿ,δuⁿ); and a_h(uⁿ,δuⁿ) + j_h(δuⁿ) − (lⁿ,δuⁿ) − boundary_work, which vanishes
 //! up to rounding and the friction solver's tolerance (NaN where a step had no audit).
 //!
+//! With normal unknowns (a unilateral or Coulomb part, `friction::normal`) also
+//! `contact/{pressure, gap, status}` (·, C): p_e = P_e/|e|, u·n(m_e) − ḡ_e and 0 stick, 1 slip,
+//! 2 separated ([`NORMAL`]); they are not part of the checksum either (the files without them have none).
+//!
 //! `u` is the displacement at the edge midpoints, the lifting of the boundary data included
 //! (`fem::lifting`); `energy` is a_h(uⁿ,uⁿ) with the Dirichlet jump measured against u_D.
 //! `tresca/steps` carries the attribute `completed` (number of complete steps), written after every
@@ -59,7 +63,11 @@ pub struct Tresca {
     audit: Option<Vec<Series>>,
     /// True if the checksums cover the audit series (attribute [`COVERS`] of the checksum).
     audit_checksummed: bool,
+    /// [`NORMAL`] (`None` without normal unknowns).
+    normal: Option<[Series; 3]>,
 }
+
+pub use super::normal_series::NORMAL;
 
 /// The audit's series under `steps`, in `stepping::Audit::as_array`'s order.
 pub const AUDIT: [&str; 6] = [
@@ -150,6 +158,7 @@ impl Tresca {
                 Series::create::<f64>(&cg, "dof", 1, &[nc], sc)?,
             ])
         };
+        let normal = super::normal_series::create(&g, space, sc)?;
         let errors = if p.meta.true_errors {
             let eg = g.create_group("errors")?;
             Some([
@@ -166,6 +175,7 @@ impl Tresca {
         let checksum = Series::create::<u64>(&sg, "checksum", 1, &[], sc)?;
         attr_str(&checksum.ds, COVERS, &covered(contact.is_some(), errors.is_some()))?;
         Ok(Tresca {
+            normal,
             audit: Some(audit),
             audit_checksummed: true,
             checksum: Some(checksum),
@@ -203,7 +213,9 @@ impl Tresca {
             Err(_) => None,
         };
         let checksum = Series::open(&sg, "checksum", 1).ok();
+        let normal = super::normal_series::open(&g);
         Ok(Tresca {
+            normal,
             audit: AUDIT.iter().map(|a| Series::open(&sg, a, 1)).collect::<hdf5::Result<_>>().ok(),
             audit_checksummed: checksum.as_ref().is_some_and(|c| c.ds.attr(COVERS).is_ok()),
             checksum,
@@ -327,6 +339,11 @@ impl Tresca {
                 s.write_steps(raw, n, k, v)?;
             }
         }
+        if let Some([p, g, st]) = &self.normal {
+            p.write_steps(raw, n, k, &b.pressure)?;
+            g.write_steps(raw, n, k, &b.gap)?;
+            st.write_steps(raw, n, k, &b.status)?;
+        }
         if let Some(a) = &self.audit {
             for (s, v) in a.iter().zip(&b.audit) {
                 s.write_steps(raw, n, k, v)?;
@@ -348,6 +365,9 @@ impl Tresca {
             let covers = read_str(&c.ds, COVERS).ok();
             c.set_steps(raw, steps, kept)?;
             covers.map_or(Ok(()), |v| attr_str(&c.ds, COVERS, &v))?;
+        }
+        for a in self.normal.iter_mut().flatten() {
+            a.set_steps(raw, steps, kept)?;
         }
         self.series(true).into_iter().try_for_each(|s| s.set_steps(raw, steps, kept))
     }
@@ -395,6 +415,7 @@ impl Tresca {
             errors,
             wall: self.wall.read::<f64>(n)?[0],
             audit: None,
+            normal: Default::default(),
         })
     }
 

@@ -63,7 +63,11 @@ const FRAMES: u64 = 51;
 impl Estimate {
     /// The estimate of `scene` run with `steps` time steps; `results`: a results file is written.
     pub fn of(scene: &Scene, steps: usize, results: bool) -> Result<Estimate> {
-        Ok(Estimate::of_sizes(sizes(scene)?, steps, results))
+        let (triangles, edges, contact) = sizes(scene)?;
+        // with normal unknowns C has two rows per Γ_C edge (4× the bytes), and a step's rows the normal
+        // series (17 bytes an edge, within the doubled count's 33)
+        let contact = if scene.has_normal_unknowns() { 2 * contact } else { contact };
+        Ok(Estimate::of_sizes((triangles, edges, contact), steps, results))
     }
 
     /// The estimate of a run on a mesh of (triangles, edges, contact edges) with `steps` time steps (an

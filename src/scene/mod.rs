@@ -15,7 +15,7 @@ mod parts;
 mod raw;
 mod tables;
 mod values;
-pub use parts::{FrictionBound, Part, PartKind};
+pub use parts::{ContactLaw, ContactPart, FrictionBound, FrictionLaw, Part, PartKind};
 pub use tables::MAX_REFINE;
 use tables::{check_refine, exact, loads, material, mesh_spec, parts, quantities, solver_settings, time_grid};
 pub use values::MAX_EXPR_CHARS;
@@ -201,13 +201,19 @@ impl Scene {
         }
     }
 
-    /// True if the scene has a contact part.
     /// True if a part imposes nonzero boundary data (u_D or g_n; see [`PartKind`]).
     pub fn has_boundary_data(&self) -> bool {
         self.parts.iter().any(|p| p.kind.has_data())
     }
 
+    /// True if the scene has a contact part.
     pub fn has_contact(&self) -> bool {
         self.parts.iter().any(|p| matches!(p.kind, PartKind::Contact(..)))
+    }
+
+    /// True if the Γ_C edges carry normal unknowns (a unilateral or a Coulomb part:
+    /// [`ContactPart::normal_unknown`]).
+    pub fn has_normal_unknowns(&self) -> bool {
+        self.parts.iter().any(|p| p.kind.contact().is_some_and(|c| c.normal_unknown))
     }
 }

@@ -137,8 +137,13 @@ pub(super) struct RawBoundary {
     /// Dirichlet data u_D(x, y, t) of a dirichlet part (default 0).
     #[serde(default, deserialize_with = "opt_exactly")]
     pub(super) u: Option<[String; 2]>,
-    /// Imposed normal displacement g_n(x, y, t) of a contact part (default 0).
+    /// Imposed normal displacement g_n(x, y, t) of a contact part (default 0); the gap of a unilateral one.
     pub(super) gap: Option<String>,
+    /// The contact law of a contact part, `"bilateral"` (default) or `"unilateral"` (read as text, so that
+    /// an unknown law is refused naming the part).
+    pub(super) law: Option<String>,
+    /// Coulomb's friction coefficient F(x, y) of a contact part (instead of `g_a`).
+    pub(super) coulomb: Option<String>,
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
@@ -147,6 +152,7 @@ pub(super) enum RawKind {
     Dirichlet,
     Neumann,
     Contact,
+    Symmetry,
 }
 
 #[derive(Deserialize)]

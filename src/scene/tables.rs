@@ -5,7 +5,10 @@
 use super::expr::{Expr, Vec2Expr};
 use super::raw::*;
 use super::values::{positive_finite, sized, uniform_times};
-use super::{Diagonal, Exact, FrictionBound, MeshSpec, Method, Outputs, Part, PartKind, SolverSettings};
+use super::SolverSettings;
+use super::{
+    ContactLaw, ContactPart, Diagonal, Exact, FrictionBound, FrictionLaw, MeshSpec, Method, Outputs, Part, PartKind,
+};
 use crate::error::{Error, Result};
 
 /// `[mesh]`: a Gmsh file or a structured quadrilateral, with its refinements.
@@ -57,36 +60,38 @@ pub(super) fn parts(file: &str, boundary: &[RawBoundary]) -> Result<Vec<Part>> {
         if parts.iter().any(|p: &Part| p.name == b.name) {
             return Err(Error::scene(file, key("name"), "boundary part named twice"));
         }
-        if b.traction.is_some() && b.kind != RawKind::Neumann {
-            return Err(Error::scene(file, key("traction"), "only neumann parts take a traction"));
-        }
-        if b.g_a.is_some() && b.kind != RawKind::Contact {
-            return Err(Error::scene(file, key("g_a"), "only contact parts take a friction bound g_a"));
-        }
-        if b.u.is_some() && b.kind != RawKind::Dirichlet {
-            return Err(Error::scene(file, key("u"), "only dirichlet parts take boundary values u"));
-        }
-        if b.gap.is_some() && b.kind != RawKind::Contact {
-            return Err(Error::scene(file, key("gap"), "only contact parts take an imposed normal displacement gap"));
-        }
+        refuse_foreign_keys(file, b, &key)?;
         let kind = match b.kind {
             RawKind::Dirichlet => PartKind::Dirichlet(super::parts::dirichlet_data(file, &key("u"), b.u.as_ref())?),
-            RawKind::Neumann => PartKind::Neumann(match &b.traction {
-                Some(g) => nonzero(Some(Vec2Expr::parse(&key("traction"), sized(file, &key("traction"), g)?)?)),
-                None => None,
-            }),
-            RawKind::Contact => {
-                let text = b.g_a.as_deref().ok_or_else(|| Error::scene(file, key("g_a"), "contact part needs g_a"))?;
-                sized(file, &key("g_a"), &[text.to_string()])?;
-                PartKind::Contact(
-                    FrictionBound::parse(file, &key("g_a"), text)?,
-                    super::parts::gap_data(file, &key("gap"), b.gap.as_ref())?,
-                )
-            }
+            RawKind::Neumann => PartKind::Neumann(traction(file, &key("traction"), b.traction.as_ref())?),
+            RawKind::Contact => PartKind::Contact(Box::new(contact_part(file, b, &key)?)),
+            RawKind::Symmetry => PartKind::Contact(Box::new(ContactPart {
+                law: ContactLaw::Bilateral,
+                friction: FrictionLaw::Tresca(FrictionBound::parse(file, &key("kind"), "0")?),
+                gap: None,
+                traction: None,
+                symmetry: true,
+                normal_unknown: false,
+            })),
         };
         parts.push(Part { name: b.name.clone(), kind });
     }
+    let normal =
+        parts.iter().filter_map(|p| p.kind.contact()).any(|c| c.law == ContactLaw::Unilateral || c.coulomb().is_some());
+    for p in &mut parts {
+        if let PartKind::Contact(c) = &mut p.kind {
+            c.normal_unknown = normal;
+        }
+    }
     if !parts.iter().any(|p| p.kind.is_dirichlet()) {
+        if parts.iter().any(|p| p.kind.contact().is_some()) {
+            return Err(Error::scene(
+                file,
+                "boundary",
+                "no dirichlet part: a body held only by contact and symmetry parts is not supported yet \
+                 (its rigid motions are not fixed; add a dirichlet part)",
+            ));
+        }
         return Err(Error::scene(
             file,
             "boundary",
@@ -94,6 +99,80 @@ pub(super) fn parts(file: &str, boundary: &[RawBoundary]) -> Result<Vec<Part>> {
         ));
     }
     Ok(parts)
+}
+
+/// The keys a part's kind does not take, refused naming the part.
+fn refuse_foreign_keys(file: &str, b: &RawBoundary, key: &dyn Fn(&str) -> String) -> Result<()> {
+    let contact = b.kind == RawKind::Contact;
+    let given = [
+        (
+            "traction",
+            b.traction.is_some(),
+            matches!(b.kind, RawKind::Neumann | RawKind::Contact),
+            "neumann and contact parts take a traction",
+        ),
+        ("g_a", b.g_a.is_some(), contact, "contact parts take a friction bound g_a"),
+        ("u", b.u.is_some(), b.kind == RawKind::Dirichlet, "dirichlet parts take boundary values u"),
+        ("gap", b.gap.is_some(), contact, "contact parts take a gap"),
+        ("law", b.law.is_some(), contact, "contact parts take a contact law"),
+        ("coulomb", b.coulomb.is_some(), contact, "contact parts take a Coulomb coefficient"),
+    ];
+    for (k, present, allowed, what) in given {
+        if present && !allowed {
+            let msg = if b.kind == RawKind::Symmetry {
+                "a symmetry part takes no keys besides name and kind (u·n = 0, no friction)".to_string()
+            } else {
+                format!("only {what}")
+            };
+            return Err(Error::scene(file, key(k), msg));
+        }
+    }
+    Ok(())
+}
+
+/// A traction of scene key `key` (`None` where absent or zero).
+fn traction(file: &str, key: &str, g: Option<&[String; 2]>) -> Result<Option<Vec2Expr>> {
+    match g {
+        Some(g) => Ok(nonzero(Some(Vec2Expr::parse(key, sized(file, key, g)?)?))),
+        None => Ok(None),
+    }
+}
+
+/// A `kind = "contact"` part: law, friction (`g_a` or `coulomb`, not both), gap and traction.
+fn contact_part(file: &str, b: &RawBoundary, key: &dyn Fn(&str) -> String) -> Result<ContactPart> {
+    let law = match b.law.as_deref() {
+        None | Some("bilateral") => ContactLaw::Bilateral,
+        Some("unilateral") => ContactLaw::Unilateral,
+        Some(other) => {
+            return Err(Error::scene(
+                file,
+                key("law"),
+                format!("unknown contact law `{other}` (expected \"bilateral\" or \"unilateral\")"),
+            ))
+        }
+    };
+    let friction = match (&b.g_a, &b.coulomb) {
+        (Some(_), Some(_)) => {
+            return Err(Error::scene(file, key("coulomb"), "give either g_a (Tresca) or coulomb (Coulomb), not both"))
+        }
+        (None, None) => return Err(Error::scene(file, key("g_a"), "contact part needs g_a (Tresca) or coulomb")),
+        (Some(g), None) => {
+            sized(file, &key("g_a"), std::array::from_ref(g))?;
+            FrictionLaw::Tresca(FrictionBound::parse(file, &key("g_a"), g)?)
+        }
+        (None, Some(f)) => {
+            sized(file, &key("coulomb"), std::array::from_ref(f))?;
+            FrictionLaw::Coulomb(FrictionBound::parse(file, &key("coulomb"), f)?)
+        }
+    };
+    Ok(ContactPart {
+        law,
+        friction,
+        gap: super::parts::gap_data(file, &key("gap"), b.gap.as_ref())?,
+        traction: traction(file, &key("traction"), b.traction.as_ref())?,
+        symmetry: false,
+        normal_unknown: false,
+    })
 }
 
 /// `[loads] f` and `[initial] u0` (independent of t); `None` where absent or zero.

@@ -90,7 +90,7 @@ impl FreeResponse {
         space: &CrSpace,
     ) -> (FreeResponse, Option<DMatrix<f64>>) {
         let n = space.n_dofs;
-        let contact_dofs: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
+        let contact_dofs: Vec<usize> = space.contact_dofs();
         let (c, w) = match condensation {
             Some(Condensation { c, w }) => (Some(c), w),
             None => (None, DMatrix::zeros(0, 0)),

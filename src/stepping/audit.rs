@@ -9,12 +9,14 @@
 //!
 //! * `stored_energy` Eⁿ = E(Uⁿ, pⁿ) = ½A(U,U) − B(p,U) + ½C(p,p) (= ½a_h(uⁿ,uⁿ) without data);
 //! * `external_work` (lⁿ, δuⁿ) = Σ_e lⁿ_e·δU_e, the loads f, g on the whole increment;
-//! * `friction_dissipation` j_h(δuⁿ) = Σ_{e ⊂ Γ_C} |e| ḡ_e |δs_e|;
+//! * `friction_dissipation` j_h(δuⁿ) = Σ_{e ⊂ Γ_C} |e| ḡ_e |δs_e| (on a Coulomb edge the threshold
+//!   F̄_e |Pⁿ_e| in place of |e| ḡ_e);
 //! * `euler_dissipation` ½Q(δX, δX) = ½A(δU,δU) − B(δp,δU) + ½C(δp,δp) (= ½a_h(δuⁿ,δuⁿ) without data);
 //! * `boundary_work` W_Γ = Σ_c Rⁿ_c δU_c + ∂_pE·δp: the reactions Rⁿ = A Uⁿ − B(pⁿ,·) − lⁿ on the
 //!   constrained components c (both axes of a Dirichlet edge with data, the normal of a Γ_C edge with a
 //!   gap) times their increments, plus the work of the Dirichlet penalty on the moving data,
-//!   ∂_pE·δp = C(pⁿ,δp) − B(δp,Uⁿ);
+//!   ∂_pE·δp = C(pⁿ,δp) − B(δp,Uⁿ); with normal unknowns (`friction::normal`) also the work of the
+//!   contact reaction −Pⁿ_e n_e on the normal increments, −Σ_e Pⁿ_e δu_n(m_e);
 //! * `balance_residual` a_h(uⁿ,δuⁿ) + j_h(δuⁿ) − (lⁿ,δuⁿ) − W_Γ with a_h(uⁿ,δuⁿ) := Q(Xⁿ, δX)
 //!   = A(Uⁿ,δU) − B(pⁿ,δU) − B(δp,Uⁿ) + C(pⁿ,δp). It equals Σ_free (AUⁿ − B(pⁿ,·) − lⁿ)_i δU_i + j_h(δuⁿ):
 //!   zero exactly when the discrete equilibrium holds on the unknowns and the friction force does the
@@ -104,8 +106,12 @@ impl Problem {
             audit.friction_dissipation = space
                 .contact
                 .iter()
+                .enumerate()
                 .zip(r.slip.iter().zip(&prev.slip))
-                .map(|(c, (s, s0))| c.length * c.g_mean * (s - s0).abs())
+                .map(|((j, c), (s, s0))| match c.coulomb {
+                    Some(f) => f * r.normal.force[j].abs() * (s - s0).abs(),
+                    None => c.length * c.g_mean * (s - s0).abs(),
+                })
                 .sum();
             // lⁿ on the unknowns: without data the solver's own load (from the superposition's
             // patterns when superposed, within its span tolerance 1e-13 of the load); with data the
@@ -125,6 +131,9 @@ impl Problem {
                     external += lc * d;
                     reactions += force * d;
                 }
+            }
+            for (c, p) in space.contact.iter().zip(&r.normal.force) {
+                reactions -= p * (du[c.edge][0] * c.normal[0] + du[c.edge][1] * c.normal[1]);
             }
             audit.external_work = external;
             audit.boundary_work = reactions + forms.data_data(&p, &dp) - dot2(&bdp, &u);

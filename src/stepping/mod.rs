@@ -24,12 +24,15 @@ use std::time::Instant;
 
 pub mod audit;
 mod conditioning;
+mod normal;
 mod run;
 mod setup;
 mod shared;
 
 pub use audit::{Audit, AuditState};
 pub use conditioning::{Guard, MAX_CONDITION};
+use normal::initial_normal;
+pub use normal::NormalState;
 pub use run::RunOptions;
 pub use setup::Discretised;
 pub use shared::MeshSetUp;
@@ -111,6 +114,8 @@ pub struct StepResult {
     /// The step's energy audit (`None` for a step without u, or not run through [`Problem::run`]'s
     /// family).
     pub audit: Option<Audit>,
+    /// The normal condition per Γ_C edge (empty without normal unknowns).
+    pub normal: NormalState,
 }
 
 impl StepResult {
@@ -119,6 +124,14 @@ impl StepResult {
     }
     pub fn n_stick(&self) -> usize {
         self.state.len() - self.n_slip()
+    }
+
+    /// The contact forces λ = (μ, P) in the order of the condensed problem (μ alone without normal
+    /// unknowns).
+    pub fn forces(&self) -> Vec<f64> {
+        let mut f = self.mu.clone();
+        f.extend_from_slice(&self.normal.force);
+        f
     }
 }
 
@@ -225,22 +238,24 @@ impl Problem {
                 errors: None,
                 wall: start.elapsed().as_secs_f64(),
                 audit: None,
+                normal: NormalState::default(),
             };
             return self.finish(r);
         };
         let (sol, slip) = contact(friction, &free.trace, prev, n, t)?;
-        let (mut u, mut energy) = (Vec::new(), f64::NAN);
+        let mut r = contact_result(n, t, sol, slip, Vec::new(), f64::NAN, 0.0);
         if want_u {
-            u = self.free.with_friction(free, &sol.mu)?;
-            // a_h(u, u) = (l, u) − Σ_e μ_e s_e, since K u = l − Eμ
-            energy = dot(load, &u) - dot(&sol.mu, &slip);
+            r.u = self.free.with_friction(free, &r.forces())?;
+            r.energy = self.energy_of(load, &r);
         }
-        self.finish(contact_result(n, t, sol, slip, u, energy, start.elapsed().as_secs_f64()))
+        r.wall = start.elapsed().as_secs_f64();
+        self.finish(r)
     }
 }
 
 /// The friction problem of step n for the free trace s_f: its solution and the slip
-/// sⁿ = sⁿ⁻¹ + Δs (with d = s_f − sⁿ⁻¹ and Δs = d − Cμ).
+/// sⁿ = sⁿ⁻¹ + Δs (with d = s_f − sⁿ⁻¹ and Δs = d − Cμ; with normal unknowns d also holds
+/// r_f − ḡ(tₙ), `friction::normal`).
 fn contact(
     friction: &Friction,
     trace: &[f64],
@@ -248,8 +263,16 @@ fn contact(
     n: usize,
     t: f64,
 ) -> Result<(FrictionSolution, Vec<f64>)> {
-    let d: Vec<f64> = trace.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
-    let sol = friction.solve(&d, &prev.mu, n, t)?;
+    let mut d: Vec<f64> = trace.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
+    let sol = match friction.normal() {
+        None => friction.solve(&d, &prev.mu, n, t)?,
+        Some(nm) => {
+            let nc = prev.slip.len();
+            d.truncate(nc);
+            d.extend(trace[nc..].iter().zip(nm.gaps(t)?).map(|(r, g)| r - g));
+            friction.solve(&d, &prev.forces(), n, t)?
+        }
+    };
     let slip = prev.slip.iter().zip(&sol.slip_increment).map(|(a, b)| a + b).collect();
     Ok((sol, slip))
 }
@@ -277,6 +300,7 @@ fn contact_result(
         errors: None,
         wall,
         audit: None,
+        normal: NormalState { force: sol.normal, gap: sol.gap, separated: sol.separated },
     }
 }
 
@@ -295,6 +319,7 @@ fn initial_state(
     let nc = space.contact.len();
     let slip = space.contact.iter().map(|c| u[c.dof]).collect();
     let energy = symmetric_energy(stiffness, &u);
+    let normal = initial_normal(d, &u)?;
     let r = StepResult {
         n: 0,
         t,
@@ -308,6 +333,7 @@ fn initial_state(
         errors: None,
         wall: 0.0,
         audit: None,
+        normal,
     };
     finish(r, d, errors)
 }

@@ -5,7 +5,6 @@
 use super::{checked, contact, contact_result, Problem, StepResult};
 use crate::error::{Error, Result};
 use crate::friction::Friction;
-use crate::sparse::dot;
 use std::time::Instant;
 
 /// Steps whose true errors are evaluated together (`Problem::finish_block`): the exact solution's
@@ -128,15 +127,16 @@ impl Problem {
                 }
             }
             let start = Instant::now();
-            let wanted: Vec<(usize, &[f64])> = done.iter().filter(|r| want(r.n)).map(|r| (r.n, &r.mu[..])).collect();
+            let forces: Vec<Vec<f64>> = done.iter().filter(|r| want(r.n)).map(StepResult::forces).collect();
+            let wanted: Vec<(usize, &[f64])> =
+                done.iter().filter(|r| want(r.n)).zip(&forces).map(|(r, f)| (r.n, &f[..])).collect();
             let mut us = self.free.finish_block(&mut block, &wanted)?.into_iter();
             solves += start.elapsed().as_secs_f64();
             let share = solves / done.len().max(1) as f64;
             for r in done.iter_mut() {
                 if want(r.n) {
                     r.u = us.next().unwrap_or_default();
-                    // a_h(u, u) = (l, u) − Σ_e μ_e s_e, since K u = l − Eμ
-                    r.energy = dot(block.load(r.n), &r.u) - dot(&r.mu, &r.slip);
+                    r.energy = self.energy_of(block.load(r.n), r);
                 }
                 r.wall += share;
             }

@@ -204,7 +204,7 @@ impl Discretised {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         let pattern = EdgePattern::new(mesh);
         // contact unknowns last: the condensation then comes from the factor (solve::condense)
-        let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
+        let contact: Vec<usize> = space.contact_dofs();
         // The ordering needs only the graph of the edges, so the second thread starts on it before K's
         // pattern (of the unknowns) is made, which it needs only for the symbolic factorisation: that
         // thread is the longer one and ends phase 1.
@@ -276,7 +276,7 @@ impl Discretised {
         let condensation = self.condense(&factor)?;
         let t5 = Instant::now();
         let (free, c) = FreeResponse::new(factor, loads, basis, assembled, condensation, space);
-        let friction = c.map(|c| Friction::new(space, c, scene.solver));
+        let friction = c.map(|c| Friction::new(scene, &self.mesh, space, c)).transpose()?;
         let ends = PhaseEnds { assembly: t2, factorisation: t3, superposition: t4, condensation: t5 };
         Ok(Operators { stiffness, free, friction, errors, conditioning, step0, ends })
     }
@@ -314,7 +314,7 @@ impl Discretised {
 
     /// C = EᵀK⁻¹E and W from the factor (`None` without Γ_C).
     pub(super) fn condense(&self, factor: &Factor) -> Result<Option<Condensation>> {
-        let contact: Vec<usize> = self.space.contact.iter().map(|c| c.dof).collect();
+        let contact: Vec<usize> = self.space.contact_dofs();
         (!contact.is_empty()).then(|| condense(&contact, factor)).transpose()
     }
 }

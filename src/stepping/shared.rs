@@ -45,7 +45,7 @@ impl Problem {
             m.condensation.clone(),
             &m.space,
         );
-        let friction = c.map(|c| Friction::new(&m.space, c, scene.solver));
+        let friction = c.map(|c| Friction::new(&scene, &m.mesh, &m.space, c)).transpose()?;
         Ok(Problem {
             setup: SetupTimes { superposition: (t4 - t3).as_secs_f64(), ..SetupTimes::default() },
             reused: Some(m.times),

@@ -64,7 +64,16 @@ fn summary_round_trips_through_json() {
             adaptive_order: 0.5,
         },
     });
-    let step = Step { n: 1, t: 0.5, iterations: 3, residual: 1e-13, stick: 2, slip: 1, errors: Some(errors(1e-3)) };
+    let step = Step {
+        n: 1,
+        t: 0.5,
+        iterations: 3,
+        residual: 1e-13,
+        stick: 2,
+        slip: 1,
+        errors: Some(errors(1e-3)),
+        lengths: None,
+    };
     s.run = Some(RunSummary {
         refine: 1,
         unknowns: 24,

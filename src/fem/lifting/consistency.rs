@@ -125,7 +125,13 @@ pub fn check(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<()> {
                     }
                 }
             }
-            PartKind::Contact(_, g) => {
+            PartKind::Contact(c) => {
+                // with normal unknowns the gap is not lifted: a unilateral initial state is checked for
+                // penetration instead (`fem::gap`)
+                if c.normal_unknown {
+                    continue;
+                }
+                let g = &c.gap;
                 if g.is_none() && scene.u0.is_none() {
                     continue;
                 }
@@ -204,12 +210,14 @@ fn shared_vertices(scene: &Scene, mesh: &Mesh, space: &CrSpace, cmp: &mut Vec<Mi
                                 cmp.push((format!("{what} (u[{c}], t = {t})"), x, va[c], vb[c], ra[c] + rb[c]));
                             }
                         }
-                        (PartKind::Dirichlet(u), PartKind::Contact(_, g)) => {
+                        (PartKind::Dirichlet(u), PartKind::Contact(c)) if !c.normal_unknown => {
+                            let g = &c.gap;
                             let (un, r) = normal_of(mesh, eb, u, x, t)?;
                             let what = format!("{what} (u·n against gap, t = {t})");
                             cmp.push((what, x, un, gap_at(g, x, t)?, r + gap_rounding(g, x, t)));
                         }
-                        (PartKind::Contact(_, g), PartKind::Dirichlet(u)) => {
+                        (PartKind::Contact(c), PartKind::Dirichlet(u)) if !c.normal_unknown => {
+                            let g = &c.gap;
                             let (un, r) = normal_of(mesh, ea, u, x, t)?;
                             let what = format!("{what} (gap against u·n, t = {t})");
                             cmp.push((what, x, gap_at(g, x, t)?, un, r + gap_rounding(g, x, t)));
@@ -233,7 +241,7 @@ fn data_size(scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<f64> {
             for &t in &scene.times {
                 let v = match kind {
                     PartKind::Dirichlet(u @ Some(_)) => vec_at(u, x, t).unwrap_or([0.0; 2]),
-                    PartKind::Contact(_, g @ Some(_)) => [gap_at(g, x, t).unwrap_or(0.0), 0.0],
+                    PartKind::Contact(c) if c.lifted_gap().is_some() => [gap_at(&c.gap, x, t).unwrap_or(0.0), 0.0],
                     _ => break,
                 };
                 size = v.iter().filter(|c| c.is_finite()).fold(size, |m, c| m.max(c.abs()));

@@ -1,5 +1,5 @@
 //! The quadrature points of the loads: Dunavant degree 4 in every triangle for the body force, 3-point
-//! Gauss on the edges of every Neumann part with a traction.
+//! Gauss on the edges of every Neumann or contact part with a traction.
 
 use super::LoadPoint;
 use crate::fem::quadrature::{edge_point, tri_point, GAUSS3, TRI4};
@@ -16,7 +16,12 @@ pub(super) fn load_points<'a>(scene: &'a Scene, mesh: &Mesh, space: &CrSpace) ->
         raw.push((f, body_points(mesh)));
     }
     for (p, part) in scene.parts.iter().enumerate() {
-        if let PartKind::Neumann(Some(g)) = &part.kind {
+        let g = match &part.kind {
+            PartKind::Neumann(g) => g.as_ref(),
+            PartKind::Contact(c) => c.traction.as_ref(),
+            PartKind::Dirichlet(_) => None,
+        };
+        if let Some(g) = g {
             raw.push((g, traction_points(mesh, space, p)));
         }
     }

@@ -1,0 +1,142 @@
+//! Coulomb friction on the condensed problem with normal unknowns (`normal`): the semismooth Newton
+//! method of Hüeber, Stadler & Wohlmuth (SIAM J. Sci. Comput. 30(2), 2008) in its primal–dual
+//! active-set form. With c_e = 1/C_ee (per unknown) and Δ = d − Cλ, the conditions of every edge are the
+//! nonlinear complementarity functions
+//!   normal (unilateral):  P_e − max(0, P_e + c Δ_n,e) = 0,
+//!   tangential:           max(θ_e, |y_e|) μ_e − θ_e y_e = 0,   y_e = μ_e + c Δs_e,
+//! with the threshold θ_e = F̄_e max(0, P_e + c Δ_n,e) inside the max (F̄_e |P_e + c Δ_n,e| on a bilateral
+//! edge; Tresca's w_e on a Tresca edge of the same scene). A Newton step on them is the linear solve on
+//! the active sets they give: a separated edge has P_e = 0 and μ_e = 0 (Coulomb) or |μ_e| ≤ w_e (Tresca),
+//! a closed edge Δ_n,e = 0; a sticking edge Δs_e = 0, a slipping one μ_e = σ_e F̄_e P_e (σ_e = sign y_e;
+//! in 2D the tangent is a line and this linearisation is exact). Iterated until the natural residual
+//! (`Qp::residual` with the bounds of the current P) is ≤ tol; a repeated active set (the iteration
+//! cycles, as for a large F̄) or the iteration limit stops it, reported as non-convergence.
+
+use super::{stalled, Qp, Solved};
+use nalgebra::{DMatrix, DVector};
+use std::collections::HashSet;
+
+/// The coefficients of the edges: F̄_e of a Coulomb edge (`None`: Tresca's bound w_e).
+pub type Coefficients<'a> = &'a [Option<f64>];
+
+/// The friction threshold of edge e for the normal force `p`: w_e (Tresca) or F̄_e |p| (Coulomb).
+pub fn threshold(f: Coefficients, w: &[f64], e: usize, p: f64) -> f64 {
+    match f[e] {
+        Some(f) => f * p.abs(),
+        None => w[e],
+    }
+}
+
+/// Solve from λ₀ = (μ₀, P₀); `w` are the Tresca bounds (used on Tresca edges), the normal forces'
+/// bounds are those of `qp` (lower bound 0: unilateral).
+pub fn solve(qp: &Qp, nm: Coefficients, w: &[f64], lam0: &[f64], tol: f64, max_iter: usize) -> Solved {
+    let n = qp.d.len();
+    let nc = n / 2;
+    let mut lam: Vec<f64> = (0..n).map(|k| if k < nc { lam0[k] } else { lam0[k].max(qp.lo[k]) }).collect();
+    let mut seen: HashSet<Vec<i8>> = HashSet::new();
+    for it in 0..=max_iter {
+        let ds = qp.slip_increment(&lam);
+        let res = residual(qp, nm, w, &lam, &ds);
+        if res <= tol {
+            return Ok((lam, it, res));
+        }
+        if it == max_iter {
+            return Err(stalled("coulomb ssn", it, res));
+        }
+        let (set, sigma_p) = active_sets(qp, nm, w, &lam, &ds);
+        if !seen.insert(set.clone()) {
+            return Err(stalled("coulomb ssn (cycling: an active set repeated)", it, res));
+        }
+        lam =
+            newton_step(qp, nm, w, &set, &sigma_p).ok_or_else(|| stalled("coulomb ssn (singular system)", it, res))?;
+    }
+    unreachable!("the loop returns at it == max_iter")
+}
+
+/// Per unknown its set: tangential 0 stick, ±1 slip, 2 free (μ = 0); normal 0 closed, 1 separated. And
+/// per edge the sign s of the normal force in the threshold F̄ s P.
+fn active_sets(qp: &Qp, nm: Coefficients, w: &[f64], lam: &[f64], ds: &[f64]) -> (Vec<i8>, Vec<f64>) {
+    let n = lam.len();
+    let nc = n / 2;
+    let mut set = vec![0i8; n];
+    let mut sign = vec![1.0; nc];
+    for e in 0..nc {
+        let k = nc + e;
+        let yn = lam[k] + ds[k] / qp.c[(k, k)];
+        let separated = qp.lo[k] == 0.0 && yn <= 0.0;
+        set[k] = i8::from(separated);
+        sign[e] = if yn < 0.0 { -1.0 } else { 1.0 };
+        let theta = if separated && nm[e].is_some() { 0.0 } else { threshold(nm, w, e, yn) };
+        let yt = lam[e] + ds[e] / qp.c[(e, e)];
+        set[e] = if theta == 0.0 {
+            2
+        } else if yt.abs() > theta {
+            if yt > 0.0 {
+                1
+            } else {
+                -1
+            }
+        } else {
+            0
+        };
+    }
+    (set, sign)
+}
+
+/// The iterate of the active sets `set` (one linear solve, dense LU).
+fn newton_step(qp: &Qp, nm: Coefficients, w: &[f64], set: &[i8], sign: &[f64]) -> Option<Vec<f64>> {
+    let n = set.len();
+    let nc = n / 2;
+    let mut a = DMatrix::zeros(n, n);
+    let mut b = DVector::zeros(n);
+    let row_of_c = |a: &mut DMatrix<f64>, b: &mut DVector<f64>, r: usize| {
+        for j in 0..n {
+            a[(r, j)] = qp.c[(r, j)];
+        }
+        b[r] = qp.d[r];
+    };
+    for e in 0..nc {
+        let k = nc + e;
+        match set[k] {
+            1 => a[(k, k)] = 1.0,
+            _ => row_of_c(&mut a, &mut b, k),
+        }
+        match (set[e], nm[e]) {
+            (0, _) => row_of_c(&mut a, &mut b, e),
+            (2, _) => a[(e, e)] = 1.0,
+            (s, Some(f)) => {
+                a[(e, e)] = 1.0;
+                a[(e, k)] = -f64::from(s) * f * sign[e];
+            }
+            (s, None) => {
+                a[(e, e)] = 1.0;
+                b[e] = f64::from(s) * w[e];
+            }
+        }
+    }
+    let x = a.lu().solve(&b)?;
+    x.iter().all(|v| v.is_finite()).then(|| x.iter().copied().collect())
+}
+
+/// The natural residual of both conditions, relative to the step's force scale: max over the normal
+/// forces of |P − max(lo, P + Δ_n/C)| and over the friction forces of |μ − clamp(μ + Δs/C, ±θ(P))|.
+fn residual(qp: &Qp, nm: Coefficients, w: &[f64], lam: &[f64], ds: &[f64]) -> f64 {
+    let n = lam.len();
+    let nc = n / 2;
+    let mut r: f64 = 0.0;
+    let mut scale: f64 = 0.0;
+    for e in 0..nc {
+        let k = nc + e;
+        r = r.max((lam[k] - qp.project(k, lam[k] + ds[k] / qp.c[(k, k)])).abs());
+        let theta = threshold(nm, w, e, lam[k]);
+        r = r.max((lam[e] - (lam[e] + ds[e] / qp.c[(e, e)]).clamp(-theta, theta)).abs());
+        scale = scale.max(qp.d[k].abs() / qp.c[(k, k)]);
+        let t = qp.d[e].abs() / qp.c[(e, e)];
+        scale = scale.max(if nm[e].is_some() { t } else { t.min(w[e]) });
+    }
+    if r == 0.0 {
+        0.0
+    } else {
+        r / scale.max(f64::MIN_POSITIVE)
+    }
+}
