@@ -7,8 +7,9 @@
 //! parts, their shared vertices and the data's consistency are properties of the data, not of the
 //! level), binds the boundary parts to it ([`CrSpace::new`]: every boundary edge in one declared part,
 //! every part with edges, g_a ≥ 0) and checks the boundary data ([`lifting::consistency::check`]: u₀
-//! against u_D(t₀) and g_n(t₀), two Dirichlet parts at a shared vertex at every time node), and refuses
-//! friction bounds whose forces cannot be multiplied ([`friction_forces`]).
+//! against u_D(t₀) and g_n(t₀), two Dirichlet parts at a shared vertex at every time node), refuses
+//! friction bounds whose forces cannot be multiplied ([`friction_forces`]) and an initial state that
+//! penetrates a unilateral part ([`crate::fem::gap::check_scene`]).
 
 use super::lifting;
 use super::space::CrSpace;

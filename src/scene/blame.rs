@@ -13,7 +13,7 @@ impl Scene {
         for p in &self.parts {
             match &p.kind {
                 PartKind::Dirichlet(Some(_)) => v.push(named(p, "u")),
-                PartKind::Contact(_, Some(_)) => v.push(named(p, "gap")),
+                PartKind::Contact(c) if c.gap.is_some() => v.push(named(p, "gap")),
                 _ => {}
             }
         }
@@ -21,12 +21,27 @@ impl Scene {
             v.push("the body force f".into());
         }
         v.extend(
-            self.parts.iter().filter(|p| matches!(p.kind, PartKind::Neumann(Some(_)))).map(|p| named(p, "traction")),
+            self.parts
+                .iter()
+                .filter(|p| match &p.kind {
+                    PartKind::Neumann(g) => g.is_some(),
+                    PartKind::Contact(c) => c.traction.is_some(),
+                    PartKind::Dirichlet(_) => false,
+                })
+                .map(|p| named(p, "traction")),
         );
         if self.u0.is_some() {
             v.push("u₀".into());
         }
-        v.extend(self.parts.iter().filter(|p| matches!(p.kind, PartKind::Contact(..))).map(|p| named(p, "g_a")));
+        // Coulomb's F is a ratio of forces: it does not scale with them
+        v.extend(
+            self.parts
+                .iter()
+                .filter(
+                    |p| matches!(&p.kind, PartKind::Contact(c) if matches!(c.friction, super::FrictionLaw::Tresca(_))),
+                )
+                .map(|p| named(p, "g_a")),
+        );
         match v.len() {
             0 => "the scene gives no data".into(),
             1 => format!("u is linear in {}, so scale it {how}", v[0]),
