@@ -17,64 +17,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import checksum, paths, virtual
-
-F8, I8, U1, U8 = np.dtype("<f8"), np.dtype("<i8"), np.dtype("u1"), np.dtype("<u8")
-
-# (dataset under /tresca, dtype written, shape in the size symbols, meaning)
-DATASETS = (
-    ("mesh/points", F8, ("P", 2), "vertices"),
-    ("mesh/triangles", I8, ("T", 3), "counter-clockwise vertex indices"),
-    ("mesh/edges", I8, ("E", 2), "edge vertex indices"),
-    ("mesh/midpoints", F8, ("E", 2), "edge midpoints (the CR nodes; tools match edges by these)"),
-    ("times", F8, ("R",), "time nodes"),
-    ("u", F8, ("R", "E", 2), "displacement at every edge midpoint"),
-    ("energy", F8, ("R",), "a_h(u^n, u^n)"),
-    ("steps/iterations", I8, ("R",), "solver iterations"),
-    ("steps/residual", F8, ("R",), "final residual"),
-    ("steps/n_stick", I8, ("R",), "contact edges sticking"),
-    ("steps/n_slip", I8, ("R",), "contact edges slipping"),
-    ("steps/wall_time", F8, ("R",), "seconds"),
-    ("steps/checksum", U8, ("R",), "XXH64 of the step's rows (tresca_py.checksum)"),
-    ("contact/edges", I8, ("C",), "indices of the Γ_C edges"),
-    ("contact/normal", F8, ("C", 2), "outward normal n_e"),
-    ("contact/tangent", F8, ("C", 2), "tangent τ_e = (−n_y, n_x)"),
-    ("contact/g", F8, ("C",), "friction bound ḡ_e"),
-    ("contact/slip", F8, ("R", "C"), "u_τ(m_e)"),
-    ("contact/sigma_t", F8, ("R", "C"), "σ_τ = −μ_e/|e|"),
-    ("contact/state", U1, ("R", "C"), "0 stick, 1 slip"),
-    ("contact/mu", F8, ("R", "C"), "friction force μ_e, exact"),
-    ("contact/dof", F8, ("R", "C"), "the contact unknown"),
-    ("contact/pressure", F8, ("R", "C"), "contact pressure p_e = P_e/|e| (scenes with normal unknowns only)"),
-    ("contact/gap", F8, ("R", "C"), "u_n(m_e) − ḡ_e (scenes with normal unknowns only)"),
-    ("contact/status", U1, ("R", "C"), "0 stick, 1 slip, 2 separated (scenes with normal unknowns only)"),
-    ("errors/energy", F8, ("R",), "true energy error"),
-    ("errors/h1", F8, ("R",), "true broken H1 error"),
-    ("errors/l2", F8, ("R",), "true L2 error"),
-)
-SPEC = {name: (dtype, shape) for name, dtype, shape, _ in DATASETS}
-STEP_FIELDS = ("iterations", "residual", "n_stick", "n_slip", "wall_time")
-CONTACT_STATIC = ("edges", "normal", "tangent", "g")
-CONTACT_SERIES = ("slip", "sigma_t", "state", "mu", "dof", "pressure", "gap", "status")
-# Written only by a run whose Γ_C edges carry normal unknowns (a unilateral or Coulomb part; issue 40); not part
-# of the step checksums (tresca_py.checksum.SERIES), as src/output/tresca.rs writes them.
-NORMAL_SERIES = ("contact/pressure", "contact/gap", "contact/status")
-ERRORS = ("energy", "h1", "l2")
-
-# /tresca attributes as the Rust binary writes them: name -> type ("floats": a 1-D float array)
-ATTRIBUTES = {
-    "scene": str, "scene_path": str, "title": str, "version": str, "git_commit": str, "solver": str,
-    "tol": float, "max_iter": int, "uzawa_step": float, "rho": float, "E": float, "nu": float, "steps": int,
-    "n_edges": int, "n_contact": int, "n_dofs": int, "paper_dofs": int, "h": float, "setup_times": "floats",
-    "setup_times_meaning": str, "status": str, "frame_every": int, "threads": int,
-}
-REQUIRED = ("scene", "version", "solver", "E", "nu", "steps", "status")
-# Written by the Python solvers before this module: no status, completed, checksum, contact/mu, contact/dof.
-LEGACY_MISSING = ("status", "steps/checksum", "contact/mu", "contact/dof")
-
-
-class ResultsError(ValueError):
-    """A results file (or results to be written) that breaks the layout; the message names what."""
+from . import checksum, paths
+from . import results_layout as layout
+# the layout's names, also read as tresca_py.results.X
+from .results_layout import ATTRIBUTES as ATTRIBUTES
+from .results_layout import (CONTACT_SERIES, CONTACT_STATIC, DATASETS, ERRORS, F8, LEGACY_MISSING, NORMAL_SERIES,
+                             REQUIRED, SPEC, STEP_FIELDS, ResultsError)
 
 
 @dataclass(eq=False)
@@ -192,19 +140,6 @@ class Results:
         return checksum.step_checksums([np.asarray(s[k], SPEC[k][0]) for k in checksum.SERIES if k in s] + audit)
 
 
-def _check_array(where, name, shape, dtype, sizes):
-    """ResultsError unless a dataset of this shape and dtype fits the layout."""
-    sym = SPEC[name][1]
-    want = tuple(sizes[s] if isinstance(s, str) else s for s in sym)
-    if tuple(shape) != want:
-        raise ResultsError(f"{where}: tresca/{name} has shape {tuple(shape)}, the layout wants {want} "
-                           f"({', '.join(map(str, sym))})")
-    kinds = {"contact/state": "iub", "contact/status": "iub", "steps/checksum": "u"}.get(
-        name, "f" if SPEC[name][0].kind == "f" else "iu")
-    if np.dtype(dtype).kind not in kinds:
-        raise ResultsError(f"{where}: tresca/{name} holds {np.dtype(dtype)}, the layout wants {SPEC[name][0]}")
-
-
 def validate(r, where="results"):
     """ResultsError unless the in-memory results fit the layout and hold valid values."""
     m = r.mesh
@@ -213,15 +148,15 @@ def validate(r, where="results"):
     arrays = {**r.static(), **r.series()}
     for name, a in arrays.items():
         a = np.asarray(a)
-        _check_array(where, name, a.shape, a.dtype, sizes)
+        layout.check_array(where, name, a.shape, a.dtype, sizes)
         bad = ~np.isfinite(a) if a.dtype.kind == "f" else None
         if bad is not None and bad.any():
             n, at = int(bad.sum()), np.unravel_index(int(np.argmax(bad)), a.shape)
             step = f"step {at[0]}" if SPEC[name][1][0] == "R" else f"{tuple(map(int, at))}"
             raise ResultsError(f"{where}: tresca/{name} holds {n} NaN/Inf value{'s' * (n > 1)} (first at {step}): "
                                "not a valid result")
-    _check_indices(where, m.triangles, sizes["P"], "mesh/triangles")
-    _check_indices(where, m.edges, sizes["P"], "mesh/edges")
+    layout.check_indices(where, m.triangles, sizes["P"], "mesh/triangles")
+    layout.check_indices(where, m.edges, sizes["P"], "mesh/edges")
     m.triangle_edges(where)
     if sizes["R"] == 0:
         raise ResultsError(f"{where}: no committed step (tresca-cr never leaves such a file under its name)")
@@ -232,7 +167,7 @@ def validate(r, where="results"):
         c = r.contact
         if sizes["C"] == 0:
             raise ResultsError(f"{where}: a tresca/contact group without contact edges")
-        _check_indices(where, c.edges, sizes["E"], "contact/edges")
+        layout.check_indices(where, c.edges, sizes["E"], "contact/edges")
         if len(np.unique(c.edges)) != len(c.edges):
             raise ResultsError(f"{where}: tresca/contact/edges lists an edge twice")
         if np.any((c.state != 0) & (c.state != 1)):
@@ -246,81 +181,22 @@ def validate(r, where="results"):
                            "-1 < nu < 0.5)")
 
 
-def _check_indices(where, a, n, name):
-    if a.size and (a.min() < 0 or a.max() >= n):
-        raise ResultsError(f"{where}: tresca/{name} holds indices outside 0..{n - 1} ({int(a.min())}..{int(a.max())})")
-
-
-def _attrs(where, g):
-    """The /tresca attributes as Python values, type-checked against ATTRIBUTES."""
-    out = {}
-    for k, v in g.attrs.items():
-        if isinstance(v, bytes):
-            v = v.decode("utf-8", "replace")
-        elif isinstance(v, np.ndarray) and v.ndim == 0:
-            v = v[()]
-        if isinstance(v, np.generic):
-            v = v.item()
-        want = ATTRIBUTES.get(k)
-        ok = (want is None or (want is str and isinstance(v, str))
-              or (want is int and isinstance(v, int) and not isinstance(v, bool))
-              or (want is float and isinstance(v, (int, float)) and not isinstance(v, bool))
-              or (want == "floats" and isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind == "f"))
-        if not ok:
-            raise ResultsError(f"{where}: attribute {k} of /tresca is {v!r}, not of type "
-                               f"{getattr(want, '__name__', want)}")
-        out[k] = v
-    return out
-
-
-def _status_rows(where, status, completed, rows, n_steps):
-    """ResultsError unless the status, the completed steps and the rows agree."""
-    if not (status == "completed" or status.startswith("running") or status.startswith("stopped")):
-        raise ResultsError(f"{where}: unknown status {status!r} (completed, running or stopped: ...)")
-    if completed < 1:
-        raise ResultsError(f"{where}: no committed step (completed = {completed}); tresca-cr never leaves such "
-                           "a file under its name")
-    if completed > rows:
-        raise ResultsError(f"{where}: {completed} steps marked complete but the series hold {rows} rows: damaged")
-    if status == "completed" and not completed == rows == n_steps + 1:
-        raise ResultsError(f"{where}: status 'completed' but {completed} committed steps and {rows} rows for "
-                           f"{n_steps} steps (N + 1 = {n_steps + 1} expected)")
-    if status.startswith("running") and rows != n_steps + 1:
-        raise ResultsError(f"{where}: a killed run (status {status!r}) must have room for all {n_steps + 1} "
-                           f"steps; the series hold {rows} rows")
-    # a stopped run is cut to its completed steps, or left at full length when the disk had no room to cut it
-    if status.startswith("stopped") and rows not in (completed, n_steps + 1):
-        raise ResultsError(f"{where}: a stopped run must be cut to its {completed} completed steps or left at "
-                           f"all {n_steps + 1}; the series hold {rows} rows")
-
-
-def _dataset(where, g, name):
-    import h5py
-    obj = g.get(name)
-    if not isinstance(obj, h5py.Dataset):
-        raise ResultsError(f"{where}: tresca/{name} is missing")
-    if obj.is_virtual and (missing := virtual.missing_source(obj)):
-        raise ResultsError(f"{where}: tresca/{name} is a virtual dataset whose source {missing} is missing; HDF5 "
-                           "would read it as zeros, not data")
-    return obj
-
-
 def _read_group(f, where, verify):
     import h5py
     g = f.get("tresca")
     if not isinstance(g, h5py.Group):
         top = ", ".join(sorted(f.keys())[:8]) or "nothing"
         raise ResultsError(f"{where}: has no /tresca group (it holds {top}): not a tresca-cr results file")
-    attrs = _attrs(where, g)
+    attrs = layout.attributes(where, g)
     legacy = "status" not in attrs and str(attrs.get("version", "")).startswith("python")
     for k in REQUIRED:
         if k not in attrs and not (legacy and k in LEGACY_MISSING):
             raise ResultsError(f"{where}: attribute {k} of /tresca is missing")
     ds = {}
     # the Python writer before this module wrote an empty contact group for a run without Γ_C
-    has_contact = "contact" in g and not (legacy and _dataset(where, g, "contact/edges").shape[:1] == (0,))
+    has_contact = "contact" in g and not (legacy and layout.dataset(where, g, "contact/edges").shape[:1] == (0,))
     for name in ("mesh/points", "mesh/triangles", "mesh/edges", "times") + (("contact/edges",) if has_contact else ()):
-        ds[name] = _dataset(where, g, name)
+        ds[name] = layout.dataset(where, g, name)
         if ds[name].ndim != len(SPEC[name][1]):
             raise ResultsError(f"{where}: tresca/{name} has {ds[name].ndim} dimensions, the layout wants "
                                f"{len(SPEC[name][1])}")
@@ -337,8 +213,8 @@ def _read_group(f, where, verify):
         optional = name == "steps/checksum" or name in NORMAL_SERIES or (legacy and name in LEGACY_MISSING)
         if optional and name not in g:
             continue
-        ds[name] = _dataset(where, g, name)
-        _check_array(where, name, ds[name].shape, ds[name].dtype, sizes)
+        ds[name] = layout.dataset(where, g, name)
+        layout.check_array(where, name, ds[name].shape, ds[name].dtype, sizes)
     steps_attrs = g["steps"].attrs if isinstance(g.get("steps"), h5py.Group) else {}
     if "completed" in steps_attrs:
         completed = int(np.asarray(steps_attrs["completed"]).reshape(-1)[0])
@@ -347,7 +223,7 @@ def _read_group(f, where, verify):
     else:
         raise ResultsError(f"{where}: attribute completed of tresca/steps is missing")
     status = attrs.get("status", "completed")
-    _status_rows(where, status, completed, sizes["R"], int(attrs.get("steps", sizes["R"] - 1)))
+    layout.status_rows(where, status, completed, sizes["R"], int(attrs.get("steps", sizes["R"] - 1)))
     S = completed
 
     def load(name, series=True):
@@ -367,7 +243,7 @@ def _read_group(f, where, verify):
                 attrs=attrs, path=where, rows=sizes["R"])
     validate(r, where)
     if "steps/checksum" in ds and checksum.covers_audit(ds["steps/checksum"]):
-        r.audit = _audit_rows(where, g, S, sizes["R"])
+        r.audit = layout.audit_rows(where, g, S, sizes["R"])
     if verify and "steps/checksum" in ds:
         stored = load("steps/checksum")
         bad = np.nonzero(r.checksums() != stored)[0]
@@ -375,20 +251,6 @@ def _read_group(f, where, verify):
             raise ResultsError(f"{where}: step {int(bad[0])} does not match its checksum (tresca/steps/checksum): "
                                "the file was damaged after it was written; steps before it are intact")
     return r
-
-
-def _audit_rows(where, g, S, rows):
-    """{name: the first S rows} of the audit series that the checksums cover; ResultsError if one is missing or
-    not a float series of the file's rows."""
-    import h5py
-    out = {}
-    for name in checksum.AUDIT:
-        obj = g.get(name)
-        if not isinstance(obj, h5py.Dataset) or obj.shape != (rows,) or obj.dtype.kind != "f":
-            what = "missing" if obj is None else "not a float series of one value per step"
-            raise ResultsError(f"{where}: tresca/{name} is {what}, though the step checksums cover the energy audit")
-        out[name] = obj[:S].astype(F8, copy=False)
-    return out
 
 
 def read(path, verify=True):

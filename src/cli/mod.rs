@@ -4,6 +4,7 @@ pub mod adapt;
 pub mod args;
 pub mod check;
 pub mod corners;
+pub mod malloc;
 pub mod out;
 pub mod plan;
 pub mod plan_adaptive;

@@ -69,7 +69,7 @@ pub fn run(scene: Scene, out: OutputArgs, verbose: bool, quiet: bool, json: Opti
         // problem's memory (the factor, K, the load basis: about 60 MB at 24,640 unknowns) back to the
         // system, which the process's exit would otherwise do alone after the file is closed.
         drop(problem);
-        crate::hand_back_memory();
+        super::malloc::hand_back_memory();
     }
     let committed = writer.map(|w| w.finish(&status)).transpose()?;
     if let (Err(_), Some(p)) = (&result, &path) {

@@ -31,7 +31,7 @@
 //! that layout. The unknown vector of the last step is rebuilt exactly from `u` (free
 //! edges hold the two unknowns verbatim) and `contact/dof` (the one unknown of a contact edge).
 
-use super::checksum::{step_checksums, COVERS};
+use super::checksum::{covered, first_corrupt, rows_checksums, COVERS};
 use super::h5::{attr, attr_str, attr_vec, put, read_str, Raw, Series};
 use super::rows::Rows;
 use super::Run;
@@ -67,31 +67,8 @@ pub struct Tresca {
     normal: Option<[Series; 3]>,
 }
 
+pub use super::checksum::AUDIT;
 pub use super::normal_series::NORMAL;
-
-/// The audit's series under `steps`, in `stepping::Audit::as_array`'s order.
-pub const AUDIT: [&str; 6] = [
-    "external_work",
-    "boundary_work",
-    "stored_energy",
-    "friction_dissipation",
-    "euler_dissipation",
-    "balance_residual",
-];
-
-/// The series a new file's checksums cover, in their order (module doc).
-fn covered(contact: bool, errors: bool) -> String {
-    let mut v = vec!["times", "u", "energy"];
-    v.extend(["steps/iterations", "steps/residual", "steps/n_stick", "steps/n_slip", "steps/wall_time"]);
-    if contact {
-        v.extend(["contact/slip", "contact/sigma_t", "contact/state", "contact/mu", "contact/dof"]);
-    }
-    if errors {
-        v.extend(["errors/energy", "errors/h1", "errors/l2"]);
-    }
-    let audit = AUDIT.map(|a| format!("steps/{a}"));
-    v.into_iter().map(String::from).chain(audit).collect::<Vec<_>>().join(", ")
-}
 
 const SCALARS: [&str; 6] = ["times", "energy", "steps/iterations", "steps/residual", "steps/n_stick", "steps/n_slip"];
 
@@ -254,31 +231,6 @@ impl Tresca {
         v
     }
 
-    /// The checksums of the buffered rows `b`, in step order.
-    fn checksums_of(&self, b: &Rows) -> Vec<u64> {
-        use bytemuck::cast_slice as c;
-        let mut v: Vec<&[u8]> = vec![
-            c(&b.times),
-            c(&b.u),
-            c(&b.energy),
-            c(&b.iterations),
-            c(&b.residual),
-            c(&b.n_stick),
-            c(&b.n_slip),
-            c(&b.wall),
-        ];
-        if self.contact.is_some() {
-            v.extend([c(&b.slip), c(&b.sigma_t), &b.state[..], c(&b.mu), c(&b.dof)]);
-        }
-        if self.errors.is_some() {
-            v.extend(b.errors.iter().map(|e| c(e)));
-        }
-        if self.audit_checksummed {
-            v.extend(b.audit.iter().map(|a| c(a)));
-        }
-        step_checksums(&v, b.count)
-    }
-
     /// The first of the `completed` stored steps whose rows do not match their checksum, if any; an
     /// error if the file has no checksums.
     pub fn first_corrupt_step(&mut self, completed: usize) -> hdf5::Result<Option<usize>> {
@@ -289,23 +241,7 @@ impl Tresca {
         if self.audit_checksummed && self.audit.is_none() {
             return Err(hdf5::Error::from("its energy audit series are missing, though its checksums cover them"));
         }
-        if self.audit_checksummed && self.audit.is_none() {
-            return Err(hdf5::Error::from("its energy audit series are missing, though its checksums cover them"));
-        }
-        // blocks of steps of about 64 MB, so that a file larger than memory is verified too
-        let series = self.series(self.audit_checksummed);
-        let per_step = series.iter().map(|s| s.step_bytes()).sum::<usize>().max(1);
-        let block = ((64 << 20) / per_step).max(1);
-        for first in (0..completed).step_by(block) {
-            let count = block.min(completed - first);
-            let bytes = series.iter().map(|s| s.read_bytes(first, count)).collect::<hdf5::Result<Vec<_>>>()?;
-            let views: Vec<&[u8]> = bytes.iter().map(|b| &b[..]).collect();
-            let sums = step_checksums(&views, count);
-            if let Some(k) = sums.iter().zip(&stored[first..]).position(|(a, b)| a != b) {
-                return Ok(Some(first + k));
-            }
-        }
-        Ok(None)
+        first_corrupt(&stored, &self.series(self.audit_checksummed), completed)
     }
 
     /// The `completed` attribute.
@@ -317,7 +253,8 @@ impl Tresca {
     pub fn write_rows(&self, raw: &Raw, b: &Rows) -> hdf5::Result<()> {
         let (n, k) = (b.first, b.count);
         if let Some(c) = &self.checksum {
-            c.write_steps(raw, n, k, &self.checksums_of(b))?;
+            let kinds = (self.contact.is_some(), self.errors.is_some(), self.audit_checksummed);
+            c.write_steps(raw, n, k, &rows_checksums(b, kinds))?;
         }
         self.times.write_steps(raw, n, k, &b.times)?;
         self.u.write_steps(raw, n, k, &b.u)?;
