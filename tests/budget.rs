@@ -2,26 +2,14 @@
 
 mod common;
 
-use common::{bin, scene, tmp_in};
+use common::{scene, tmp_in};
 use tresca_cr::scene::budget::Estimate;
 
-/// Peak resident memory of the run `tresca-cr run SCENE --refine R --steps 4 -o OUT -q --force`, bytes:
-/// the child's own `ru_maxrss` (wait4), so tests running beside it do not count.
+/// Peak resident memory of the run `tresca-cr run SCENE --refine R --steps 4 -o OUT -q --force`, bytes.
 fn peak_of_run(path: &str, refine: u32) -> u64 {
     let out = tmp_in("budget", &format!("r{refine}.h5"));
-    // reaped below by wait4, which reports the child's own peak (std's wait does not)
-    let child = bin()
-        .args(["run", path, "--refine", &refine.to_string(), "--steps", "4", "-q", "--force", "-o"])
-        .arg(&out)
-        .spawn()
-        .unwrap()
-        .id() as libc::pid_t;
-    let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
-    // SAFETY: waits for our own child, filling the status and rusage given.
-    let pid = unsafe { libc::wait4(child, &mut status, 0, &mut usage) };
-    assert_eq!(pid, child);
-    assert!(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0, "the run failed: {status}");
-    usage.ru_maxrss as u64 * 1024
+    let refine = refine.to_string();
+    common::peak_rss(&["run", path, "--refine", &refine, "--steps", "4", "-q", "--force", "-o", out.to_str().unwrap()])
 }
 
 /// The system shall estimate a run's peak memory before it starts within 15 % (the bar of issue 32), here

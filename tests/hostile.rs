@@ -4,6 +4,8 @@
 //! (§3), inputs that would be read forever (§4), and messages that blamed the wrong cause (§5). The
 //! inputs that are scenes are also in `tests/fuzz_corpus/` (replayed by `tests/fuzz.rs`).
 
+#[path = "hostile/budget.rs"]
+mod budget;
 mod common;
 #[path = "hostile/faults.rs"]
 mod faults;

@@ -17,7 +17,14 @@
 //! `METIS_FILL` of them (0.870 at 6,292,480 unknowns: 2.007e9 against 2.307e9 entries; 0.87 in nnz(L) at
 //! 1,573,376, `reference/bench_factorisation_r8.json`), 8 bytes an entry; refine 9 of Example 5.1 ran
 //! with METIS at a 21.66 GB peak against 21.8 GB so estimated (24.2 GB with the coordinate fill).
+//!
+//! Beside the fit, what the calibration scene does not hold: the results writer's queue of steps, full
+//! (how full it gets depends on the speed of the solve), and the expressions evaluated at every volume
+//! quadrature point at every time node (a body force, an exact solution), whose cached values are
+//! counted from their compiled programs.
 
+use super::expr::program::Program;
+use super::expr::Expr;
 use super::{MeshSpec, PartKind, Scene};
 use crate::error::{human, Error, Result};
 use std::path::Path;
@@ -59,6 +66,20 @@ const BLOCK_VALUES: u64 = 1 << 24;
 const BYTES_PER_STEP: u64 = 64;
 /// Frames of the visualisation views by default (`output::AUTO_FRAMES`).
 const FRAMES: u64 = 51;
+/// Steps queued for the results writer at most (`output::background::QUEUE`), each holding u at the edge
+/// midpoints (16 bytes an edge), and the bytes of rows buffered for one commit (`output::rows::BUDGET`):
+/// whether the queue fills depends on how fast the steps are solved, so the estimate counts it full.
+const WRITER_QUEUE: u64 = 32;
+const WRITER_ROWS: u64 = 4 << 20;
+/// Quadrature points a triangle has for the body force and the error norms (Dunavant degree 4,
+/// `fem::quadrature::TRI4`).
+const VOLUME_POINTS: u64 = 6;
+/// Bytes a volume point holds beside the cached values of its expressions, measured (peak RSS with and
+/// without the expression, mms_data_front refine 5: 85 and 31 bytes a point): for the body force the
+/// point (16), its weights w·φ (24), its values at a node (16) and what the allocator keeps of the
+/// set-up's points; for the exact solution the point and its share of the elements' geometry.
+const FORCE_POINT: u64 = 88;
+const EXACT_POINT: u64 = 32;
 
 impl Estimate {
     /// The estimate of `scene` run with `steps` time steps; `results`: a results file is written.
@@ -67,7 +88,11 @@ impl Estimate {
         // with normal unknowns C has two rows per Γ_C edge (4× the bytes), and a step's rows the normal
         // series (17 bytes an edge, within the doubled count's 33)
         let contact = if scene.has_normal_unknowns() { 2 * contact } else { contact };
-        Ok(Estimate::of_sizes((triangles, edges, contact), steps, results))
+        let mut e = Estimate::of_sizes((triangles, edges, contact), steps, results);
+        let volume = triangles.saturating_mul(expression_bytes(scene));
+        e.memory = e.memory.saturating_add(volume);
+        e.memory_metis = e.memory_metis.map(|m| m.saturating_add(volume));
+        Ok(e)
     }
 
     /// The estimate of a run on a mesh of (triangles, edges, contact edges) with `steps` time steps (an
@@ -81,7 +106,8 @@ impl Estimate {
         let memory = ((BYTES_FIXED + per_unknown * unknowns as f64).min(u64::MAX as f64 / 2.0) as u64)
             .saturating_add(blocks)
             .saturating_add(contact.saturating_mul(contact).saturating_mul(16))
-            .saturating_add(steps.saturating_mul(BYTES_PER_STEP));
+            .saturating_add(steps.saturating_mul(BYTES_PER_STEP))
+            .saturating_add(if results { writer_bytes(edges, steps) } else { 0 });
         let memory_metis = (unknowns >= FALLBACK_MIN_UNKNOWNS).then(|| {
             let n = unknowns as f64;
             memory.saturating_sub((8.0 * (1.0 - METIS_FILL) * FILL_ND * n * n.log2()) as u64)
@@ -138,6 +164,28 @@ impl Estimate {
         let metis = self.memory_metis.map(|m| format!(" (~{} with METIS's ordering, the fallback)", human(m)));
         format!("memory ~{}{}{mem}; results file ~{}", human(self.memory), metis.unwrap_or_default(), human(self.disk))
     }
+}
+
+/// Bytes of the results writer's queue and buffered rows (a run that writes a file, `output::background`).
+fn writer_bytes(edges: u64, steps: u64) -> u64 {
+    (steps + 1).min(WRITER_QUEUE).saturating_mul(16).saturating_mul(edges).saturating_add(WRITER_ROWS)
+}
+
+/// Bytes a triangle holds for the expressions evaluated at its volume points at every time node, kept
+/// for the run: the body force and the exact solution of the error norms, each bound to the points with
+/// its spatial subexpressions cached (`scene::expr::BoundSet`, 8 bytes a cached value). A separated exact
+/// solution keeps its space parts instead (`fem::exact`): the larger of the two counts. A separated body
+/// force keeps at most `fem::loads::MAX_FACTORS` vectors of the unknowns (at most 8 · 8 bytes an unknown,
+/// below the 6 · 56 bytes its points would hold bound), so the bound route bounds it.
+fn expression_bytes(scene: &Scene) -> u64 {
+    let cached = |es: &[&Expr]| Program::new(&es.iter().map(|e| e.tree()).collect::<Vec<_>>()).n_cached() as u64;
+    let force = scene.f.as_ref().map_or(0, |f| 8 * cached(&[&f.0[0], &f.0[1]]) + FORCE_POINT);
+    let exact = scene.exact.as_ref().map_or(0, |x| {
+        let six = [&x.u.0[0], &x.u.0[1], &x.grad[0][0], &x.grad[0][1], &x.grad[1][0], &x.grad[1][1]];
+        let parts: Option<usize> = six.iter().map(|e| e.separate().map(|p| p.len())).sum();
+        8 * cached(&six).max(parts.unwrap_or(0) as u64) + EXACT_POINT
+    });
+    VOLUME_POINTS * (force + exact)
 }
 
 /// Bytes of a results file of a mesh of (triangles, edges, contact edges) with `steps` time steps and

@@ -166,3 +166,19 @@ pub fn spawn(cmd: &mut std::process::Command) -> std::process::Child {
     let _g = fork_guard();
     cmd.stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap()
 }
+
+/// Peak resident memory of the release binary run with `args`, bytes: the child's own `ru_maxrss` (wait4),
+/// so tests running beside it do not count. Panics unless it exits 0.
+pub fn peak_rss(args: &[&str]) -> u64 {
+    // reaped below by wait4, which reports the child's own peak (std's wait does not)
+    let child = {
+        let _g = fork_guard();
+        bin().args(args).stdout(std::process::Stdio::null()).spawn().unwrap().id() as libc::pid_t
+    };
+    let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
+    // SAFETY: waits for our own child, filling the status and rusage given.
+    let pid = unsafe { libc::wait4(child, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child);
+    assert!(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0, "{args:?} failed: {status}");
+    usage.ru_maxrss as u64 * 1024
+}
