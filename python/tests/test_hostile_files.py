@@ -2,6 +2,7 @@
 beyond the file, virtual datasets without their source, NaN in adapt's tables, a user block before the
 superblock, and exact zeros on the energy picture's log axis."""
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -10,7 +11,7 @@ import h5py
 import numpy as np
 import pytest
 
-from tresca_py import audit, check, hostile, paths, render, results
+from tresca_py import audit, check, hostile, paths, render, results, vtkhdf_layout
 from tresca_py.common import SCRIPTS
 
 
@@ -67,8 +68,8 @@ def test_a_declared_point_count_beyond_the_file_is_refused_before_reading(runs, 
     with h5py.File(p, "r+") as f:
         f["VTKHDF/body/NumberOfPoints"][0] = 10**9
     with pytest.raises(results.ResultsError, match="NumberOfPoints declares 1000000000"):
-        check.declared_sizes(p)
-    check.declared_sizes(runs["contact"])  # the good file passes
+        vtkhdf_layout.declared_sizes(p)
+    vtkhdf_layout.declared_sizes(runs["contact"])  # the good file passes
 
 
 def test_a_virtual_dataset_without_its_source_is_refused(runs, tmp_path):
@@ -128,3 +129,44 @@ def test_energy_picture_plots_exact_zeros_as_zeros(runs):
     low, high = a2.get_ylim()
     assert low >= r[r > 0].min() / 100, (low, high)
     assert any("exactly 0" in t.get_text() for t in a2.get_legend().get_texts())
+
+
+def lengthen(path, names):
+    """Each dataset ``names`` under every block's ``VTKHDF/<block>/Steps`` made 12 times as long (the added
+    values continue its last one)."""
+    with h5py.File(path, "r+") as f:
+        for b, _ in vtkhdf_layout.blocks(f):
+            st = f[f"VTKHDF/{b}/Steps"]
+            for k in names(st):
+                a = st[k][()]
+                del st[k]
+                st.create_dataset(k, data=np.concatenate([a, np.repeat(a[-1:], 11 * len(a))]))
+
+
+@pytest.mark.parametrize("how", ["values", "every_array", "offset", "nsteps"])
+def test_vtkhdf_steps_beyond_nsteps_are_refused_before_vtk_reads(runs, tmp_path, how):
+    """The system shall refuse a VTKHDF view whose Steps arrays are longer than NSteps (Values alone, or every
+    one), whose NSteps exceeds them, or whose data offset sends a step past its dataset, naming the dataset,
+    with a non-zero exit: VTK's reader corrupted its heap on them (SIGSEGV or glibc's abort)."""
+    p = copy(runs["contact"], tmp_path, f"{how}.h5")
+    if how == "values":
+        lengthen(p, lambda st: ["Values"])
+    elif how == "every_array":
+        lengthen(p, lambda st: [k for k in st if isinstance(st[k], h5py.Dataset)]
+                 + [f"{g}/{k}" for g in ("PointDataOffsets", "CellDataOffsets") for k in st[g]])
+    with h5py.File(p, "r+") as f:
+        if how == "offset":
+            f["VTKHDF/body/Steps/PointDataOffsets/displacement"][-1] = 10**6
+        elif how == "nsteps":
+            f["VTKHDF/body/Steps"].attrs["NSteps"] = np.int64(10**6)
+    want = {"values": r"Steps/Values has shape \(\d+,\), but NSteps = \d+",
+            "every_array": r"Steps/.* has shape \(\d+,\), but NSteps = \d+",
+            "offset": r"PointDataOffsets/displacement sends step \d+ to rows up to 1000",
+            "nsteps": r"Steps/.* has shape \(\d+,\), but NSteps = 1000000"}[how]
+    with pytest.raises(results.ResultsError, match=want):
+        vtkhdf_layout.validate(p)
+    vtkhdf_layout.validate(runs["contact"])  # the good file passes
+    c = subprocess.run([sys.executable, os.path.join(SCRIPTS, "check_results.py"), p], capture_output=True,
+                       text=True, timeout=300)
+    assert c.returncode == 1, (c.returncode, c.stdout[-2000:], c.stderr[-2000:])
+    assert re.search(want, c.stdout) and "Traceback" not in c.stdout + c.stderr, c.stdout[-2000:]

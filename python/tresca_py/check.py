@@ -25,7 +25,7 @@ import sys
 
 import numpy as np
 
-from . import audit, audit_evidence, fields, paths, results
+from . import audit, audit_evidence, fields, paths, results, vtkhdf_layout
 
 BODY_CELLS = ["strain", "stress", "von_mises"]
 CONTACT_CELLS = ["sigma_t", "slip", "slip_increment", "stick_slip"]
@@ -104,35 +104,6 @@ def check_tresca(c, run):
             c.close(ct.sigma_t, -ct.mu / length, "sigma_t = -mu/|e|", 1e-14)
 
 
-# what each block of /VTKHDF declares, and the dataset that must hold that many rows
-DECLARED = (("NumberOfPoints", "Points"), ("NumberOfCells", "Types"), ("NumberOfConnectivityIds", "Connectivity"))
-
-
-def declared_sizes(h5):
-    """ResultsError unless every count a /VTKHDF block declares (points, cells, connectivity ids) is held by its
-    dataset and fits the file's size: the VTK reader allocates what is declared before it reads, so a count
-    of 10⁹ in a small file would take gigabytes first."""
-    import h5py
-    size = os.path.getsize(h5)
-    with h5py.File(h5, "r") as f:
-        root = f.get("VTKHDF")
-        blocks = [(k, g) for k, g in root.items() if isinstance(g, h5py.Group) and k != "Assembly"] if root else []
-        for name, g in blocks:
-            for count, held in DECLARED:
-                c, d = g.get(count), g.get(held)
-                if not (isinstance(c, h5py.Dataset) and isinstance(d, h5py.Dataset)):
-                    continue
-                n = np.asarray(c[()]).reshape(-1)
-                if n.dtype.kind not in "iu" or np.any(n < 0):
-                    raise results.ResultsError(f"{h5}: VTKHDF/{name}/{count} holds {n.dtype} {n[:4]}, not counts")
-                need = int(n.max(initial=0))
-                row = d.dtype.itemsize * int(np.prod(d.shape[1:], dtype=np.int64))
-                if need > d.shape[0] or need * row > size:
-                    raise results.ResultsError(
-                        f"{h5}: VTKHDF/{name}/{count} declares {need}, but VTKHDF/{name}/{held} holds "
-                        f"{d.shape[0]} rows and the file has {size} bytes: damaged, not read")
-
-
 def check_audit(c, r, views, budget):
     """The energy audit: its balance (``tresca_py.audit``) and its terms against the stored fields
     (``tresca_py.audit_evidence``); a file of the Rust solver (it has the views) without its audit fails, and an
@@ -157,7 +128,7 @@ def check_audit(c, r, views, budget):
 def check_vtkhdf(c, run, h5):
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy as v2n
-    declared_sizes(h5)
+    vtkhdf_layout.validate(h5)
     r = vtk.vtkHDFReader()
     r.SetFileName(h5)
     r.UpdateInformation()
