@@ -1,8 +1,8 @@
 """The sizes a results file's ``/VTKHDF`` view declares, checked against what it holds before VTK's
 ``vtkHDFReader`` reads it: the reader allocates what is declared and indexes with the stored offsets without
-checking them, so a count of 10⁹ in a small file takes gigabytes first, and a ``Steps`` array longer than
-``NSteps`` or an offset past its dataset corrupts its heap (SIGSEGV, or glibc's abort). ``validate`` raises
-``ResultsError`` naming the dataset instead.
+checking them, so a count of 10⁹ in a small file takes gigabytes first, and a ``Steps/Values`` longer than
+the other ``Steps`` arrays or an offset past its dataset corrupts its heap (SIGSEGV, or glibc's abort).
+``validate`` raises ``ResultsError`` naming the dataset instead.
 """
 import os
 
@@ -27,8 +27,9 @@ def blocks(f):
 
 
 def counts(h5, where, d):
-    """The values of dataset ``d`` as non-negative whole numbers (1-D), else ResultsError naming ``where``."""
-    n = np.asarray(d[()]).reshape(-1)
+    """The values of dataset (or array) ``d`` as non-negative whole numbers (1-D), else ResultsError naming
+    ``where``."""
+    n = np.asarray(d).reshape(-1)
     if n.dtype.kind not in "iu" or np.any(n < 0):
         raise ResultsError(f"{h5}: VTKHDF/{where} holds {n.dtype} {n[:4]}, not counts")
     return n.astype(np.int64)
@@ -53,32 +54,38 @@ def declared_sizes(h5):
 
 
 def step_arrays(h5, name, st):
-    """{path under Steps: dataset} of a block's ``Steps`` group, each checked to hold one value per step
-    (``NSteps``, a whole number ≥ 0), and ``NSteps``."""
+    """{path under Steps: its first R values} of a block's ``Steps`` group, and R, the values of
+    ``Steps/Values``: every array holds at least R ≥ ``NSteps`` (a run that stopped early cuts ``Values`` to
+    its frames and keeps room for all of them in the others), else ResultsError."""
     import h5py
     ns = np.asarray(st.attrs.get("NSteps", -1)).reshape(-1)
     if ns.size != 1 or ns.dtype.kind not in "iu" or ns[0] < 0:
         raise ResultsError(f"{h5}: VTKHDF/{name}/Steps has no whole number NSteps ({ns[:4]}): damaged, not read")
     nsteps, out = int(ns[0]), {}
     st.visititems(lambda k, d: out.update({k: d}) if isinstance(d, h5py.Dataset) else None)
+    rows = out["Values"].shape[0] if "Values" in out and out["Values"].ndim == 1 else nsteps
+    if rows < nsteps:
+        raise ResultsError(f"{h5}: VTKHDF/{name}/Steps/Values holds {rows} values, fewer than NSteps = {nsteps}: "
+                           "damaged, not read")
     for k, d in out.items():
-        if d.shape != (nsteps,):
-            raise ResultsError(f"{h5}: VTKHDF/{name}/Steps/{k} has shape {d.shape}, but NSteps = {nsteps} wants "
-                               f"({nsteps},): damaged, not read")
-    return out, nsteps
+        if d.ndim != 1 or d.shape[0] < rows:
+            raise ResultsError(f"{h5}: VTKHDF/{name}/Steps/{k} has shape {d.shape}, fewer than the {rows} values of "
+                               "Steps/Values: damaged, not read")
+    return {k: d[:rows] for k, d in out.items()}, rows
 
 
 def steps(h5):
-    """ResultsError unless every block's ``Steps`` arrays hold ``NSteps`` values, the time values are finite and
-    every step's offsets, with the counts its parts declare, stay within the block's datasets."""
+    """ResultsError unless every block's ``Steps`` arrays hold at least as many values as ``Steps/Values``, it
+    at least ``NSteps``, the time values are finite and the offsets of those rows, with the counts their parts
+    declare, stay within the block's datasets."""
     import h5py
     with h5py.File(h5, "r") as f:
         for name, g in blocks(f):
             st = g.get("Steps")
             if not isinstance(st, h5py.Group):
                 continue
-            arrays, nsteps = step_arrays(h5, name, st)
-            if "Values" in arrays and not np.all(np.isfinite(np.asarray(arrays["Values"][()], dtype=float))):
+            arrays, nsteps = step_arrays(h5, name, st)  # the rows VTK may read
+            if "Values" in arrays and not np.all(np.isfinite(np.asarray(arrays["Values"], dtype=float))):
                 raise ResultsError(f"{h5}: VTKHDF/{name}/Steps/Values holds values that are not finite numbers")
             step = {k: counts(h5, f"{name}/Steps/{k}", d) for k, d in arrays.items() if k != "Values"}
             first = step.get("PartOffsets", np.zeros(nsteps, np.int64))
