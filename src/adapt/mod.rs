@@ -246,7 +246,12 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
         }
         let t0 = Instant::now();
         let min_angle = mesh.min_angle();
-        let generation = reference::generations(&mesh, &root_area).into_iter().max().unwrap_or(0);
+        let generations = reference::generations(&mesh, &root_area);
+        let generation = generations.iter().copied().max().unwrap_or(0);
+        let coarsest = generations.iter().copied().min().unwrap_or(0);
+        if let Some(g) = opts.reference.filter(|&g| g <= coarsest) {
+            return Err(not_finer(scene, g, level, coarsest));
+        }
         let out = opts.out.as_ref().map(|d| files::level_results(d, level));
         if let (Some(dir), true) = (&opts.out, opts.gmsh) {
             export::write_gmsh(&mesh, &files::level_mesh(dir, level), opts.force)?;
@@ -317,6 +322,18 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
         stopped = Some(format!("the target was not reached in {} levels", rows.len()));
     }
     Ok(Outcome { rows, stopped })
+}
+
+/// The refusal of a reference of generation `g` that is not finer than level `level`, whose coarsest
+/// triangles have generation `coarsest` ≥ g: the reference would be that level's own mesh (and every
+/// later level's, refinement only raising generations).
+fn not_finer(scene: &Scene, g: u32, level: usize, coarsest: u32) -> Error {
+    let msg = format!(
+        "--reference {g}: every triangle of level {level} already has generation {coarsest} or more, so a reference \
+         of generation {g} is level {level}'s own mesh, not finer (its effectivity would be measured against \
+         itself); give a generation above {coarsest} or fewer levels"
+    );
+    Error::scene(&scene.file, "adapt", msg)
 }
 
 /// Why the reference solve on `mesh` is not run: its memory, beside the fields of every level kept for

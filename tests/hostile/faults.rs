@@ -187,6 +187,27 @@ fn adapt_refuses_what_it_cannot_do_as_run_does() {
     assert!(stderr(&o).contains("--force") && !stderr(&o).contains("--resume"), "{}", stderr(&o));
 }
 
+/// §5: the system shall refuse `adapt --reference G` when every triangle of a level has generation G or
+/// more (uniform levels: level k has generation k), naming the generation and the level, before that level
+/// is solved: the reference would be that level's own mesh, an effectivity against itself. One generation
+/// more is a reference.
+#[test]
+fn adapt_refuses_a_reference_not_finer_than_its_levels() {
+    let scene = scene40();
+    let args = ["adapt", &scene, "--levels", "3", "--theta", "1", "--steps", "4", "--reference", "2"];
+    let o = spawn(bin().args(args)).wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("--reference 2: every triangle of level 2 already has generation 2") && e.contains("not finer"),
+        "{e}"
+    );
+    let args = ["adapt", &scene, "--levels", "3", "--theta", "1", "--steps", "4", "--reference", "3"];
+    let o = spawn(bin().args(args)).wait_with_output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("vs ref"), "no reference measured");
+}
+
 /// §5: the system shall refuse a study whose level does not fit under the process's address-space limit
 /// (`ulimit -v`) even when --max-memory allows it, naming the limit, before any level runs.
 #[test]
