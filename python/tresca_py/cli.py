@@ -45,6 +45,11 @@ def exit_on_failure(report=True):
         sys.exit(2)
 
 
+def input_files(args, scene):
+    """The (path, what) of a solver's inputs: the scene and its mesh file, if any."""
+    return [(args.scene, "scene")] + ([(scene.mesh["file"], "mesh")] if "file" in scene.mesh else [])
+
+
 def output_path(args, scene):
     """The results path (``-o`` or the scene's ``[output] path``), made absolute, checked before any work under
     the rule of every output (``paths.new_output``: an existing file replaced only with ``--force``; never the
@@ -52,8 +57,7 @@ def output_path(args, scene):
     out = args.output or scene.output
     if not out:
         raise SceneError("no output path: give -o OUT.h5 or [output] path in the scene")
-    inputs = [(args.scene, "scene")] + ([(scene.mesh["file"], "mesh")] if "file" in scene.mesh else [])
-    paths.distinct([(out, "results file")], inputs)
+    paths.distinct([(out, "results file")], input_files(args, scene))
     paths.new_output(out, "results file", args.force)
     return paths.output_file(out, "results file")
 

@@ -11,6 +11,8 @@ import time
 from paraview.simple import (ColorBy, ExtractBlock, GetActiveViewOrCreate, GetColorTransferFunction,
                              GetScalarBar, Render, SaveScreenshot, Show, Text, WarpByVector, XDMFReader)
 
+from . import paths
+
 
 class RenderError(RuntimeError):
     """ParaView could not show the file."""
@@ -137,15 +139,20 @@ def render(p, args):
     view.ResetCamera()
     view.GetActiveCamera().Zoom(0.85)
     line = "body: von Mises; contact line: stick / slip" if has_contact else "body: von Mises (no contact line)"
+    outs = [os.path.join(p["frames"], f"frame_{k:04d}.png") for k in range(len(shown))] if p["frames"] else [p["out"]]
+    # the rule of every output (tresca_py.paths), for every picture before the first is drawn
+    paths.distinct([(o, "screenshot") for o in outs], p["inputs"])
+    for o in outs:
+        paths.new_output(o, "screenshot", p["force"])
     written = []
-    for k, t in enumerate(shown):
-        out = os.path.join(p["frames"], f"frame_{k:04d}.png") if p["frames"] else p["out"]
+    for t, out in zip(shown, outs, strict=True):
         label.Text = (f"{p['name']} ({kind}): t = {t:.4g} (frame {times.index(t) + 1} of {len(times)})\n"
                       f"displacement magnified x{scale:.3g} (grey: reference); {line}")
         view.ViewTime = t
         Render(view)
         start = time.time()
-        SaveScreenshot(out, view, ImageResolution=args.size)
+        paths.write_named(out, lambda tmp: SaveScreenshot(tmp, view, ImageResolution=args.size), "screenshot",
+                          p["force"])
         written.append((out, start))
         print(out)
     return written

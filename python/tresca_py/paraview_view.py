@@ -57,11 +57,12 @@ def arguments(argv):
                     help="displacement magnification (default 0: automatic)")
     ap.add_argument("--size", type=pixels, nargs=2, default=[1200, 800], help="picture size in pixels")
     ap.add_argument("--vtkhdf", action="store_true", help="read /VTKHDF (ParaView >= 5.13) instead of the XDMF")
+    ap.add_argument("--force", action="store_true", help="replace an existing screenshot (or frame)")
     return ap.parse_args(argv)
 
 
 def plan(args):
-    """{h5, xdmf, blocks, out, frames} of valid arguments, or PathError naming the problem."""
+    """{h5, xdmf, blocks, out, frames, name, inputs, force} of valid arguments, or PathError naming the problem."""
     given = os.path.abspath(args.results)
     stem, ext = os.path.splitext(given)
     h5 = paths.hdf5_file(stem + ".h5" if ext == ".xdmf" else given)
@@ -73,11 +74,15 @@ def plan(args):
                                   "(is this a tresca-cr results file?)")
         blocks = paths.check_sidecar(h5, xdmf)
     out = frames = None
+    inputs = [(h5, "results file")] + ([(xdmf, "XDMF sidecar")] if xdmf else [])
     if args.frames:
-        frames = paths.output_dir(args.frames, "frames directory")
+        frames = paths.output_subdir(args.frames, "frames directory")
     else:
-        out = paths.output_file(args.out or stem + "_view.png", "screenshot")
-    return {"h5": h5, "xdmf": xdmf, "blocks": blocks, "out": out, "frames": frames, "name": os.path.basename(stem)}
+        out = args.out or stem + "_view.png"
+        paths.distinct([(out, "screenshot")], inputs)
+        out = paths.output_file(paths.new_output(out, "screenshot", args.force), "screenshot")
+    return {"h5": h5, "xdmf": xdmf, "blocks": blocks, "out": out, "frames": frames, "name": os.path.basename(stem),
+            "inputs": inputs, "force": args.force}
 
 
 def main(argv=None):
@@ -96,7 +101,7 @@ def main(argv=None):
     from . import paraview_render
     try:
         written = paraview_render.render(p, args)
-    except paraview_render.RenderError as err:
+    except (paraview_render.RenderError, paths.PathError) as err:
         print(f"error: {err}", file=sys.stderr)
         sys.stderr.flush()
         os._exit(1)

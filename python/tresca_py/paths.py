@@ -8,9 +8,10 @@ own Python (``pvpython``, without the venv) runs them too (``tresca_py.paraview`
 * ``output_file`` / ``output_dir``: the path is not a directory (or is one), its directory exists or can be
   made, and a file can be created in it (tried, so read-only directories and file systems are found even
   for root, whom the permission bits do not stop).
-* ``new_output`` / ``distinct`` / ``write_new``: the rule of every file a tool writes, stated in docs/results.md
-  ("Every output, one rule"; ``src/output/guard.rs`` for the Rust commands): checked before any work with
-  ``lstat`` (never opened), compared with the inputs by ``(st_dev, st_ino)``, written through ``FILE.tmp``.
+* ``new_output`` / ``distinct`` / ``write_new`` / ``write_named`` / ``output_subdir``: the rule of every file a
+  tool writes, stated in docs/results.md ("Every output, one rule"; ``src/output/guard.rs`` for the Rust
+  commands): checked before any work with ``lstat`` (never opened), compared with the inputs by
+  ``(st_dev, st_ino)``, written through ``FILE.tmp``.
 * ``sidecar_targets`` / ``check_sidecar``: the HDF5 files an XDMF sidecar references, and that it references
   the results file being opened (a ``run.h5`` copied with its ``run.xdmf`` keeps pointing at the original).
 """
@@ -199,12 +200,10 @@ def distinct(outputs, inputs=()):
                             "other; give them different paths")
 
 
-def write_new(path, write, what="output file", force=False):
-    """Write the file ``path`` under the rule of every output: ``new_output`` again, then ``write(f)`` into
-    ``FILE.tmp``, a binary file created exclusively without following links (a stale regular one is removed
-    first), renamed over ``path``. A failure leaves no temporary and an old file as it was."""
-    path = new_output(path, what, force)
-    tmp = path + ".tmp"
+def _fresh_tmp(path, what, tmp=None):
+    """``tmp`` (default ``FILE.tmp``) beside ``path``, created exclusively without following links (a stale
+    regular one is removed first): (its name, its open descriptor)."""
+    tmp = tmp or path + ".tmp"
     try:
         st = os.lstat(tmp)
     except FileNotFoundError:
@@ -216,9 +215,17 @@ def write_new(path, write, what="output file", force=False):
                             "(not one this program left); remove it")
         os.unlink(tmp)
     try:
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
+        return tmp, os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
     except OSError as err:
         raise PathError(f"{tmp}: cannot create the temporary of the {what}: {err.strerror}") from None
+
+
+def write_new(path, write, what="output file", force=False):
+    """Write the file ``path`` under the rule of every output: ``new_output`` again, then ``write(f)`` into
+    ``FILE.tmp``, a binary file created exclusively without following links (a stale regular one is removed
+    first), renamed over ``path``. A failure leaves no temporary and an old file as it was."""
+    path = new_output(path, what, force)
+    tmp, fd = _fresh_tmp(path, what)
     try:
         with os.fdopen(fd, "wb") as f:
             write(f)
@@ -228,6 +235,38 @@ def write_new(path, write, what="output file", force=False):
             os.unlink(tmp)
         raise
     return path
+
+
+def write_named(path, write, what="output file", force=False):
+    """``write_new`` for a writer that takes a file name, not a file (ParaView's screenshots, HDF5 files):
+    ``write(tmp)`` writes the regular file ``FILE.tmp.EXT`` (the extension kept: writers choose the format by
+    it) this call created exclusively, which must still be one (not replaced by a link or another kind of file)
+    when it is renamed over ``path``."""
+    path = new_output(path, what, force)
+    root, ext = os.path.splitext(path)
+    tmp, fd = _fresh_tmp(path, what, f"{root}.tmp{ext}")
+    os.close(fd)
+    try:
+        write(tmp)
+        st = os.lstat(tmp)
+        if not stat.S_ISREG(st.st_mode) or st.st_nlink > 1:
+            raise PathError(f"{tmp}: the temporary of the {what} was replaced by {kind_of(st.st_mode)} while it was "
+                            "written; nothing was renamed into place")
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.lexists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def output_subdir(path, what="output directory"):
+    """``output_dir`` that is a directory itself, not a symbolic link to one (a tool that writes or removes files
+    in it would do so wherever the link points)."""
+    if os.path.islink(path):
+        raise PathError(f"{path}: the {what} would go here, but the path is a symbolic link; give the directory it "
+                        "points to, or remove the link")
+    return output_dir(path, what)
 
 
 def save_figure(fig, path, **kw):

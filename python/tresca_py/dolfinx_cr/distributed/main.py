@@ -13,9 +13,9 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from tresca_py.dolfinx_cr.distributed.mesh import Fail
-from tresca_py.dolfinx_cr.distributed.output import PartWriter, setup_time_attrs, write_main
+from tresca_py.dolfinx_cr.distributed.output import PartWriter, check_outputs, setup_time_attrs, write_main
 from tresca_py.dolfinx_cr.distributed.problem import Problem, peak_mb
-from tresca_py.cli import FAILURES, message, output_path
+from tresca_py.cli import FAILURES, input_files, message, output_path
 from tresca_py.errors import InputError
 from tresca_py.dolfinx_cr.friction import TaoBoxQP, natural_residual
 from tresca_py.dolfinx_cr.stepping import slipping
@@ -65,6 +65,7 @@ def set_up(comm, args, log):
             raise Fail(str(e)) from None
         try:
             out = output_path(args, scene)
+            stale = check_outputs(out, args.force, input_files(args, scene))
         except FAILURES as e:
             raise Fail(message(e)) from None
         if args.rhs_block < 1:
@@ -77,7 +78,7 @@ def set_up(comm, args, log):
             raise Fail(str(e)) from None
     except Fail as e:
         stop(comm, e)
-    return scene, out, prob
+    return scene, out, prob, stale
 
 
 def stop(comm, err):
@@ -160,7 +161,7 @@ def solve_step(prob, friction, n, t, res):
     ur.axpy(-1.0, w)
 
 
-def time_loop(prob, args, out, log):
+def time_loop(prob, args, out, log, stale):
     """Backward Euler over the scene's times; returns (results on rank 0, step wall times, part writer)."""
     comm, scene = prob.comm, prob.scene
     times = scene.times
@@ -168,7 +169,7 @@ def time_loop(prob, args, out, log):
     root = comm.rank == 0
     nc = prob.n_c
     res = new_results(scene, nc) if root else None
-    writer = PartWriter(out, prob, N + 1)
+    writer = PartWriter(out, prob, N + 1, stale)
     fe = args.frame_every if args.frame_every is not None else max(1, N // 50)
     vis = None
     if fe > 0:
@@ -224,12 +225,12 @@ def main(argv=None):
         sys.excepthook = abort_on_error
     t_start = time.perf_counter()
     log = (lambda *a: print(*a, flush=True)) if comm.rank == 0 and not args.quiet else (lambda *a: None)
-    scene, out, prob = set_up(comm, args, log)
+    scene, out, prob, stale = set_up(comm, args, log)
     setup_time = time.perf_counter() - t_start
     log(f"set-up {setup_time:.2f} s: " + ", ".join(f"{k} {v:.2f} s" for k, v in prob.times_setup.items())
         + f"; {2 * prob.nb_glob} unknowns, {prob.n_c} contact edges, {comm.size} rank(s)")
     try:
-        res, step_times, writer = time_loop(prob, args, out, log)
+        res, step_times, writer = time_loop(prob, args, out, log, stale)
     except Fail as e:
         stop(comm, e)
     N = len(scene.times) - 1
@@ -245,7 +246,7 @@ def main(argv=None):
                  "peak_rss_mb": np.array(peaks), "setup_peak_rss_mb": json.dumps(mem_setup),
                  "mumps": json.dumps(prob.mumps), "linear_solver": args.ksp, "condensation": prob.condense_path,
                  "linear_solves": prob.n_solves, "ksp_iterations_max": int(max(prob.ksp_its)) if prob.ksp_its else 0}
-        write_main(out, prob, res, writer.dir, sizes, attrs)
+        write_main(out, prob, res, writer.dir, sizes, attrs, args.force)
         log(f"dolfinx distributed ({comm.size} rank{'s' if comm.size > 1 else ''}): {2 * prob.nb_glob} unknowns, "
             f"{prob.n_c} contact edges, {N} steps; set-up {setup_time:.2f} s, total {total:.2f} s, "
             f"peak RSS per rank {', '.join(f'{p:.0f}' for p in peaks)} MB -> {out}")

@@ -11,30 +11,56 @@ dtypes of ``tresca_py.results.SPEC`` and the attributes ``read`` requires (``sta
 whole steps of u that no rank holds, the energy audit and the visualisation views (``/VTKHDF``,
 ``OUT.xdmf``) of the Rust solver; the displacement for ParaView is ``OUT_vtk/displacement.pvd``
 (dolfinx's parallel VTKFile).
+
+Every file written follows the rule of every output (``tresca_py.paths``): ``check_outputs`` refuses, before any
+work, a parts or frames directory that is a link (or not a directory) and, without ``--force``, the files of an
+earlier run in them; the parts are created exclusively (``w-``: never through a link planted since), and
+``OUT.h5`` is built beside it and renamed into place (``paths.write_named``).
 """
 import os
 
 import numpy as np
 
+from tresca_py import paths
 from tresca_py.results import SPEC
 from tresca_py.common import git_commit
+
+#: the files of a run in its parts and frames directories: (directory of ``OUT.h5``, test of a file name)
+RUN_FILES = ((lambda out: out + ".parts", lambda f: f.startswith("rank") and f.endswith(".h5")),
+             (lambda out: os.path.splitext(out)[0] + "_vtk", lambda f: f.startswith("displacement")))
+
+
+def check_outputs(out, force, inputs):
+    """PathError unless the parts and frames directories of ``OUT.h5`` may be written: each a directory (not a
+    link) or absent, the files of an earlier run in them (``RUN_FILES``) replaced only with ``force``, each then
+    a regular file of one link and not one of ``inputs`` ((path, what) pairs). Returns the files to remove."""
+    stale = []
+    for where, ours in RUN_FILES:
+        d = where(out)
+        if not os.path.lexists(d):
+            continue
+        paths.output_subdir(d, "directory of the run's parts and frames")
+        for f in sorted(os.listdir(d)):
+            if ours(f):
+                stale.append(paths.new_output(os.path.join(d, f), "file of an earlier run", force))
+    paths.distinct([(f, "file of an earlier run") for f in stale], inputs)
+    return stale
 
 
 class PartWriter:
     """This rank's part: owned points, triangles, edges, midpoints and u at every step."""
 
-    def __init__(self, out, prob, n_times):
+    def __init__(self, out, prob, n_times, stale):
         import h5py
         comm = prob.comm
         self.dir = out + ".parts"
         if comm.rank == 0:
+            for f in stale:                        # checked by check_outputs (regular, --force given)
+                os.unlink(f)
             os.makedirs(self.dir, exist_ok=True)
-            for f in os.listdir(self.dir):
-                if f.startswith("rank") and f.endswith(".h5"):
-                    os.remove(os.path.join(self.dir, f))
         comm.barrier()
         self.path = os.path.join(self.dir, f"rank{comm.rank}.h5")
-        self.h5 = h5py.File(self.path, "w")
+        self.h5 = h5py.File(self.path, "w-")
         g = self.h5
         g["points"] = prob.points
         g["triangles"] = prob.triangles
@@ -64,8 +90,16 @@ def setup_times(attrs):
     return dict(zip(names, (float(v) for v in attrs["setup_times"]), strict=True))
 
 
-def write_main(out, prob, res, writer_dirname, sizes, attrs):
-    """Rank 0: the README /tresca layout, the big arrays as virtual datasets over the parts."""
+def write_main(out, prob, res, writer_dirname, sizes, attrs, force):
+    """Rank 0: ``OUT.h5`` (``write_layout``) under the rule of every output, replacing a file there only with
+    ``force``."""
+    paths.write_named(out, lambda tmp: write_layout(tmp, prob, res, writer_dirname, sizes, attrs), "results file",
+                      force)
+
+
+def write_layout(out, prob, res, writer_dirname, sizes, attrs):
+    """Rank 0: the README /tresca layout into the new file ``out``, the big arrays as virtual datasets over the
+    parts."""
     import h5py
     scene = prob.scene
     N1 = len(scene.times)
