@@ -243,6 +243,12 @@ class Expr:
     def depends_on_t(self):
         return self.symbols[2] in self.sym.free_symbols
 
+    def rounding(self, x, y, t):
+        """A bound on the rounding error of the values at (x, y, t), broadcast (``tresca_py.rounding``)."""
+        from tresca_py.rounding import value_and_bound
+        _, e = value_and_bound(self.sym, x, y, t)
+        return np.broadcast_to(e, np.broadcast(np.asarray(x), np.asarray(y)).shape).copy()
+
     def __call__(self, x, y, t):
         """The values at (x, y, t), broadcast; ``ExprError`` naming the expression, the point and the value
         where one is not finite (Rust: ``value inf at (x=…, y=…, t=…)``, src/scene/expr/mod.rs). t enters as
@@ -284,3 +290,6 @@ class VecExpr:
 
     def __call__(self, x, y, t):
         return np.stack([c(x, y, t) for c in self.comps])
+
+    def rounding(self, x, y, t):
+        return np.stack([c.rounding(x, y, t) for c in self.comps])
