@@ -13,26 +13,13 @@ from tresca_py.common import BIN, ROOT
 from tresca_py.mesh import build_mesh
 from tresca_py.scene import SceneError, load_scene
 
-# the scene of src/fem/lifting/consistency.rs's module doc (a doctest there)
-DOC_SCENE = '''
-mesh = { corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], cells = [2, 2] }
-material = { E = 10.0, nu = 0.3 }
-time = { T = 1.0, steps = 2 }
-[[boundary]]
-name = "top"
-kind = "dirichlet"
-[[boundary]]
-name = "left"
-kind = "neumann"
-[[boundary]]
-name = "right"
-kind = "neumann"
-[[boundary]]
-name = "bottom"
-kind = "contact"
-g_a = "0.1"
-gap = "GAP"
-'''
+CONSISTENCY = os.path.join(ROOT, "src/fem/lifting/consistency.rs")
+
+
+def doc_scene():
+    """The scene of src/fem/lifting/consistency.rs's module doc (a doctest there), read from it: GAP for the gap."""
+    doc = "\n".join(ln[4:] for ln in open(CONSISTENCY).read().splitlines() if ln.startswith("//! "))
+    return re.search(r'let text = r#"(.*?)"#;', doc, re.S).group(1)
 
 
 def python_check(path):
@@ -50,7 +37,7 @@ def test_data_cancelling_by_rounding_are_judged_as_the_rust_solver_does(tmp_path
     """The system shall accept data that cancel to zero at t₀ by rounding (1.7e-18, within twice its rounding
     bound of 1.1e-17) and refuse a mismatch beyond it (1e-17 against u₀·n = 0), in Python as in Rust."""
     path = tmp_path / "doc.toml"
-    path.write_text(DOC_SCENE.replace("GAP", gap))
+    path.write_text(doc_scene().replace("GAP", gap))
     rust = subprocess.run([BIN, "check", str(path)], capture_output=True, text=True, timeout=120)
     assert (rust.returncode == 0) == accepted, rust.stderr
     if accepted:
@@ -62,7 +49,7 @@ def test_data_cancelling_by_rounding_are_judged_as_the_rust_solver_does(tmp_path
 
 def test_the_tolerance_constants_are_the_rust_ones():
     """The system shall state the comparison's rule once: the Python constants are those of consistency.rs."""
-    text = open(os.path.join(ROOT, "src/fem/lifting/consistency.rs")).read()
+    text = open(CONSISTENCY).read()
     for name in ("ROUNDING_ULPS", "ROUNDING_SAFETY"):
         rust = float(re.search(rf"pub const {name}: f64 = ([0-9.e+-]+);", text).group(1))
         assert getattr(scene_data, name) == rust, name
