@@ -193,8 +193,8 @@ fn adapt_refuses_what_it_cannot_do_as_run_does() {
 /// more is a reference.
 #[test]
 fn adapt_refuses_a_reference_not_finer_than_its_levels() {
-    let scene = scene40();
-    let args = ["adapt", &scene, "--levels", "3", "--theta", "1", "--steps", "4", "--reference", "2"];
+    let scene = scene_with("not_finer.toml", "steps = 40", "steps = 4");
+    let args = ["adapt", &scene, "--levels", "3", "--theta", "1", "--reference", "2"];
     let o = spawn(bin().args(args)).wait_with_output().unwrap();
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     let e = stderr(&o);
@@ -202,7 +202,7 @@ fn adapt_refuses_a_reference_not_finer_than_its_levels() {
         e.contains("--reference 2: every triangle of level 2 already has generation 2") && e.contains("not finer"),
         "{e}"
     );
-    let args = ["adapt", &scene, "--levels", "3", "--theta", "1", "--steps", "4", "--reference", "3"];
+    let args = ["adapt", &scene, "--levels", "3", "--theta", "1", "--reference", "3"];
     let o = spawn(bin().args(args)).wait_with_output().unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("vs ref"), "no reference measured");
