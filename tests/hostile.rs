@@ -33,7 +33,11 @@ fn scene_with(name: &str, from: &str, to: &str) -> String {
     let text = std::fs::read_to_string(root("verification/cases/paper_example_5_1.toml")).unwrap();
     assert!(text.contains(from), "{from}");
     let p = tmp(name);
-    std::fs::write(&p, text.replace(from, to)).unwrap();
+    // written beside it and renamed: tests running at once write the same scene, and a reader must never see
+    // it half written
+    let part = tmp(&format!("{name}.{:?}", std::thread::current().id()));
+    std::fs::write(&part, text.replace(from, to)).unwrap();
+    std::fs::rename(&part, &p).unwrap();
     p.display().to_string()
 }
 
