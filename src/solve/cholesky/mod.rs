@@ -50,6 +50,8 @@ pub(crate) mod etree;
 pub(crate) mod factor;
 pub(crate) mod ordering;
 pub(crate) mod pages;
+pub(crate) mod queue;
+pub(crate) mod schedule;
 pub(crate) mod subtrees;
 pub(crate) mod symbolic;
 

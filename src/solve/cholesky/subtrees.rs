@@ -8,6 +8,8 @@
 //! called with the arguments faer gives it), so the factor is faer's sequential one bit for bit whatever
 //! the thread count (test: `solve::cholesky::factor::tests::two_threads_factorise_bit_identically_run_after_run`).
 
+use super::queue::{Guard, Queue};
+use super::schedule::{self, Tasks, Tree, NONE};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
 use faer::linalg::solvers::LltError;
@@ -23,7 +25,6 @@ use faer::{MatMut, MatRef, Par};
 pub(crate) const MIN_ENTRIES: usize = 1 << 16;
 
 type Numeric = std::result::Result<(), LltError>;
-const NONE: usize = usize::MAX;
 
 /// Whether this machine has faer's update kernel (x86-64 with AVX2 and FMA); elsewhere faer's own
 /// numeric factorisation is used.
@@ -76,14 +77,12 @@ struct Ctx<'a> {
     symbolic: &'a SymbolicSupernodalCholesky<usize>,
     a: SparseColMatRef<'a, usize, f64>,
     values: Values,
-    /// The supernodes that update supernode s, increasing: `updaters[update_ptr[s]..update_ptr[s + 1]]`.
-    update_ptr: Vec<usize>,
-    updaters: Vec<usize>,
+    tree: Tree,
 }
 
 /// Bytes [`factorize`] allocates with `threads` threads beside L and faer's scratch, at most: a row map of
-/// n entries per thread, the tree and each supernode's updaters (at most one per row index of L's
-/// supernodal pattern, kept as pairs then as a list).
+/// n entries per thread, the tree, each supernode's updaters (at most one per row index of L's
+/// supernodal pattern, kept as pairs then as a list) and the tasks.
 pub(crate) fn scratch_bytes(symbolic: &SymbolicSupernodalCholesky<usize>, threads: usize) -> u64 {
     let word = std::mem::size_of::<usize>() as u64;
     let (n, ns, rows) = (symbolic.nrows() as u64, symbolic.n_supernodes() as u64, symbolic.row_idx().len() as u64);
@@ -92,151 +91,73 @@ pub(crate) fn scratch_bytes(symbolic: &SymbolicSupernodalCholesky<usize>, thread
 
 /// L's values of the lower triangle `a` (permuted) with `threads` threads (≥ 2), as faer's
 /// `factorize_supernodal_numeric_llt` with default parameters computes them. `values` must be zeros.
-/// In rounds: the subtrees of [`plan`] on threads of their own, then the same for the supernodes above
-/// them, until the subtrees would hold less than a quarter of what is left or one thread would do
-/// most of their work; the rest in order, with faer's parallel dense kernels.
+/// The tasks of [`Tasks`] run on the threads as they become ready (`solve::cholesky::schedule`), each
+/// with faer's sequential dense kernels, or its parallel ones when it is the only task that can run.
 pub(super) fn factorize(
     values: &mut [f64],
     a: SparseColMatRef<'_, usize, f64>,
     symbolic: &SymbolicSupernodalCholesky<usize>,
     threads: usize,
 ) -> Numeric {
-    let (parent, update_ptr, updaters) = tree(symbolic);
-    let own = own_work(symbolic);
-    let ctx = Ctx { symbolic, a, values: Values(values.as_mut_ptr(), values.len()), update_ptr, updaters };
-    let mut members: Vec<usize> = (0..parent.len()).collect();
-    loop {
-        let (groups, top) = plan(&own, &parent, &members, threads);
-        let sum = |list: &[usize]| list.iter().map(|&s| own[s]).sum::<f64>();
-        let mut loads: Vec<f64> = groups.iter().map(|g| sum(g)).collect();
-        loads.sort_by(|a, b| b.total_cmp(a));
-        let left = sum(&members);
-        // little left for the subtrees, or one thread with most of it: the rest with parallel dense kernels
-        if left - sum(&top) < 0.25 * left || loads[1] < 0.25 * loads[0] {
-            return run(&ctx, &members, Par::rayon(threads));
+    let tree = Tree::new(symbolic.supernode_begin(), symbolic.supernode_end(), symbolic.nrows(), |s| pattern(symbolic, s));
+    let tasks = Tasks::new(&tree, threads);
+    if std::env::var_os(schedule::ENV).is_some() {
+        let (total, critical, makespan) = tasks.figures(threads);
+        eprintln!(
+            "schedule: {} tasks, work {total:.4e}, critical path {critical:.4e} ({:.3}), makespan on {threads} \
+             threads {makespan:.4e} (speed-up {:.3})",
+            tasks.work.len(),
+            critical / total,
+            total / makespan
+        );
+    }
+    let ctx = Ctx { symbolic, a, values: Values(values.as_mut_ptr(), values.len()), tree };
+    let queue = Queue::new(&tasks);
+    std::thread::scope(|sc| {
+        for _ in 0..threads {
+            sc.spawn(|| worker(&ctx, &tasks, &queue, threads));
         }
-        let done: Vec<Numeric> = std::thread::scope(|sc| {
-            let ctx = &ctx;
-            let h: Vec<_> = groups.iter().map(|g| sc.spawn(move || run(ctx, g, Par::Seq))).collect();
-            h.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
-        });
-        // the failure of the first supernode in order among those computed
-        if let Some(e) =
-            done.into_iter().filter_map(|r| r.err()).min_by_key(|LltError::NonPositivePivot { index }| *index)
-        {
-            return Err(e);
-        }
-        if top.is_empty() {
-            return Ok(());
-        }
-        members = top;
+    });
+    queue.result()
+}
+
+/// One thread's share: the ready tasks it takes, until none is left.
+fn worker(ctx: &Ctx, tasks: &Tasks, queue: &Queue, threads: usize) {
+    let _guard = Guard(queue);
+    let n = ctx.symbolic.nrows();
+    let widest = (0..ctx.symbolic.n_supernodes()).map(|s| width(ctx.symbolic, s)).max().unwrap_or(0);
+    let mut g2l = vec![NONE; n];
+    let mut idx = (Vec::new(), Vec::new());
+    let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(widest, Par::rayon(threads), Default::default()));
+    while let Some((t, alone)) = queue.take() {
+        let par = if alone { Par::rayon(threads) } else { Par::Seq };
+        let first = ctx.symbolic.supernode_begin()[tasks.members[t][0]];
+        let r = if queue.failed_before(first) {
+            Ok(false)
+        } else {
+            run(ctx, &tasks.members[t], par, &mut g2l, &mut idx, &mut mem).map(|_| true)
+        };
+        queue.done(t, r);
     }
 }
 
-/// The work of each supernode's own columns, Σ c² over them (c a column's entries, diagonal included).
-fn own_work(symbolic: &SymbolicSupernodalCholesky<usize>) -> Vec<f64> {
-    (0..symbolic.n_supernodes())
-        .map(|s| {
-            let (w, below) = (width(symbolic, s), symbolic.nnz_per_super()[s]);
-            (0..w).map(|j| ((w - j + below) as f64).powi(2)).sum::<f64>()
-        })
-        .collect()
-}
-
-/// The supernodal elimination tree (parent of each supernode, `NONE` at roots) and, for each supernode s,
-/// the supernodes whose columns update it (those with a row in s's columns), increasing.
-fn tree(symbolic: &SymbolicSupernodalCholesky<usize>) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
-    let ns = symbolic.n_supernodes();
-    let mut of_col = vec![0; symbolic.nrows()];
-    for s in 0..ns {
-        of_col[symbolic.supernode_begin()[s]..symbolic.supernode_end()[s]].fill(s);
+/// The supernodes `list`, in order, with the parallelism `par` in their dense work.
+fn run(
+    ctx: &Ctx,
+    list: &[usize],
+    par: Par,
+    g2l: &mut [usize],
+    idx: &mut (Vec<usize>, Vec<usize>),
+    mem: &mut MemBuffer,
+) -> Numeric {
+    for &s in list {
+        supernode(ctx, s, g2l, idx, par, MemStack::new(mem))?;
     }
-    let parent: Vec<usize> = (0..ns).map(|d| pattern(symbolic, d).first().map_or(NONE, |&r| of_col[r])).collect();
-    let mut pairs = Vec::new();
-    for d in 0..ns {
-        let mut last = NONE;
-        for &r in pattern(symbolic, d) {
-            let s = of_col[r];
-            if s != last {
-                pairs.push((s, d));
-                last = s;
-            }
-        }
-    }
-    let mut ptr = vec![0; ns + 1];
-    pairs.iter().for_each(|&(s, _)| ptr[s + 1] += 1);
-    (0..ns).for_each(|s| ptr[s + 1] += ptr[s]);
-    let mut next = ptr.clone();
-    let mut updaters = vec![0; pairs.len()];
-    for (s, d) in pairs {
-        updaters[next[s]] = d;
-        next[s] += 1;
-    }
-    (parent, ptr, updaters)
+    Ok(())
 }
 
 fn pattern(symbolic: &SymbolicSupernodalCholesky<usize>, s: usize) -> &[usize] {
     &symbolic.row_idx()[symbolic.col_ptr_for_row_idx()[s]..][..symbolic.nnz_per_super()[s]]
-}
-
-/// The supernodes of `members` (increasing, closed under parents) for each thread (whole subtrees of
-/// theirs, increasing), and those above the subtrees (increasing). The largest subtree is split (its root
-/// goes above, its children become subtrees) until none holds more than 1/(4·threads) of the subtrees'
-/// work (`own`); the subtrees then go to the least loaded thread, largest first.
-fn plan(own: &[f64], parent: &[usize], members: &[usize], threads: usize) -> (Vec<Vec<usize>>, Vec<usize>) {
-    let ns = parent.len();
-    let mut work = vec![0.0f64; ns];
-    let mut children = vec![Vec::new(); ns];
-    for &s in members {
-        work[s] += own[s];
-        if parent[s] != NONE {
-            work[parent[s]] += work[s];
-            children[parent[s]].push(s);
-        }
-    }
-    let mut owner = vec![NONE; ns];
-    let above = threads;
-    let mut roots: Vec<usize> = members.iter().copied().filter(|&s| parent[s] == NONE).collect();
-    loop {
-        let total: f64 = roots.iter().map(|&r| work[r]).sum();
-        let Some(i) = (0..roots.len()).max_by(|&i, &j| work[roots[i]].total_cmp(&work[roots[j]])) else { break };
-        let r = roots[i];
-        if work[r] <= total / (4 * threads) as f64 || children[r].is_empty() {
-            break;
-        }
-        owner[r] = above;
-        roots.swap_remove(i);
-        roots.extend_from_slice(&children[r]);
-    }
-    roots.sort_by(|&a, &b| work[b].total_cmp(&work[a]).then(a.cmp(&b)));
-    let mut load = vec![0.0f64; threads];
-    for r in roots {
-        let t = (0..threads).min_by(|&i, &j| load[i].total_cmp(&load[j])).unwrap_or(0);
-        load[t] += work[r];
-        owner[r] = t;
-    }
-    for &s in members.iter().rev() {
-        if owner[s] == NONE {
-            owner[s] = owner[parent[s]];
-        }
-    }
-    let mut groups = vec![Vec::new(); threads + 1];
-    members.iter().for_each(|&s| groups[owner[s]].push(s));
-    let top = groups.pop().unwrap_or_default();
-    (groups, top)
-}
-
-/// The supernodes `list`, in order, with the parallelism `par` in their dense work.
-fn run(ctx: &Ctx, list: &[usize], par: Par) -> Numeric {
-    let n = ctx.symbolic.nrows();
-    let widest = list.iter().map(|&s| width(ctx.symbolic, s)).max().unwrap_or(0);
-    let mut g2l = vec![NONE; n];
-    let mut idx = (Vec::new(), Vec::new());
-    let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(widest, par, Default::default()));
-    for &s in list {
-        supernode(ctx, s, &mut g2l, &mut idx, par, MemStack::new(&mut mem))?;
-    }
-    Ok(())
 }
 
 fn width(symbolic: &SymbolicSupernodalCholesky<usize>, s: usize) -> usize {
@@ -271,7 +192,7 @@ fn supernode(
             }
         }
     }
-    for &d in &ctx.updaters[ctx.update_ptr[s]..ctx.update_ptr[s + 1]] {
+    for &d in &ctx.tree.updaters[ctx.tree.update_ptr[s]..ctx.tree.update_ptr[s + 1]] {
         let d_pattern = pattern(sym, d);
         let d_ncols = width(sym, d);
         // SAFETY: d is below s in the tree: finished before s started, and no longer written
