@@ -1,10 +1,10 @@
 //! The ready tasks of the factorisation on several threads (`solve::cholesky::subtrees`): a task is ready
-//! once every task below it is done; the threads take the ready task of highest priority
-//! (`solve::cholesky::schedule`). A failed task (a pivot that is not positive) leaves the tasks above
-//! it never ready; the others still run, but those whose columns all come after a failure's are skipped,
+//! once every task it waits for is done; the threads take the ready task of highest priority
+//! (`solve::cholesky::schedule`). A failed task (a pivot that is not positive) leaves the tasks waiting
+//! for it never ready; the others still run, but those whose columns all come after a failure's are skipped,
 //! so the failure reported is the first in column order, as faer's sequential kernel reports it.
 
-use super::schedule::{Tasks, NONE};
+use super::schedule::Tasks;
 use faer::linalg::solvers::LltError;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -28,7 +28,7 @@ pub(super) struct Queue<'a> {
 }
 
 impl<'a> Queue<'a> {
-    /// The tasks below which there is none are ready.
+    /// The tasks that wait for none are ready.
     pub fn new(tasks: &'a Tasks) -> Queue<'a> {
         let mut ready = BinaryHeap::new();
         for (t, &b) in tasks.below.iter().enumerate() {
@@ -75,11 +75,10 @@ impl<'a> Queue<'a> {
         st.running -= 1;
         match r {
             Ok(true) => {
-                let p = self.tasks.parent[t];
-                if p != NONE {
-                    st.below[p] -= 1;
-                    if st.below[p] == 0 {
-                        st.ready.push((self.tasks.priority[p].to_bits(), Reverse(p)));
+                for &u in &self.tasks.next[t] {
+                    st.below[u] -= 1;
+                    if st.below[u] == 0 {
+                        st.ready.push((self.tasks.priority[u].to_bits(), Reverse(u)));
                     }
                 }
             }

@@ -19,11 +19,13 @@ const GRAIN: f64 = 16.0;
 pub(super) struct Tree {
     /// The parent of each supernode, `NONE` at roots.
     pub parent: Vec<usize>,
-    /// The supernodes that update supernode s, increasing: `updaters[update_ptr[s]..update_ptr[s + 1]]`.
+    /// The supernodes that update supernode s, increasing: `updaters[update_ptr[s]..update_ptr[s + 1]]`,
+    /// and the multiply-adds of each of these updates.
     pub update_ptr: Vec<usize>,
     pub updaters: Vec<usize>,
-    /// The multiply-adds of each supernode (see the module's text).
-    pub work: Vec<f64>,
+    pub update_work: Vec<f64>,
+    /// The multiply-adds of each supernode's dense factor and solve.
+    pub dense: Vec<f64>,
 }
 
 impl Tree {
@@ -35,7 +37,7 @@ impl Tree {
             of_col[begin[s]..end[s]].fill(s);
         }
         let parent: Vec<usize> = (0..ns).map(|d| pattern(d).first().map_or(NONE, |&r| of_col[r])).collect();
-        let mut work: Vec<f64> = (0..ns)
+        let dense: Vec<f64> = (0..ns)
             .map(|s| {
                 let (w, below) = ((end[s] - begin[s]) as f64, pattern(s).len() as f64);
                 w * w * w / 6.0 + w * w * below / 2.0
@@ -50,41 +52,61 @@ impl Tree {
                 let mid = p[lo..].partition_point(|&r| r < end[s]);
                 // C[rows below, mid columns] −= A Bᵀ, its lower triangle: depth `width`
                 let (rows, cols) = ((p.len() - lo) as f64, mid as f64);
-                work[s] += width * cols * (rows - (cols - 1.0) / 2.0);
-                pairs.push((s, d));
+                pairs.push((s, d, width * cols * (rows - (cols - 1.0) / 2.0)));
                 lo += mid;
             }
         }
         let mut update_ptr = vec![0; ns + 1];
-        pairs.iter().for_each(|&(s, _)| update_ptr[s + 1] += 1);
+        pairs.iter().for_each(|&(s, _, _)| update_ptr[s + 1] += 1);
         (0..ns).for_each(|s| update_ptr[s + 1] += update_ptr[s]);
         let mut next = update_ptr.clone();
-        let mut updaters = vec![0; pairs.len()];
-        for (s, d) in pairs {
+        let (mut updaters, mut update_work) = (vec![0; pairs.len()], vec![0.0; pairs.len()]);
+        for (s, d, w) in pairs {
             updaters[next[s]] = d;
+            update_work[next[s]] = w;
             next[s] += 1;
         }
-        Tree { parent, update_ptr, updaters, work }
+        Tree { parent, update_ptr, updaters, update_work, dense }
+    }
+
+    /// The work of each supernode: its updates and its dense work.
+    fn work(&self) -> Vec<f64> {
+        (0..self.parent.len())
+            .map(|s| self.dense[s] + self.update_work[self.update_ptr[s]..self.update_ptr[s + 1]].iter().sum::<f64>())
+            .collect()
     }
 }
 
-/// The tasks: each a list of supernodes (increasing), the task above it, how many tasks below it, and
-/// its priority (the work on its path to the root, its own included). A task's number is above those
-/// of the tasks below it.
+/// What a task computes.
+pub(super) enum Job {
+    /// These supernodes (increasing) whole.
+    Whole(Vec<usize>),
+    /// Of supernode s, K's columns if `first`, then the updates `updaters[from..to]` in order.
+    Update { s: usize, from: usize, to: usize, first: bool },
+    /// The dense factor of supernode s and the solve below it, once its updates are done.
+    Dense(usize),
+}
+
+/// The tasks: what each computes, the tasks that wait for it, how many it waits for, its work and its
+/// priority (the most work on a path from it to the end, its own included). Tasks wait only for tasks
+/// numbered before them.
 pub(super) struct Tasks {
-    pub members: Vec<Vec<usize>>,
-    pub parent: Vec<usize>,
+    pub jobs: Vec<Job>,
+    pub next: Vec<Vec<usize>>,
     pub below: Vec<usize>,
     pub priority: Vec<f64>,
     pub work: Vec<f64>,
 }
 
 impl Tasks {
-    /// The tasks of `tree` for `threads` threads: subtrees whose root is split off (a task of its own,
-    /// its children's subtrees cut again) while they hold more than 1/(GRAIN · threads) of the work.
+    /// The tasks of `tree` for `threads` threads. Subtrees are split (their root taken off, its children's
+    /// subtrees cut again) while they hold more than 1/(GRAIN · threads) of the work; a subtree that is
+    /// not split is one task. A supernode taken off is computed by several: one per task among those that
+    /// computed its updaters (its updates from them, in order, as soon as they are done), then its dense work.
     pub fn new(tree: &Tree, threads: usize) -> Tasks {
-        let ns = tree.parent.len();
-        let mut sub = tree.work.clone();
+        let own = tree.work();
+        let ns = own.len();
+        let mut sub = own.clone();
         let mut children = vec![Vec::new(); ns];
         for s in 0..ns {
             if tree.parent[s] != NONE {
@@ -92,14 +114,14 @@ impl Tasks {
                 children[tree.parent[s]].push(s);
             }
         }
-        let total: f64 = tree.work.iter().sum();
-        let limit = total / (GRAIN * threads as f64);
-        // the root of each supernode's task: itself when split off or a subtree's root
-        let mut head = vec![NONE; ns];
+        let limit = own.iter().sum::<f64>() / (GRAIN * threads as f64);
+        // the head of each supernode's subtree task, or itself when taken off
+        let (mut head, mut split) = (vec![NONE; ns], vec![false; ns]);
         let mut stack: Vec<usize> = (0..ns).filter(|&s| tree.parent[s] == NONE).collect();
         while let Some(r) = stack.pop() {
             head[r] = r;
             if sub[r] > limit && !children[r].is_empty() {
+                split[r] = true;
                 stack.extend_from_slice(&children[r]);
             }
         }
@@ -108,37 +130,69 @@ impl Tasks {
                 head[s] = head[tree.parent[s]];
             }
         }
-        // tasks numbered by their heads, increasing (a head is above every member of its task)
-        let mut task_of = vec![NONE; ns];
-        let mut members: Vec<Vec<usize>> = Vec::new();
-        for s in 0..ns {
-            if head[s] == s {
-                task_of[s] = members.len();
-                members.push(Vec::new());
-            }
+        let mut tasks =
+            Tasks { jobs: Vec::new(), next: Vec::new(), below: Vec::new(), priority: Vec::new(), work: Vec::new() };
+        // the task after which each supernode is done
+        let mut done = vec![NONE; ns];
+        let mut whole: Vec<Vec<usize>> = vec![Vec::new(); ns];
+        (0..ns).filter(|&s| !split[s]).for_each(|s| whole[head[s]].push(s));
+        for (h, list) in whole.into_iter().enumerate().filter(|(_, l)| !l.is_empty()) {
+            let work = list.iter().map(|&m| own[m]).sum();
+            list.iter().for_each(|&m| done[m] = tasks.jobs.len());
+            debug_assert!(list.last() == Some(&h));
+            tasks.add(Job::Whole(list), &[], work);
         }
-        (0..ns).for_each(|s| members[task_of[head[s]]].push(s));
-        let nt = members.len();
-        let (mut parent, mut below, mut work) = (vec![NONE; nt], vec![0; nt], vec![0.0; nt]);
-        for (t, list) in members.iter().enumerate() {
-            work[t] = list.iter().map(|&s| tree.work[s]).sum();
-            let &root = list.last().unwrap_or(&0);
-            if let Some(&p) = (tree.parent[root] != NONE).then_some(&tree.parent[root]) {
-                parent[t] = task_of[head[p]];
-                below[parent[t]] += 1;
+        for s in (0..ns).filter(|&s| split[s]) {
+            let (mut from, end) = (tree.update_ptr[s], tree.update_ptr[s + 1]);
+            let mut prev =
+                if from == end { tasks.add(Job::Update { s, from, to: end, first: true }, &[], 0.0) } else { NONE };
+            while from < end {
+                let by = done[tree.updaters[from]];
+                let to = from + tree.updaters[from..end].iter().take_while(|&&d| done[d] == by).count();
+                let work = tree.update_work[from..to].iter().sum();
+                let job = Job::Update { s, from, to, first: prev == NONE };
+                prev = tasks.add(job, &[by, prev], work);
+                from = to;
             }
+            done[s] = tasks.add(Job::Dense(s), &[prev], tree.dense[s]);
         }
-        let mut priority = work.clone();
-        for t in (0..nt).rev() {
-            if parent[t] != NONE {
-                priority[t] += priority[parent[t]];
-            }
-        }
-        Tasks { members, parent, below, priority, work }
+        tasks.prioritise();
+        tasks
     }
 
-    /// The total work, the critical path (the most work on one path from a task to the root) and the
-    /// makespan of the schedule simulated on `threads` threads, each task on one.
+    /// A task computing `job`, waiting for the tasks `after` (`NONE` ignored).
+    fn add(&mut self, job: Job, after: &[usize], work: f64) -> usize {
+        let t = self.jobs.len();
+        self.jobs.push(job);
+        self.next.push(Vec::new());
+        self.below.push(0);
+        self.work.push(work);
+        for &a in after.iter().filter(|&&a| a != NONE) {
+            self.next[a].push(t);
+            self.below[t] += 1;
+        }
+        t
+    }
+
+    fn prioritise(&mut self) {
+        let nt = self.jobs.len();
+        self.priority = self.work.clone();
+        for t in (0..nt).rev() {
+            let after = self.next[t].iter().map(|&u| self.priority[u]).fold(0.0, f64::max);
+            self.priority[t] += after;
+        }
+    }
+
+    /// The first column a task computes.
+    pub fn first_supernode(&self, t: usize) -> usize {
+        match &self.jobs[t] {
+            Job::Whole(list) => list[0],
+            Job::Update { s, .. } | Job::Dense(s) => *s,
+        }
+    }
+
+    /// The total work, the critical path (the most work on one path of tasks) and the makespan of the
+    /// schedule simulated on `threads` threads, each task on one.
     pub fn figures(&self, threads: usize) -> (f64, f64, f64) {
         let total = self.work.iter().sum();
         let critical = self.priority.iter().copied().fold(0.0, f64::max);
@@ -157,11 +211,10 @@ impl Tasks {
             let Some(i) = (0..running.len()).min_by(|&i, &j| running[i].0.total_cmp(&running[j].0)) else { break };
             let (end, t) = running.swap_remove(i);
             now = end;
-            let p = self.parent[t];
-            if p != NONE {
-                below[p] -= 1;
-                if below[p] == 0 {
-                    ready.push(p);
+            for &u in &self.next[t] {
+                below[u] -= 1;
+                if below[u] == 0 {
+                    ready.push(u);
                 }
             }
         }

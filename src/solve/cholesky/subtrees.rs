@@ -9,7 +9,7 @@
 //! the thread count (test: `solve::cholesky::factor::tests::two_threads_factorise_bit_identically_run_after_run`).
 
 use super::queue::{Guard, Queue};
-use super::schedule::{self, Tasks, Tree, NONE};
+use super::schedule::{self, Job, Tasks, Tree, NONE};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
 use faer::linalg::solvers::LltError;
@@ -99,7 +99,8 @@ pub(super) fn factorize(
     symbolic: &SymbolicSupernodalCholesky<usize>,
     threads: usize,
 ) -> Numeric {
-    let tree = Tree::new(symbolic.supernode_begin(), symbolic.supernode_end(), symbolic.nrows(), |s| pattern(symbolic, s));
+    let tree =
+        Tree::new(symbolic.supernode_begin(), symbolic.supernode_end(), symbolic.nrows(), |s| pattern(symbolic, s));
     let tasks = Tasks::new(&tree, threads);
     if std::env::var_os(schedule::ENV).is_some() {
         let (total, critical, makespan) = tasks.figures(threads);
@@ -126,34 +127,41 @@ fn worker(ctx: &Ctx, tasks: &Tasks, queue: &Queue, threads: usize) {
     let _guard = Guard(queue);
     let n = ctx.symbolic.nrows();
     let widest = (0..ctx.symbolic.n_supernodes()).map(|s| width(ctx.symbolic, s)).max().unwrap_or(0);
-    let mut g2l = vec![NONE; n];
-    let mut idx = (Vec::new(), Vec::new());
-    let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(widest, Par::rayon(threads), Default::default()));
+    let mut scratch = Scratch {
+        g2l: vec![NONE; n],
+        idx: (Vec::new(), Vec::new()),
+        mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(widest, Par::rayon(threads), Default::default())),
+    };
     while let Some((t, alone)) = queue.take() {
         let par = if alone { Par::rayon(threads) } else { Par::Seq };
-        let first = ctx.symbolic.supernode_begin()[tasks.members[t][0]];
-        let r = if queue.failed_before(first) {
-            Ok(false)
-        } else {
-            run(ctx, &tasks.members[t], par, &mut g2l, &mut idx, &mut mem).map(|_| true)
-        };
+        let first = ctx.symbolic.supernode_begin()[tasks.first_supernode(t)];
+        let r = if queue.failed_before(first) { Ok(false) } else { job(ctx, &tasks.jobs[t], par, &mut scratch) };
         queue.done(t, r);
     }
 }
 
-/// The supernodes `list`, in order, with the parallelism `par` in their dense work.
-fn run(
-    ctx: &Ctx,
-    list: &[usize],
-    par: Par,
-    g2l: &mut [usize],
-    idx: &mut (Vec<usize>, Vec<usize>),
-    mem: &mut MemBuffer,
-) -> Numeric {
-    for &s in list {
-        supernode(ctx, s, g2l, idx, par, MemStack::new(mem))?;
+/// A thread's scratch: the row map (global row → row in the supernode's block, `NONE` elsewhere), the
+/// update's indices, the dense factor's memory.
+struct Scratch {
+    g2l: Vec<usize>,
+    idx: (Vec<usize>, Vec<usize>),
+    mem: MemBuffer,
+}
+
+/// Compute `job` with the parallelism `par` in its dense work: `Ok(true)` once done.
+fn job(ctx: &Ctx, job: &Job, par: Par, sc: &mut Scratch) -> Result<bool, LltError> {
+    match *job {
+        Job::Whole(ref list) => {
+            for &s in list {
+                let (from, to) = (ctx.tree.update_ptr[s], ctx.tree.update_ptr[s + 1]);
+                updates(ctx, s, (from, to), true, par, sc);
+                dense(ctx, s, par, MemStack::new(&mut sc.mem))?;
+            }
+        }
+        Job::Update { s, from, to, first } => updates(ctx, s, (from, to), first, par, sc),
+        Job::Dense(s) => dense(ctx, s, par, MemStack::new(&mut sc.mem))?,
     }
-    Ok(())
+    Ok(true)
 }
 
 fn pattern(symbolic: &SymbolicSupernodalCholesky<usize>, s: usize) -> &[usize] {
@@ -164,38 +172,40 @@ fn width(symbolic: &SymbolicSupernodalCholesky<usize>, s: usize) -> usize {
     symbolic.supernode_end()[s] - symbolic.supernode_begin()[s]
 }
 
-/// Supernode s of L, as faer's kernel computes it: K's columns, the updates of the supernodes below, the
-/// dense Cholesky factor of the diagonal block and the solve of the block below it.
-fn supernode(
-    ctx: &Ctx,
-    s: usize,
-    g2l: &mut [usize],
-    (row_idx, col_idx): &mut (Vec<usize>, Vec<usize>),
-    par: Par,
-    stack: &mut MemStack,
-) -> Numeric {
+/// Supernode s's block of L: its rows, its columns.
+fn block<'a>(ctx: &'a Ctx, s: usize) -> MatMut<'a, f64> {
+    let (sym, cpv) = (ctx.symbolic, ctx.symbolic.col_ptr_for_val());
+    // SAFETY: supernode s is computed by one task at a time (its tasks wait for each other)
+    let block = unsafe { ctx.values.block_mut(cpv[s], cpv[s + 1]) };
+    MatMut::from_column_major_slice_mut(block, pattern(sym, s).len() + width(sym, s), width(sym, s))
+}
+
+/// Of supernode s, as faer's kernel computes it: K's columns (if `first`), then the updates of the
+/// supernodes `updaters[from..to]`, in order.
+fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Par, sc: &mut Scratch) {
     let sym = ctx.symbolic;
     let cpv = sym.col_ptr_for_val();
     let (s_start, s_end) = (sym.supernode_begin()[s], sym.supernode_end()[s]);
     let s_pattern = pattern(sym, s);
     let s_ncols = s_end - s_start;
+    let (g2l, (row_idx, col_idx)) = (&mut sc.g2l, &mut sc.idx);
     for (i, &row) in s_pattern.iter().enumerate() {
         g2l[row] = i + s_ncols;
     }
-    // SAFETY: supernode s is computed by this thread only
-    let block = unsafe { ctx.values.block_mut(cpv[s], cpv[s + 1]) };
-    let mut ls = MatMut::from_column_major_slice_mut(block, s_pattern.len() + s_ncols, s_ncols);
-    for j in s_start..s_end {
-        for (i, &v) in ctx.a.row_idx_of_col(j).zip(ctx.a.val_of_col(j)) {
-            if i >= j {
-                ls[(if i >= s_end { g2l[i] } else { i - s_start }, j - s_start)] += v;
+    let mut ls = block(ctx, s);
+    if first {
+        for j in s_start..s_end {
+            for (i, &v) in ctx.a.row_idx_of_col(j).zip(ctx.a.val_of_col(j)) {
+                if i >= j {
+                    ls[(if i >= s_end { g2l[i] } else { i - s_start }, j - s_start)] += v;
+                }
             }
         }
     }
-    for &d in &ctx.tree.updaters[ctx.tree.update_ptr[s]..ctx.tree.update_ptr[s + 1]] {
+    for &d in &ctx.tree.updaters[from..to] {
         let d_pattern = pattern(sym, d);
         let d_ncols = width(sym, d);
-        // SAFETY: d is below s in the tree: finished before s started, and no longer written
+        // SAFETY: d is below s in the tree: done before this task started, and no longer written
         let ld = unsafe { ctx.values.block(cpv[d], cpv[d + 1]) };
         let ld = MatRef::from_column_major_slice(ld, d_pattern.len() + d_ncols, d_ncols);
         let lo = d_pattern.partition_point(|&r| r < s_start);
@@ -207,11 +217,18 @@ fn supernode(
         col_idx.extend(d_pattern[lo..lo + mid].iter().map(|&r| r - s_start));
         update(ls.rb_mut(), row_idx, col_idx, ld_mid_bot, ld_mid_bot.subrows(0, mid).transpose(), par);
     }
-    let (mut top, mut bot) = ls.split_at_row_mut(s_ncols);
+    s_pattern.iter().for_each(|&row| g2l[row] = NONE);
+}
+
+/// Of supernode s, once its updates are done: the dense Cholesky factor of its diagonal block and the
+/// solve of the block below it.
+fn dense(ctx: &Ctx, s: usize, par: Par, stack: &mut MemStack) -> Numeric {
+    let s_start = ctx.symbolic.supernode_begin()[s];
+    let mut ls = block(ctx, s);
+    let (mut top, mut bot) = ls.rb_mut().split_at_row_mut(width(ctx.symbolic, s));
     cholesky_in_place(top.rb_mut(), Default::default(), par, stack, Default::default())
         .map_err(|LltError::NonPositivePivot { index }| LltError::NonPositivePivot { index: index + s_start })?;
     solve_lower_triangular_in_place(top.rb().conjugate(), bot.rb_mut().transpose_mut(), par);
-    s_pattern.iter().for_each(|&row| g2l[row] = NONE);
     Ok(())
 }
 
