@@ -43,7 +43,7 @@ impl Tree {
                 w * w * w / 6.0 + w * w * below / 2.0
             })
             .collect();
-        let mut pairs = Vec::new();
+        let mut pairs = Vec::with_capacity((0..ns).map(|d| pattern(d).len()).sum());
         for d in 0..ns {
             let (p, width) = (pattern(d), (end[d] - begin[d]) as f64);
             let mut lo = 0;

@@ -1,9 +1,11 @@
 //! The numeric supernodal factorisation on several threads, by subtrees of the supernodal elimination
 //! tree. faer's kernel (`factorize_supernodal_numeric_llt`) walks the supernodes in order and splits only
 //! each supernode's dense work between threads, which leaves the many small supernodes of a 2D problem on
-//! one thread. Here disjoint subtrees run on threads of their own (a supernode reads only its
-//! descendants' columns of L and writes only its own), then the supernodes above them, in order, with
-//! their dense work split between the threads. Every supernode is computed as faer's kernel computes it:
+//! one thread. Here the tasks of `solve::cholesky::schedule` (whole subtrees, and the supernodes above
+//! them in parts: their updates from each task below as soon as it is done, then their dense work) run
+//! on the threads as they become ready (`solve::cholesky::queue`): a supernode reads only its
+//! descendants' columns of L and writes only its own. A task that runs alone (no other can start before
+//! it ends) splits its dense work between the threads. Every supernode is computed as faer's kernel computes it:
 //! the same updates in the same order, with faer's own kernels (its update kernel, `private_gemm_x86`,
 //! called with the arguments faer gives it), so the factor is faer's sequential one bit for bit whatever
 //! the thread count (test: `solve::cholesky::factor::tests::two_threads_factorise_bit_identically_run_after_run`).
@@ -81,12 +83,13 @@ struct Ctx<'a> {
 }
 
 /// Bytes [`factorize`] allocates with `threads` threads beside L and faer's scratch, at most: a row map of
-/// n entries per thread, the tree, each supernode's updaters (at most one per row index of L's
-/// supernodal pattern, kept as pairs then as a list) and the tasks.
+/// n entries per thread and one for the tree, each supernode's updaters and the work of their updates (at
+/// most one per row index of L's supernodal pattern, kept as triples then as two lists), the tree and
+/// the tasks (about 24 words a supernode).
 pub(crate) fn scratch_bytes(symbolic: &SymbolicSupernodalCholesky<usize>, threads: usize) -> u64 {
     let word = std::mem::size_of::<usize>() as u64;
     let (n, ns, rows) = (symbolic.nrows() as u64, symbolic.n_supernodes() as u64, symbolic.row_idx().len() as u64);
-    word * (threads as u64 * n + 3 * rows + 12 * ns)
+    word * ((threads as u64 + 1) * n + 5 * rows + 24 * ns)
 }
 
 /// L's values of the lower triangle `a` (permuted) with `threads` threads (≥ 2), as faer's
