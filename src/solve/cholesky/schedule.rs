@@ -1,11 +1,12 @@
 //! The schedule of the factorisation on several threads (`solve::cholesky::subtrees`): the supernodal
-//! elimination tree cut into tasks, whole subtrees at the bottom and single supernodes above them, each
-//! task ready once the tasks below it are done, the ready task with the longest path of work to the root
-//! taken first. The work of a supernode is what the left-looking kernel does for it: the multiply-adds of
+//! elimination tree cut into tasks, whole subtrees at the bottom and the supernodes above them in parts
+//! (their updates from each task below, in order, then their dense work), each task ready once the tasks
+//! it waits for are done, the ready task with the most work on a path from it to the end taken first. The work of a supernode is what the left-looking kernel does for it: the multiply-adds of
 //! the updates it receives from the supernodes below and of its own dense factor and solve.
 //!
 //! With the environment variable `TRESCA_SCHEDULE` set, the factorisation prints the schedule's work, its
-//! critical path and its makespan simulated on the threads (all in multiply-adds) to standard error.
+//! critical path, its makespan simulated on the threads and the work of the tasks that run alone in that
+//! simulation (all in multiply-adds) to standard error.
 
 /// The environment variable that asks for the schedule's figures on standard error.
 pub(super) const ENV: &str = "TRESCA_SCHEDULE";
@@ -191,9 +192,10 @@ impl Tasks {
         }
     }
 
-    /// The total work, the critical path (the most work on one path of tasks) and the makespan of the
-    /// schedule simulated on `threads` threads, each task on one.
-    pub fn figures(&self, threads: usize) -> (f64, f64, f64) {
+    /// The total work, the critical path (the most work on one path of tasks), the makespan of the
+    /// schedule simulated on `threads` threads, each task on one, and the work of the tasks that run alone
+    /// in it (with faer's parallel dense kernels in the factorisation).
+    pub fn figures(&self, threads: usize) -> [f64; 4] {
         let total = self.work.iter().sum();
         let critical = self.priority.iter().copied().fold(0.0, f64::max);
         let nt = self.work.len();
@@ -201,11 +203,14 @@ impl Tasks {
         let mut ready: Vec<usize> = (0..nt).filter(|&t| below[t] == 0).collect();
         // (finish time, task) of the tasks running
         let mut running: Vec<(f64, usize)> = Vec::new();
-        let mut now = 0.0f64;
+        let (mut now, mut alone) = (0.0f64, 0.0);
         loop {
             while running.len() < threads && !ready.is_empty() {
                 let i = (0..ready.len()).max_by(|&i, &j| self.priority[ready[i]].total_cmp(&self.priority[ready[j]]));
                 let t = ready.swap_remove(i.unwrap_or(0));
+                if running.is_empty() && ready.is_empty() {
+                    alone += self.work[t];
+                }
                 running.push((now + self.work[t], t));
             }
             let Some(i) = (0..running.len()).min_by(|&i, &j| running[i].0.total_cmp(&running[j].0)) else { break };
@@ -218,6 +223,6 @@ impl Tasks {
                 }
             }
         }
-        (total, critical, now)
+        [total, critical, now, alone]
     }
 }

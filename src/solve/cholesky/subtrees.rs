@@ -106,13 +106,14 @@ pub(super) fn factorize(
         Tree::new(symbolic.supernode_begin(), symbolic.supernode_end(), symbolic.nrows(), |s| pattern(symbolic, s));
     let tasks = Tasks::new(&tree, threads);
     if std::env::var_os(schedule::ENV).is_some() {
-        let (total, critical, makespan) = tasks.figures(threads);
+        let [total, critical, makespan, alone] = tasks.figures(threads);
         eprintln!(
             "schedule: {} tasks, work {total:.4e}, critical path {critical:.4e} ({:.3}), makespan on {threads} \
-             threads {makespan:.4e} (speed-up {:.3})",
+             threads {makespan:.4e} (speed-up {:.3}), of which alone {alone:.4e} ({:.3})",
             tasks.work.len(),
             critical / total,
-            total / makespan
+            total / makespan,
+            alone / total
         );
     }
     let ctx = Ctx { symbolic, a, values: Values(values.as_mut_ptr(), values.len()), tree };
