@@ -43,13 +43,16 @@
 //!
 //! Its modules: [`ordering`] (the graph, AMD and METIS) and [`dissect`] (coordinate bisection); [`etree`]
 //! (elimination tree, postorder, column counts) and [`symbolic`] (the symbolic factorisation); [`factor`]
-//! (numeric factorisation and solves) and [`pages`] (the factor's memory, mapped in huge pages).
+//! (numeric factorisation and solves), [`subtrees`], [`schedule`] and [`queue`] (the numeric factorisation on
+//! several threads) and [`pages`] (the factor's memory, mapped in huge pages).
 
 pub(crate) mod dissect;
 pub(crate) mod etree;
 pub(crate) mod factor;
 pub(crate) mod ordering;
 pub(crate) mod pages;
+pub(crate) mod queue;
+pub(crate) mod schedule;
 pub(crate) mod subtrees;
 pub(crate) mod symbolic;
 

@@ -1,13 +1,17 @@
 //! The numeric supernodal factorisation on several threads, by subtrees of the supernodal elimination
 //! tree. faer's kernel (`factorize_supernodal_numeric_llt`) walks the supernodes in order and splits only
 //! each supernode's dense work between threads, which leaves the many small supernodes of a 2D problem on
-//! one thread. Here disjoint subtrees run on threads of their own (a supernode reads only its
-//! descendants' columns of L and writes only its own), then the supernodes above them, in order, with
-//! their dense work split between the threads. Every supernode is computed as faer's kernel computes it:
+//! one thread. Here the tasks of `solve::cholesky::schedule` (whole subtrees, and the supernodes above
+//! them in parts: their updates from each task below as soon as it is done, then their dense work) run
+//! on the threads as they become ready (`solve::cholesky::queue`): a supernode reads only its
+//! descendants' columns of L and writes only its own. A task that runs alone (no other can start before
+//! it ends) splits its dense work between the threads. Every supernode is computed as faer's kernel computes it:
 //! the same updates in the same order, with faer's own kernels (its update kernel, `private_gemm_x86`,
 //! called with the arguments faer gives it), so the factor is faer's sequential one bit for bit whatever
 //! the thread count (test: `solve::cholesky::factor::tests::two_threads_factorise_bit_identically_run_after_run`).
 
+use super::queue::{Guard, Queue};
+use super::schedule::{self, Job, Tasks, Tree, NONE};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
 use faer::linalg::solvers::LltError;
@@ -23,7 +27,6 @@ use faer::{MatMut, MatRef, Par};
 pub(crate) const MIN_ENTRIES: usize = 1 << 16;
 
 type Numeric = std::result::Result<(), LltError>;
-const NONE: usize = usize::MAX;
 
 /// Whether this machine has faer's update kernel (x86-64 with AVX2 and FMA); elsewhere faer's own
 /// numeric factorisation is used.
@@ -76,205 +79,137 @@ struct Ctx<'a> {
     symbolic: &'a SymbolicSupernodalCholesky<usize>,
     a: SparseColMatRef<'a, usize, f64>,
     values: Values,
-    /// The supernodes that update supernode s, increasing: `updaters[update_ptr[s]..update_ptr[s + 1]]`.
-    update_ptr: Vec<usize>,
-    updaters: Vec<usize>,
+    tree: Tree,
 }
 
 /// Bytes [`factorize`] allocates with `threads` threads beside L and faer's scratch, at most: a row map of
-/// n entries per thread, the tree and each supernode's updaters (at most one per row index of L's
-/// supernodal pattern, kept as pairs then as a list).
+/// n entries per thread and one for the tree, each supernode's updaters and the work of their updates (at
+/// most one per row index of L's supernodal pattern, kept as triples then as two lists), the tree and
+/// the tasks (about 24 words a supernode).
 pub(crate) fn scratch_bytes(symbolic: &SymbolicSupernodalCholesky<usize>, threads: usize) -> u64 {
     let word = std::mem::size_of::<usize>() as u64;
     let (n, ns, rows) = (symbolic.nrows() as u64, symbolic.n_supernodes() as u64, symbolic.row_idx().len() as u64);
-    word * (threads as u64 * n + 3 * rows + 12 * ns)
+    word * ((threads as u64 + 1) * n + 5 * rows + 24 * ns)
 }
 
 /// L's values of the lower triangle `a` (permuted) with `threads` threads (≥ 2), as faer's
 /// `factorize_supernodal_numeric_llt` with default parameters computes them. `values` must be zeros.
-/// In rounds: the subtrees of [`plan`] on threads of their own, then the same for the supernodes above
-/// them, until the subtrees would hold less than a quarter of what is left or one thread would do
-/// most of their work; the rest in order, with faer's parallel dense kernels.
+/// The tasks of [`Tasks`] run on the threads as they become ready (`solve::cholesky::schedule`), each
+/// with faer's sequential dense kernels, or its parallel ones when it is the only task that can run.
 pub(super) fn factorize(
     values: &mut [f64],
     a: SparseColMatRef<'_, usize, f64>,
     symbolic: &SymbolicSupernodalCholesky<usize>,
     threads: usize,
 ) -> Numeric {
-    let (parent, update_ptr, updaters) = tree(symbolic);
-    let own = own_work(symbolic);
-    let ctx = Ctx { symbolic, a, values: Values(values.as_mut_ptr(), values.len()), update_ptr, updaters };
-    let mut members: Vec<usize> = (0..parent.len()).collect();
-    loop {
-        let (groups, top) = plan(&own, &parent, &members, threads);
-        let sum = |list: &[usize]| list.iter().map(|&s| own[s]).sum::<f64>();
-        let mut loads: Vec<f64> = groups.iter().map(|g| sum(g)).collect();
-        loads.sort_by(|a, b| b.total_cmp(a));
-        let left = sum(&members);
-        // little left for the subtrees, or one thread with most of it: the rest with parallel dense kernels
-        if left - sum(&top) < 0.25 * left || loads[1] < 0.25 * loads[0] {
-            return run(&ctx, &members, Par::rayon(threads));
+    let tree =
+        Tree::new(symbolic.supernode_begin(), symbolic.supernode_end(), symbolic.nrows(), |s| pattern(symbolic, s));
+    let tasks = Tasks::new(&tree, threads);
+    if std::env::var_os(schedule::ENV).is_some() {
+        let [total, critical, makespan, alone] = tasks.figures(threads);
+        eprintln!(
+            "schedule: {} tasks, work {total:.4e}, critical path {critical:.4e} ({:.3}), makespan on {threads} \
+             threads {makespan:.4e} (speed-up {:.3}), of which alone {alone:.4e} ({:.3})",
+            tasks.work.len(),
+            critical / total,
+            total / makespan,
+            alone / total
+        );
+    }
+    let ctx = Ctx { symbolic, a, values: Values(values.as_mut_ptr(), values.len()), tree };
+    let queue = Queue::new(&tasks);
+    std::thread::scope(|sc| {
+        for _ in 0..threads {
+            sc.spawn(|| worker(&ctx, &tasks, &queue, threads));
         }
-        let done: Vec<Numeric> = std::thread::scope(|sc| {
-            let ctx = &ctx;
-            let h: Vec<_> = groups.iter().map(|g| sc.spawn(move || run(ctx, g, Par::Seq))).collect();
-            h.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
-        });
-        // the failure of the first supernode in order among those computed
-        if let Some(e) =
-            done.into_iter().filter_map(|r| r.err()).min_by_key(|LltError::NonPositivePivot { index }| *index)
-        {
-            return Err(e);
-        }
-        if top.is_empty() {
-            return Ok(());
-        }
-        members = top;
+    });
+    queue.result()
+}
+
+/// One thread's share: the ready tasks it takes, until none is left.
+fn worker(ctx: &Ctx, tasks: &Tasks, queue: &Queue, threads: usize) {
+    let _guard = Guard(queue);
+    let n = ctx.symbolic.nrows();
+    let widest = (0..ctx.symbolic.n_supernodes()).map(|s| width(ctx.symbolic, s)).max().unwrap_or(0);
+    let mut scratch = Scratch {
+        g2l: vec![NONE; n],
+        idx: (Vec::new(), Vec::new()),
+        mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(widest, Par::rayon(threads), Default::default())),
+    };
+    while let Some((t, alone)) = queue.take() {
+        let par = if alone { Par::rayon(threads) } else { Par::Seq };
+        let first = ctx.symbolic.supernode_begin()[tasks.first_supernode(t)];
+        let r = if queue.failed_before(first) { Ok(false) } else { job(ctx, &tasks.jobs[t], par, &mut scratch) };
+        queue.done(t, r);
     }
 }
 
-/// The work of each supernode's own columns, Σ c² over them (c a column's entries, diagonal included).
-fn own_work(symbolic: &SymbolicSupernodalCholesky<usize>) -> Vec<f64> {
-    (0..symbolic.n_supernodes())
-        .map(|s| {
-            let (w, below) = (width(symbolic, s), symbolic.nnz_per_super()[s]);
-            (0..w).map(|j| ((w - j + below) as f64).powi(2)).sum::<f64>()
-        })
-        .collect()
+/// A thread's scratch: the row map (global row → row in the supernode's block, `NONE` elsewhere), the
+/// update's indices, the dense factor's memory.
+struct Scratch {
+    g2l: Vec<usize>,
+    idx: (Vec<usize>, Vec<usize>),
+    mem: MemBuffer,
 }
 
-/// The supernodal elimination tree (parent of each supernode, `NONE` at roots) and, for each supernode s,
-/// the supernodes whose columns update it (those with a row in s's columns), increasing.
-fn tree(symbolic: &SymbolicSupernodalCholesky<usize>) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
-    let ns = symbolic.n_supernodes();
-    let mut of_col = vec![0; symbolic.nrows()];
-    for s in 0..ns {
-        of_col[symbolic.supernode_begin()[s]..symbolic.supernode_end()[s]].fill(s);
-    }
-    let parent: Vec<usize> = (0..ns).map(|d| pattern(symbolic, d).first().map_or(NONE, |&r| of_col[r])).collect();
-    let mut pairs = Vec::new();
-    for d in 0..ns {
-        let mut last = NONE;
-        for &r in pattern(symbolic, d) {
-            let s = of_col[r];
-            if s != last {
-                pairs.push((s, d));
-                last = s;
+/// Compute `job` with the parallelism `par` in its dense work: `Ok(true)` once done.
+fn job(ctx: &Ctx, job: &Job, par: Par, sc: &mut Scratch) -> Result<bool, LltError> {
+    match *job {
+        Job::Whole(ref list) => {
+            for &s in list {
+                let (from, to) = (ctx.tree.update_ptr[s], ctx.tree.update_ptr[s + 1]);
+                updates(ctx, s, (from, to), true, par, sc);
+                dense(ctx, s, par, MemStack::new(&mut sc.mem))?;
             }
         }
+        Job::Update { s, from, to, first } => updates(ctx, s, (from, to), first, par, sc),
+        Job::Dense(s) => dense(ctx, s, par, MemStack::new(&mut sc.mem))?,
     }
-    let mut ptr = vec![0; ns + 1];
-    pairs.iter().for_each(|&(s, _)| ptr[s + 1] += 1);
-    (0..ns).for_each(|s| ptr[s + 1] += ptr[s]);
-    let mut next = ptr.clone();
-    let mut updaters = vec![0; pairs.len()];
-    for (s, d) in pairs {
-        updaters[next[s]] = d;
-        next[s] += 1;
-    }
-    (parent, ptr, updaters)
+    Ok(true)
 }
 
 fn pattern(symbolic: &SymbolicSupernodalCholesky<usize>, s: usize) -> &[usize] {
     &symbolic.row_idx()[symbolic.col_ptr_for_row_idx()[s]..][..symbolic.nnz_per_super()[s]]
 }
 
-/// The supernodes of `members` (increasing, closed under parents) for each thread (whole subtrees of
-/// theirs, increasing), and those above the subtrees (increasing). The largest subtree is split (its root
-/// goes above, its children become subtrees) until none holds more than 1/(4·threads) of the subtrees'
-/// work (`own`); the subtrees then go to the least loaded thread, largest first.
-fn plan(own: &[f64], parent: &[usize], members: &[usize], threads: usize) -> (Vec<Vec<usize>>, Vec<usize>) {
-    let ns = parent.len();
-    let mut work = vec![0.0f64; ns];
-    let mut children = vec![Vec::new(); ns];
-    for &s in members {
-        work[s] += own[s];
-        if parent[s] != NONE {
-            work[parent[s]] += work[s];
-            children[parent[s]].push(s);
-        }
-    }
-    let mut owner = vec![NONE; ns];
-    let above = threads;
-    let mut roots: Vec<usize> = members.iter().copied().filter(|&s| parent[s] == NONE).collect();
-    loop {
-        let total: f64 = roots.iter().map(|&r| work[r]).sum();
-        let Some(i) = (0..roots.len()).max_by(|&i, &j| work[roots[i]].total_cmp(&work[roots[j]])) else { break };
-        let r = roots[i];
-        if work[r] <= total / (4 * threads) as f64 || children[r].is_empty() {
-            break;
-        }
-        owner[r] = above;
-        roots.swap_remove(i);
-        roots.extend_from_slice(&children[r]);
-    }
-    roots.sort_by(|&a, &b| work[b].total_cmp(&work[a]).then(a.cmp(&b)));
-    let mut load = vec![0.0f64; threads];
-    for r in roots {
-        let t = (0..threads).min_by(|&i, &j| load[i].total_cmp(&load[j])).unwrap_or(0);
-        load[t] += work[r];
-        owner[r] = t;
-    }
-    for &s in members.iter().rev() {
-        if owner[s] == NONE {
-            owner[s] = owner[parent[s]];
-        }
-    }
-    let mut groups = vec![Vec::new(); threads + 1];
-    members.iter().for_each(|&s| groups[owner[s]].push(s));
-    let top = groups.pop().unwrap_or_default();
-    (groups, top)
-}
-
-/// The supernodes `list`, in order, with the parallelism `par` in their dense work.
-fn run(ctx: &Ctx, list: &[usize], par: Par) -> Numeric {
-    let n = ctx.symbolic.nrows();
-    let widest = list.iter().map(|&s| width(ctx.symbolic, s)).max().unwrap_or(0);
-    let mut g2l = vec![NONE; n];
-    let mut idx = (Vec::new(), Vec::new());
-    let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(widest, par, Default::default()));
-    for &s in list {
-        supernode(ctx, s, &mut g2l, &mut idx, par, MemStack::new(&mut mem))?;
-    }
-    Ok(())
-}
-
 fn width(symbolic: &SymbolicSupernodalCholesky<usize>, s: usize) -> usize {
     symbolic.supernode_end()[s] - symbolic.supernode_begin()[s]
 }
 
-/// Supernode s of L, as faer's kernel computes it: K's columns, the updates of the supernodes below, the
-/// dense Cholesky factor of the diagonal block and the solve of the block below it.
-fn supernode(
-    ctx: &Ctx,
-    s: usize,
-    g2l: &mut [usize],
-    (row_idx, col_idx): &mut (Vec<usize>, Vec<usize>),
-    par: Par,
-    stack: &mut MemStack,
-) -> Numeric {
+/// Supernode s's block of L: its rows, its columns.
+fn block<'a>(ctx: &'a Ctx, s: usize) -> MatMut<'a, f64> {
+    let (sym, cpv) = (ctx.symbolic, ctx.symbolic.col_ptr_for_val());
+    // SAFETY: supernode s is computed by one task at a time (its tasks wait for each other)
+    let block = unsafe { ctx.values.block_mut(cpv[s], cpv[s + 1]) };
+    MatMut::from_column_major_slice_mut(block, pattern(sym, s).len() + width(sym, s), width(sym, s))
+}
+
+/// Of supernode s, as faer's kernel computes it: K's columns (if `first`), then the updates of the
+/// supernodes `updaters[from..to]`, in order.
+fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Par, sc: &mut Scratch) {
     let sym = ctx.symbolic;
     let cpv = sym.col_ptr_for_val();
     let (s_start, s_end) = (sym.supernode_begin()[s], sym.supernode_end()[s]);
     let s_pattern = pattern(sym, s);
     let s_ncols = s_end - s_start;
+    let (g2l, (row_idx, col_idx)) = (&mut sc.g2l, &mut sc.idx);
     for (i, &row) in s_pattern.iter().enumerate() {
         g2l[row] = i + s_ncols;
     }
-    // SAFETY: supernode s is computed by this thread only
-    let block = unsafe { ctx.values.block_mut(cpv[s], cpv[s + 1]) };
-    let mut ls = MatMut::from_column_major_slice_mut(block, s_pattern.len() + s_ncols, s_ncols);
-    for j in s_start..s_end {
-        for (i, &v) in ctx.a.row_idx_of_col(j).zip(ctx.a.val_of_col(j)) {
-            if i >= j {
-                ls[(if i >= s_end { g2l[i] } else { i - s_start }, j - s_start)] += v;
+    let mut ls = block(ctx, s);
+    if first {
+        for j in s_start..s_end {
+            for (i, &v) in ctx.a.row_idx_of_col(j).zip(ctx.a.val_of_col(j)) {
+                if i >= j {
+                    ls[(if i >= s_end { g2l[i] } else { i - s_start }, j - s_start)] += v;
+                }
             }
         }
     }
-    for &d in &ctx.updaters[ctx.update_ptr[s]..ctx.update_ptr[s + 1]] {
+    for &d in &ctx.tree.updaters[from..to] {
         let d_pattern = pattern(sym, d);
         let d_ncols = width(sym, d);
-        // SAFETY: d is below s in the tree: finished before s started, and no longer written
+        // SAFETY: d is below s in the tree: done before this task started, and no longer written
         let ld = unsafe { ctx.values.block(cpv[d], cpv[d + 1]) };
         let ld = MatRef::from_column_major_slice(ld, d_pattern.len() + d_ncols, d_ncols);
         let lo = d_pattern.partition_point(|&r| r < s_start);
@@ -286,11 +221,18 @@ fn supernode(
         col_idx.extend(d_pattern[lo..lo + mid].iter().map(|&r| r - s_start));
         update(ls.rb_mut(), row_idx, col_idx, ld_mid_bot, ld_mid_bot.subrows(0, mid).transpose(), par);
     }
-    let (mut top, mut bot) = ls.split_at_row_mut(s_ncols);
+    s_pattern.iter().for_each(|&row| g2l[row] = NONE);
+}
+
+/// Of supernode s, once its updates are done: the dense Cholesky factor of its diagonal block and the
+/// solve of the block below it.
+fn dense(ctx: &Ctx, s: usize, par: Par, stack: &mut MemStack) -> Numeric {
+    let s_start = ctx.symbolic.supernode_begin()[s];
+    let mut ls = block(ctx, s);
+    let (mut top, mut bot) = ls.rb_mut().split_at_row_mut(width(ctx.symbolic, s));
     cholesky_in_place(top.rb_mut(), Default::default(), par, stack, Default::default())
         .map_err(|LltError::NonPositivePivot { index }| LltError::NonPositivePivot { index: index + s_start })?;
     solve_lower_triangular_in_place(top.rb().conjugate(), bot.rb_mut().transpose_mut(), par);
-    s_pattern.iter().for_each(|&row| g2l[row] = NONE);
     Ok(())
 }
 

@@ -1,0 +1,228 @@
+//! The schedule of the factorisation on several threads (`solve::cholesky::subtrees`): the supernodal
+//! elimination tree cut into tasks, whole subtrees at the bottom and the supernodes above them in parts
+//! (their updates from each task below, in order, then their dense work), each task ready once the tasks
+//! it waits for are done, the ready task with the most work on a path from it to the end taken first. The work of a supernode is what the left-looking kernel does for it: the multiply-adds of
+//! the updates it receives from the supernodes below and of its own dense factor and solve.
+//!
+//! With the environment variable `TRESCA_SCHEDULE` set, the factorisation prints the schedule's work, its
+//! critical path, its makespan simulated on the threads and the work of the tasks that run alone in that
+//! simulation (all in multiply-adds) to standard error.
+
+/// The environment variable that asks for the schedule's figures on standard error.
+pub(super) const ENV: &str = "TRESCA_SCHEDULE";
+pub(super) const NONE: usize = usize::MAX;
+
+/// Subtrees are cut until none holds more than 1/(GRAIN · threads) of the work: small enough that the
+/// threads finish the bottom of the tree within a small fraction of each other.
+const GRAIN: f64 = 16.0;
+
+/// The supernodal elimination tree with, for each supernode, the supernodes that update it and its work.
+pub(super) struct Tree {
+    /// The parent of each supernode, `NONE` at roots.
+    pub parent: Vec<usize>,
+    /// The supernodes that update supernode s, increasing: `updaters[update_ptr[s]..update_ptr[s + 1]]`,
+    /// and the multiply-adds of each of these updates.
+    pub update_ptr: Vec<usize>,
+    pub updaters: Vec<usize>,
+    pub update_work: Vec<f64>,
+    /// The multiply-adds of each supernode's dense factor and solve.
+    pub dense: Vec<f64>,
+}
+
+impl Tree {
+    /// The tree of supernodes `begin[s]..end[s]` whose row patterns below their columns are `pattern(s)`.
+    pub fn new<'p>(begin: &[usize], end: &[usize], n: usize, pattern: impl Fn(usize) -> &'p [usize]) -> Tree {
+        let ns = begin.len();
+        let mut of_col = vec![0; n];
+        for s in 0..ns {
+            of_col[begin[s]..end[s]].fill(s);
+        }
+        let parent: Vec<usize> = (0..ns).map(|d| pattern(d).first().map_or(NONE, |&r| of_col[r])).collect();
+        let dense: Vec<f64> = (0..ns)
+            .map(|s| {
+                let (w, below) = ((end[s] - begin[s]) as f64, pattern(s).len() as f64);
+                w * w * w / 6.0 + w * w * below / 2.0
+            })
+            .collect();
+        let mut pairs = Vec::with_capacity((0..ns).map(|d| pattern(d).len()).sum());
+        for d in 0..ns {
+            let (p, width) = (pattern(d), (end[d] - begin[d]) as f64);
+            let mut lo = 0;
+            while lo < p.len() {
+                let s = of_col[p[lo]];
+                let mid = p[lo..].partition_point(|&r| r < end[s]);
+                // C[rows below, mid columns] −= A Bᵀ, its lower triangle: depth `width`
+                let (rows, cols) = ((p.len() - lo) as f64, mid as f64);
+                pairs.push((s, d, width * cols * (rows - (cols - 1.0) / 2.0)));
+                lo += mid;
+            }
+        }
+        let mut update_ptr = vec![0; ns + 1];
+        pairs.iter().for_each(|&(s, _, _)| update_ptr[s + 1] += 1);
+        (0..ns).for_each(|s| update_ptr[s + 1] += update_ptr[s]);
+        let mut next = update_ptr.clone();
+        let (mut updaters, mut update_work) = (vec![0; pairs.len()], vec![0.0; pairs.len()]);
+        for (s, d, w) in pairs {
+            updaters[next[s]] = d;
+            update_work[next[s]] = w;
+            next[s] += 1;
+        }
+        Tree { parent, update_ptr, updaters, update_work, dense }
+    }
+
+    /// The work of each supernode: its updates and its dense work.
+    fn work(&self) -> Vec<f64> {
+        (0..self.parent.len())
+            .map(|s| self.dense[s] + self.update_work[self.update_ptr[s]..self.update_ptr[s + 1]].iter().sum::<f64>())
+            .collect()
+    }
+}
+
+/// What a task computes.
+pub(super) enum Job {
+    /// These supernodes (increasing) whole.
+    Whole(Vec<usize>),
+    /// Of supernode s, K's columns if `first`, then the updates `updaters[from..to]` in order.
+    Update { s: usize, from: usize, to: usize, first: bool },
+    /// The dense factor of supernode s and the solve below it, once its updates are done.
+    Dense(usize),
+}
+
+/// The tasks: what each computes, the tasks that wait for it, how many it waits for, its work and its
+/// priority (the most work on a path from it to the end, its own included). Tasks wait only for tasks
+/// numbered before them.
+pub(super) struct Tasks {
+    pub jobs: Vec<Job>,
+    pub next: Vec<Vec<usize>>,
+    pub below: Vec<usize>,
+    pub priority: Vec<f64>,
+    pub work: Vec<f64>,
+}
+
+impl Tasks {
+    /// The tasks of `tree` for `threads` threads. Subtrees are split (their root taken off, its children's
+    /// subtrees cut again) while they hold more than 1/(GRAIN · threads) of the work; a subtree that is
+    /// not split is one task. A supernode taken off is computed by several: one per task among those that
+    /// computed its updaters (its updates from them, in order, as soon as they are done), then its dense work.
+    pub fn new(tree: &Tree, threads: usize) -> Tasks {
+        let own = tree.work();
+        let ns = own.len();
+        let mut sub = own.clone();
+        let mut children = vec![Vec::new(); ns];
+        for s in 0..ns {
+            if tree.parent[s] != NONE {
+                sub[tree.parent[s]] += sub[s];
+                children[tree.parent[s]].push(s);
+            }
+        }
+        let limit = own.iter().sum::<f64>() / (GRAIN * threads as f64);
+        // the head of each supernode's subtree task, or itself when taken off
+        let (mut head, mut split) = (vec![NONE; ns], vec![false; ns]);
+        let mut stack: Vec<usize> = (0..ns).filter(|&s| tree.parent[s] == NONE).collect();
+        while let Some(r) = stack.pop() {
+            head[r] = r;
+            if sub[r] > limit && !children[r].is_empty() {
+                split[r] = true;
+                stack.extend_from_slice(&children[r]);
+            }
+        }
+        for s in (0..ns).rev() {
+            if head[s] == NONE {
+                head[s] = head[tree.parent[s]];
+            }
+        }
+        let mut tasks =
+            Tasks { jobs: Vec::new(), next: Vec::new(), below: Vec::new(), priority: Vec::new(), work: Vec::new() };
+        // the task after which each supernode is done
+        let mut done = vec![NONE; ns];
+        let mut whole: Vec<Vec<usize>> = vec![Vec::new(); ns];
+        (0..ns).filter(|&s| !split[s]).for_each(|s| whole[head[s]].push(s));
+        for (h, list) in whole.into_iter().enumerate().filter(|(_, l)| !l.is_empty()) {
+            let work = list.iter().map(|&m| own[m]).sum();
+            list.iter().for_each(|&m| done[m] = tasks.jobs.len());
+            debug_assert!(list.last() == Some(&h));
+            tasks.add(Job::Whole(list), &[], work);
+        }
+        for s in (0..ns).filter(|&s| split[s]) {
+            let (mut from, end) = (tree.update_ptr[s], tree.update_ptr[s + 1]);
+            let mut prev =
+                if from == end { tasks.add(Job::Update { s, from, to: end, first: true }, &[], 0.0) } else { NONE };
+            while from < end {
+                let by = done[tree.updaters[from]];
+                let to = from + tree.updaters[from..end].iter().take_while(|&&d| done[d] == by).count();
+                let work = tree.update_work[from..to].iter().sum();
+                let job = Job::Update { s, from, to, first: prev == NONE };
+                prev = tasks.add(job, &[by, prev], work);
+                from = to;
+            }
+            done[s] = tasks.add(Job::Dense(s), &[prev], tree.dense[s]);
+        }
+        tasks.prioritise();
+        tasks
+    }
+
+    /// A task computing `job`, waiting for the tasks `after` (`NONE` ignored).
+    fn add(&mut self, job: Job, after: &[usize], work: f64) -> usize {
+        let t = self.jobs.len();
+        self.jobs.push(job);
+        self.next.push(Vec::new());
+        self.below.push(0);
+        self.work.push(work);
+        for &a in after.iter().filter(|&&a| a != NONE) {
+            self.next[a].push(t);
+            self.below[t] += 1;
+        }
+        t
+    }
+
+    fn prioritise(&mut self) {
+        let nt = self.jobs.len();
+        self.priority = self.work.clone();
+        for t in (0..nt).rev() {
+            let after = self.next[t].iter().map(|&u| self.priority[u]).fold(0.0, f64::max);
+            self.priority[t] += after;
+        }
+    }
+
+    /// The first column a task computes.
+    pub fn first_supernode(&self, t: usize) -> usize {
+        match &self.jobs[t] {
+            Job::Whole(list) => list[0],
+            Job::Update { s, .. } | Job::Dense(s) => *s,
+        }
+    }
+
+    /// The total work, the critical path (the most work on one path of tasks), the makespan of the
+    /// schedule simulated on `threads` threads, each task on one, and the work of the tasks that run alone
+    /// in it (with faer's parallel dense kernels in the factorisation).
+    pub fn figures(&self, threads: usize) -> [f64; 4] {
+        let total = self.work.iter().sum();
+        let critical = self.priority.iter().copied().fold(0.0, f64::max);
+        let nt = self.work.len();
+        let mut below = self.below.clone();
+        let mut ready: Vec<usize> = (0..nt).filter(|&t| below[t] == 0).collect();
+        // (finish time, task) of the tasks running
+        let mut running: Vec<(f64, usize)> = Vec::new();
+        let (mut now, mut alone) = (0.0f64, 0.0);
+        loop {
+            while running.len() < threads && !ready.is_empty() {
+                let i = (0..ready.len()).max_by(|&i, &j| self.priority[ready[i]].total_cmp(&self.priority[ready[j]]));
+                let t = ready.swap_remove(i.unwrap_or(0));
+                if running.is_empty() && ready.is_empty() {
+                    alone += self.work[t];
+                }
+                running.push((now + self.work[t], t));
+            }
+            let Some(i) = (0..running.len()).min_by(|&i, &j| running[i].0.total_cmp(&running[j].0)) else { break };
+            let (end, t) = running.swap_remove(i);
+            now = end;
+            for &u in &self.next[t] {
+                below[u] -= 1;
+                if below[u] == 0 {
+                    ready.push(u);
+                }
+            }
+        }
+        [total, critical, now, alone]
+    }
+}
