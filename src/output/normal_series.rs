@@ -4,6 +4,7 @@
 
 use super::h5::Series;
 use crate::fem::space::CrSpace;
+use crate::stepping::StepResult;
 use hdf5::Group;
 
 /// Their names, in the order of the series.
@@ -25,4 +26,9 @@ pub fn open(tresca: &Group) -> Option<[Series; 3]> {
     let cg = tresca.group("contact").ok()?;
     let [a, b, c] = NORMAL.map(|k| Series::open(&cg, k, 1).ok());
     Some([a?, b?, c?])
+}
+
+/// The status of each Γ_C edge of `r` (0 stick, 1 slip, 2 separated; none without normal unknowns).
+pub fn status(r: &StepResult) -> impl Iterator<Item = u8> + '_ {
+    r.normal.separated.iter().zip(&r.state).map(|(&sep, &s)| if sep { 2 } else { s as u8 })
 }

@@ -53,7 +53,7 @@ impl Writer {
         let mut tresca = Tresca::open(&file).map_err(io(path, "not a tresca-cr results file"))?;
         check_settings(&tresca.group, run, path)?;
         check_points(&tresca.group, run, path)?;
-        let contact = !run.space.contact.is_empty();
+        let contact = (!run.space.contact.is_empty(), !run.space.normal_edges().is_empty());
         let mut vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
         let (completed, times) = completed_steps(&mut tresca, run, path)?;
         let every = int(&tresca.group, "frame_every").max(1) as usize;

@@ -75,7 +75,7 @@ impl Rows {
         if !r.normal.force.is_empty() {
             append(&mut self.pressure, &r.normal.force.iter().zip(lengths).map(|(p, l)| p / l).collect::<Vec<_>>());
             append(&mut self.gap, &r.normal.gap);
-            self.status.extend(r.state.iter().zip(&r.normal.separated).map(|(&s, &sep)| if sep { 2 } else { s as u8 }));
+            self.status.extend(super::normal_series::status(r));
         }
         let audit = r.audit.map_or([f64::NAN; 6], |a| a.as_array());
         self.audit.iter_mut().zip(audit).for_each(|(v, a)| v.push(a));
