@@ -224,6 +224,8 @@ def validate(r, where="results"):
         a = np.asarray(a)
         _check_array(where, name, a.shape, a.dtype, sizes)
         bad = ~np.isfinite(a) if a.dtype.kind == "f" else None
+        if name == "contact/coulomb":
+            bad = np.isinf(a) | (a < 0)  # NaN marks a Tresca edge; F̄_e is finite and ≥ 0
         if bad is not None and bad.any():
             n, at = int(bad.sum()), np.unravel_index(int(np.argmax(bad)), a.shape)
             step = f"step {at[0]}" if SPEC[name][1][0] == "R" else f"{tuple(map(int, at))}"
