@@ -31,9 +31,9 @@ EX51 = os.path.join(CASES, "paper_example_5_1.toml")
 BOTTOM = 'name = "bottom"\nkind = "contact"\n'
 
 
-def scene_of(name, fallback):
-    """(path, note) of an iteration scene: the case itself, else its stand-in, else (None, why)."""
-    path = os.path.join(CASES, name)
+def scene_of(name, fallback, cases=CASES):
+    """(path, note) of an iteration scene in ``cases``: the case itself, else its stand-in, else (None, why)."""
+    path = os.path.join(cases, name)
     if os.path.exists(path):
         return path, ""
     if fallback:
@@ -119,11 +119,12 @@ def main(argv=None):
     ap.add_argument("--level-budget", type=float, default=120.0,
                     help="stop the iteration levels after one that took more than a quarter of this (seconds)")
     ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds of the cost ratio")
+    ap.add_argument("--cases", default=CASES, help="where the iteration scenes are (default verification/cases)")
     ap.add_argument("--write", default=None, help="put the section into this markdown file")
     a = ap.parse_args(argv)
     its = []
     for label, name, fallback in ITERATION_SCENES:
-        path, note = scene_of(name, fallback)
+        path, note = scene_of(name, fallback, a.cases)
         print(f"== iterations: {label} ({note or os.path.relpath(path, ROOT)})", flush=True)
         its.append((label, note, iterations(path, a.max_refine, a.level_budget) if path else []))
     print(f"== cost ratio: Example 5.1 at refine {a.ratio_refine}", flush=True)
