@@ -95,6 +95,7 @@ reference: venv
 bench: build venv bench-env
 	$(PY) verification/bench/report.py
 	$(PY) verification/planner.py --costs
+	$(PY) verification/bench/contact.py --write reference/performance.md
 	$(MAKE) bench-factorisation
 
 # The factorisation bench (issue 32): tresca-cr's set-up against CHOLMOD (scikit-sparse 0.4.16, built against

@@ -123,7 +123,8 @@ enum Cmd {
         #[arg(long, allow_negative_numbers = true)]
         target: f64,
         /// energy-norm (the energy-norm error, max over the time nodes), or an output of [quantities] at T:
-        /// max-slip, stick-length, elastic-energy (½a_h(u,u)) or traction_x_y.
+        /// max-slip, stick-length, contact-length, max-pressure (these two with unilateral or Coulomb contact),
+        /// elastic-energy (½a_h(u,u)) or traction_x_y.
         #[arg(long, default_value = "energy-norm")]
         quantity: String,
         /// Wall time the planned run may take (e.g. 90s, 10m, 2h).

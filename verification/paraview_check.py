@@ -1,6 +1,7 @@
 """ParaView as users meet it: Debian's ParaView (pvpython, on a virtual X server) opens the files of a finished, a
 killed and a resumed run with each XDMF reader, with the solver's values, and renders a picture that
-shows the body and the contact line.
+shows the body and the contact line; and a finished run with unilateral contact, whose contact line also
+holds the normal condition.
 
     .venv/bin/python verification/paraview_check.py [--skip-missing] [--json OUT]
 
@@ -11,8 +12,9 @@ Requirement (make verify V1-paraview, make test): for each file, `XDMFReader`, `
 `Xdmf3ReaderT` (opened by a bare relative name with XDMFReader, by absolute path with the Xdmf3 readers,
 whose 5.11 versions abort on bare names) see exactly the committed frames as a two-block dataset —
 the body (triangles: displacement, strain, stress, von_mises) and the contact line (Γ_C edges:
-displacement, sigma_t, slip, slip_increment, stick_slip) — with von Mises, displacement, slip and
-stick/slip equal to the values recomputed from `/tresca` at two times; and `scripts/paraview_view.py`
+displacement, sigma_t, slip, slip_increment, stick_slip, and on a scene with normal unknowns
+(mms_signorini_moving) also pressure, gap and status) — with von Mises, displacement, slip and
+stick/slip (and pressure, gap, status) equal to the values of `/tresca` at two times; and `scripts/paraview_view.py`
 renders a PNG of the last frame (relative path) whose pixels show a coloured body and the red/blue contact
 line. Pictures are kept in out/paraview/. With --skip-missing a machine without `pvpython` passes with a
 message (make test); `make paraview` installs it (Debian: paraview python3-paraview xvfb xauth).

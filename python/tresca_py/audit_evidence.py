@@ -2,7 +2,8 @@
 when its checksums were recomputed: what the file allows of ``src/stepping/audit.rs``'s terms.
 
 * ``friction_dissipation`` j_h(δuⁿ) = Σ_{e ⊂ Γ_C} |e| ḡ_e |sⁿ_e − sⁿ⁻¹_e| from ``contact/g``, ``contact/slip`` and the
-  mesh (every run with Γ_C);
+  mesh (every run with Γ_C); on a Coulomb edge (``contact/coulomb`` not NaN) F̄_e |Pⁿ_e| in place of |e| ḡ_e, from
+  ``contact/force``;
 * ``boundary_work`` W_Γ: exactly 0 in a scene without boundary data (no ``u`` or ``gap`` key in its parts), where
   the file does not hold the loads that the external work needs;
 * ``stored_energy`` Eⁿ = ½a_h(uⁿ, uⁿ) and ``euler_dissipation`` ½a_h(δuⁿ, δuⁿ) from ``u``, the mesh, E, ν and ρ:
@@ -40,9 +41,13 @@ def friction(r):
         return None
     ends = m.points[m.edges[ct.edges]]
     w = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1) * ct.g
+    w = np.broadcast_to(w, ct.slip[1:].shape)
+    if ct.coulomb is not None and ct.force is not None:
+        cou = ~np.isnan(ct.coulomb)
+        w = np.where(cou, np.nan_to_num(ct.coulomb) * np.abs(ct.force[1:]), w)
     terms = np.abs(np.diff(ct.slip, axis=0)) * w
     j = np.concatenate([[0.0], terms.sum(axis=1)])
-    return j, (len(w) + TERM_ROUNDINGS) * EPS * j
+    return j, (ct.slip.shape[1] + TERM_ROUNDINGS) * EPS * j
 
 
 def _parts(r):

@@ -29,6 +29,7 @@ from . import audit, audit_evidence, fields, paths, results, vtkhdf_layout
 
 BODY_CELLS = ["strain", "stress", "von_mises"]
 CONTACT_CELLS = ["sigma_t", "slip", "slip_increment", "stick_slip"]
+NORMAL_CELLS = ["pressure", "gap", "status"]  # with normal unknowns (a unilateral or Coulomb part) only
 
 
 class Checker:
@@ -91,8 +92,10 @@ class Run:
         self.disp, self.vm, self.sxx = reference(r)
         self.contact_pts = fields.contact_points(r) if self.C else None
         self.blocks = {"body": (3 * self.T, self.T, ["displacement"], BODY_CELLS)}
+        self.normal = self.C and r.contact.pressure is not None
+        self.contact_cells = CONTACT_CELLS + (NORMAL_CELLS if self.normal else [])
         if self.C:
-            self.blocks["contact"] = (2 * self.C, self.C, ["displacement"], CONTACT_CELLS)
+            self.blocks["contact"] = (2 * self.C, self.C, ["displacement"], self.contact_cells)
 
 
 def check_tresca(c, run):
@@ -158,7 +161,7 @@ def check_vtkhdf(c, run, h5):
                 c.close(v2n(body.GetCellData().GetArray("von_mises")), run.vm[n], f"VTKHDF von_mises frame {k}", 2e-5)
                 c.close(v2n(body.GetCellData().GetArray("stress"))[:, 0], run.sxx[n], f"VTKHDF stress xx frame {k}",
                         2e-5)
-        if run.C and cont is not None and array_names(cont.GetCellData()) == sorted(CONTACT_CELLS):
+        if run.C and cont is not None and array_names(cont.GetCellData()) == sorted(run.contact_cells):
             cd = cont.GetCellData()
             c.close(v2n(cd.GetArray("sigma_t")), res.contact.sigma_t[n], f"VTKHDF sigma_t frame {k}")
             c.close(v2n(cd.GetArray("slip")), res.contact.slip[n], f"VTKHDF slip frame {k}")
@@ -166,6 +169,7 @@ def check_vtkhdf(c, run, h5):
                     f"VTKHDF stick_slip frame {k}")
             c.close(v2n(cont.GetPointData().GetArray("displacement"))[:, :2], run.disp[n][run.contact_pts],
                     f"VTKHDF contact displacement frame {k}")
+            check_normal(c, run, cd, n, f"VTKHDF frame {k}")
         tval = r.GetOutputInformation(0).Get(vtk.vtkStreamingDemandDrivenPipeline.TIME_STEPS())
         if k == 0 and tval is not None:
             c.close(np.array(tval), res.times[frames], "VTKHDF time values", 1e-15)
@@ -209,10 +213,23 @@ def check_vtkxdmf(c, run, xdmf):
             c.check(array_names(body.GetCellData()) == sorted(BODY_CELLS), "XDMF (VTK) body cell arrays")
         if run.C and "contact" in blocks:
             cd = blocks["contact"].GetCellData()
-            if c.check(array_names(cd) == sorted(CONTACT_CELLS), f"XDMF (VTK) contact cell arrays {array_names(cd)}"):
+            if c.check(array_names(cd) == sorted(run.contact_cells),
+                       f"XDMF (VTK) contact cell arrays {array_names(cd)}"):
+                check_normal(c, run, cd, n, f"XDMF (VTK) frame {k}")
                 c.close(v2n(cd.GetArray("slip")), res.contact.slip[n], f"XDMF (VTK) slip frame {k}")
                 c.check(np.array_equal(v2n(cd.GetArray("stick_slip")), res.contact.state[n]),
                         f"XDMF (VTK) stick_slip frame {k}")
+
+
+def check_normal(c, run, cd, n, where):
+    """The contact block's pressure, gap (f32 of /tresca's) and status (exact) at step n, with normal unknowns."""
+    if not run.normal:
+        return
+    from vtk.util.numpy_support import vtk_to_numpy as v2n
+    ct = run.r.contact
+    c.close(v2n(cd.GetArray("pressure")), ct.pressure[n], f"{where} pressure")
+    c.close(v2n(cd.GetArray("gap")), ct.gap[n], f"{where} gap")
+    c.check(np.array_equal(v2n(cd.GetArray("status")), ct.status[n]), f"{where} status")
 
 
 def main(argv=None):

@@ -7,7 +7,10 @@ For each chosen time (nearest stored step; default: quarter, half and final time
   magnified by S, stated in the title; default: 10 % of the body's size over max |u|), coloured by von Mises
   stress or |u|, with Γ_C drawn in black;
 * ``DIR/contact_<n>.png`` (when Γ_C exists): σ_τ/ḡ along Γ_C and the slip velocity Δs/Δt, with slip
-  edges shaded.
+  edges shaded;
+* ``DIR/normal_<n>.png`` (unilateral or Coulomb runs, whose files hold the normal condition): the contact
+  pressure p along Γ_C, and |σ_τ| over the friction threshold (ḡ_e on a Tresca edge, F̄_e p_e on a Coulomb
+  one), 1 on a slipping edge and below 1 on a sticking one; stick, slip and separated edges shaded apart.
 Only committed steps are drawn: a killed or stopped run is said so on stdout and in every title. Axis and
 colour-bar units come from the scene's optional ``[units]`` table (``length``, ``force``, ``time``; stress is
 force/length²), read from the scene text stored in the file; without it the labels say "length",
@@ -47,8 +50,9 @@ def load(path):
          "nu": float(r.attrs["nu"]), "title": str(r.attrs.get("title", "")) or os.path.basename(path),
          "units": units(str(r.attrs.get("scene", ""))), "note": r.note}
     if r.contact is not None:
-        for k in ("edges", "tangent", "g", "slip", "sigma_t", "state"):
-            d["c_" + k] = getattr(r.contact, k)
+        for k in ("edges", "tangent", "g", "slip", "sigma_t", "state", "pressure", "status", "coulomb"):
+            if getattr(r.contact, k) is not None:
+                d["c_" + k] = getattr(r.contact, k)
     d["audit"] = audit.read(path, r.completed)
     return d
 
@@ -109,12 +113,7 @@ def deformed(d, n, field, scale, out):
 
 
 def contact(d, n, out):
-    pts, e2 = d["mesh/points"], d["mesh/edges"][d["c_edges"]]
-    mid = pts[e2].mean(axis=1)
-    tau = d["c_tangent"][0]
-    s = mid @ tau  # arclength-like coordinate along Γ_C (straight contact boundary)
-    order = np.argsort(s)
-    half = 0.5 * np.abs((pts[e2[:, 1]] - pts[e2[:, 0]]) @ tau)
+    s, half, order = along(d)
     g = d["c_g"]
     sig = d["c_sigma_t"][n] / np.where(g > 0, g, 1.0)
     times = d["times"]
@@ -144,6 +143,58 @@ def contact(d, n, out):
     a1.set_title(title(d, f"Γ_C at t = {times[n]:.4g}{u_['T']} (step {n}); "
                           f"shaded: slip ({nslip} of {len(state)} edges)"),
                  fontsize=9)
+    paths.save_figure(fig, out, dpi=120, bbox_inches="tight")
+
+
+def along(d):
+    """(position of each Γ_C edge's midpoint along Γ_C, half its extent there, the order along Γ_C)."""
+    pts, e2 = d["mesh/points"], d["mesh/edges"][d["c_edges"]]
+    tau = d["c_tangent"][0]
+    s = pts[e2].mean(axis=1) @ tau  # arclength-like coordinate along Γ_C (straight contact boundary)
+    return s, 0.5 * np.abs((pts[e2[:, 1]] - pts[e2[:, 0]]) @ tau), np.argsort(s)
+
+
+STATUS = ((0, "stick", "tab:blue"), (1, "slip", "tab:orange"), (2, "separated", "tab:gray"))
+
+
+def threshold_ratio(d, n):
+    """|σ_τ| over the friction threshold per Γ_C edge at step n: ḡ_e (Tresca) or F̄_e p_e (Coulomb); NaN on a
+    separated edge (no threshold, no traction)."""
+    p, status = d["c_pressure"][n], d["c_status"][n]
+    cou = d.get("c_coulomb")
+    thr = d["c_g"] if cou is None else np.where(np.isnan(cou), d["c_g"], np.nan_to_num(cou) * np.abs(p))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.abs(d["c_sigma_t"][n]) / thr
+    return np.where(status == 2, np.nan, ratio)
+
+
+def normal(d, n, out):
+    """The normal condition along Γ_C at step n: pressure, and σ_τ over the threshold (``threshold_ratio``)."""
+    s, half, order = along(d)
+    status, u_ = d["c_status"][n], d["units"]
+    fig = Figure(figsize=(7, 5.6))
+    a1, a2 = fig.subplots(2, 1, sharex=True)
+    for ax in (a1, a2):
+        for code, name, colour in STATUS:
+            for i, k in enumerate(np.nonzero(status == code)[0]):
+                ax.axvspan(s[k] - half[k], s[k] + half[k], color=colour, alpha=0.2, lw=0,
+                           label=name if (i == 0 and ax is a1) else None)
+        ax.grid(alpha=0.3)
+    p = d["c_pressure"][n]
+    a1.step(s[order], p[order], where="mid", color="k")
+    a1.plot(s[order], p[order], ".", color="k")
+    a1.set_ylabel(f"contact pressure p [{u_['S']}]")
+    a1.legend(fontsize=8, loc="best")
+    r = threshold_ratio(d, n)
+    a2.step(s[order], r[order], where="mid", color="tab:red")
+    a2.plot(s[order], r[order], ".", color="tab:red")
+    a2.axhline(1, color="k", lw=0.8, ls="--")
+    a2.set_ylabel("|σ_τ| / threshold  [–]")
+    a2.set_ylim(0, 1.15)
+    a2.set_xlabel(f"position along Γ_C, x·τ [{u_['L']}]")
+    counts = ", ".join(f"{int(np.sum(status == c))} {name}" for c, name, _ in STATUS)
+    a1.set_title(title(d, f"Γ_C at t = {d['times'][n]:.4g}{u_['T']} (step {n}): {counts}; threshold ḡ (Tresca) "
+                          "or F̄ p (Coulomb), none where separated"), fontsize=9)
     paths.save_figure(fig, out, dpi=120, bbox_inches="tight")
 
 
@@ -223,7 +274,8 @@ def main(argv=None):
     if d["note"]:
         print(f"note: {args.h5}: {d['note']}; drawing committed steps only (t ≤ {t[-1]:.4g})")
     draw = {"deformed": lambda n, p: deformed(d, n, args.field, args.scale, p),
-            "contact": lambda n, p: contact(d, n, p), "energy": lambda n, p: energy(d, p)}
+            "contact": lambda n, p: contact(d, n, p), "normal": lambda n, p: normal(d, n, p),
+            "energy": lambda n, p: energy(d, p)}
     for kind, n, p in pictures:
         draw[kind](n, p)
         print(p)
@@ -240,6 +292,8 @@ def planned(d, times, out):
         pictures.append(("deformed", n, os.path.join(out, f"deformed_{n:06d}.png")))
         if "c_edges" in d:
             pictures.append(("contact", n, os.path.join(out, f"contact_{n:06d}.png")))
+        if "c_pressure" in d:
+            pictures.append(("normal", n, os.path.join(out, f"normal_{n:06d}.png")))
     if d["audit"] is not None and len(t) > 1:
         pictures.append(("energy", len(t) - 1, os.path.join(out, "energy.png")))
     return pictures

@@ -64,6 +64,9 @@ class Contact:
     pressure: np.ndarray | None = None
     gap: np.ndarray | None = None
     status: np.ndarray | None = None
+    force: np.ndarray | None = None
+    normal_dof: np.ndarray | None = None
+    coulomb: np.ndarray | None = None
 
 
 @dataclass(eq=False)
@@ -125,6 +128,8 @@ class Results:
         out = {f"mesh/{k}": getattr(self.mesh, k) for k in ("points", "triangles", "edges", "midpoints")}
         if self.contact is not None:
             out.update({f"contact/{k}": getattr(self.contact, k) for k in CONTACT_STATIC})
+            if self.contact.coulomb is not None:
+                out["contact/coulomb"] = self.contact.coulomb
         return out
 
     @property
@@ -150,6 +155,8 @@ def validate(r, where="results"):
         a = np.asarray(a)
         layout.check_array(where, name, a.shape, a.dtype, sizes)
         bad = ~np.isfinite(a) if a.dtype.kind == "f" else None
+        if name == "contact/coulomb":
+            bad = np.isinf(a) | (a < 0)  # NaN marks a Tresca edge; F̄_e is finite and ≥ 0
         if bad is not None and bad.any():
             n, at = int(bad.sum()), np.unravel_index(int(np.argmax(bad)), a.shape)
             step = f"step {at[0]}" if SPEC[name][1][0] == "R" else f"{tuple(map(int, at))}"
@@ -236,7 +243,7 @@ def _read_group(f, where, verify):
     contact = None
     if has_contact:
         contact = Contact(*(load(f"contact/{k}", False) for k in CONTACT_STATIC),
-                          *(load(f"contact/{k}") for k in CONTACT_SERIES))
+                          *(load(f"contact/{k}") for k in CONTACT_SERIES), load("contact/coulomb", False))
     errors = {k: load(f"errors/{k}") for k in ERRORS} if "errors" in g else None
     r = Results(mesh=mesh, times=load("times"), u=load("u"), energy=load("energy"),
                 steps={k: load(f"steps/{k}") for k in STEP_FIELDS}, contact=contact, errors=errors,

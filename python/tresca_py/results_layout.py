@@ -35,6 +35,9 @@ DATASETS = (
     ("contact/pressure", F8, ("R", "C"), "contact pressure p_e = P_e/|e| (scenes with normal unknowns only)"),
     ("contact/gap", F8, ("R", "C"), "u_n(m_e) − ḡ_e (scenes with normal unknowns only)"),
     ("contact/status", U1, ("R", "C"), "0 stick, 1 slip, 2 separated (scenes with normal unknowns only)"),
+    ("contact/force", F8, ("R", "C"), "normal force P_e, exact (scenes with normal unknowns only)"),
+    ("contact/normal_dof", F8, ("R", "C"), "the normal unknown, exact (scenes with normal unknowns only)"),
+    ("contact/coulomb", F8, ("C",), "F̄_e of a Coulomb edge, NaN on a Tresca one (scenes with normal unknowns only)"),
     ("errors/energy", F8, ("R",), "true energy error"),
     ("errors/h1", F8, ("R",), "true broken H1 error"),
     ("errors/l2", F8, ("R",), "true L2 error"),
@@ -42,10 +45,11 @@ DATASETS = (
 SPEC = {name: (dtype, shape) for name, dtype, shape, _ in DATASETS}
 STEP_FIELDS = ("iterations", "residual", "n_stick", "n_slip", "wall_time")
 CONTACT_STATIC = ("edges", "normal", "tangent", "g")
-CONTACT_SERIES = ("slip", "sigma_t", "state", "mu", "dof", "pressure", "gap", "status")
+CONTACT_SERIES = ("slip", "sigma_t", "state", "mu", "dof", "pressure", "gap", "status", "force", "normal_dof")
 # Written only by a run whose Γ_C edges carry normal unknowns (a unilateral or Coulomb part; issue 40); not part
 # of the step checksums (tresca_py.checksum.SERIES), as src/output/tresca.rs writes them.
-NORMAL_SERIES = ("contact/pressure", "contact/gap", "contact/status")
+NORMAL_SERIES = ("contact/pressure", "contact/gap", "contact/status", "contact/force", "contact/normal_dof",
+                 "contact/coulomb")
 ERRORS = ("energy", "h1", "l2")
 
 # /tresca attributes as the Rust binary writes them: name -> type ("floats": a 1-D float array)

@@ -35,7 +35,8 @@ _SCHEMA = {
     "exact": {"u", "grad"},
     "output": {"path"},
     "units": {"length", "force", "time"},  # labels for pictures only (scripts/render.py)
-    "outputs": {"max_slip", "stick_length", "energy", "traction_at"},  # what `tresca-cr study` estimates
+    # what `tresca-cr study` estimates
+    "outputs": {"max_slip", "stick_length", "contact_length", "max_pressure", "energy", "traction_at"},
 }
 
 

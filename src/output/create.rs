@@ -137,7 +137,7 @@ impl Writer {
         raw: Raw,
     ) -> Result<(Fields, Tresca, VtkHdf, Xdmf, Raw)> {
         let fields = Fields::new(run);
-        let contact = !run.space.contact.is_empty();
+        let contact = (!run.space.contact.is_empty(), !run.space.normal_edges().is_empty());
         let tresca = Tresca::create(file, run).map_err(io(path, "writing the tresca group"))?;
         h5::attr(&tresca.group, "frame_every", frames.every as i64).map_err(io(path, "attribute frame_every"))?;
         let vtk =

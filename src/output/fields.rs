@@ -16,7 +16,8 @@
 //! * `von_mises`: √(½[(σxx−σyy)² + (σyy−σzz)² + (σzz−σxx)²] + 3σxy²).
 //!
 //! Contact cell arrays: `sigma_t` = σ_τ·τ_e = −μ_e/|e|, `slip` = u_τ(m_e),
-//! `slip_increment` = sⁿ − sⁿ⁻¹ (0 at step 0), `stick_slip` = 0 stick, 1 slip.
+//! `slip_increment` = sⁿ − sⁿ⁻¹ (0 at step 0), `stick_slip` = 0 stick, 1 slip; with normal unknowns
+//! also `pressure` p_e = P_e/|e|, `gap` u·n(m_e) − ḡ_e and `status` (0 stick, 1 slip, 2 separated).
 
 use super::Run;
 use crate::fem::elasticity::{von_mises, Elasticity};
@@ -54,6 +55,10 @@ pub struct StepFields {
     pub slip: Vec<f32>,
     pub slip_increment: Vec<f32>,
     pub stick_slip: Vec<u8>,
+    /// The normal condition (empty without normal unknowns).
+    pub pressure: Vec<f32>,
+    pub gap: Vec<f32>,
+    pub status: Vec<u8>,
 }
 
 impl Fields {
@@ -148,5 +153,17 @@ impl Fields {
             out.slip_increment.push(prev_slip.map_or(0.0, |p| r.slip[k] - p[k]) as f32);
             out.stick_slip.push(r.state[k] as u8);
         }
+        self.eval_normal(r, out);
+    }
+
+    /// The normal condition's arrays of `r` into `out` (left empty without normal unknowns).
+    fn eval_normal(&self, r: &StepResult, out: &mut StepFields) {
+        let n = &r.normal;
+        out.pressure.clear();
+        out.pressure.extend(n.force.iter().zip(&self.contact_len).map(|(p, l)| (p / l) as f32));
+        out.gap.clear();
+        out.gap.extend(n.gap.iter().map(|&g| g as f32));
+        out.status.clear();
+        out.status.extend(super::normal_series::status(r));
     }
 }

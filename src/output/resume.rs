@@ -37,14 +37,6 @@ impl Writer {
             return Err(Error::Io { path: path.to_path_buf(), msg: "no results file to --resume".into() });
         }
         paths::check_target(path, true)?;
-        if !run.space.normal_edges().is_empty() {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: "--resume of a run with unilateral or Coulomb contact is not supported yet (the normal \
-                      forces are not stored for a warm start): run it again without --resume"
-                    .into(),
-            });
-        }
         let file = hdf5::File::with_options()
             .with_fapl(h5::file_access)
             .open_rw(path)
@@ -53,7 +45,15 @@ impl Writer {
         let mut tresca = Tresca::open(&file).map_err(io(path, "not a tresca-cr results file"))?;
         check_settings(&tresca.group, run, path)?;
         check_points(&tresca.group, run, path)?;
-        let contact = !run.space.contact.is_empty();
+        let contact = (!run.space.contact.is_empty(), !run.space.normal_edges().is_empty());
+        if contact.1 && !tresca.has_normal() {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: "--resume: the file holds no normal forces (tresca/contact/force, normal_dof) for a warm start \
+                      of this unilateral or Coulomb run (written by an older version): rerun with --force"
+                    .into(),
+            });
+        }
         let mut vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
         let (completed, times) = completed_steps(&mut tresca, run, path)?;
         let every = int(&tresca.group, "frame_every").max(1) as usize;

@@ -53,10 +53,14 @@ pub struct Rows {
     pub(super) pressure: Vec<f64>,
     pub(super) gap: Vec<f64>,
     pub(super) status: Vec<u8>,
+    /// The exact normal forces P_e and normal unknowns (for `--resume`).
+    pub(super) force: Vec<f64>,
+    pub(super) normal_dof: Vec<f64>,
 }
 
 impl Rows {
-    /// Append step `r` (`lengths`: |e| of the Γ_C edges, for the pressure P_e/|e|).
+    /// Append step `r` (`lengths`: |e| of the Γ_C edges, for the pressure P_e/|e|; `dof`: the contact
+    /// unknown of each Γ_C edge, followed by its normal unknown when the edges have one).
     pub fn push(&mut self, r: &StepResult, mid: &[[f64; 2]], (sigma_t, dof): (&[f64], &[f64]), lengths: &[f64]) {
         self.count += 1;
         self.times.push(r.t);
@@ -71,11 +75,14 @@ impl Rows {
         append(&mut self.sigma_t, sigma_t);
         self.state.extend(r.state.iter().map(|&s| s as u8));
         append(&mut self.mu, &r.mu);
+        let (dof, normal_dof) = dof.split_at(lengths.len().min(dof.len()));
         append(&mut self.dof, dof);
         if !r.normal.force.is_empty() {
             append(&mut self.pressure, &r.normal.force.iter().zip(lengths).map(|(p, l)| p / l).collect::<Vec<_>>());
             append(&mut self.gap, &r.normal.gap);
-            self.status.extend(r.state.iter().zip(&r.normal.separated).map(|(&s, &sep)| if sep { 2 } else { s as u8 }));
+            self.status.extend(super::normal_series::status(r));
+            append(&mut self.force, &r.normal.force);
+            append(&mut self.normal_dof, normal_dof);
         }
         let audit = r.audit.map_or([f64::NAN; 6], |a| a.as_array());
         self.audit.iter_mut().zip(audit).for_each(|(v, a)| v.push(a));
@@ -88,7 +95,8 @@ impl Rows {
 
     /// Bytes buffered in the per-unknown and per-contact-edge rows.
     pub fn bytes(&self) -> usize {
-        bytes([&self.u, &self.slip, &self.sigma_t, &self.mu, &self.dof, &self.pressure, &self.gap])
+        bytes([&self.u, &self.slip, &self.sigma_t, &self.mu, &self.dof, &self.pressure, &self.gap, &self.force])
+            + bytes([&self.normal_dof])
             + self.state.len()
             + self.status.len()
     }
@@ -98,7 +106,7 @@ impl Rows {
         self.first = first;
         self.count = 0;
         let f64s = [&mut self.times, &mut self.u, &mut self.energy, &mut self.residual, &mut self.wall, &mut self.slip];
-        let more = [&mut self.sigma_t, &mut self.mu, &mut self.dof, &mut self.pressure, &mut self.gap];
+        let more = [&mut self.sigma_t, &mut self.mu, &mut self.dof, &mut self.pressure, &mut self.gap, &mut self.force];
         for v in f64s.into_iter().chain(more) {
             v.clear();
         }
@@ -107,6 +115,7 @@ impl Rows {
         }
         self.state.clear();
         self.status.clear();
+        self.normal_dof.clear();
         self.errors.iter_mut().for_each(Vec::clear);
         self.audit.iter_mut().for_each(Vec::clear);
     }

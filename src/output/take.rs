@@ -73,7 +73,9 @@ impl Unknowns {
         }
         check_finite(path, n, "u", &r.u)?;
         crate::fem::lifting::displacement_into(space, data, &r.u, r.t, &mut mid)?;
-        let dof = space.contact.iter().map(|c| r.u[c.dof]).collect();
+        // the contact unknowns, then the normal ones (`Rows::push`)
+        let normal = space.contact.iter().filter_map(|c| c.normal_dof.map(|k| r.u[k]));
+        let dof = space.contact.iter().map(|c| r.u[c.dof]).chain(normal).collect();
         let r = StepResult {
             u: Vec::new(),
             mu: r.mu.clone(),

@@ -64,7 +64,7 @@ pub struct Tresca {
     /// True if the checksums cover the audit series (attribute [`COVERS`] of the checksum).
     audit_checksummed: bool,
     /// [`NORMAL`] (`None` without normal unknowns).
-    normal: Option<[Series; 3]>,
+    normal: Option<[Series; 5]>,
 }
 
 pub use super::checksum::AUDIT;
@@ -276,10 +276,12 @@ impl Tresca {
                 s.write_steps(raw, n, k, v)?;
             }
         }
-        if let Some([p, g, st]) = &self.normal {
+        if let Some([p, g, st, f, nd]) = &self.normal {
             p.write_steps(raw, n, k, &b.pressure)?;
             g.write_steps(raw, n, k, &b.gap)?;
             st.write_steps(raw, n, k, &b.status)?;
+            f.write_steps(raw, n, k, &b.force)?;
+            nd.write_steps(raw, n, k, &b.normal_dof)?;
         }
         if let Some(a) = &self.audit {
             for (s, v) in a.iter().zip(&b.audit) {
@@ -339,7 +341,7 @@ impl Tresca {
             }
             None => None,
         };
-        Ok(StepResult {
+        let mut r = StepResult {
             n,
             t,
             u,
@@ -353,7 +355,16 @@ impl Tresca {
             wall: self.wall.read::<f64>(n)?[0],
             audit: None,
             normal: Default::default(),
-        })
+        };
+        if let Some(s) = &self.normal {
+            super::normal_series::read_into(s, space, n, &mut r)?;
+        }
+        Ok(r)
+    }
+
+    /// True when the file holds the normal unknowns a resumed run needs ([`super::normal_series`]).
+    pub fn has_normal(&self) -> bool {
+        self.normal.is_some()
     }
 
     /// Overwrite the values of `setup_times` (a file created beside the set-up holds zeros until then).

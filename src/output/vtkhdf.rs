@@ -8,7 +8,8 @@
 //!   `displacement` (3T, 3); cell data `strain`, `stress` (T, 6) and `von_mises` (T).
 //! * `/VTKHDF/contact` (`Index` 1, only when Γ_C exists): C line cells on 2C points; point data
 //!   `displacement` (2C, 3, the body's at the same points); cell data `sigma_t`, `slip`, `slip_increment`
-//!   (f32) and `stick_slip` (u8).
+//!   (f32) and `stick_slip` (u8); with normal unknowns (a unilateral or Coulomb part) also `pressure`,
+//!   `gap` (f32) and `status` (u8: 0 stick, 1 slip, 2 separated), as `/tresca/contact` holds them.
 //! * Per block, static `NumberOfPoints`, `NumberOfCells`, `NumberOfConnectivityIds`, `Points`,
 //!   `Connectivity`, `Offsets`, `Types`; per frame f (rows f·B … (f+1)·B−1 of flattened time-space arrays,
 //!   f32; frames are the steps n with n % frame_every == 0 and the last step, see [`Frames`]) the arrays above.
@@ -28,6 +29,24 @@ use hdf5::{Attribute, Dataset, Extent, Extents, File, Group};
 pub const BODY_CELLS: [(&str, usize); 3] = [("strain", TENSOR), ("stress", TENSOR), ("von_mises", 1)];
 /// Cell arrays of the contact block (f32 but `stick_slip`, u8).
 pub const CONTACT_CELLS: [(&str, usize); 4] = [("sigma_t", 1), ("slip", 1), ("slip_increment", 1), ("stick_slip", 1)];
+/// Cell arrays of the contact block with normal unknowns: [`CONTACT_CELLS`], then the normal condition
+/// (f32 but `status`, u8).
+pub const CONTACT_NORMAL_CELLS: [(&str, usize); 7] =
+    [("sigma_t", 1), ("slip", 1), ("slip_increment", 1), ("stick_slip", 1), ("pressure", 1), ("gap", 1), ("status", 1)];
+
+/// The u8 cell arrays (the others are f32).
+pub fn is_byte(name: &str) -> bool {
+    matches!(name, "stick_slip" | "status")
+}
+
+/// The contact block's cell arrays, with or without the normal condition.
+pub fn contact_cells(normal: bool) -> &'static [(&'static str, usize)] {
+    if normal {
+        &CONTACT_NORMAL_CELLS
+    } else {
+        &CONTACT_CELLS
+    }
+}
 
 /// What a block is: its name and index in the collection, its cells (points per cell and VTK cell
 /// type) and its cell arrays.
@@ -41,8 +60,10 @@ struct BlockKind {
 
 /// The body: triangles (VTK type 5).
 const BODY: BlockKind = BlockKind { name: "body", index: 0, per_cell: 3, vtk_type: 5, arrays: &BODY_CELLS };
-/// The contact line: Γ_C edges as lines (VTK type 3).
-const CONTACT: BlockKind = BlockKind { name: "contact", index: 1, per_cell: 2, vtk_type: 3, arrays: &CONTACT_CELLS };
+/// The contact line: Γ_C edges as lines (VTK type 3), with the cell arrays of `contact_cells(normal)`.
+fn contact_kind(normal: bool) -> BlockKind {
+    BlockKind { name: "contact", index: 1, per_cell: 2, vtk_type: 3, arrays: contact_cells(normal) }
+}
 
 /// Which steps are visualisation frames: n % every == 0, and the last step N.
 #[derive(Clone, Copy, Debug)]
@@ -76,6 +97,9 @@ pub struct FrameRows {
     /// Contact f32 cell arrays in the order of [`CONTACT_CELLS`] (without `stick_slip`).
     contact_cells: [Vec<f32>; 3],
     stick_slip: Vec<u8>,
+    /// `pressure`, `gap` (empty without normal unknowns).
+    normal_cells: [Vec<f32>; 2],
+    status: Vec<u8>,
 }
 
 impl FrameRows {
@@ -90,25 +114,33 @@ impl FrameRows {
             append(d, v);
         }
         append(&mut self.stick_slip, &s.stick_slip);
+        for (d, v) in self.normal_cells.iter_mut().zip([&s.pressure, &s.gap]) {
+            append(d, v);
+        }
+        append(&mut self.status, &s.status);
     }
     pub fn count(&self) -> usize {
         self.times.len()
     }
     /// Bytes buffered in the frames' arrays.
     pub fn bytes(&self) -> usize {
-        let f32s =
-            [&self.displacement, &self.contact_displacement].into_iter().chain(&self.cells).chain(&self.contact_cells);
-        bytes(f32s) + self.stick_slip.len()
+        let f32s = [&self.displacement, &self.contact_displacement]
+            .into_iter()
+            .chain(&self.cells)
+            .chain(&self.contact_cells)
+            .chain(&self.normal_cells);
+        bytes(f32s) + self.stick_slip.len() + self.status.len()
     }
     /// Empty the buffer, keeping its memory; the next frame is frame `first`.
     pub fn reset(&mut self, first: usize) {
         self.first = first;
         self.times.clear();
         let f32s = [&mut self.displacement, &mut self.contact_displacement];
-        for v in f32s.into_iter().chain(&mut self.cells).chain(&mut self.contact_cells) {
+        for v in f32s.into_iter().chain(&mut self.cells).chain(&mut self.contact_cells).chain(&mut self.normal_cells) {
             v.clear();
         }
         self.stick_slip.clear();
+        self.status.clear();
     }
 }
 
@@ -162,7 +194,7 @@ impl Block {
         for &(name, nc) in arrays {
             put(&cdo, name, &[m], &off(ncell))?;
             let rest: &[usize] = if nc == 1 { &[] } else { &[nc] };
-            cells.push(if name == "stick_slip" {
+            cells.push(if is_byte(name) {
                 Series::create::<u8>(&cd, name, ncell, rest, m)?
             } else {
                 Series::create::<f32>(&cd, name, ncell, rest, m)?
@@ -215,7 +247,8 @@ pub struct VtkHdf {
 }
 
 impl VtkHdf {
-    pub fn create(file: &File, f: &Fields, n_frames: usize, contact: bool) -> hdf5::Result<VtkHdf> {
+    /// `contact`: Γ_C exists; `normal`: its edges have normal unknowns.
+    pub fn create(file: &File, f: &Fields, n_frames: usize, (contact, normal): (bool, bool)) -> hdf5::Result<VtkHdf> {
         let root = ordered_group(file, "VTKHDF")?;
         attr_vec(&root, "Version", &[2i64, 2])?;
         attr_fixed_ascii::<28>(&root, "Type", "PartitionedDataSetCollection")?;
@@ -223,7 +256,7 @@ impl VtkHdf {
         let body = Block::create(&root, &BODY, &f.points, n_frames)?;
         assembly.link_soft("/VTKHDF/body", "body")?;
         let contact = if contact {
-            let b = Block::create(&root, &CONTACT, &f.contact_points, n_frames)?;
+            let b = Block::create(&root, &contact_kind(normal), &f.contact_points, n_frames)?;
             assembly.link_soft("/VTKHDF/contact", "contact")?;
             Some(b)
         } else {
@@ -232,10 +265,10 @@ impl VtkHdf {
         Ok(VtkHdf { body, contact })
     }
 
-    pub fn open(file: &File, contact: bool) -> hdf5::Result<VtkHdf> {
+    pub fn open(file: &File, (contact, normal): (bool, bool)) -> hdf5::Result<VtkHdf> {
         let root = file.group("VTKHDF")?;
         let body = Block::open(&root.group("body")?, &BODY_CELLS)?;
-        let contact = if contact { Some(Block::open(&root.group("contact")?, &CONTACT_CELLS)?) } else { None };
+        let contact = if contact { Some(Block::open(&root.group("contact")?, contact_cells(normal))?) } else { None };
         Ok(VtkHdf { body, contact })
     }
 
@@ -254,6 +287,11 @@ impl VtkHdf {
                 series.write_steps(raw, f, k, data)?;
             }
             c.cells[3].write_steps(raw, f, k, &b.stick_slip)?;
+            if c.cells.len() == CONTACT_NORMAL_CELLS.len() {
+                c.cells[4].write_steps(raw, f, k, &b.normal_cells[0])?;
+                c.cells[5].write_steps(raw, f, k, &b.normal_cells[1])?;
+                c.cells[6].write_steps(raw, f, k, &b.status)?;
+            }
         }
         Ok(())
     }

@@ -36,7 +36,7 @@
 use super::fields::Fields;
 use super::h5::{put, rows};
 use super::paths::sidecar;
-use super::vtkhdf::{BODY_CELLS, CONTACT_CELLS};
+use super::vtkhdf::{contact_cells, is_byte, BODY_CELLS};
 use hdf5::{File, Group};
 use std::io::Write;
 use std::os::unix::fs::FileExt;
@@ -61,21 +61,24 @@ struct Array {
     /// Rows per frame and components.
     rows: usize,
     comps: usize,
-    /// u8 (`stick_slip`) or f32.
+    /// u8 (`stick_slip`, `status`) or f32.
     byte: bool,
     node: bool,
 }
 
+/// Which blocks a file has: Γ_C (the contact block) and its normal unknowns (the normal condition's arrays).
+pub type Blocks = (bool, bool);
+
 /// Arrays exposed per frame, body first.
-fn arrays(z: Sizes, contact: bool) -> Vec<Array> {
+fn arrays(z: Sizes, (contact, normal): Blocks) -> Vec<Array> {
     let mut v = vec![Array { block: "body", name: "displacement", rows: z.np, comps: 3, byte: false, node: true }];
     for (name, comps) in BODY_CELLS {
         v.push(Array { block: "body", name, rows: z.nt, comps, byte: false, node: false });
     }
     if contact {
         v.push(Array { block: "contact", name: "displacement", rows: z.cp, comps: 3, byte: false, node: true });
-        for (name, comps) in CONTACT_CELLS {
-            v.push(Array { block: "contact", name, rows: z.nc, comps, byte: name == "stick_slip", node: false });
+        for &(name, comps) in contact_cells(normal) {
+            v.push(Array { block: "contact", name, rows: z.nc, comps, byte: is_byte(name), node: false });
         }
     }
     v
@@ -97,7 +100,7 @@ pub struct Xdmf {
     groups: Vec<Group>,
     file: std::fs::File,
     sizes: Sizes,
-    contact: bool,
+    contact: Blocks,
     /// Frames of the whole run.
     total_frames: usize,
     sections: Vec<Section>,
@@ -113,13 +116,19 @@ pub struct Xdmf {
 impl Xdmf {
     /// Create `/xdmf` (topologies, per-array groups, the virtual datasets of all `total_frames` frames) in
     /// the HDF5 file and start the text.
-    pub fn create(h5: &File, h5_path: &Path, f: &Fields, contact: bool, total_frames: usize) -> std::io::Result<Xdmf> {
+    pub fn create(
+        h5: &File,
+        h5_path: &Path,
+        f: &Fields,
+        contact: Blocks,
+        total_frames: usize,
+    ) -> std::io::Result<Xdmf> {
         let z = Sizes { np: f.n_points(), nt: f.n_tris(), cp: f.contact_points.len(), nc: f.n_contact() };
         let mk = || -> hdf5::Result<Group> {
             let g = h5.create_group("xdmf")?;
             let body = g.create_group("body")?;
             put(&body, "topology", &[z.nt, 3], &(0..z.np as i64).collect::<Vec<_>>())?;
-            if contact {
+            if contact.0 {
                 let c = g.create_group("contact")?;
                 put(&c, "topology", &[z.nc, 2], &(0..z.cp as i64).collect::<Vec<_>>())?;
             }
@@ -140,13 +149,13 @@ impl Xdmf {
         h5: &File,
         h5_path: &Path,
         frames: &[(usize, f64)],
-        contact: bool,
+        contact: Blocks,
         total_frames: usize,
     ) -> std::io::Result<Xdmf> {
         let get = || -> hdf5::Result<(Group, Sizes)> {
             let n = |p: &str| h5.dataset(p).map(|d| d.shape()[0]);
             let (np, nt) = (n("VTKHDF/body/Points")?, n("VTKHDF/body/Types")?);
-            let (cp, nc) = if contact { (n("VTKHDF/contact/Points")?, n("VTKHDF/contact/Types")?) } else { (0, 0) };
+            let (cp, nc) = if contact.0 { (n("VTKHDF/contact/Points")?, n("VTKHDF/contact/Types")?) } else { (0, 0) };
             Ok((h5.group("xdmf")?, Sizes { np, nt, cp, nc }))
         };
         let (group, z) = get().map_err(std::io::Error::other)?;
@@ -174,7 +183,13 @@ impl Xdmf {
         Ok(())
     }
 
-    fn start(h5_path: &Path, group: Group, sizes: Sizes, contact: bool, total_frames: usize) -> std::io::Result<Xdmf> {
+    fn start(
+        h5_path: &Path,
+        group: Group,
+        sizes: Sizes,
+        contact: Blocks,
+        total_frames: usize,
+    ) -> std::io::Result<Xdmf> {
         let path = sidecar(h5_path);
         let partial = super::partial_path(&path);
         let groups = arrays(sizes, contact)
@@ -200,7 +215,7 @@ impl Xdmf {
             spare: None,
         };
         // contact first: meshio reads the last collection, which should be the body
-        let blocks: &[&'static str] = if contact { &["contact", "body"] } else { &["body"] };
+        let blocks: &[&'static str] = if contact.0 { &["contact", "body"] } else { &["body"] };
         let mut text = String::from(HEAD);
         for &block in blocks {
             // the longest grid text of this run (widest time, frame and step numbers) plus slack

@@ -199,6 +199,14 @@ pub fn pilot_scene(scene: &Scene, q: &Quantity) -> Result<Scene> {
     let mut s = scene.clone();
     s.exact = None;
     if let Quantity::Output(name) = q {
+        let on_normal = ["contact_length", "max_pressure"].contains(&name.as_str());
+        if on_normal && !scene.has_normal_unknowns() {
+            return Err(Error::scene(
+                &scene.file,
+                "--quantity",
+                format!("`{name}` is measured on the contact pressure, and this scene has no unilateral or Coulomb contact part"),
+            ));
+        }
         let on_contact = ["max_slip", "stick_length"].contains(&name.as_str()) || name.starts_with("traction_");
         if on_contact && !scene.has_contact() {
             return Err(Error::scene(
@@ -211,6 +219,8 @@ pub fn pilot_scene(scene: &Scene, q: &Quantity) -> Result<Scene> {
         match name.as_str() {
             "max_slip" => o.max_slip = true,
             "stick_length" => o.stick_length = true,
+            "contact_length" => o.contact_length = true,
+            "max_pressure" => o.max_pressure = true,
             "elastic_energy" => o.elastic_energy = true,
             _ => {}
         }
@@ -218,7 +228,7 @@ pub fn pilot_scene(scene: &Scene, q: &Quantity) -> Result<Scene> {
             return Err(Error::scene(
                 &scene.file,
                 "--quantity",
-                format!("`{name}` is not an output of this scene (energy-norm, elastic-energy, max-slip, stick-length, or a traction_x_y of [quantities])"),
+                format!("`{name}` is not an output of this scene (energy-norm, elastic-energy, max-slip, stick-length, contact-length, max-pressure, or a traction_x_y of [quantities])"),
             ));
         }
         s.outputs = Some(o);

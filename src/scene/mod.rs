@@ -82,6 +82,12 @@ pub struct Outputs {
     pub max_slip: bool,
     /// Total length of the Γ_C edges that stick in the last step.
     pub stick_length: bool,
+    /// Total length of the Γ_C edges in contact (not separated) in the last step (scenes with normal
+    /// unknowns only).
+    pub contact_length: bool,
+    /// max over Γ_C edges of the contact pressure p_e = P_e/|e| in the last step (scenes with normal
+    /// unknowns only).
+    pub max_pressure: bool,
     /// Elastic energy ½ a_h(u, u) (key `elastic_energy`; the old key `energy` is read with a deprecation).
     pub elastic_energy: bool,
     /// σ_τ·τ on the Γ_C edge nearest to each point.
@@ -150,7 +156,7 @@ impl Scene {
         values::representable(file, e, nu, rho)?;
         let solver = solver_settings(file, raw.solver)?;
         let exact = exact(file, raw.exact)?;
-        Ok(Scene {
+        let scene = Scene {
             file: file.to_string(),
             text: text.to_string(),
             title: raw.title.unwrap_or_default(),
@@ -167,7 +173,9 @@ impl Scene {
             output: raw.output.and_then(|o| o.path),
             outputs,
             deprecations,
-        })
+        };
+        tables::normal_quantities(file, scene.outputs.as_ref(), scene.has_normal_unknowns())?;
+        Ok(scene)
     }
 
     /// Override the number of uniform refinements (`--refine`).

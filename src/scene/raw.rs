@@ -89,6 +89,10 @@ pub(super) struct RawQuantities {
     pub(super) max_slip: bool,
     #[serde(default)]
     pub(super) stick_length: bool,
+    #[serde(default)]
+    pub(super) contact_length: bool,
+    #[serde(default)]
+    pub(super) max_pressure: bool,
     pub(super) elastic_energy: Option<bool>,
     /// The deprecated name of `elastic_energy`.
     pub(super) energy: Option<bool>,

@@ -297,9 +297,31 @@ pub(super) fn quantities(
     Ok(Some(Outputs {
         max_slip: raw.max_slip,
         stick_length: raw.stick_length,
+        contact_length: raw.contact_length,
+        max_pressure: raw.max_pressure,
         elastic_energy,
         traction_at: raw.traction_at,
     }))
+}
+
+/// `contact_length` and `max_pressure` are measured on the normal unknowns: refused on a scene without
+/// (no unilateral or Coulomb part).
+pub(super) fn normal_quantities(file: &str, o: Option<&Outputs>, normal: bool) -> Result<()> {
+    for (on, key) in
+        o.map_or([(false, ""); 2], |o| [(o.contact_length, "contact_length"), (o.max_pressure, "max_pressure")])
+    {
+        if on && !normal {
+            return Err(Error::scene(
+                file,
+                format!("quantities.{key}"),
+                format!(
+                    "`{key}` is measured on the contact pressure, which only a scene with a unilateral or Coulomb \
+                     contact part has (law = \"unilateral\" or coulomb = F); this scene has none"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Uniform refinements beyond [`MAX_REFINE`] are refused (4¹² times the triangles is beyond any machine).

@@ -7,6 +7,8 @@
 //! |---|---|
 //! | `max_slip` | max over Γ_C edges of |u_τ(m_e)| |
 //! | `stick_length` | Σ |e| over the Γ_C edges sticking in the last step |
+//! | `contact_length` | Σ |e| over the Γ_C edges in contact (not separated) in the last step (normal unknowns) |
+//! | `max_pressure` | max over Γ_C edges of p_e = P_e/|e| in the last step (normal unknowns) |
 //! | `elastic_energy` | ½ a_h(u, u) |
 //! | `traction_<x>_<y>` | σ_τ·τ = −μ_e/|e| on the Γ_C edge nearest to (x, y) |
 
@@ -21,6 +23,8 @@ pub fn selected(scene: &Scene) -> Outputs {
     scene.outputs.clone().unwrap_or(Outputs {
         max_slip: scene.has_contact(),
         stick_length: scene.has_contact(),
+        contact_length: false,
+        max_pressure: false,
         elastic_energy: true,
         traction_at: vec![],
     })
@@ -42,8 +46,13 @@ pub fn theoretical_order(name: &str, size: Axis) -> f64 {
 /// Column names of the outputs, in order.
 pub fn names(o: &Outputs) -> Vec<String> {
     let mut v = Vec::new();
-    for (on, name) in [(o.max_slip, "max_slip"), (o.stick_length, "stick_length"), (o.elastic_energy, "elastic_energy")]
-    {
+    for (on, name) in [
+        (o.max_slip, "max_slip"),
+        (o.stick_length, "stick_length"),
+        (o.contact_length, "contact_length"),
+        (o.max_pressure, "max_pressure"),
+        (o.elastic_energy, "elastic_energy"),
+    ] {
         if on {
             v.push(name.to_string());
         }
@@ -68,6 +77,13 @@ pub fn values(o: &Outputs, p: &Problem, last: &StepResult) -> Vec<f64> {
     }
     if o.stick_length {
         v.push(contact.iter().zip(&last.state).filter(|(_, s)| **s == EdgeState::Stick).map(|(c, _)| c.length).sum());
+    }
+    if o.contact_length {
+        v.push(last.contact_lengths(&p.space).map_or(f64::NAN, |l| l[0]));
+    }
+    if o.max_pressure {
+        let p = last.normal.force.iter().zip(contact).map(|(f, c)| f / c.length);
+        v.push(if last.normal.force.is_empty() { f64::NAN } else { p.fold(f64::NEG_INFINITY, f64::max) });
     }
     if o.elastic_energy {
         v.push(0.5 * last.energy);

@@ -144,13 +144,13 @@ tresca-cr's orderings: AMD below 1,000,000 unknowns, nested dissection by coordi
 """
 
 
-def write_section(path, text):
-    """Replace the section in `path` (or append it)."""
+def write_section(path, text, heading=HEADING):
+    """Replace the section that starts with `heading` in `path` (or append it)."""
     old = open(path).read() if os.path.exists(path) else ""
-    if HEADING not in old:
+    if heading not in old:
         open(path, "w").write(old.rstrip("\n") + "\n\n" + text)
         return
-    head, rest = old.split(HEADING, 1)
+    head, rest = old.split(heading, 1)
     nxt = rest.find("\n## ")
     tail = "\n" + rest[nxt + 1:] if nxt >= 0 else ""
     open(path, "w").write(head + text + tail)

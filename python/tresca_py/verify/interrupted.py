@@ -72,10 +72,10 @@ def wait_for(path, p, limit=120.0):
     return time.perf_counter() - t
 
 
-def killed_and_resumed(check, out, run):
-    """A run killed in the step phase, then resumed; returns its file."""
+def killed_and_resumed(check, out, run, name="killed.h5"):
+    """A run killed in the step phase, then resumed; returns its file (out/name)."""
     # 1. killed in the step phase, then resumed
-    h5 = os.path.join(out, "killed.h5")
+    h5 = os.path.join(out, name)
     clear(h5)
     t = time.perf_counter()
     p = subprocess.Popen(run + ["-o", h5], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -190,6 +190,9 @@ def main(argv=None):
     os.makedirs(out, exist_ok=True)
     run = [BIN, "run", EX51, "--refine", "3", "--steps", "2000", "-q"]
     h5 = killed_and_resumed(check, out, run)
+    # with normal unknowns (unilateral contact): the resumed run warm-starts from the stored normal forces
+    uni = [BIN, "run", case("mms_signorini_moving"), "--refine", "2", "--steps", "1500", "-q"]
+    killed_and_resumed(check, out, uni, "killed_unilateral.h5")
     killed_while_creating(check, h5, run)
     killed_often(check, out, run)
     stopped(check, out)

@@ -15,6 +15,10 @@ from tresca_py.verify.harness import Harness, out_dir
 from tresca_py.xvfb import VirtualDisplay
 
 EX51 = os.path.join(ROOT, "verification", "cases", "paper_example_5_1.toml")
+# a scene with normal unknowns: the contact block also holds pressure, gap and status
+SIGNORINI = os.path.join(ROOT, "verification", "cases", "mms_signorini_moving.toml")
+CONTACT_ARRAYS = ["sigma_t", "slip", "slip_increment", "stick_slip"]
+NORMAL_ARRAYS = ["gap", "pressure", "status"]
 OUT = os.path.join(ROOT, "out", "paraview")
 READERS = ("XDMFReader", "Xdmf3ReaderS", "Xdmf3ReaderT")
 ENTRY = os.path.join(ROOT, "verification", "paraview_check.py")
@@ -57,15 +61,17 @@ def state(h5):
 
 
 def runs(ss):
-    """A finished run, a killed one (SIGKILL in the step phase) and the killed one resumed:
-    out/paraview/<kind>/run.h5."""
+    """A finished run, a killed one (SIGKILL in the step phase), the killed one resumed and a finished run with
+    unilateral contact: out/paraview/<kind>/run.h5."""
     cmd = [BIN, "run", EX51, "--refine", "3", "--steps", "2000", "-q"]
-    dirs = {k: os.path.join(OUT, k) for k in ("finished", "killed", "resumed")}
+    dirs = {k: os.path.join(OUT, k) for k in ("finished", "killed", "resumed", "unilateral")}
     for d in dirs.values():
         shutil.rmtree(d, ignore_errors=True)
         os.makedirs(d)
     fin = os.path.join(dirs["finished"], "run.h5")
     subprocess.run(cmd + ["-o", fin], check=True, stdout=subprocess.DEVNULL)
+    uni = os.path.join(dirs["unilateral"], "run.h5")
+    subprocess.run([BIN, "run", SIGNORINI, "--refine", "2", "-q", "-o", uni], check=True, stdout=subprocess.DEVNULL)
     h5 = os.path.join(dirs["killed"], "run.h5")
     # Killed on the run's own progress, not on a clock: with -v it prints a line per step as the step is
     # solved, and the file commits lag that by at most a commit group (output::background::QUEUE = 32
@@ -95,7 +101,7 @@ def runs(ss):
         shutil.copy(os.path.join(dirs["killed"], name), os.path.join(dirs["resumed"], name))
     res = os.path.join(dirs["resumed"], "run.h5")
     subprocess.run(cmd + ["-o", res, "--resume"], check=True, stdout=subprocess.DEVNULL)
-    return {"finished": fin, "killed": h5, "resumed": res}
+    return {"finished": fin, "killed": h5, "resumed": res, "unilateral": uni}
 
 
 def compare(ss, label, h5, reader, data):
@@ -111,6 +117,7 @@ def compare(ss, label, h5, reader, data):
         disp, vm, _ = reference(g, S)
         slip, state_ = g["contact/slip"][:S], g["contact/state"][:S]
         T, C = len(g["mesh/triangles"]), len(g["contact/edges"])
+        normal = {k: g["contact/" + k][:S] for k in NORMAL_ARRAYS if "contact/" + k in g}
     ok = ss.check(len(data["times"]) == len(frames) and np.allclose(data["times"], times, rtol=0, atol=1e-12),
                f"{label} / {reader}: {len(data['times'])} time steps, expected the {len(frames)} committed frames")
     for k, blocks in data["frames"].items():
@@ -123,8 +130,9 @@ def compare(ss, label, h5, reader, data):
             errs.append(f"sizes body {b['points']}/{b['cells']} contact {c['points']}/{c['cells']}")
         if b["cell_arrays"] != ["strain", "stress", "von_mises"]:
             errs.append(f"body cell arrays {b['cell_arrays']}")
-        if c["cell_arrays"] != ["sigma_t", "slip", "slip_increment", "stick_slip"]:
+        if c["cell_arrays"] != sorted(CONTACT_ARRAYS + list(normal)):
             errs.append(f"contact cell arrays {c['cell_arrays']}")
+        errs += normal_errors(c["arrays"], {k: v[n] for k, v in normal.items()})
 
         def rel(a, ref):
             a, ref = np.asarray(a, float).reshape(np.shape(ref)), np.asarray(ref, float)
@@ -140,6 +148,22 @@ def compare(ss, label, h5, reader, data):
                     + ("; ".join(errs) if errs
                        else f"body and contact blocks equal /tresca (max rel. diff {max(e):.1e})"))
     return ok
+
+
+def normal_errors(arrays, ref):
+    """How the contact block's pressure, gap and status differ from `/tresca/contact` (`ref`, one step;
+    empty without normal unknowns). The views hold the f64 values rounded to f32 (relative error
+    ≤ 2⁻²⁴ = 6e-8 of each value, so ≤ 2e-7 of the frame's largest); the status is exact."""
+    errs = []
+    import numpy as np
+    for k, want in ref.items():
+        got = np.asarray(arrays.get(k, [[np.nan]] * len(want)), float)[:, 0]
+        if k == "status":
+            if not np.array_equal(got, want):
+                errs.append("status differs from /tresca/contact/status")
+        elif np.max(np.abs(got - want)) > 2e-7 * max(np.max(np.abs(want)), 1e-300):
+            errs.append(f"{k} differs from /tresca/contact/{k}")
+    return errs
 
 
 def picture(ss, label, png):
