@@ -71,15 +71,15 @@ fn print(a: &AdaptivePlan, file: &str) {
     if a.choice == Route::Adaptive {
         say!(
             "  run it: tresca-cr adapt {file} --target {:.3e} --theta {} --steps {}",
-            a.eta,
+            a.estimate_target,
             tresca_cr::plan::adaptive::THETA,
             a.steps
         );
     }
 }
 
-/// `plan --run` where the adaptive route is recommended: its `adapt` loop (θ, the plan's steps, until η ≤ the
-/// uniform plan's η, under the same memory and disk checks as `tresca-cr adapt` and the plan's memory limit and
+/// `plan --run` where the adaptive route is recommended: its `adapt` loop (θ, the plan's steps, until the error estimate
+/// ≤ 0.8 T, under the same memory and disk checks as `tresca-cr adapt` and the plan's memory limit and
 /// wall budget), printed as `adapt` prints it,
 /// then whether it reached that η and, with an exact solution, the true error against the target. Returns the
 /// exit code (3 when the loop was refused) and the loop's levels.
@@ -88,8 +88,7 @@ pub fn execute(scene: &Scene, a: &AdaptivePlan, p: &Plan) -> Result<(i32, Vec<Ro
     let mut s = scene.clone();
     s.set_steps(a.steps)?;
     let opts = tresca_cr::adapt::Options {
-        target: None,
-        target_estimate: Some(a.estimate_target),
+        target: Some(a.estimate_target),
         levels: None,
         max_memory: p.options.max_memory,
         budget: Some(p.options.budget),
