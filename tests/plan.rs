@@ -92,6 +92,31 @@ fn contact_corners_take_the_pilots_states() {
     assert!(at(&[]).contains("the bound over stick and slip"));
 }
 
+/// Requirement (issue 42): where the scene's corners allow α = 0.7112 but the pilot shows CR's order 1 (the
+/// smooth manufactured mms_rotated), the system shall split the finest pilot level's error into a smooth
+/// part (order 1) and a singular part (order α) and extrapolate both, so that it plans the cheapest
+/// refinement that meets the target in truth: at 3.162e-3 refine 5 (refine 4's true error is 5.95e-3), not
+/// refine 6 as the bound alone (5× the cost); the plan run with the exact solution meets the target.
+#[test]
+fn smooth_part_and_singular_part_are_extrapolated_apart() {
+    let s = scene("verification/cases/mms_rotated.toml");
+    let target = 3.162e-3;
+    let p = plan(&s, &options(target)).unwrap();
+    assert!(p.refused.is_none(), "{:?}", p.refused);
+    let model = p.error.unwrap();
+    let singular = model.singular.expect("a two-term spatial error");
+    assert_eq!((model.space.p, singular.p), (1.0, p.order_limit));
+    assert!(p.notes.iter().any(|n| n.contains("splits into a smooth part")), "{:?}", p.notes);
+    let b = &p.best[0];
+    assert_eq!(b.refine, 5, "{b:?}");
+    let mut c = s.clone();
+    c.set_refine(b.refine).unwrap();
+    c.set_steps(b.steps).unwrap();
+    c.solver.tol = p.tol;
+    let (truth, _) = max_errors(&run(c).1);
+    assert!(truth <= target, "refine {}: true {truth:e}, predicted {:e}", b.refine, b.error);
+}
+
 /// Requirement: a scene whose slip only passes from stick to slip needs no more steps than it asks for:
 /// the planner says so (a time-error bound far below the target) and plans the scene's own steps.
 #[test]

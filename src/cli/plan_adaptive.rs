@@ -5,14 +5,11 @@ use anyhow::Result;
 use tresca_cr::adapt::Row;
 use tresca_cr::plan::adaptive::{weigh as weigh_routes, AdaptivePlan, Route};
 use tresca_cr::plan::pilot::Quantity;
+// a uniform space fit at or above CR's optimal order less the pilots' scatter leaves the adaptive route
+// nothing to gain but its overhead
+use tresca_cr::plan::two_term::{OPTIMAL_ORDER, ORDER_SCATTER};
 use tresca_cr::plan::Plan;
 use tresca_cr::Scene;
-
-/// The energy-norm order in h of the lowest-order CR element on a smooth solution. A uniform space fit at or
-/// above it less the pilots' scatter leaves the adaptive route nothing to gain but its overhead.
-const OPTIMAL_ORDER: f64 = 1.0;
-/// The scatter of a fitted space order over the pilots' few levels (the planner's in-range band).
-const ORDER_SCATTER: f64 = 0.05;
 
 /// Weigh and print; `None` for targets the indicator does not bound (outputs other than the energy norm),
 /// when the uniform plan has no error model, or when its observed space order is already optimal (then the

@@ -26,6 +26,7 @@ pub mod corners;
 pub mod model;
 pub mod pilot;
 mod search;
+pub mod two_term;
 
 use crate::error::{Error, Result};
 use crate::scene::budget::Estimate;

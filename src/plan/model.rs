@@ -84,14 +84,18 @@ impl TimeError {
 /// e(h, k) = e_h ⊕ e_k (module doc).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ErrorModel {
+    /// C_h hᵖ; with `singular`, the smooth part of the spatial error (p = 1).
     pub space: PowerLaw,
+    /// The singular part C_s h^α of a two-term spatial error, e_h = √((C_h h)² + (C_s h^α)²)
+    /// (`plan::pilot::fit`, `two_term`), α = min(1, α_min).
+    pub singular: Option<PowerLaw>,
     pub time: TimeError,
     pub combine: Combine,
 }
 
 impl ErrorModel {
     pub fn space_error(&self, h: f64) -> f64 {
-        self.space.at(h)
+        self.space.at(h).hypot(self.singular.map_or(0.0, |s| s.at(h)))
     }
 
     pub fn time_error(&self, k: f64) -> f64 {
@@ -191,7 +195,7 @@ mod tests {
     fn error_parts_combine() {
         let space = PowerLaw { c: 3.0, p: 1.0 };
         let time = TimeError::Law(PowerLaw { c: 4.0, p: 1.0 });
-        let q = ErrorModel { space, time, combine: Combine::Quadrature };
+        let q = ErrorModel { space, singular: None, time, combine: Combine::Quadrature };
         assert!((q.predict(1.0, 1.0) - 5.0).abs() < 1e-14);
         let s = ErrorModel { combine: Combine::Sum, ..q };
         assert!((s.predict(1.0, 1.0) - 7.0).abs() < 1e-14);

@@ -234,6 +234,14 @@ REQUIREMENTS = (
         'reference/adaptive/study.md',
     ),
     Requirement(
+        'A7-estimate',
+        'report with every adapted level an error estimate (`adapt::estimate`) whose effectivity E / error lies in '
+        '[0.8, 1.25] at every level past the first four on `mms_lshape` (24 levels) and `mms_data_front` (20; true '
+        'errors) and on Example 5.1 (16, against its generation-12 reference) (issue 42); `adapt --target` stops on it',
+        'verification/run_all.py --only adaptive',
+        'reference/adaptive/study.md',
+    ),
+    Requirement(
         'O1-clients',
         "write results that VTK's `vtkHDFReader`, meshio (XDMF) and h5py open, with the solver's values",
         'scripts/check_results.py out/verify_ex51.h5',
