@@ -71,10 +71,10 @@ pub struct Fit {
     /// Why the estimates are bounds: the observed order exceeded the scene's order bound, which replaced it
     /// ([`fit`]).
     pub bounded: Option<String>,
-    /// The finest level's error split into its smooth part (order 1) and its singular part (order `p`,
-    /// the scene's bound), [smooth, singular], where the observed order is above the bound and not
-    /// falling ([`super::two_term`]).
-    pub two_term: Option<[f64; 2]>,
+    /// The finest level's error split into its smooth part and its singular part (order `p`, the scene's
+    /// bound), with the smooth part's order: [smooth, singular, its order], where the observed order is
+    /// above the bound and not falling ([`super::two_term`]).
+    pub two_term: Option<[f64; 3]>,
 }
 
 impl Fit {
@@ -176,14 +176,18 @@ fn bound_order(f: &mut Fit, study: &Study, model: NormModel, limit: f64) {
     let consistent = matches!(f.verdicts.last(), Some(Verdict::InRange));
     let optimal = model.p >= super::two_term::OPTIMAL_ORDER - super::two_term::ORDER_SCATTER;
     let split = (!falling && consistent && optimal)
-        .then(|| super::two_term::split(&f.x, &f.distances, *f.errors.last().expect("levels"), limit))
+        .then(|| {
+            let orders = (limit, model.p.min(1.0), super::two_term::ORDER_SCATTER);
+            super::two_term::split(&f.x, &f.distances, *f.errors.last().expect("levels"), orders)
+        })
         .flatten();
     let how = if let Some([g, s]) = split {
-        f.two_term = Some([g, s]);
+        f.two_term = Some([g, s, model.p.min(1.0)]);
         format!(
-            "the finest pilot level's error {:.3e} splits into a smooth part {g:.3e} (order 1) and a singular part \
+            "the finest pilot level's error {:.3e} splits into a smooth part {g:.3e} (order {:.3}) and a singular part \
              {s:.3e} (order {limit:.3}) from the ratios of its last increments (`plan::two_term`)",
-            g.hypot(s)
+            g.hypot(s),
+            model.p.min(1.0)
         )
     } else if falling || !consistent {
         let bounded = NormModel { p: limit, beta: model.beta.min(1.0), ..model };

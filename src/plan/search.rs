@@ -68,7 +68,7 @@ pub(super) fn decide(s: &Scene, options: &Options, pilots: &Pilots, mut notes: V
         _ => Combine::Sum,
     };
     let (smooth, singular) = match space_fit.two_term {
-        Some([g, e]) => (PowerLaw::through(hx, g, 1.0), Some(PowerLaw::through(hx, e, space_fit.p))),
+        Some([g, e, p]) => (PowerLaw::through(hx, g, p), Some(PowerLaw::through(hx, e, space_fit.p))),
         None => (PowerLaw::through(hx, he, space_fit.p), None),
     };
     let error = ErrorModel { space: smooth, singular, time: time_law, combine };
