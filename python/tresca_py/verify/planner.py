@@ -220,7 +220,10 @@ def sweep_case(name, spec, tmp, quick, cache, costs, run_plans=False):
         p, pcpu, pwall, cmd, _ = plan(runner.full, t, ["--run"] if run_plans else [], costs=costs)
         meets = [g for g in grid if g["error"] <= t]
         cheapest = min(meets, key=lambda g: g["cpu"], default=None) if costs else None
-        cheapest_work = min((dict(g, work=work(g["unknowns"], g["steps"])) for g in meets), key=lambda g: g["work"],
+        # PL5 compares with the cheapest configuration meeting the target with the margin MARGIN: one that meets
+        # it by less is found only by a prediction better than the pilots' 10 % (the sweep's targets, above)
+        robust = [g for g in grid if g["error"] <= MARGIN * t]
+        cheapest_work = min((dict(g, work=work(g["unknowns"], g["steps"])) for g in robust), key=lambda g: g["work"],
                             default=None)
         row = dict(case=name, target=t, planner_cpu=pcpu, planner_wall=pwall, plan_cmd=cmdline(cmd), cheapest=cheapest,
                    cheapest_work=cheapest_work)
@@ -264,8 +267,8 @@ def requirements(hs, name, sweep, grid_cmd):
                f"plan work / cheapest grid work: max {max(ratios, default=float('nan')):.2f}, median "
                f"{statistics.median(ratios) if ratios else float('nan'):.2f} over {len(ratios)} targets",
                statement=f"{name}: the plan (the route `plan --run` runs) shall cost at most {WORK_RATIO:g}× the "
-                         "cheapest grid configuration that meets the target, in work units n^1.5 + N·n·ln n "
-                         "(tresca_py/verify/planner_md.py; issue 42)", command=grid_cmd, reference=ref)
+                         f"cheapest grid configuration that meets the target with the margin {MARGIN:g}, in work units "
+                         "n^1.5 + N·n·ln n (tresca_py/verify/planner_md.py; issue 42)", command=grid_cmd, reference=ref)
 
 
 def example51(tmp, quick, costs):
