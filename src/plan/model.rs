@@ -13,8 +13,8 @@
 //! **Cost.** wall(n, N) = S(n) + N s(n) for n unknowns and N steps, S the set-up (assembly, the one
 //! factorisation, condensation) and s the cost of a step (load, one triangular-solve pair, the friction
 //! solve). S is a power law through the space pilot's finest level, its exponent from the two finest
-//! levels clamped to what the algorithms can do: between O(n) (assembly) and O(n^1.5) (sparse Cholesky
-//! of a 2D mesh). s = c n ln n, the cost of the triangular solves with a fill-reducing factor of a 2D mesh
+//! levels clamped to what the algorithms do at the plans' sizes: between n^1.2 (measured: [`SETUP_EXPONENT`])
+//! and O(n^1.5) (sparse Cholesky of a 2D mesh). s = c n ln n, the cost of the triangular solves with a fill-reducing factor of a 2D mesh
 //! (the friction work, O(n_c²) per iteration with n_c ∝ √n under uniform refinement, is smaller), with c
 //! from the time pilot's level with the most steps: per-step costs measured over a few steps are
 //! dominated by the first steps' extra Newton iterations and by start-up.
@@ -116,8 +116,12 @@ impl ErrorModel {
     }
 }
 
-/// Exponent range of the set-up cost (module doc).
-pub const SETUP_EXPONENT: (f64, f64) = (1.0, 1.5);
+/// Exponent range of the set-up cost (module doc): at most sparse Cholesky's n^1.5 on a 2D mesh, at least
+/// n^1.2, the growth the set-up shows at the plans' sizes, where the factor's O(n log n) entries outgrow the
+/// caches (mms_stop, refine 3 → 6: 0.047, 0.44, 1.41, 7.7 s at 6k, 25k, 98k, 393k unknowns, n^1.23 over the
+/// range). Pilot levels of a few thousand unknowns are bound by overheads and show n^0.8–1.0: an exponent
+/// from them alone predicted refine 5 at half its set-up.
+pub const SETUP_EXPONENT: (f64, f64) = (1.2, 1.5);
 
 /// One measured run: unknowns, set-up seconds, seconds per step.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -219,17 +223,17 @@ mod tests {
         }
     }
 
-    /// Samples of S = 1e-6 n^1.2 and s = 1e-8 n ln n give back those laws; a set-up slope outside the
+    /// Samples of S = 1e-6 n^1.3 and s = 1e-8 n ln n give back those laws; a set-up slope outside the
     /// allowed range is clamped (a flat, overhead-dominated set-up is taken as linear).
     #[test]
     fn cost_fit_recovers_and_clamps() {
-        let sample = |n: f64| CostSample { n, setup: 1e-6 * n.powf(1.2), step: 1e-8 * n * n.ln() };
+        let sample = |n: f64| CostSample { n, setup: 1e-6 * n.powf(1.3), step: 1e-8 * n * n.ln() };
         let space: Vec<CostSample> = [1e3, 4e3, 1.6e4].iter().map(|&n| sample(n)).collect();
         let time = [(sample(1e3), 10), (sample(2e3), 400), (CostSample { step: 1.0, ..sample(5e2) }, 40)];
         let m = CostModel::fit(&space, &time).unwrap();
-        assert!((m.setup.p - 1.2).abs() < 1e-12);
+        assert!((m.setup.p - 1.3).abs() < 1e-12);
         let n: f64 = 1e6;
-        let want = 1e-6 * n.powf(1.2) + 10.0 * 1e-8 * n * n.ln();
+        let want = 1e-6 * n.powf(1.3) + 10.0 * 1e-8 * n * n.ln();
         assert!((m.predict(n, 10) / want - 1.0).abs() < 1e-12);
         let flat = [CostSample { n: 1e3, setup: 0.01, step: 0.0 }, CostSample { n: 4e3, setup: 0.011, step: 0.0 }];
         assert_eq!(CostModel::fit(&flat, &time).unwrap().setup.p, SETUP_EXPONENT.0);
