@@ -79,7 +79,7 @@ enum Cmd {
     /// level, each level a whole run; a table per level (exit code 3 when stopped before the goal).
     Adapt {
         scene: PathBuf,
-        /// Stop once the estimator is at most this (energy norm, max over the time nodes).
+        /// Stop once the error estimate is at most this (energy norm, max over the time nodes; from level 4 on).
         #[arg(long, required_unless_present = "levels", allow_hyphen_values = true, value_parser = cli::args::positive)]
         target: Option<f64>,
         /// Number of levels (solves), the starting mesh included.
@@ -331,7 +331,6 @@ fn adapt(cmd: Cmd) -> Result<()> {
         levels,
         target,
         until_unknowns: None,
-        target_estimate: None,
         theta,
         out,
         gmsh,

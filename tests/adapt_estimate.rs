@@ -41,14 +41,14 @@ fn estimate_effectivity_is_near_one_past_the_first_four_levels() {
 }
 
 /// The system shall stop the loop at the first level from `TRUSTED_FROM` on whose estimate is at most
-/// the `target_estimate` given, and not before.
+/// the target given (`adapt --target`: the estimate, not the indicator η), and not before.
 #[test]
 fn loop_stops_at_its_target_estimate() {
     let s = scene("verification/cases/mms_lshape.toml");
     let full = rows("verification/cases/mms_lshape.toml", 10);
     let goal = full[7].estimate.unwrap();
     let stop = full.iter().position(|r| r.level >= TRUSTED_FROM && r.estimate.unwrap() <= goal).unwrap();
-    let got = adapt(&s, &Options { target_estimate: Some(goal), ..Options::levels(20, 0.5) }, |_| {}).unwrap();
+    let got = adapt(&s, &Options { target: Some(goal), ..Options::levels(20, 0.5) }, |_| {}).unwrap();
     assert_eq!(got.rows.len(), stop + 1);
     assert_eq!(got.rows[stop].estimate.map(f64::to_bits), full[stop].estimate.map(f64::to_bits));
 }

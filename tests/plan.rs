@@ -62,6 +62,63 @@ fn corner_exponent_bounds_the_extrapolation() {
     assert!(truth <= b.error && truth <= target, "refine {}: true {truth:e}, predicted {:e}", b.refine, b.error);
 }
 
+/// Requirement (issue 42): the system shall take a contact corner's exponent from the states the pilot
+/// runs went through there, conservative over the states seen, and say which it used. mms_rotated: its
+/// contact side only slips at (0.8, 0.6), where it meets a free side at a right angle (sliding–free: no
+/// exponent below 1), and sticks at some steps at the origin (clamped–free, 0.7112); the same corners
+/// with states made up show the rule: stick alone is clamped, separated alone free, none the bound.
+#[test]
+fn contact_corners_take_the_pilots_states() {
+    use tresca_cr::plan::corners::order_limit;
+    use tresca_cr::study::contact_states::{SEPARATED, SLIP, STICK};
+    use tresca_cr::study::LevelResult;
+    let s = scene("verification/cases/mms_rotated.toml");
+    let p = plan(&s, &options(3e-2)).unwrap();
+    let line = |at: &str| p.notes.iter().find(|n| n.starts_with(&format!("contact corner {at}"))).cloned();
+    let slipping = line("(0.8000, 0.6000)").expect("the corner's line");
+    assert!(slipping.contains("saw slip there; sliding–free, α = none below 1"), "{slipping}");
+    let origin = line("(0.0000, 0.0000)").expect("the corner's line");
+    assert!(origin.contains("stick") && origin.contains("α = 0.7112"), "{origin}");
+    let level = |bits: u8| LevelResult { h: 0.1, contact_states: vec![([0.8, 0.6], bits)], ..LevelResult::default() };
+    let at = |levels: &[&LevelResult]| {
+        let (_, lines) = order_limit(&s, levels).unwrap();
+        lines.into_iter().find(|l| l.starts_with("contact corner (0.8000, 0.6000)")).unwrap()
+    };
+    assert!(at(&[&level(STICK)]).ends_with("clamped–free, α = 0.7112"));
+    assert!(at(&[&level(SEPARATED)]).ends_with("free–free, α = none below 1"));
+    // the union over levels: one level that saw stick makes the corner clamped
+    assert!(at(&[&level(SLIP), &level(STICK)]).contains("saw stick, slip"));
+    assert!(at(&[&level(SLIP), &level(STICK)]).ends_with("α = 0.7112"));
+    assert!(at(&[]).contains("the bound over stick and slip"));
+}
+
+/// Requirement (issue 42): where the scene's corners allow α = 0.7112 but the pilot shows CR's order 1 (the
+/// smooth manufactured mms_rotated), the system shall split the finest pilot level's error into a smooth
+/// part (the observed order, ≤ 1) and a singular part (order α) and extrapolate both, so that it plans the cheapest
+/// refinement that meets the target in truth: at 3.162e-3 refine 5 (refine 4's true error is 5.95e-3), not
+/// refine 6 as the bound alone (5× the cost); the plan run with the exact solution meets the target.
+#[test]
+fn smooth_part_and_singular_part_are_extrapolated_apart() {
+    let s = scene("verification/cases/mms_rotated.toml");
+    let target = 3.162e-3;
+    let p = plan(&s, &options(target)).unwrap();
+    assert!(p.refused.is_none(), "{:?}", p.refused);
+    let model = p.error.unwrap();
+    let singular = model.singular.expect("a two-term spatial error");
+    // the smooth part at the observed order (≤ 1), the singular part at the scene's bound
+    let observed = p.space.estimates.model.unwrap().p;
+    assert_eq!((model.space.p, singular.p), (observed.min(1.0), p.order_limit));
+    assert!(p.notes.iter().any(|n| n.contains("splits into a smooth part")), "{:?}", p.notes);
+    let b = &p.best[0];
+    assert_eq!(b.refine, 5, "{b:?}");
+    let mut c = s.clone();
+    c.set_refine(b.refine).unwrap();
+    c.set_steps(b.steps).unwrap();
+    c.solver.tol = p.tol;
+    let (truth, _) = max_errors(&run(c).1);
+    assert!(truth <= target, "refine {}: true {truth:e}, predicted {:e}", b.refine, b.error);
+}
+
 /// Requirement: a scene whose slip only passes from stick to slip needs no more steps than it asks for:
 /// the planner says so (a time-error bound far below the target) and plans the scene's own steps.
 #[test]

@@ -5,7 +5,7 @@
 
 use super::summary::{Singular, SingularPoint};
 use tresca_cr::fem::singular::{uniform_order, Singularity};
-use tresca_cr::scene::Part;
+use tresca_cr::scene::{Part, PartKind};
 
 /// The human lines (the first a header) and the `--json` record.
 pub fn describe(points: &[Singularity], parts: &[Part]) -> (Vec<String>, Singular) {
@@ -24,8 +24,11 @@ pub fn describe(points: &[Singularity], parts: &[Part]) -> (Vec<String>, Singula
             Some(a) if a.im == 0.0 => format!("{:.6}", a.re),
             Some(a) => format!("{:.6} ± {:.6}i", a.re, a.im),
         };
+        let contact = s.parts.iter().any(|&p| matches!(parts[p].kind, PartKind::Contact(_)));
+        let how =
+            if contact { "  (contact: the bound over stick and slip; `plan` uses its pilots' states)" } else { "" };
         lines.push(format!(
-            "           ({:.6}, {:.6}) angle {:>7.2}°  {}–{} ({}–{})  alpha = {alpha}",
+            "           ({:.6}, {:.6}) angle {:>7.2}°  {}–{} ({}–{})  alpha = {alpha}{how}",
             s.point[0],
             s.point[1],
             s.angle.to_degrees(),

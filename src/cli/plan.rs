@@ -187,8 +187,9 @@ fn print_evidence(p: &Plan) {
     };
     if let Some(m) = &p.error {
         let range = |x: &[f64]| format!("[{:.3e}, {:.3e}]", x.last().copied().unwrap_or(0.0), x[0]);
+        let singular = m.singular.map_or(String::new(), |s| format!(" ⊕ {:.4e} h^{:.3}", s.c, s.p));
         say!(
-            "\nError model: e_h = {:.4e} h^{:.3} (h in {}{}, β = {})",
+            "\nError model: e_h = {:.4e} h^{:.3}{singular} (h in {}{}, β = {})",
             m.space.c,
             m.space.p,
             range(&p.space_fit.x),

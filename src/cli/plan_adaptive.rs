@@ -5,14 +5,11 @@ use anyhow::Result;
 use tresca_cr::adapt::Row;
 use tresca_cr::plan::adaptive::{weigh as weigh_routes, AdaptivePlan, Route};
 use tresca_cr::plan::pilot::Quantity;
+// a uniform space fit at or above CR's optimal order less the pilots' scatter leaves the adaptive route
+// nothing to gain but its overhead
+use tresca_cr::plan::two_term::{OPTIMAL_ORDER, ORDER_SCATTER};
 use tresca_cr::plan::Plan;
 use tresca_cr::Scene;
-
-/// The energy-norm order in h of the lowest-order CR element on a smooth solution. A uniform space fit at or
-/// above it less the pilots' scatter leaves the adaptive route nothing to gain but its overhead.
-const OPTIMAL_ORDER: f64 = 1.0;
-/// The scatter of a fitted space order over the pilots' few levels (the planner's in-range band).
-const ORDER_SCATTER: f64 = 0.05;
 
 /// Weigh and print; `None` for targets the indicator does not bound (outputs other than the energy norm),
 /// when the uniform plan has no error model, or when its observed space order is already optimal (then the
@@ -71,15 +68,15 @@ fn print(a: &AdaptivePlan, file: &str) {
     if a.choice == Route::Adaptive {
         say!(
             "  run it: tresca-cr adapt {file} --target {:.3e} --theta {} --steps {}",
-            a.eta,
+            a.estimate_target,
             tresca_cr::plan::adaptive::THETA,
             a.steps
         );
     }
 }
 
-/// `plan --run` where the adaptive route is recommended: its `adapt` loop (θ, the plan's steps, until η ≤ the
-/// uniform plan's η, under the same memory and disk checks as `tresca-cr adapt` and the plan's memory limit and
+/// `plan --run` where the adaptive route is recommended: its `adapt` loop (θ, the plan's steps, until the error estimate
+/// ≤ 0.8 T, under the same memory and disk checks as `tresca-cr adapt` and the plan's memory limit and
 /// wall budget), printed as `adapt` prints it,
 /// then whether it reached that η and, with an exact solution, the true error against the target. Returns the
 /// exit code (3 when the loop was refused) and the loop's levels.
@@ -88,8 +85,7 @@ pub fn execute(scene: &Scene, a: &AdaptivePlan, p: &Plan) -> Result<(i32, Vec<Ro
     let mut s = scene.clone();
     s.set_steps(a.steps)?;
     let opts = tresca_cr::adapt::Options {
-        target: None,
-        target_estimate: Some(a.estimate_target),
+        target: Some(a.estimate_target),
         levels: None,
         max_memory: p.options.max_memory,
         budget: Some(p.options.budget),

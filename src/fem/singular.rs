@@ -26,6 +26,9 @@ pub struct Singularity {
     pub sides: [Side; 2],
     /// The leading exponent with 0 < Re α < 1, if there is one.
     pub alpha: Option<Complex<f64>>,
+    /// The conditions of a contact side are the ones a run was seen in there ([`of_scene_observed`]),
+    /// not the bound over stick and slip.
+    pub observed: bool,
 }
 
 impl Singularity {
@@ -47,14 +50,32 @@ pub fn sides_of(kind: &PartKind) -> &'static [Side] {
 /// Every corner and change of condition of the mesh's boundary with its exponent; `edge_part` gives each
 /// boundary edge's part (as `CrSpace::edge_part`).
 pub fn singularities(mesh: &Mesh, edge_part: &[Option<usize>], parts: &[Part], nu: f64) -> Vec<Singularity> {
+    singularities_observed(mesh, edge_part, parts, nu, |_| None)
+}
+
+/// [`singularities`] where `seen(point)` may give the conditions a contact side was in at that point (the
+/// states a run went through there); a contact side without them takes the bound over stick and slip.
+pub fn singularities_observed(
+    mesh: &Mesh,
+    edge_part: &[Option<usize>],
+    parts: &[Part],
+    nu: f64,
+    seen: impl Fn([f64; 2]) -> Option<Vec<Side>>,
+) -> Vec<Singularity> {
     let part = |e: usize| edge_part[e].expect("boundary edges belong to a part");
     let points = mesh.boundary_points(|a, b| sides_of(&parts[part(a)].kind) != sides_of(&parts[part(b)].kind));
     points
         .into_iter()
         .map(|p| {
             let pair = [part(p.edges[0]), part(p.edges[1])];
-            let (sides, alpha) = worst(pair.map(|q| sides_of(&parts[q].kind)), p.angle, nu);
-            Singularity { point: p.point, angle: p.angle, parts: pair, sides, alpha }
+            let observed = pair.iter().any(|&q| matches!(parts[q].kind, PartKind::Contact(_))).then(|| seen(p.point));
+            let observed = observed.flatten().filter(|s| !s.is_empty());
+            let can = pair.map(|q| match (&parts[q].kind, &observed) {
+                (PartKind::Contact(_), Some(s)) => s.clone(),
+                (kind, _) => sides_of(kind).to_vec(),
+            });
+            let (sides, alpha) = worst([can[0].as_slice(), can[1].as_slice()], p.angle, nu);
+            Singularity { point: p.point, angle: p.angle, parts: pair, sides, alpha, observed: observed.is_some() }
         })
         .collect()
 }
@@ -81,9 +102,14 @@ pub fn uniform_order(points: &[Singularity]) -> f64 {
 /// The singular points of a scene, found on its mesh before any refinement (refinement adds no corner and
 /// no change of condition): what `check` lists, for the planner's order bound.
 pub fn of_scene(scene: &Scene) -> Result<Vec<Singularity>> {
+    of_scene_observed(scene, |_| None)
+}
+
+/// [`of_scene`] with the conditions contact sides were seen in ([`singularities_observed`]).
+pub fn of_scene_observed(scene: &Scene, seen: impl Fn([f64; 2]) -> Option<Vec<Side>>) -> Result<Vec<Singularity>> {
     let mut s = scene.clone();
     s.set_refine(0)?;
     let mesh = Mesh::from_spec(&s.mesh)?;
     let space = CrSpace::new(&mesh, &s.parts)?;
-    Ok(singularities(&mesh, &space.edge_part, &s.parts, s.material.nu))
+    Ok(singularities_observed(&mesh, &space.edge_part, &s.parts, s.material.nu, seen))
 }

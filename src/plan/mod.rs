@@ -22,9 +22,11 @@
 //! tighter one buys nothing, a looser one saves no Newton iteration worth having).
 
 pub mod adaptive;
+pub mod corners;
 pub mod model;
 pub mod pilot;
 mod search;
+pub mod two_term;
 
 use crate::error::{Error, Result};
 use crate::scene::budget::Estimate;
@@ -144,7 +146,6 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         return Err(Error::scene(&scene.file, "--target", format!("{target}: must be a positive number")));
     }
     let s = pilot_scene(scene, &options.quantity)?;
-    let limit = crate::fem::singular::uniform_order(&crate::fem::singular::of_scene(&s)?);
     // the guard against a nearly singular K on the time pilot's mesh, the first made
     cache.guard_first_mesh_only();
     let (r0, n0) = (s.mesh_level(), s.times.len() - 1);
@@ -169,7 +170,7 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         // inside a step is partly missed on coarse grids, and so is its spatial error). The space pilot
         // runs on the coarsest grid of the law's family whose time error is at most LAW_SAMPLING_SHARE of
         // the spatial error on the time pilot's mesh (first found with the scene's steps).
-        let first = space_pilot(&s, options, (&time_pilot_run, limit), &time_fit, n0, *spent, cache)?;
+        let first = space_pilot(&s, options, &time_pilot_run, &time_fit, n0, *spent, cache)?;
         let (Some(e), Some(TimeError::Law(law))) = (on_mesh(&first), first.error.map(|m| m.time)) else {
             return Ok(first);
         };
@@ -181,7 +182,7 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         if n == n0 {
             return Ok(first);
         }
-        let mut p = space_pilot(&s, options, (&time_pilot_run, limit), &time_fit, n, first.pilot_wall, cache)?;
+        let mut p = space_pilot(&s, options, &time_pilot_run, &time_fit, n, first.pilot_wall, cache)?;
         p.notes.insert(
             0,
             format!(
@@ -192,14 +193,14 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         );
         return Ok(p);
     }
-    let coarse = space_pilot(&s, options, (&time_pilot_run, limit), &time_fit, nt, *spent, cache)?;
+    let coarse = space_pilot(&s, options, &time_pilot_run, &time_fit, nt, *spent, cache)?;
     // sampling time on nt steps is sound when the time grids change the solution on the time pilot's
     // mesh by at most SAMPLING_SHARE of that mesh's spatial error
     let moved = time_fit.distances.iter().copied().fold(0.0, f64::max);
     match on_mesh(&coarse).as_ref() {
         Some(&e) if moved <= SAMPLING_SHARE * e => Ok(coarse),
         _ => {
-            let mut p = space_pilot(&s, options, (&time_pilot_run, limit), &time_fit, n0, coarse.pilot_wall, cache)?;
+            let mut p = space_pilot(&s, options, &time_pilot_run, &time_fit, n0, coarse.pilot_wall, cache)?;
             p.notes.insert(
                 0,
                 format!(
@@ -217,7 +218,7 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
 fn space_pilot(
     s: &Scene,
     options: &Options,
-    ((time, time_ratio, _), order_limit): (&(Study, usize, f64), f64),
+    (time, time_ratio, _): &(Study, usize, f64),
     time_fit: &Fit,
     nh: usize,
     mut spent: f64,
@@ -231,6 +232,7 @@ fn space_pilot(
         let cost = CostModel::fit(&space_samples(run.levels()), &samples(&time.levels));
         let predicted = |r: u32| cost.map_or(0.0, |c| c.predict(unknowns(s, r).unwrap_or(0) as f64, nh));
         if run.levels().len() as u32 >= SPACE_LEVELS {
+            let (order_limit, corner_notes) = observed_limit(s, time, run.levels())?;
             let study = run.study();
             let pilots =
                 Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, order_limit, wall: spent + run.spent };
@@ -245,13 +247,15 @@ fn space_pilot(
             };
             if !extend || r > r0 + MAX_REFINE {
                 let mut done = draft;
-                done.notes.splice(0..0, notes);
+                done.notes.splice(0..0, notes.into_iter().chain(corner_notes));
                 return Ok(done);
             }
         }
         if let Some(why) = run.push(Level { refine: r, steps: nh }, predicted(r), options.pilot_budget - spent)? {
             notes.push(why);
             spent += run.spent;
+            let (order_limit, corner_notes) = observed_limit(s, time, run.levels())?;
+            notes.extend(corner_notes);
             let study = run.study();
             let pilots = Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, order_limit, wall: spent };
             let mut done = decide(s, options, &pilots, notes)?;
@@ -263,6 +267,13 @@ fn space_pilot(
         }
         r += 1;
     }
+}
+
+/// The order bound with the contact corners' conditions from the states the time pilot's and the space
+/// pilot's levels went through ([`corners`]), and the lines that say which were used.
+fn observed_limit(s: &Scene, time: &Study, space: &[LevelResult]) -> Result<(f64, Vec<String>)> {
+    let levels: Vec<&LevelResult> = time.levels.iter().chain(space).collect();
+    corners::order_limit(s, &levels)
 }
 
 /// The time pilot's first grid: N/2^j for the largest j ≤ 4 that divides N and leaves at least

@@ -71,6 +71,10 @@ pub struct Fit {
     /// Why the estimates are bounds: the observed order exceeded the scene's order bound, which replaced it
     /// ([`fit`]).
     pub bounded: Option<String>,
+    /// The finest level's error split into its smooth part and its singular part (order `p`, the scene's
+    /// bound), with the smooth part's order: [smooth, singular, its order], where the observed order is
+    /// above the bound and not falling ([`super::two_term`]).
+    pub two_term: Option<[f64; 3]>,
 }
 
 impl Fit {
@@ -114,6 +118,7 @@ pub fn fit(study: &Study, q: &Quantity, limit: Option<f64>) -> Result<Fit> {
                 refused: e.refused.clone(),
                 distances,
                 bounded: None,
+                two_term: None,
             };
             if let (Some(limit), Some(model), Axis::H) = (limit, e.model, size) {
                 bound_order(&mut f, study, model, limit);
@@ -143,6 +148,7 @@ pub fn fit(study: &Study, q: &Quantity, limit: Option<f64>) -> Result<Fit> {
                 refused,
                 distances,
                 bounded: None,
+                two_term: None,
             })
         }
     }
@@ -168,7 +174,22 @@ fn bound_order(f: &mut Fit, study: &Study, model: NormModel, limit: f64) {
         .then(|| (f.distances[n - 2] / f.distances[n - 1]).ln() / (f.x[n - 2] / f.x[n - 1]).ln());
     let falling = finest.is_some_and(|o| o < model.p - ORDER_TOL);
     let consistent = matches!(f.verdicts.last(), Some(Verdict::InRange));
-    let how = if falling || !consistent {
+    let optimal = model.p >= super::two_term::OPTIMAL_ORDER - super::two_term::ORDER_SCATTER;
+    let split = (!falling && consistent && optimal)
+        .then(|| {
+            let orders = (limit, model.p.min(1.0), super::two_term::ORDER_SCATTER);
+            super::two_term::split(&f.x, &f.distances, *f.errors.last().expect("levels"), orders)
+        })
+        .flatten();
+    let how = if let Some([g, s]) = split {
+        f.two_term = Some([g, s, model.p.min(1.0)]);
+        format!(
+            "the finest pilot level's error {:.3e} splits into a smooth part {g:.3e} (order {:.3}) and a singular part \
+             {s:.3e} (order {limit:.3}) from the ratios of its last increments (`plan::two_term`)",
+            g.hypot(s),
+            model.p.min(1.0)
+        )
+    } else if falling || !consistent {
         let bounded = NormModel { p: limit, beta: model.beta.min(1.0), ..model };
         f.errors = level_errors(&study.levels, &bounded).iter().map(|e| e[0]).collect();
         format!(
@@ -180,9 +201,10 @@ fn bound_order(f: &mut Fit, study: &Study, model: NormModel, limit: f64) {
     };
     f.bounded = Some(format!(
         "the observed space order {:.3} (finest increment {}) is above min(1, α_min) = {limit:.3}, the order the \
-         scene's corners allow (`tresca-cr check`); {how}, and the error is extrapolated with {limit:.3} (a bound)",
+         scene's corners allow (`tresca-cr check`); {how}, and the error is extrapolated with {limit:.3}{}",
         model.p,
-        finest.map_or("-".into(), |o| format!("{o:.3}"))
+        finest.map_or("-".into(), |o| format!("{o:.3}")),
+        if split.is_some() { " for that part" } else { " (a bound)" }
     ));
     f.p = limit;
 }

@@ -67,7 +67,11 @@ pub(super) fn decide(s: &Scene, options: &Options, pilots: &Pilots, mut notes: V
         Some(b) if b >= ORTHOGONAL_BETA => Combine::Quadrature,
         _ => Combine::Sum,
     };
-    let error = ErrorModel { space: PowerLaw::through(hx, he, space_fit.p), time: time_law, combine };
+    let (smooth, singular) = match space_fit.two_term {
+        Some([g, e, p]) => (PowerLaw::through(hx, g, p), Some(PowerLaw::through(hx, e, space_fit.p))),
+        None => (PowerLaw::through(hx, he, space_fit.p), None),
+    };
+    let error = ErrorModel { space: smooth, singular, time: time_law, combine };
     plan.error = Some(error);
     let Some(cost) = cost else {
         plan.refused = Some("no pilot run to fit the cost model to".into());
@@ -150,7 +154,7 @@ fn candidates(
     for r in s.mesh_level()..=MAX_REFINE {
         let h = finest.h * 0.5f64.powi(r as i32 - finest.refine as i32);
         let error = &match floor.iter().find(|&&(q, e)| q == r && e > model.space_error(h)) {
-            Some(&(_, e)) => ErrorModel { space: PowerLaw::through(h, e, model.space.p), ..*model },
+            Some(&(_, e)) => ErrorModel { space: PowerLaw::through(h, e, model.space.p), singular: None, ..*model },
             None => *model,
         };
         if error.space_error(h) >= target {

@@ -11,6 +11,7 @@
 //! long runs stay cheap (with an exact solution u is formed at every node for the true errors).
 
 pub mod cache;
+pub mod contact_states;
 pub mod csv;
 pub mod differences;
 pub mod estimate;
@@ -105,6 +106,8 @@ pub struct LevelResult {
     pub jumps: Vec<f64>,
     /// Scalar outputs at T ([`outputs`]).
     pub outputs: Vec<f64>,
+    /// The contact states seen over all steps at each vertex of Γ_C ([`contact_states`]).
+    pub contact_states: Vec<([f64; 2], u8)>,
 }
 
 /// A finished study: the levels, the energy-norm estimates and the output estimates.
@@ -143,10 +146,12 @@ fn run_level(
     let all = own_nodes && problem.scene.exact.is_some();
     let names = outputs::selected(scene);
     let mut values = Vec::new();
+    let mut seen = contact_states::Seen::default();
     let first = problem.initial()?;
     let last_n = times.len() - 1;
     let mut on_step = |r: &StepResult| -> Result<()> {
         iterations += r.iterations;
+        seen.record(&problem.space, r);
         if let Some(e) = r.errors {
             let mx = |m: Option<ErrorNorms>| Some(m.map_or(e, |m| m.max(e)));
             max_err = mx(max_err);
@@ -192,6 +197,7 @@ fn run_level(
         final_err,
         norm_max,
         outputs: values,
+        contact_states: seen.at_vertices(&problem.mesh, &problem.space),
         ..LevelResult::default()
     };
     Ok(Kept { problem, u, t: kept_t })

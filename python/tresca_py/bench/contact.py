@@ -23,7 +23,7 @@ from tresca_py.bench.factorisation import write_section
 from tresca_py.bench.timing import timed
 from tresca_py.common import BIN, CASES, ROOT, load1
 
-HEADING = "## 10. Contact with normal unknowns: iterations and cost (issue 40)"
+HEADING = "## 11. Contact with normal unknowns: iterations and cost (issue 40)"
 ITERATION_SCENES = (("Coulomb block", "coulomb_block.toml", "mms_signorini_coulomb.toml"),
                     ("Hertz a/R = 0.05", "hertz_a05.toml", None),
                     ("Hertz a/R = 0.1", "hertz_a10.toml", None))

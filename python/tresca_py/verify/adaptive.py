@@ -40,6 +40,9 @@ FIT_BAND, WINDOW_BAND, PAIR_BAND = 0.05, 0.12, 0.05
 SCATTER = 1.05 ** 2
 # CSV min angles carry 4 decimals
 ANGLE_ROUNDING = 5e-5
+# issue 42: the error estimate's effectivity E/error at every level past the first four (src/adapt/estimate.rs:
+# TRUSTED_FROM = 4, the levels before it calibrate on one to three increments)
+ESTIMATE_BAND, TRUSTED_FROM = (0.8, 1.25), 4
 
 
 def staged(hs, name):
@@ -98,6 +101,20 @@ def effectivity_check(rows):
     ok = len(rows) >= 10 and lo >= 1.0 and hi / lo <= bound
     return ok, (f"η/error {lo:.2f}–{hi:.2f} over {len(rows)} levels ({rows[0]['unknowns']:.0f}–"
                 f"{rows[-1]['unknowns']:.0f} unknowns): max/min {hi / lo:.3f} ≤ {bound:.3f}, min ≥ 1")
+
+
+def estimate_check(hs, name, rows, col, cmd):
+    """A7: the error estimate's effectivity E / error (``col``: the true error or the reference distance) in
+    ESTIMATE_BAND at every level from TRUSTED_FROM on."""
+    eff = [(int(r["level"]), r["estimate"] / r[col]) for r in rows[TRUSTED_FROM:]
+           if r["estimate"] is not None and r[col]]
+    lo, hi = min(e for _, e in eff), max(e for _, e in eff)
+    ok = len(eff) == len(rows) - TRUSTED_FROM >= 10 and ESTIMATE_BAND[0] <= lo and hi <= ESTIMATE_BAND[1]
+    label = "true error" if col == "error" else "reference distance"
+    req(hs, f"A7-estimate-{name}", f"on `{name}` the adaptive error estimate's effectivity E / {label} shall lie in "
+        f"[{ESTIMATE_BAND[0]}, {ESTIMATE_BAND[1]}] at every level past the first {TRUSTED_FROM} (issue 42)", ok,
+        f"E/error {lo:.3f}–{hi:.3f} over levels {eff[0][0]}–{eff[-1][0]} "
+        f"({rows[TRUSTED_FROM]['unknowns']:.0f}–{rows[-1]['unknowns']:.0f} unknowns)", cmd, STUDY_MD)
 
 
 def dof_for(rows, col, target):
@@ -261,13 +278,15 @@ def figures(hs, pairs, mesh_dirs):
 def table(name, rows, col):
     """One Markdown table of a route's levels."""
     label = "true error" if col == "error" else "vs reference"
-    lines = [f"### {name}", "", f"| level | unknowns | estimator η | {label} | η / error | min angle ° |",
-             "|---|---|---|---|---|---|"]
+    lines = [f"### {name}", "", f"| level | unknowns | estimator η | {label} | η / error | estimate E | E / error "
+             "| min angle ° |", "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         e = "–" if r[col] is None else f"{r[col]:.3e}"
         eff = "–" if r["effectivity"] is None else f"{r['effectivity']:.2f}"
+        est = r.get("estimate")
+        ee = "–" if est is None or not r[col] else f"{est / r[col]:.3f}"
         lines.append(f"| {r['level']:.0f} | {r['unknowns']:.0f} | {r['estimator']:.3e} | {e} | {eff} | "
-                     f"{r['min_angle_deg']:.2f} |")
+                     f"{'–' if est is None else f'{est:.3e}'} | {ee} | {r['min_angle_deg']:.2f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -285,11 +304,18 @@ def study(hs):
         routes[name] = [("adaptive", a), ("uniform", u)]
         md += [table(f"{name}, adaptive (θ = 0.5)", a, "error"), table(f"{name}, uniform", u, "error")]
     a, u = example_5_1(hs, 16, 12, ex51_dir)
+    estimate_check(hs, "paper_example_5_1", a, "vs_reference", "tresca-cr adapt "
+                   "verification/cases/paper_example_5_1.toml --levels 16 --theta 0.5 --reference 12 --csv …")
     routes["paper_example_5_1"] = [("adaptive", a), ("uniform", u)]
     md += [table("Example 5.1, adaptive (reference generation 12)", a, "vs_reference"),
            table("Example 5.1, uniform", u, "vs_reference")]
     a, u = lshape_mms(hs, 24, 13, mms_dir)
+    estimate_check(hs, "mms_lshape", a, "error", "tresca-cr adapt verification/cases/mms_lshape.toml --levels 24 "
+                   "--theta 0.5 --csv …")
     routes["mms_lshape"] = [("adaptive", a), ("uniform", u)]
+    a, cmd = adapt(hs, case("mms_data_front"), "mms_data_front_adaptive", 20, 0.5)
+    estimate_check(hs, "mms_data_front", a, "error", cmd)
+    md.append(table("mms_data_front, adaptive (θ = 0.5)", a, "error"))
     md += [table("mms_lshape, adaptive (θ = 0.5)", a, "error"), table("mms_lshape, uniform", u, "error")]
     a, u, physical = lshape(hs, 13, 7, 10, lsh_dir)
     routes["lshape_adapt"] = [("adaptive", a), ("uniform", u)]

@@ -87,10 +87,11 @@ def distributed(hs, quick):
 
 
 def planner(hs, quick):
-    """PL1, PL2 per manufactured case (verification/planner.py): the plans against the truth."""
+    """PL1, PL2, PL5 per manufactured case (verification/planner.py --run: the route `plan --run` recommends
+    and runs, uniform or adaptive): the plans against the truth and the cheapest grid configuration."""
     out = os.path.join(hs.out, "planner.json")
     md = os.path.join(hs.out, "planner_quick.md") if quick else hs.path("planner.md")
-    cmd = [PY, "verification/planner.py", "--json", out, "--md", md] + (["--quick"] if quick else [])
+    cmd = [PY, "verification/planner.py", "--run", "--json", out, "--md", md] + (["--quick"] if quick else [])
     hs.run_script(cmd, out, "PL0-planner")
 
 

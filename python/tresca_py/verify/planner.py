@@ -49,6 +49,7 @@ import time
 from tresca_py.common import BIN, REF, ROOT, case, cmdline, load1, run, strip_exact
 from tresca_py.verify import summary as cli_summary
 from tresca_py.verify.harness import Harness, out_dir
+from tresca_py.verify.planner_md import case_md, csv_rows, work
 from tresca_py.bench.timing import timed
 
 # grid per case: steps N_s·2^j for j < len; refinements 0..R
@@ -60,8 +61,26 @@ CASES = {
     # data with a slip front; the time grid does not move their answers (exact at the nodes / 64 steps)
     "mms_lshape": dict(doublings=1, R=6),
     "mms_data_front": dict(doublings=1, R=5),
+    # issue 42: every other manufactured case with an exact solution (R = 5 keeps the sweep's wall modest: its
+    # targets end where the grid reaches); the stops' time errors need the longer time families
+    "mms_elastic": dict(doublings=1, R=5),
+    "mms_data_cep": dict(doublings=1, R=5),
+    "mms_data_stop": dict(doublings=5, R=5),
+    "mms_stick_to_slip": dict(doublings=1, R=5),
+    "mms_signorini_coulomb": dict(doublings=1, R=5),
+    "mms_signorini_incompressible": dict(doublings=1, R=5),
+    "mms_signorini_moving": dict(doublings=1, R=5),
+    "mms_signorini_stop": dict(doublings=6, R=5),
+    "elastic_rect": dict(doublings=1, R=5),
+    "elastic_rotated": dict(doublings=1, R=5),
+    "near_incompressible": dict(doublings=1, R=5),
 }
 
+
+# PL5 (not PL3, the CPU-time requirement issue 32 removed): the plan's work within this factor of the cheapest grid
+# configuration meeting the target (issue 15's "within 2x", issue 42's requirement; in work units, not CPU time:
+# no requirement depends on a time)
+WORK_RATIO = 2.0
 
 # A target must be met by a grid point with this margin (error <= MARGIN x target) to end a sweep: the truth
 # then decides it robustly. A target that only the grid's best point meets, by less than the planner's
@@ -147,7 +166,8 @@ class Runner:
         cmd = [BIN, "run", self.full, "--refine", r, "--steps", n, "-q"] + extra
         if row is None:
             s, _ = cli_summary.run(cmd)
-            row = dict(refine=r, steps=n, tol=tol, error=s["run"]["max_errors"]["energy"], cmd=cmdline(cmd))
+            row = dict(refine=r, steps=n, tol=tol, error=s["run"]["max_errors"]["energy"], cmd=cmdline(cmd),
+                       unknowns=s["run"]["unknowns"])
         if self.costs and "cpu" not in row:
             cpu, wall, load = median_cost([BIN, "run", self.bare, "--refine", r, "--steps", n, "-q"] + extra)
             row.update(cpu=cpu, wall=wall, load=load)
@@ -175,7 +195,8 @@ def adaptive_run(runner, p, costs):
         return None
     last = a["run"][-1]
     row = dict(route="adaptive", refine=f"adapt {len(a['run'])} lv", steps=a["steps"], tol=p["tol"],
-               pred_error=last["estimate"], error=last["error"], unknowns=last["unknowns"])
+               pred_error=last["estimate"], error=last["error"], unknowns=last["unknowns"],
+               work=sum(work(lv["unknowns"], a["steps"]) for lv in a["run"]))
     if costs:
         cmd = [BIN, "adapt", runner.bare, "--levels", len(a["run"]), "--theta", 0.5, "--steps", a["steps"]]
         row["cpu"], row["wall"], _ = median_cost(cmd)
@@ -199,7 +220,13 @@ def sweep_case(name, spec, tmp, quick, cache, costs, run_plans=False):
         p, pcpu, pwall, cmd, _ = plan(runner.full, t, ["--run"] if run_plans else [], costs=costs)
         meets = [g for g in grid if g["error"] <= t]
         cheapest = min(meets, key=lambda g: g["cpu"], default=None) if costs else None
-        row = dict(case=name, target=t, planner_cpu=pcpu, planner_wall=pwall, plan_cmd=cmdline(cmd), cheapest=cheapest)
+        # PL5 compares with the cheapest configuration meeting the target with the margin MARGIN: one that meets
+        # it by less is found only by a prediction better than the pilots' 10 % (the sweep's targets, above)
+        robust = [g for g in grid if g["error"] <= MARGIN * t]
+        cheapest_work = min((dict(g, work=work(g["unknowns"], g["steps"])) for g in robust), key=lambda g: g["work"],
+                            default=None)
+        row = dict(case=name, target=t, planner_cpu=pcpu, planner_wall=pwall, plan_cmd=cmdline(cmd), cheapest=cheapest,
+                   cheapest_work=cheapest_work)
         best, adaptive = p["plan"], adaptive_run(runner, p, costs) if run_plans else None
         if adaptive is not None:
             row.update(refused=False, pilot_wall=p["pilot_wall"], pred_wall=p["adaptive"]["adaptive_wall"],
@@ -210,7 +237,7 @@ def sweep_case(name, spec, tmp, quick, cache, costs, run_plans=False):
             r, n, tol = best["refine"], best["steps"], p["tol"]
             got = runner.config(r, n, tol)
             row.update(refused=False, route="uniform", refine=r, steps=n, tol=tol, pred_error=best["error"],
-                       pred_wall=best["wall"],
+                       pred_wall=best["wall"], work=work(got["unknowns"], n),
                        pilot_wall=p["pilot_wall"], error=got["error"], cpu=got.get("cpu"), wall=got.get("wall"),
                        run_cmd=got["cmd"])
         sweep.append(row)
@@ -221,7 +248,7 @@ def sweep_case(name, spec, tmp, quick, cache, costs, run_plans=False):
 
 
 def requirements(hs, name, sweep, grid_cmd):
-    """PL1 and PL2 of one case, recorded in the harness ``hs``."""
+    """PL1, PL2 and PL5 of one case, recorded in the harness ``hs``."""
     planned = [s for s in sweep if not s["refused"]]
     met = [s for s in planned if s["error"] <= s["target"]]
     frac = len(met) / len(sweep)
@@ -235,21 +262,13 @@ def requirements(hs, name, sweep, grid_cmd):
     hs.require(f"PL2-{name}", len(planned) == len(sweep) and worst <= 1.25, f"worst true/target {worst:.3f}",
                statement=f"{name}: the plan shall never miss the target by more than 25 %", command=grid_cmd,
                reference=ref)
-
-
-def cost_rows(sweep):
-    """The --costs benchmark rows of one case (no pass/fail): the plan's CPU against the cheapest grid
-    configuration meeting the target, and the planner's CPU against the plan's at the two finest levels."""
-    planned = [s for s in sweep if not s["refused"]]
-    ratios = [s["cpu"] / s["cheapest"]["cpu"] for s in planned if s["cheapest"]]
-    uniform = [s for s in planned if s["route"] == "uniform"]
-    levels = sorted({s["refine"] for s in uniform})[-2:]
-    shares = [s["planner_cpu"] / s["cpu"] for s in uniform if s["refine"] in levels]
-    nan = float("nan")
-    return [f"plan CPU / cheapest grid CPU: max {max(ratios, default=nan):.2f}, median "
-            f"{statistics.median(ratios) if ratios else nan:.2f} over {len(ratios)} targets (issue 15: within 2x)",
-            f"planner CPU / plan CPU at refine {levels}: max {max(shares, default=nan):.3f} over {len(shares)} targets "
-            "(issue 15: < 0.2; issue 32: <= 0.05)"]
+    ratios = [s["work"] / s["cheapest_work"]["work"] for s in planned]
+    hs.require(f"PL5-{name}", len(planned) == len(sweep) and max(ratios, default=float("inf")) <= WORK_RATIO,
+               f"plan work / cheapest grid work: max {max(ratios, default=float('nan')):.2f}, median "
+               f"{statistics.median(ratios) if ratios else float('nan'):.2f} over {len(ratios)} targets",
+               statement=f"{name}: the plan (the route `plan --run` runs) shall cost at most {WORK_RATIO:g}× the "
+                         f"cheapest grid configuration that meets the target with the margin {MARGIN:g}, in work units "
+                         "n^1.5 + N·n·ln n (tresca_py/verify/planner_md.py; issue 42)", command=grid_cmd, reference=ref)
 
 
 def example51(tmp, quick, costs):
@@ -290,57 +309,6 @@ def example51(tmp, quick, costs):
                  "data need the scene's 40 (the time grids do not change the answer, above). CPU time, median of 3:\n\n"
                  "| steps | mode | CPU | command |\n|---|---|---|---|\n" + "\n".join(rows) + "\n")
     return "\n".join(lines)
-
-
-def case_md(name, grid, sweep, steps, costs):
-    """The Markdown section of one case: the sweep, the grid, and with ``costs`` the benchmark rows."""
-    md = [f"## {name}", ""]
-    if costs:
-        md += [
-            "| target | plan r | N | tol | predicted error | true error | true/target | plan CPU | predicted wall "
-            "| planner CPU | planner/plan | cheapest r, N | its error | its CPU | plan/cheapest |",
-            "|" + "---|" * 15,
-        ]
-    else:
-        md += ["| target | plan r | N | tol | predicted error | true error | true/target |", "|" + "---|" * 7]
-    for s in sweep:
-        if s["refused"]:
-            md.append(f"| {s['target']:.3e} | refused |" + " |" * (13 if costs else 5))
-            continue
-        row = (f"| {s['target']:.3e} | {s['refine']} | {s['steps']} | {s['tol']:g} | {s['pred_error']:.3e} | "
-               f"{s['error']:.3e} | {s['error'] / s['target']:.3f} |")
-        if costs:
-            ch = s["cheapest"]
-            chs = (f"{ch['refine']}, {ch['steps']} | {ch['error']:.3e} | {ch['cpu']:.3f} s") if ch else "– | – | –"
-            ratio = f"{s['cpu'] / ch['cpu']:.2f}" if ch else "–"
-            row += (f" {s['cpu']:.3f} s | {s['pred_wall']:.3f} s | {s['planner_cpu']:.3f} s | "
-                    f"{s['planner_cpu'] / s['cpu']:.3f} | {chs} | {ratio} |")
-        md.append(row)
-    what = "true energy error / CPU seconds" if costs else "true energy error"
-    md += ["", f"Plan command: `tresca-cr plan verification/cases/{name}.toml --target T`. Grid ({what}; steps as "
-           "columns):", "", "| r | " + " | ".join(f"N = {n}" for n in steps) + " |", "|" + "---|" * (len(steps) + 1)]
-    for r in sorted({g["refine"] for g in grid}):
-        cells = [next(g for g in grid if g["refine"] == r and g["steps"] == n) for n in steps]
-        md.append(f"| {r} | " + " | ".join(f"{c['error']:.3e}" + (f" / {c['cpu']:.3f}" if costs else "")
-                                          for c in cells) + " |")
-    md.append("")
-    if costs:
-        md += ["Benchmark rows (CPU times; not requirements):", ""] + [f"* {line}" for line in cost_rows(sweep)] + [""]
-    return md
-
-
-def csv_rows(sweep):
-    rows = []
-    for s in sweep:
-        if s["refused"]:
-            continue
-        ch = s["cheapest"]
-        rows.append(dict(case=s["case"], target=s["target"], refine=s["refine"], steps=s["steps"], tol=s["tol"],
-                         pred_error=s["pred_error"], true_error=s["error"], cpu=s["cpu"], wall=s["wall"],
-                         pred_wall=s["pred_wall"], planner_cpu=s["planner_cpu"],
-                         cheapest_refine=ch["refine"] if ch else "", cheapest_steps=ch["steps"] if ch else "",
-                         cheapest_cpu=ch["cpu"] if ch else ""))
-    return rows
 
 
 def main(argv=None):

@@ -33,11 +33,16 @@ impl Pilot {
     }
 }
 
-/// e_h = space_c h^space_p; e_k = time_c k^time_p or ≤ time_bound; combined as `combine`.
+/// e_h = space_c h^space_p (⊕ singular_c h^singular_p, a two-term spatial error: `plan::two_term`);
+/// e_k = time_c k^time_p or ≤ time_bound; combined as `combine`.
 #[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
 pub struct ErrorModel {
     pub space_c: f64,
     pub space_p: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub singular_c: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub singular_p: Option<f64>,
     pub time_c: Option<f64>,
     pub time_p: Option<f64>,
     pub time_bound: Option<f64>,
@@ -131,7 +136,16 @@ impl PlanSummary {
                 Combine::Quadrature => "quadrature",
                 Combine::Sum => "sum",
             };
-            ErrorModel { space_c: m.space.c, space_p: m.space.p, time_c, time_p, time_bound, combine: combine.into() }
+            ErrorModel {
+                space_c: m.space.c,
+                space_p: m.space.p,
+                singular_c: m.singular.map(|s| s.c),
+                singular_p: m.singular.map(|s| s.p),
+                time_c,
+                time_p,
+                time_bound,
+                combine: combine.into(),
+            }
         });
         PlanSummary {
             target: p.options.target,
@@ -199,6 +213,8 @@ pub(super) mod tests {
             error_model: Some(ErrorModel {
                 space_c: 0.1,
                 space_p: 1.0,
+                singular_c: Some(0.02),
+                singular_p: Some(0.7112),
                 time_c: None,
                 time_p: None,
                 time_bound: Some(1e-5),
