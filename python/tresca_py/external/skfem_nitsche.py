@@ -107,7 +107,18 @@ class Solver:
 
     def load(self, t):
         """(lⁿ, v) + N(g_n n, v) at time t (data evaluated once at the quadrature points)."""
-        prob, lam, mu, n = self.prob, self.lam_s, self.mu, self.n
+        lam, mu, n = self.lam_s, self.mu, self.n
+        rhs = self.source(t)
+        x = self.fb.global_coordinates().value
+        g = evaluate(self.contact["gap"], x[0], x[1], t)
+
+        def gap_form(v, w):
+            return g * (-_nsn(v.grad, lam, mu, n, n) + self.pen * (v[0] * n[0] + v[1] * n[1]))
+        return rhs + self.pad(asm(LinearForm(gap_form), self.fb)) + self.gap_load_p(g)
+
+    def source(self, t):
+        """(lⁿ, v): the body force and the Neumann tractions at time t, on all unknowns."""
+        prob = self.prob
         rhs = np.zeros(self.ndof)
         if prob["f"] is not None:
             x = self.basis.global_coordinates().value
@@ -118,12 +129,7 @@ class Solver:
                 x = fb.global_coordinates().value
                 tv = [evaluate(part["traction"][c], x[0], x[1], t) for c in range(2)]
                 rhs += self.pad(asm(LinearForm(lambda v, w, tv=tv: tv[0] * v[0] + tv[1] * v[1]), fb))
-        x = self.fb.global_coordinates().value
-        g = evaluate(self.contact["gap"], x[0], x[1], t)
-
-        def gap_form(v, w):
-            return g * (-_nsn(v.grad, lam, mu, n, n) + self.pen * (v[0] * n[0] + v[1] * n[1]))
-        return rhs + self.pad(asm(LinearForm(gap_form), self.fb)) + self.gap_load_p(g)
+        return rhs
 
     def pad(self, vec):
         """A u-space vector extended by zeros to all unknowns."""
