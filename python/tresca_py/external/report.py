@@ -32,6 +32,8 @@ def theory_order(code, scene, q):
     (``quantities``), so the endpoints converge at order 2/3 there."""
     sc = next((s for s in SCENES if s.name == scene), None)
     k = ORDER[code]
+    if q == "max_pressure":  # a trace of the stress: ‖σ − σ_h‖ on Γ_C ≲ h^{-1/2} ‖σ − σ_h‖_{L2(Ω)} = O(h^{k−½})
+        return k - 0.5
     return 2 / 3 if sc is not None and sc.cubic_front and q in ("stick_a", "stick_b") else k
 
 

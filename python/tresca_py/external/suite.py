@@ -15,7 +15,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import problem, quantities, skfem_mixed, skfem_nitsche, tresca
+from . import problem, quantities, skfem_mixed, skfem_nitsche, skfem_signorini, tresca
 
 GETFEM_PYTHON = "/usr/bin/python3"
 CODES = ("getfem-P1", "getfem-P2", "skfem-P2-nitsche", "getfem-TH", "skfem-TH-nitsche", "tresca-cr")
@@ -69,7 +69,22 @@ SCENES = (
     Scene("pentagon", "verification/external/scenes/pentagon_tresca.toml", (1, 2, 3, 4, 5), 1,
           "Chouly-Ern-Pignet solution at lambda = 3 on a Gmsh pentagon (12 triangles, red-refined), "
           "Dirichlet data on two sides, Neumann on one"),
+) + (
+    # unilateral contact (issue 40 item 5): the GetFEM codes use Coulomb_friction_coupled_projection, the
+    # scikit-fem code skfem_signorini. Hook: a further unilateral scene (Hertz) is one more entry here,
+    # Scene(name, path, levels, steps, note), and then shows in `run.py --scene NAME`, the tables and make verify.
+    Scene("sig_moving", "verification/cases/mms_signorini_moving.toml", (0, 1, 2, 3, 4), 8,
+          "manufactured Signorini-Tresca, moving contact/separation and stick/slip points", cubic_front=True),
+    Scene("sig_coulomb", "verification/cases/mms_signorini_coulomb.toml", (0, 1, 2, 3, 4), 8,
+          "manufactured Signorini-Coulomb, threshold F p, moving fronts", cubic_front=True),
+    Scene("coulomb_block", "verification/cases/coulomb_block.toml", (1, 2, 3, 4, 5), 8,
+          "Coulomb block (F = 0.3) pressed, then sheared by its Dirichlet top on a rigid foundation"),
 )
+
+
+def unilateral(prob):
+    """Whether a problem's contact part is unilateral (u·n ≤ g) rather than bilateral (u·n = g)."""
+    return any(p["kind"] == "contact" and p.get("law") == "unilateral" for p in prob["parts"])
 
 
 def getfem_available():
@@ -126,7 +141,8 @@ def run_scene(sc: Scene, codes, out_dir, binary, log=print):
             if code.startswith("getfem"):
                 raw = run_getfem(prob, work)
             elif code == "skfem-P2-nitsche":
-                raw = skfem_nitsche.solve(prob)
+                raw = skfem_nitsche.solve(prob, skfem_signorini.SignoriniSolver if unilateral(prob)
+                                          else skfem_nitsche.Solver)
             elif code == "skfem-TH-nitsche":
                 raw = skfem_nitsche.solve(prob, skfem_mixed.MixedSolver)
             else:
