@@ -204,15 +204,19 @@ class Solver:
             y = lu.solve(-res[free])
             du = np.zeros_like(u)
             du[free] = y - Z @ np.linalg.solve(np.eye(B.size) + M @ Z, M @ y)
-            alpha = 1.0
-            while True:
-                res_new, chi_new = self.residual(A, rhs, u + alpha * du, u_prev, t)
-                if np.linalg.norm(res_new[free]) / scale < (1 - 1e-4 * alpha) * rnorm or alpha < 1e-3:
-                    break
-                alpha *= 0.5
-            u, res, chi = u + alpha * du, res_new, chi_new
+            u, res, chi, alpha = self.line_search(A, rhs, u, du, u_prev, t, rnorm, scale, free)
         raise NotConverged(f"skfem-nitsche: step at t={t:g} did not converge in {max_iter} Newton iterations "
                            f"(relative residual {rnorm:.3e})")
+
+    def line_search(self, A, rhs, u, du, u_prev, t, rnorm, scale, free):
+        """Backtracking on |R| over the free dofs from u along du (halving α from 1 until the residual norm
+        divided by scale falls below (1 − 10⁻⁴α)·rnorm, or α < 10⁻³): (u + α du, its residual, its state, α)."""
+        alpha = 1.0
+        while True:
+            res_new, state_new = self.residual(A, rhs, u + alpha * du, u_prev, t)
+            if np.linalg.norm(res_new[free]) / scale < (1 - 1e-4 * alpha) * rnorm or alpha < 1e-3:
+                return u + alpha * du, res_new, state_new, alpha
+            alpha *= 0.5
 
     def embed(self, mat):
         """A u-space matrix as the u block of a matrix on all unknowns."""

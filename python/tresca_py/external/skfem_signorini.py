@@ -108,13 +108,7 @@ class SignoriniSolver(Solver):
             J = self.jacobian(state, t).tocsr()[free][:, free].tocsc()
             du = np.zeros_like(u)
             du[free] = spla.splu(J).solve(-res[free])
-            alpha = 1.0
-            while True:
-                res_new, state_new = self.residual(self.K, rhs, u + alpha * du, u_prev, t)
-                if np.linalg.norm(res_new[free]) / scale < (1 - 1e-4 * alpha) * rnorm or alpha < 1e-3:
-                    break
-                alpha *= 0.5
-            u, res, state = u + alpha * du, res_new, state_new
+            u, res, state, _ = self.line_search(self.K, rhs, u, du, u_prev, t, rnorm, scale, free)
         raise NotConverged(f"skfem-signorini: step at t={t:g} did not converge in {max_iter} Newton iterations "
                            f"(relative residual {rnorm:.3e})")
 
