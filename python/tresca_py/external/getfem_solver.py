@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""GetFEM 5.4 (Debian python3-getfem) solver for bilateral contact with Tresca friction, P1 or P2 Lagrange.
+"""GetFEM 5.4 (Debian python3-getfem) solver for bilateral contact with Tresca friction, P1 or P2 Lagrange,
+and for unilateral contact with Tresca or Coulomb friction (``Solver._unilateral_terms``).
 
 Standalone: it imports only numpy, getfem and the standard library, because Debian's GetFEM lives under
 /usr/bin/python3 (3.11), outside the project's venv. Usage:
@@ -176,17 +177,7 @@ class Solver:
             md.assembly("build_rhs")
             r0 = max(float(np.linalg.norm(md.rhs())), 1e-300)
             target = tol * r0  # relative to the step's first residual
-            # unilateral: the "simplest" line search (Armijo on the residual); "basic" stalled on sig_moving,
-            # P1, 64×64 cells, step 5 (residual 2.9e-3 of r0 after 40 iterations)
-            nit, converged = md.solve("max_res", target, "max_iter", max_iter, "lsearch",
-                                      "simplest" if self.unilateral else "basic")
-            md.assembly("build_rhs")
-            rnorm = float(np.linalg.norm(md.rhs()))
-            # rounding floor: at λ/μ = 10⁴ (cep, P1, 64×64 cells) Newton stalls at ~1e-9·r0 ≈ ε·cond(A); a
-            # stalled iteration below FLOOR·r0 is accepted, anything else is a failure
-            if not np.isfinite(rnorm) or rnorm > (10 * target if converged else FLOOR * r0):
-                raise RuntimeError(f"getfem: step {n} (t={t:g}) did not converge: {nit} Newton iterations, "
-                                   f"residual {rnorm:.3e} (target {target:.3e})")
+            nit = self.newton(n, t, target, r0, max_iter)
             iters.append(int(nit))
         wall = time.perf_counter() - t0
         out = self.quantities(times[-1])
@@ -195,6 +186,24 @@ class Solver:
                     "wall_s": wall,
                     "newton_iterations": iters})
         return out
+
+    def newton(self, n, t, target, r0, max_iter):
+        """GetFEM's Newton for step n from the previous u; the iteration count. Unilateral: from the same start
+        with the line searches "basic", then "simplest", then "systematic" until one converges (the semismooth
+        iteration cycles with "basic" on sig_moving, P1, 64×64 cells, step 5, residual 2.9e-3·r0 after 40
+        iterations, and with "simplest" on sig_moving, P2, 4×4 cells, step 7); bilateral: "basic" only."""
+        md, start, msg = self.md, self.md.variable("u"), ""
+        for search in ("basic", "simplest", "systematic") if self.unilateral else ("basic",):
+            md.set_variable("u", start)
+            nit, converged = md.solve("max_res", target, "max_iter", max_iter, "lsearch", search)
+            md.assembly("build_rhs")
+            rnorm = float(np.linalg.norm(md.rhs()))
+            # rounding floor: at λ/μ = 10⁴ (cep, P1, 64×64 cells) Newton stalls at ~1e-9·r0 ≈ ε·cond(A); a
+            # stalled iteration below FLOOR·r0 is accepted, anything else is a failure
+            if np.isfinite(rnorm) and rnorm <= (10 * target if converged else FLOOR * r0):
+                return int(nit)
+            msg += f"; {search}: {nit} Newton iterations, residual {rnorm:.3e}"
+        raise RuntimeError(f"getfem: step {n} (t={t:g}) did not converge (target {target:.3e}){msg}")
 
     def quantities(self, t):
         md, mim, mfu, pr = self.md, self.mim, self.mfu, self.prob["probes"]
