@@ -78,7 +78,7 @@ SCENES = (
     Scene("sig_coulomb", "verification/cases/mms_signorini_coulomb.toml", (0, 1, 2, 3, 4), 8,
           "manufactured Signorini-Coulomb, threshold F p, moving fronts", cubic_front=True),
     Scene("coulomb_block", "verification/cases/coulomb_block.toml", (1, 2, 3, 4, 5), 8,
-          "Coulomb block (F = 0.3) pressed, then sheared by its Dirichlet top on a rigid foundation"),
+          "Coulomb block (F = 0.3) pressed and sheared at once by its Dirichlet top on a rigid foundation"),
 )
 
 
