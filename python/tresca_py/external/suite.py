@@ -76,7 +76,10 @@ SCENES = (
     Scene("sig_moving", "verification/cases/mms_signorini_moving.toml", (0, 1, 2, 3, 4), 8,
           "manufactured Signorini-Tresca, moving contact/separation and stick/slip points", cubic_front=True),
     Scene("sig_coulomb", "verification/cases/mms_signorini_coulomb.toml", (0, 1, 2, 3, 4), 8,
-          "manufactured Signorini-Coulomb, threshold F p, moving fronts", cubic_front=True),
+          "manufactured Signorini-Coulomb, threshold F p, moving fronts", cubic_front=True,
+          # GetFEM P1's Newton does not converge at 64×64 cells (step 1: residual 1e-4·r0 after 40 iterations
+          # with each of its line searches basic, simplest, systematic); P2 runs one level lower and converges
+          codes=tuple(c for c in DEFAULT_CODES if c != "getfem-P1")),
     Scene("coulomb_block", "verification/cases/coulomb_block.toml", (1, 2, 3, 4, 5), 8,
           "Coulomb block (F = 0.3) pressed and sheared at once by its Dirichlet top on a rigid foundation"),
 )
