@@ -196,7 +196,7 @@ def markdown(rows, scenes, notes, reqs, elapsed, lims, ref_dir):
         out += [f"## {sc.name}: {sc.note}", "",
                 f"`{sc.path}`, refine {', '.join(map(str, sc.levels))}, {sc.steps} step(s). "
                 f"Command: `{ENTRY} --scene {sc.name}` (one code: add `--code CODE`).", ""]
-        scene_notes = list(notes.get(sc.name, []))
+        scene_notes = list(notes.get(sc.name, [])) + ([sc.remark] if sc.remark else [])
         if sc.locking:
             scene_notes.append("λ/μ = 10⁴: getfem-P1 is the locking witness (out of XA and XO: conforming P1's "
                                "asymptotic range needs h√(λ/μ) ≪ 1); the displacement-only P2 codes are in XA "

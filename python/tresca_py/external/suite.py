@@ -47,6 +47,9 @@ class Scene:
     locking: bool = False
     #: the manufactured stick margin closes cubically at the fronts: the endpoints' theoretical order is k/3
     cubic_front: bool = False
+    #: codes kept in the tables but left out of XA, with the reason in ``remark`` (printed under the scene)
+    xa_exclude: tuple = ()
+    remark: str = ""
 
     def levels_of(self, code):
         return tuple(r + P2_SHIFT for r in self.levels) if ORDER[code] == 2 else self.levels
@@ -77,11 +80,16 @@ SCENES = (
           "manufactured Signorini-Tresca, moving contact/separation and stick/slip points", cubic_front=True),
     Scene("sig_coulomb", "verification/cases/mms_signorini_coulomb.toml", (0, 1, 2, 3, 4), 8,
           "manufactured Signorini-Coulomb, threshold F p, moving fronts", cubic_front=True,
-          # GetFEM P1's Newton does not converge at 64×64 cells (step 1: residual 1e-4·r0 after 40 iterations
-          # with each of its line searches basic, simplest, systematic); P2 runs one level lower and converges
-          codes=tuple(c for c in DEFAULT_CODES if c != "getfem-P1")),
+          codes=("skfem-P2-nitsche", "tresca-cr"),
+          remark="GetFEM is not run here: its Newton on the Coulomb coupled projection does not converge at "
+                 "the finer levels (P1, 64×64 cells, step 1: residual 1e-4·r0; P2, 32×32 cells, step 2: 8e-6·r0, "
+                 "after 40 iterations with each line search basic, simplest, systematic)"),
     Scene("coulomb_block", "verification/cases/coulomb_block.toml", (1, 2, 3, 4, 5), 8,
-          "Coulomb block (F = 0.3) pressed and sheared at once by its Dirichlet top on a rigid foundation"),
+          "Coulomb block (F = 0.3) pressed and sheared at once by its Dirichlet top on a rigid foundation",
+          xa_exclude=("getfem-P1",),
+          remark="getfem-P1 is out of XA: its θ = 0 Nitsche stick zone carries slip increments above the "
+                 "threshold (h/|Γ_C|)² max|δu_τ|, so its stick–slip endpoints are not found (NaN at refine 3, "
+                 "one short zone elsewhere); its other quantities are in the table"),
 )
 
 
