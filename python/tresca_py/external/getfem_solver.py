@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""GetFEM 5.4 (Debian python3-getfem) solver for bilateral contact with Tresca friction, P1 or P2 Lagrange.
+"""GetFEM 5.4 (Debian python3-getfem) solver for bilateral contact with Tresca friction, P1 or P2 Lagrange,
+and for unilateral contact with Tresca or Coulomb friction (``Solver._unilateral_terms``).
 
 Standalone: it imports only numpy, getfem and the standard library, because Debian's GetFEM lives under
 /usr/bin/python3 (3.11), outside the project's venv. Usage:
@@ -108,13 +109,38 @@ class Solver:
         self._scalar_data("GAP", self.contact["gap"])
         self._scalar_data("GA", self.contact["g_a"])
         md.add_initialized_fem_data("UP", self.mfu, np.zeros(self.mfu.nbdof()))
-        if self.mixed:
+        self.unilateral = self.contact.get("law") == "unilateral"
+        if self.unilateral:
+            self._unilateral_terms()
+        elif self.mixed:
             md.add_nonlinear_term(self.mim, NITSCHE_M, CONTACT)
             md.add_nonlinear_term(self.mim, "-" + PROJ.replace(SIGMA, SIGMA_M) + ".Test_u", CONTACT)
         else:
             md.add_normal_Dirichlet_condition_with_Nitsche_method(self.mim, "u", md.Neumann_term("u", CONTACT),
                                                                   "gamma0", CONTACT, 1.0, "GAP")
             md.add_nonlinear_term(self.mim, "-" + PROJ + ".Test_u", CONTACT)
+
+    def _unilateral_terms(self):
+        """Signorini with Tresca or Coulomb friction (Chouly–Hild–Renard Nitsche, θ = 0): −∫_{Γ_C} P·v with P
+        GetFEM's ``Coulomb_friction_coupled_projection`` of the reaction r(u) = σ(u)n − t_C at the gap
+        g − u·n, the slip increment u − uⁿ⁻¹ and r = 1/(γ₀ h): normal part −(r_n(u) − (u·n − g)/(γ₀h))₋,
+        tangential part its ball projection of radius f; f = [0, g_a, g_a] is Tresca's threshold g_a (adhesion
+        τ_adh = g_a capped at g_a, also on separated points), a scalar f = F is Coulomb's F·pressure."""
+        md, c = self.md, self.contact
+        lam_expr = SIGMA + "*Normal"
+        if c.get("contact_traction") is not None:
+            self._fem_data("TC", c["contact_traction"])
+            md.add_source_term_brick(self.mim, "u", "[TC1;TC2]", CONTACT)
+            lam_expr = "(" + lam_expr + " - [TC1;TC2])"
+        if c.get("coulomb") is not None:
+            self._scalar_data("FC", c["coulomb"])
+            fr = "FC"
+        else:
+            fr = "[0;GA;GA]"
+        self.lam_expr = lam_expr
+        self.cfp = (f"Coulomb_friction_coupled_projection({lam_expr}, Normal, u-UP, GAP-u.Normal, {fr}, "
+                    "1/(gamma0*element_size))")
+        md.add_nonlinear_term(self.mim, "-" + self.cfp + ".Test_u", CONTACT)
 
     def _scalar_data(self, name, src):
         self.md.add_initialized_fem_data(name, self.mfd, np.zeros(self.mfd.nbdof()))
@@ -151,14 +177,7 @@ class Solver:
             md.assembly("build_rhs")
             r0 = max(float(np.linalg.norm(md.rhs())), 1e-300)
             target = tol * r0  # relative to the step's first residual
-            nit, converged = md.solve("max_res", target, "max_iter", max_iter, "lsearch", "basic")
-            md.assembly("build_rhs")
-            rnorm = float(np.linalg.norm(md.rhs()))
-            # rounding floor: at λ/μ = 10⁴ (cep, P1, 64×64 cells) Newton stalls at ~1e-9·r0 ≈ ε·cond(A); a
-            # stalled iteration below FLOOR·r0 is accepted, anything else is a failure
-            if not np.isfinite(rnorm) or rnorm > (10 * target if converged else FLOOR * r0):
-                raise RuntimeError(f"getfem: step {n} (t={t:g}) did not converge: {nit} Newton iterations, "
-                                   f"residual {rnorm:.3e} (target {target:.3e})")
+            nit = self.newton(n, t, target, r0, max_iter)
             iters.append(int(nit))
         wall = time.perf_counter() - t0
         out = self.quantities(times[-1])
@@ -167,6 +186,26 @@ class Solver:
                     "wall_s": wall,
                     "newton_iterations": iters})
         return out
+
+    def newton(self, n, t, target, r0, max_iter):
+        """GetFEM's Newton for step n from the previous u; the iteration count. Unilateral: from the same start
+        with the line searches "basic", then "simplest", then "systematic" until one converges (the semismooth
+        iteration cycles with "basic" on sig_moving, P1, 64×64 cells, step 5, residual 2.9e-3·r0 after 40
+        iterations, and with "simplest" on sig_moving, P2, 4×4 cells, step 7); bilateral: "basic" only."""
+        md, start, msg = self.md, self.md.variable("u"), ""
+        if self.unilateral:  # the Coulomb coupled projection took 82 iterations (sig_coulomb, P2, 32×32 cells)
+            max_iter = max(max_iter, 150)
+        for search in ("basic", "simplest", "systematic") if self.unilateral else ("basic",):
+            md.set_variable("u", start)
+            nit, converged = md.solve("max_res", target, "max_iter", max_iter, "lsearch", search)
+            md.assembly("build_rhs")
+            rnorm = float(np.linalg.norm(md.rhs()))
+            # rounding floor: at λ/μ = 10⁴ (cep, P1, 64×64 cells) Newton stalls at ~1e-9·r0 ≈ ε·cond(A); a
+            # stalled iteration below FLOOR·r0 is accepted, anything else is a failure
+            if np.isfinite(rnorm) and rnorm <= (10 * target if converged else FLOOR * r0):
+                return int(nit)
+            msg += f"; {search}: {nit} Newton iterations, residual {rnorm:.3e}"
+        raise RuntimeError(f"getfem: step {n} (t={t:g}) did not converge (target {target:.3e}){msg}")
 
     def quantities(self, t):
         md, mim, mfu, pr = self.md, self.mim, self.mfu, self.prob["probes"]
@@ -177,10 +216,17 @@ class Solver:
         energy = gf.asm("generic", mim, 0, "mu*Sym(Grad_u):Sym(Grad_u) + 0.5*p*p/lambda" if self.mixed
                         else "0.5*(" + SIGMA + "):Sym(Grad_u)", -1, md)
         sig_expr = SIGMA_M if self.mixed else SIGMA
-        sig = gf.asm("generic", mim, 0, "[-Normal(2);Normal(1)]." + PROJ.replace(SIGMA, sig_expr), CONTACT, md)
         mimd2, mimd1 = gf.MeshImData(mim, CONTACT, [2]), gf.MeshImData(mim, CONTACT)
+        extra = {}
+        if self.unilateral:
+            sig = gf.asm("generic", mim, 0, "[-Normal(2);Normal(1)]." + self.cfp, CONTACT, md)
+            extra = {"normal_force": float(gf.asm("generic", mim, 0, "-Normal." + self.cfp, CONTACT, md)),
+                     "max_pressure": float(np.max(md.interpolation("-Normal." + self.cfp, mimd1, CONTACT)))}
+            margin = np.zeros(0)
+        else:
+            sig = gf.asm("generic", mim, 0, "[-Normal(2);Normal(1)]." + PROJ.replace(SIGMA, sig_expr), CONTACT, md)
+            margin = np.asarray(md.interpolation("GA - " + QTAU.replace(SIGMA, sig_expr), mimd1, CONTACT))
         xq = np.asarray(md.interpolation("X", mimd2, CONTACT)).reshape(-1, 2).T
-        margin = np.asarray(md.interpolation("GA - " + QTAU.replace(SIGMA, sig_expr), mimd1, CONTACT))
         stick = margin > 0
         dslip = np.asarray(md.interpolation("Norm((Id(2) - Normal@Normal)*(u - UP))", mimd1, CONTACT))
         start = np.asarray(pr["start"])
@@ -192,7 +238,7 @@ class Solver:
         out = {"h1_norm": float(np.hypot(l2, semi)), "energy": float(energy), "sigma_t_integral": float(sig),
                "u_tau_points": probe(pr["points"]).tolist(), "u_tau_samples": probe(pr["samples"]).tolist(),
                "quad_s": s_q.tolist(), "quad_stick": stick.astype(int).tolist(), "quad_margin": margin.tolist(),
-               "quad_dslip": dslip.tolist()}
+               "quad_dslip": dslip.tolist(), **extra}
         if self.prob["exact"] is not None:
             out.update(self.errors(U, t))
         return out

@@ -141,6 +141,17 @@ def _vec(texts, key):
     return [code(s, f"{key}[{i}]") for i, s in enumerate(texts)]
 
 
+def _contact_law(b, k):
+    """A contact part's law (bilateral or unilateral u·n ≤ g), its Coulomb coefficient F (code or None: Tresca
+    with g_a) and its prescribed contact traction t_C (σ(u)n = r + t_C on Γ_C, r the reaction; or None)."""
+    law = b.get("law", "bilateral")
+    if law not in ("bilateral", "unilateral"):
+        raise ProblemError(f"boundary[{k}].law: {law!r} is not bilateral/unilateral")
+    coulomb = b.get("coulomb")
+    return {"law": law, "coulomb": None if coulomb is None else code(coulomb, f"boundary[{k}].coulomb"),
+            "contact_traction": _vec(b.get("traction"), f"boundary[{k}].traction")}
+
+
 def read_scene(path):
     """The TOML of a scene as a dict (tomllib), with a clear error for a missing or malformed file."""
     path = Path(path)
@@ -177,6 +188,7 @@ def load(path):
             n_contact += 1
             part["g_a"] = code(b.get("g_a", "0"), f"boundary[{k}].g_a")
             part["gap"] = code(b.get("gap", "0"), f"boundary[{k}].gap")
+            part.update(_contact_law(b, k))
         else:
             raise ProblemError(f"boundary[{k}].kind: {kind!r} is not dirichlet/neumann/contact")
         parts.append(part)

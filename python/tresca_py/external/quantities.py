@@ -35,7 +35,10 @@ import numpy as np
 
 #: quantities compared between codes, in table order
 QUANTITIES = ("h1_norm", "energy", "u_tau_1", "u_tau_2", "u_tau_3", "sigma_t_integral", "stick_a", "stick_b",
-              "max_slip")
+              "max_slip", "normal_force", "max_pressure")
+#: quantities only the unilateral codes report (NaN on bilateral scenes): the total normal force ∫_{Γ_C} p and
+#: the maximal contact pressure max p (Nitsche: at the contact quadrature points; tresca-cr: over the edges)
+UNILATERAL = ("normal_force", "max_pressure")
 ERRORS = ("err_h1_semi", "err_l2")
 
 
@@ -72,6 +75,8 @@ def summarise(raw, probes):
     keep = ~((start_d & (s_q < raw["h"])) | (end_d & (s_q > length - raw["h"])))
     eta = slip_threshold(dslip, raw["h"], length)
     row["stick_a"], row["stick_b"] = stick_ends(s_q[keep], dslip[keep], eta)
+    for k in UNILATERAL:
+        row[k] = float(raw.get(k, math.nan))
     for k in ERRORS:
         if k in raw:
             row[k] = float(raw[k])

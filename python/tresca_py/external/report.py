@@ -8,7 +8,7 @@ from pathlib import Path
 
 from tresca_py.common import orders
 
-from .quantities import ERRORS, QUANTITIES
+from .quantities import ERRORS, QUANTITIES, UNILATERAL
 from .richardson import limit
 from .suite import ORDER, SCENES
 
@@ -32,6 +32,8 @@ def theory_order(code, scene, q):
     (``quantities``), so the endpoints converge at order 2/3 there."""
     sc = next((s for s in SCENES if s.name == scene), None)
     k = ORDER[code]
+    if q == "max_pressure":  # a trace of the stress: ‖σ − σ_h‖ on Γ_C ≲ h^{-1/2} ‖σ − σ_h‖_{L2(Ω)} = O(h^{k−½})
+        return k - 0.5
     return 2 / 3 if sc is not None and sc.cubic_front and q in ("stick_a", "stick_b") else k
 
 
@@ -179,14 +181,22 @@ def markdown(rows, scenes, notes, reqs, elapsed, lims, ref_dir):
            "confirms p (GCI ratio within 10 %, as `tresca-cr study`), otherwise no extrapolation and the band",
            "3·max(|d₁|, |d₂|)/(2^p_th − 1) with the theoretical order p_th (the code's H1 order k; 2/3 for the",
            "endpoints on the scenes whose slip grows cubically from the fronts). Raw rows:",
-           "`reference/external.csv`.", ""]
+           "`reference/external.csv`.",
+           "",
+           "Unilateral scenes (issue 40 item 5: sig_moving, sig_coulomb, coulomb_block): GetFEM P1/P2 with the",
+           "Nitsche term (θ = 0) built on GWFL's `Coulomb_friction_coupled_projection` of σ(u)n − t_C at the gap",
+           "g − u·n, the slip increment and r = 1/(γ₀h) (Tresca: f = [0, g_a, g_a]; Coulomb: f = F), the scikit-fem",
+           "P2 solver extended to Signorini (`tresca_py/external/skfem_signorini.py`, Chouly–Hild–Renard Nitsche",
+           "θ = 0, semismooth Newton) and tresca-cr. Two more quantities: normal_force = ∫_{Γ_C} p and",
+           "max_pressure = max p (Nitsche: at the contact quadrature points; tresca-cr: over the edges, p_e),",
+           "the latter with theoretical order k − ½ (a stress trace).", ""]
     for sc in scenes:
         L = lims[sc.name]
         codes = sorted(L)
         out += [f"## {sc.name}: {sc.note}", "",
                 f"`{sc.path}`, refine {', '.join(map(str, sc.levels))}, {sc.steps} step(s). "
                 f"Command: `{ENTRY} --scene {sc.name}` (one code: add `--code CODE`).", ""]
-        scene_notes = list(notes.get(sc.name, []))
+        scene_notes = list(notes.get(sc.name, [])) + ([sc.remark] if sc.remark else [])
         if sc.locking:
             scene_notes.append("λ/μ = 10⁴: getfem-P1 is the locking witness (out of XA and XO: conforming P1's "
                                "asymptotic range needs h√(λ/μ) ≪ 1); the displacement-only P2 codes are in XA "
@@ -194,6 +204,8 @@ def markdown(rows, scenes, notes, reqs, elapsed, lims, ref_dir):
         out += [f"- {n}" for n in scene_notes] + ([""] if scene_notes else [])
         out += ["| quantity | " + " | ".join(codes) + " |", "|---|" + "---|" * len(codes)]
         for q in QUANTITIES:
+            if q in UNILATERAL and not any(math.isfinite(L[c][q].value) for c in codes):
+                continue  # a bilateral scene: no normal force or pressure reported
             out.append(f"| {q} | " + " | ".join(_fmt(L[c][q]) for c in codes) + " |")
         eo = error_orders(rows, sc.name)
         if eo:

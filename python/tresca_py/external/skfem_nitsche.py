@@ -107,7 +107,18 @@ class Solver:
 
     def load(self, t):
         """(lⁿ, v) + N(g_n n, v) at time t (data evaluated once at the quadrature points)."""
-        prob, lam, mu, n = self.prob, self.lam_s, self.mu, self.n
+        lam, mu, n = self.lam_s, self.mu, self.n
+        rhs = self.source(t)
+        x = self.fb.global_coordinates().value
+        g = evaluate(self.contact["gap"], x[0], x[1], t)
+
+        def gap_form(v, w):
+            return g * (-_nsn(v.grad, lam, mu, n, n) + self.pen * (v[0] * n[0] + v[1] * n[1]))
+        return rhs + self.pad(asm(LinearForm(gap_form), self.fb)) + self.gap_load_p(g)
+
+    def source(self, t):
+        """(lⁿ, v): the body force and the Neumann tractions at time t, on all unknowns."""
+        prob = self.prob
         rhs = np.zeros(self.ndof)
         if prob["f"] is not None:
             x = self.basis.global_coordinates().value
@@ -118,12 +129,7 @@ class Solver:
                 x = fb.global_coordinates().value
                 tv = [evaluate(part["traction"][c], x[0], x[1], t) for c in range(2)]
                 rhs += self.pad(asm(LinearForm(lambda v, w, tv=tv: tv[0] * v[0] + tv[1] * v[1]), fb))
-        x = self.fb.global_coordinates().value
-        g = evaluate(self.contact["gap"], x[0], x[1], t)
-
-        def gap_form(v, w):
-            return g * (-_nsn(v.grad, lam, mu, n, n) + self.pen * (v[0] * n[0] + v[1] * n[1]))
-        return rhs + self.pad(asm(LinearForm(gap_form), self.fb)) + self.gap_load_p(g)
+        return rhs
 
     def pad(self, vec):
         """A u-space vector extended by zeros to all unknowns."""
@@ -198,15 +204,19 @@ class Solver:
             y = lu.solve(-res[free])
             du = np.zeros_like(u)
             du[free] = y - Z @ np.linalg.solve(np.eye(B.size) + M @ Z, M @ y)
-            alpha = 1.0
-            while True:
-                res_new, chi_new = self.residual(A, rhs, u + alpha * du, u_prev, t)
-                if np.linalg.norm(res_new[free]) / scale < (1 - 1e-4 * alpha) * rnorm or alpha < 1e-3:
-                    break
-                alpha *= 0.5
-            u, res, chi = u + alpha * du, res_new, chi_new
+            u, res, chi, alpha = self.line_search(A, rhs, u, du, u_prev, t, rnorm, scale, free)
         raise NotConverged(f"skfem-nitsche: step at t={t:g} did not converge in {max_iter} Newton iterations "
                            f"(relative residual {rnorm:.3e})")
+
+    def line_search(self, A, rhs, u, du, u_prev, t, rnorm, scale, free):
+        """Backtracking on |R| over the free dofs from u along du (halving α from 1 until the residual norm
+        divided by scale falls below (1 − 10⁻⁴α)·rnorm, or α < 10⁻³): (u + α du, its residual, its state, α)."""
+        alpha = 1.0
+        while True:
+            res_new, state_new = self.residual(A, rhs, u + alpha * du, u_prev, t)
+            if np.linalg.norm(res_new[free]) / scale < (1 - 1e-4 * alpha) * rnorm or alpha < 1e-3:
+                return u + alpha * du, res_new, state_new, alpha
+            alpha *= 0.5
 
     def embed(self, mat):
         """A u-space matrix as the u block of a matrix on all unknowns."""

@@ -46,6 +46,7 @@ def read_results(path, probes, pen_scale):
         g_mean = g["contact/g"][:]
         energy = 0.5 * float(g["energy"][-1])
         err = {k: float(g[f"errors/{k}"][-1]) for k in ("h1", "l2")} if "errors" in g else {}
+        pressure = g["contact/pressure"][-1] if "contact/pressure" in g else None
     te = _tri_edges(tri, edges)
     P = pts[tri]
     grads, area = _bary_grads(P)
@@ -82,6 +83,8 @@ def read_results(path, probes, pen_scale):
            "quad_s": mids.tolist(), "quad_stick": (state == 0).astype(int).tolist(), "dofs": int(2 * len(edges)),
            "quad_margin": (g_mean - np.abs(sig - pen_scale / lengths * (slip[-1] - slip[0]))).tolist(),
            "quad_dslip": np.abs(slip[-1] - slip[0]).tolist()}
+    if pressure is not None:  # a unilateral scene: p_e = P_e/|e| per contact edge
+        raw["normal_force"], raw["max_pressure"] = float(np.sum(pressure * lengths)), float(np.max(pressure))
     if err:
         raw["err_h1_semi"], raw["err_l2"] = err["h1"], err["l2"]
     return raw
