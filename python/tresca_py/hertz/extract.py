@@ -53,9 +53,14 @@ def facing_edges(r):
 
 def check(path, R, E, nu):
     """The :class:`Check` of the results file ``path`` (cylinder of radius R, material E, ν)."""
-    x0, x1, length, ny, p = facing_edges(results.read(path))
+    return check_results(results.read(path), R, E, nu)
+
+
+def check_results(r, R, E, nu):
+    """The :class:`Check` of results ``r`` (a :class:`tresca_py.results.Results`)."""
+    x0, x1, length, ny, p = facing_edges(r)
     if not np.any(p > 0):
-        raise ValueError(f"{path}: no pressed contact edge (p_e > 0): the cylinder does not touch the plane")
+        raise ValueError(f"{r.path}: no pressed contact edge (p_e > 0): the cylinder does not touch the plane")
     P = 2.0 * float(np.sum(length * p * ny))
     a = formulas.half_width(P, R, E, nu)
     p0 = formulas.peak_pressure(P, a)

@@ -44,15 +44,15 @@ def profile(x, a, p0):
     return p0 * np.sqrt(np.clip(1.0 - (x / a) ** 2, 0.0, None))
 
 
-def edge_means(x0, x1, a, p0, points=8):
-    """Mean of the Hertz profile over each segment [x0, x1] of the x axis (Gauss–Legendre with ``points``
-    nodes on each side of ±a so that the kink is a node; exact to rounding for the pieces that are smooth)."""
+def edge_means(x0, x1, a, p0):
+    """Mean of the Hertz profile over each segment [x0, x1] of the x axis, exactly: with x = a sin t,
+    ∫ √(1 − x²/a²) dx = (a/2)(t + sin t cos t), t clipped to [−π/2, π/2] outside the zone."""
     x0, x1 = np.asarray(x0, float), np.asarray(x1, float)
-    lo, hi = np.minimum(x0, x1), np.maximum(x0, x1)
-    t, w = np.polynomial.legendre.leggauss(points)
-    total = np.zeros_like(lo)
-    for s, e in ((lo, np.minimum(hi, a)), (np.maximum(lo, a), hi)):
-        ln = np.clip(e - s, 0.0, None)
-        xs = 0.5 * (s + e)[:, None] + 0.5 * ln[:, None] * t[None, :]
-        total += 0.5 * ln * (profile(xs, a, p0) @ w)
-    return total / np.where(hi > lo, hi - lo, 1.0)
+
+    def primitive(x):
+        t = np.arcsin(np.clip(x / a, -1.0, 1.0))
+        return 0.5 * a * (t + np.sin(t) * np.cos(t))
+
+    length = x1 - x0
+    return p0 * np.where(length != 0, (primitive(x1) - primitive(x0)) / np.where(length != 0, length, 1.0),
+                         profile(x0, a, 1.0))

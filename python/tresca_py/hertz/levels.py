@@ -33,15 +33,16 @@ def load(name, a_over_R, delta):
 LOADS = (load("hertz_a10", 0.1, 0.015), load("hertz_a05", 0.05, 0.0042))
 
 
-def write_level(directory, ld: Load, level):
-    """Write NAME_lLEVEL.msh and NAME_lLEVEL.toml into ``directory``; the scene's path."""
+def write_level(directory, ld: Load, level, stem=None, header=""):
+    """Write STEM.msh and STEM.toml (default stem NAME_lLEVEL) into ``directory``, the scene text after
+    ``header``; the scene's path."""
     os.makedirs(directory, exist_ok=True)
-    stem = f"{ld.name}_l{level}"
+    stem = stem or f"{ld.name}_l{level}"
     write_msh(os.path.join(directory, stem + ".msh"), *quarter_disc(ld.case.R, ld.grading, level))
     path = os.path.join(directory, stem + ".toml")
     title = f"Hertz: elastic cylinder on a rigid plane, {ld.name}, mesh level {level} (tresca_py.hertz)"
     with open(path, "w", encoding="utf-8") as f:
-        f.write(scene_text(ld.case, stem + ".msh", title))
+        f.write(header + scene_text(ld.case, stem + ".msh", title))
     return path
 
 

@@ -55,6 +55,8 @@ def discretisation(rows, key):
     """(errors |f_l − f_finest|/|f_finest| for l < finest, successive orders, fitted order) of quantity ``key``."""
     f = rows[-1][key]
     e = [abs(r[key] - f) / abs(f) for r in rows[:-1]]
+    if min(e) == 0:                               # no order from an exact zero (a pointwise value can repeat)
+        return e, [math.nan] * (len(e) - 1), math.nan
     succ, fit = orders([r["h"] for r in rows[:-1]], e)
     return e, succ, fit
 
