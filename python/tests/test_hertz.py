@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from tresca_py.hertz import extract, formulas
-from tresca_py.hertz.levels import LOADS, write_level
+from tresca_py.hertz.levels import LOADS, variant, write_level
 from tresca_py.hertz.mesh import Grading, quarter_disc
 from tresca_py.scene import load_scene
 from tresca_py.verify import hertz as vh
@@ -52,8 +52,9 @@ def test_mesh_on_circle_and_parts():
 
 
 def test_scene_loads(tmp_path):
-    """The system shall write a Hertz scene that the scene reader accepts, with its symmetry and unilateral parts."""
-    path = write_level(str(tmp_path), LOADS[0], 0)
+    """The system shall write a Hertz scene that the Python scene reader accepts, with its symmetry and unilateral
+    parts (the displacement-driven form: the Python reader refuses floating bodies)."""
+    path = write_level(str(tmp_path), variant(LOADS[0], P=None, delta=0.015), 0)
     sc = load_scene(path)
     kinds = {b.name: b.kind for b in sc.boundaries}
     assert kinds == {"axis": "contact", "top": "dirichlet", "free": "neumann", "contact": "contact"}   # symmetry:
@@ -72,7 +73,9 @@ def synthetic(a, p0, n=40, span=2.0):
     normal[-1] = [-1.0, 0.0]
     p = np.append(formulas.edge_means(pts[edges[:-1, 0], 0], pts[edges[:-1, 1], 0], a, p0), 1e3)
     c = SimpleNamespace(edges=np.arange(n + 1), normal=normal, pressure=np.stack([0 * p, p]))
-    return SimpleNamespace(mesh=SimpleNamespace(points=pts, edges=edges), require_contact=lambda why: c, path="x")
+    u = np.zeros((2, len(edges), 2))
+    return SimpleNamespace(mesh=SimpleNamespace(points=pts, edges=edges), require_contact=lambda why: c, path="x",
+                           u=u)
 
 
 def test_extract_exact_profile():
@@ -107,7 +110,8 @@ def test_level0_run(tmp_path, rust_bin):
 
 
 def rows(devs, a_R=0.1):
-    return [dict(level=k, h=0.025 * 2 ** -k, h_a=0.25 * 2 ** -k, a_R=a_R, P=1 + 0.01 * 4 ** -k,
+    return [dict(level=k, h=0.025 * 2 ** -k, h_a=0.25 * 2 ** -k, a_R=a_R, P=LOADS[0].case.P,
+                 delta=1 + 0.01 * 4 ** -k,
                  a_moment=0.1 * (1 + 0.02 * 4 ** -k), p0_h=1.0 + 1e-5 * (2 + (-1) ** k), dev_am=devs, dev_p0=devs,
                  l2=2 * devs) for k in range(5)]
 
@@ -118,7 +122,10 @@ def test_requirements_can_fail():
     assert vh.hz1(ld, rows(0.01))[0]
     assert vh.hz2(ld, rows(0.01))[0]
     assert not vh.hz2(ld, rows(0.03))[0]
+    unbalanced = rows(0.01)
+    unbalanced[2]["P"] *= 1 + 1e-6
+    assert not vh.hz2(ld, unbalanced)[0]
     bad = rows(0.01)
     for k, r in enumerate(bad):
-        r["P"] = 1 + 0.01 * 2 ** -k                       # order 1, not 2
+        r["delta"] = 1 + 0.01 * 2 ** -k                   # order 1, not 2
     assert not vh.hz1(ld, bad)[0]

@@ -8,6 +8,8 @@ p_e = P_e/|e| at the last step. With x₀ ≤ x₁ the ends of an edge's project
 * a_moment = 2 √(M₂/M₀), M_k = Σ_e |e| p_e x_e^k at the midpoints (Hertz: ∫p x² = a² ∫p/4), a smooth functional
   of the pressure; a_edge = x₁ of the outermost pressed edge (p_e > 0), within one edge of the discrete zone's end;
 * p₀_h = max_e p_e (the first edge, whose Hertz mean is p₀ (1 − O(h²/a²)));
+* δ = −(mean of u_y over the cut y = R, by edge length): the approach of the loaded cut (the load's work P δ/2 is
+  the compliance, a functional converging like the energy);
 * the profile error e_e = p_e − (Hertz mean over [x₀, x₁]) over every facing edge, relative to p₀:
   L∞ = max |e_e|/p₀ and L² = √(Σ |e| e_e² / a)/p₀.
 """
@@ -31,6 +33,7 @@ class Check:
     l2: float
     h_c: float        # longest pressed edge (the mesh size in the contact zone)
     edges: int        # pressed edges
+    delta: float      # approach of the cut y = R
 
     def deviations(self):
         """Relative deviations from Hertz: (a_moment, a_edge, p₀) each / Hertz − 1."""
@@ -49,6 +52,18 @@ def facing_edges(r):
     order = np.argsort(x[:, 0])
     return (x[order, 0], x[order, 1], length[order], np.abs(c.normal[keep, 1])[order],
             c.pressure[-1][keep][order])
+
+
+def approach(r, R):
+    """−(length-weighted mean of u_y over the edges of the cut y = R) at the last step; NaN without such edges."""
+    m = r.mesh
+    ends = m.points[m.edges]
+    on_cut = np.all(np.abs(ends[:, :, 1] - R) <= 1e-12 * R, axis=1)
+    if not on_cut.any():
+        return float("nan")
+    length = np.linalg.norm(ends[on_cut, 1] - ends[on_cut, 0], axis=1)
+    uy = r.u[-1].reshape(-1, 2)[on_cut, 1]
+    return -float(np.sum(length * uy) / np.sum(length))
 
 
 def check(path, R, E, nu):
@@ -71,4 +86,4 @@ def check_results(r, R, E, nu):
     return Check(P=P, a=a, p0=p0, a_moment=2.0 * float(np.sqrt(m2 / m0)), a_edge=float(np.max(x1[pressed])),
                  p0_h=float(np.max(p)), linf=float(np.max(np.abs(err)) / p0),
                  l2=float(np.sqrt(np.sum(length * err * err) / a) / p0), h_c=float(np.max(length[pressed])),
-                 edges=int(np.sum(pressed)))
+                 edges=int(np.sum(pressed)), delta=approach(r, R))

@@ -1,7 +1,7 @@
 """The Hertz loads and their mesh levels: writes each level's mesh and scene, runs the release binary on it and
 checks the result against Hertz (:mod:`tresca_py.hertz.extract`).
 
-Two loads, a/R ≈ 0.1 and ≈ 0.05 (δ chosen so; the check uses the measured P, so a/R need not be exact). Each
+Two loads, a/R = 0.1 and 0.05: the force per unit length P = π E* a²/(4R) on the floating cylinder. Each
 load's mesh size in the contact zone is h_c = (a/R)/4 · R · 2^(−level) within |p| ≤ 2a of the touching point,
 graded up to R/8 (mesh.Grading); the contact part of the arc ends at x_c = 3a, beyond the zone. ``variant``
 changes a load's case (the circle's gap instead of the polygon's, another ν) to measure what that changes.
@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 from tresca_py import results
 from tresca_py.common import BIN, run
-from tresca_py.hertz import extract
+from tresca_py.hertz import extract, formulas
 from tresca_py.hertz.mesh import Grading, quarter_disc, write_msh
 from tresca_py.hertz.scene import Case, scene_text
 
@@ -24,13 +24,14 @@ class Load:
     grading: Grading
 
 
-def load(name, a_over_R, delta):
-    return Load(name, Case(R=1.0, E=1.0, nu=0.3, delta=delta),
+def load(name, a_over_R, R=1.0, E=1.0, nu=0.3):
+    """The floating load whose Hertz half-width is a_over_R · R, and its grading."""
+    return Load(name, Case(R=R, E=E, nu=nu, P=formulas.load_for(a_over_R, R, E, nu)),
                 Grading(h_c=a_over_R / 4, d_c=2 * a_over_R, x_c=3 * a_over_R))
 
 
-#: the loads of the study: the nominal a/R fixes the grading, δ the approach that gives about that a/R
-LOADS = (load("hertz_a10", 0.1, 0.015), load("hertz_a05", 0.05, 0.0042))
+#: the loads of the study
+LOADS = (load("hertz_a10", 0.1), load("hertz_a05", 0.05))
 
 
 def write_level(directory, ld: Load, level, stem=None, header=""):

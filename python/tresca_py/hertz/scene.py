@@ -1,8 +1,13 @@
 """The scene text of the Hertz case: the quarter disc of :mod:`tresca_py.hertz.mesh` (radius R, centre (0, R)) on
 the rigid plane y = 0, frictionless unilateral contact on the lower arc, a symmetry part on the axis x = 0, a free
-outer arc, and the cut y = R through the centre pushed down by δ (Dirichlet u = (0, −δ t)). The force per unit
-length P is not imposed but measured (Σ_e |e| p_e n_y over Γ_C, twice for the full cylinder), so the check against
-Hertz's formulas holds for whatever P results.
+outer arc, and the cut y = R through the centre loaded one of two ways:
+
+* ``P`` given (the issue's set-up): a traction (0, −P/(2R)) on the cut, so the half cylinder x ∈ [−R, R] carries
+  the force per unit length P; no Dirichlet part: the body floats, held in y by the contact alone;
+* ``delta`` given: the cut pushed down by δ (Dirichlet u = (0, −δ t)).
+
+Either way the check against Hertz uses the P measured on Γ_C (Σ_e |e| p_e |n_y|, twice for the full cylinder),
+which in the floating form equals the given P to the solver's tolerance (the body's vertical equilibrium).
 
 The gap of a point (x, y) of the arc to the plane, measured along the circle's outward normal
 n = (x, y − R)/R, is y R/(R − y) (the linearised, normal-gap Signorini condition u·n ≤ gap): the polygon's own
@@ -15,17 +20,25 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class Case:
-    """Material and load of one Hertz scene (R the radius, delta the imposed approach of the centre line)."""
+    """Material and load of one Hertz scene: R the radius, and either P (the force per unit length, floating) or
+    delta (the imposed approach of the centre line)."""
     R: float
     E: float
     nu: float
-    delta: float
+    delta: float | None = None
+    P: float | None = None
     circle_gap: bool = False
+
+    def __post_init__(self):
+        if (self.delta is None) == (self.P is None):
+            raise ValueError(f"a Hertz case gives exactly one of delta and P, got delta = {self.delta}, P = {self.P}")
 
 
 def scene_text(case: Case, mesh_file, title):
     """The TOML text of the scene on ``mesh_file`` (a path relative to the scene file)."""
     R = repr(float(case.R))
+    top = (f'kind = "neumann"\ntraction = ["0", "-{case.P / (2 * case.R)!r}*t"]' if case.P is not None
+           else f'kind = "dirichlet"\nu = ["0", "-{case.delta!r}*t"]')
     gap = f"{R}*sqrt(x^2+({R}-y)^2)/({R}-y)-{R}" if case.circle_gap else f"y*{R}/({R}-y)"
     return f"""title = "{title}"
 
@@ -43,8 +56,7 @@ kind = "symmetry"
 
 [[boundary]]
 name = "top"
-kind = "dirichlet"
-u = ["0", "-{case.delta!r}*t"]
+{top}
 
 [[boundary]]
 name = "free"
