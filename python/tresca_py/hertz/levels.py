@@ -59,5 +59,5 @@ def run_level(directory, ld: Load, level, threads=1):
 
 def variant(ld: Load, **changes):
     """Load ``ld`` with its case's fields changed (``circle_gap=True``, ``nu=…``), named after the change."""
-    tag = "_".join(f"{k}{v}" for k, v in changes.items())
+    tag = "_".join(f"{k}{v}" for k, v in changes.items() if v is not None)
     return Load(f"{ld.name}_{tag}", dataclasses.replace(ld.case, **changes), ld.grading)

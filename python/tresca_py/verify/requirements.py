@@ -151,7 +151,7 @@ REQUIREMENTS = (
     ),
     Requirement(
         'HZ3-hertz-model-order',
-        'deviate from Hertz (a, p₀, profile L²) by a model error that shrinks with a/R at order 1 ± 0.3 '
+        'deviate from Hertz (a, p₀) by a model error that shrinks with a/R at order 1 ± 0.3 '
         '(a/R = 0.1 → 0.05) and falls below half at ν = 0.49, where its first-order term nearly vanishes',
         '.venv/bin/python verification/run_all.py --only hertz',
         'reference/hertz.md',
