@@ -155,7 +155,7 @@ def hz3(all_rows, all_nus):
 def hz4(ld, rows, poly):
     e, _, _ = discretisation(rows, "a_moment")
     ok = all(p <= r["h_a"] ** 2 / 8 and p <= d / 4 for p, r, d in zip(poly, rows[:-1], e, strict=True))
-    ratios = ", ".join(f"{p / d:.2f}" for p, d in zip(poly, e, strict=True))
+    ratios = ", ".join(f"{p / d:.1e}" for p, d in zip(poly, e, strict=True))
     return ok, f"{ld.name}: polygon / discretisation error per level {ratios}"
 
 
