@@ -1,5 +1,5 @@
 """Hertz's line contact of an elastic cylinder (radius R) on a rigid plane, plane strain, frictionless
-(Johnson, *Contact Mechanics*, 1985, §4.2 and (5.x) for the 2D case): with E* = E/(1 − ν²) and P the force per
+(Johnson, *Contact Mechanics*, 1985, §4.3, two-dimensional contact of cylinders): with E* = E/(1 − ν²) and P the force per
 unit length,
 
     a  = √(4 P R / (π E*))        contact half-width
@@ -8,7 +8,8 @@ unit length,
 The solution is that of an elastic half-space under the parabolic gap x²/(2R); a cylinder of finite radius
 departs from it by relative O((a/R)²) (the next term of the circle, x⁴/(8R³), over the contact zone is (a/R)²/4
 of the parabolic gap; the finite body changes the surface slope by O(P/(E* R)) = O((a/R)²)), up to a factor
-log(R/a) from the 2D far field.
+log(R/a) from the 2D far field. A scheme that imposes the contact along the body's own normal instead of the
+vertical adds a first-order term (tresca_py.verify.hertz).
 """
 import math
 
