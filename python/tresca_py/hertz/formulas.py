@@ -1,6 +1,6 @@
 """Hertz's line contact of an elastic cylinder (radius R) on a rigid plane, plane strain, frictionless
-(Johnson, *Contact Mechanics*, 1985, §4.3, two-dimensional contact of cylinders): with E* = E/(1 − ν²) and P the force per
-unit length,
+(Johnson, *Contact Mechanics*, 1985, §4.3, two-dimensional contact of cylinders): with E* = E/(1 − ν²) and P
+the force per unit length,
 
     a  = √(4 P R / (π E*))        contact half-width
     p₀ = 2 P / (π a)              peak pressure,  p(x) = p₀ √(1 − x²/a²) on |x| < a,  ∫ p dx = P.
