@@ -15,7 +15,8 @@ RECORDED = ["E1-rect-energy", "E1-rect-L2", "E2-rotated-energy", "E2-rotated-L2"
             "P3-paper-estimate", "R1-estimate-effectivity", "R2-estimate-refuses", "R3-differences", "O1-clients",
             "O2-interrupted", "V1-paraview", "X-mms_front-r1", "X-mpi-mms_stop-r0", "D1-distributed-agree",
             "D2-distributed-memory", "PL1-mms_front", "PL2-mms_stop", "S1-stability", "S12-stability", "F1-fuzz",
-            "EB1-external", "EB1-clients", "EB1-audit", "EB1-audit-run-trapezoid"]
+            "EB1-external", "EB1-clients", "EB1-audit", "EB1-audit-run-trapezoid", "HZ1-hertz-discretisation",
+            "HZ2-hertz-formulas", "HZ3-hertz-model-order", "HZ4-hertz-polygon", "EB1-hertz"]
 
 
 def test_ids_are_unique():

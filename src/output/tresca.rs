@@ -355,6 +355,7 @@ impl Tresca {
             wall: self.wall.read::<f64>(n)?[0],
             audit: None,
             normal: Default::default(),
+            rigid: vec![],
         };
         if let Some(s) = &self.normal {
             super::normal_series::read_into(s, space, n, &mut r)?;

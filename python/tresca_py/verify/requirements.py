@@ -133,6 +133,37 @@ REQUIREMENTS = (
         'reference/k_skfem_mms_signorini_stop.md',
     ),
     Requirement(
+        'HZ1-hertz-discretisation',
+        'converge on the Hertz line contact (plane-strain cylinder on a rigid plane, frictionless unilateral, '
+        'symmetry axis, floating under a load P, a/R = 0.1 and 0.05, 5 graded mesh levels): the displacement of '
+        'the load and the moment half-width with fitted order '
+        '2 ± 0.5 and last successive order ≥ 1, the peak pressure changing ≤ 1/4 of the model bound at the finest',
+        '.venv/bin/python verification/run_all.py --only hertz',
+        'reference/hertz.md',
+    ),
+    Requirement(
+        'HZ2-hertz-formulas',
+        "agree with Hertz's a = √(4PR/(πE*)) and p₀ = 2P/(πa) within κ a/(2R), κ = (1 − 2ν)/(1 − ν) (the "
+        "linearised normal's first-order model error), with the profile p₀√(1 − x²/a²) within κ a/R in L², and "
+        "balance P by the contact pressure to 1e-9",
+        '.venv/bin/python verification/run_all.py --only hertz',
+        'reference/hertz.md',
+    ),
+    Requirement(
+        'HZ3-hertz-model-order',
+        'deviate from Hertz (a, p₀) by a model error that shrinks with a/R at order 1 ± 0.3 '
+        '(a/R = 0.1 → 0.05) and falls below half at ν = 0.49, where its first-order term nearly vanishes',
+        '.venv/bin/python verification/run_all.py --only hertz',
+        'reference/hertz.md',
+    ),
+    Requirement(
+        'HZ4-hertz-polygon',
+        "keep the polygonal disc's own error (circle's gap instead of the polygon's) ≤ h²/(8a²) and ≤ 1/4 of the "
+        "discretisation error of the half-width at every level",
+        '.venv/bin/python verification/run_all.py --only hertz',
+        'reference/hertz.md',
+    ),
+    Requirement(
         'P1-paper-orders',
         "rest on the paper's Table 5.1 as printed (a data check): its orders recomputed from its errors are 0.8577, "
         "0.9671, 0.9015, 0.866",
