@@ -210,6 +210,9 @@ impl Motions {
 
     /// The free rigid motions named, one per column (for `check`).
     pub fn names(&self) -> Vec<String> {
+        if self.len() == 3 {
+            return ["the translation in x", "the translation in y", "the rotation"].map(String::from).to_vec();
+        }
         let unit = |j: usize| (0..self.len()).map(|i| f64::from(u8::from(i == j))).collect::<Vec<f64>>();
         (0..self.len()).map(|j| self.describe(&unit(j))).collect()
     }
