@@ -37,6 +37,14 @@ pub enum Error {
     )]
     Unbalanced { step: usize, time: f64, motion: String, force: [f64; 2], moment: f64, centre: [f64; 2] },
 
+    /// A floating body's rigid motion that no contact force resists (the solution is not unique).
+    #[error(
+        "step {step} (t = {time}): {motion} of the body is not held: no contact edge in contact, sticking or \
+         bilateral resists it, so the solution is not unique; add a dirichlet part, a symmetry part or friction \
+         that holds it"
+    )]
+    Unheld { step: usize, time: f64, motion: String },
+
     /// Reading or writing a file failed.
     #[error("{path}: {msg}")]
     Io { path: PathBuf, msg: String },

@@ -75,6 +75,13 @@ pub fn check(scene: Scene, estimate: Estimate, reports: super::summary::Reports)
         let n = edges_of(sp.edge_part.iter().filter(|&&q| q == Some(p)).count());
         say!("part       {:<10} {:>6} edges  {}", part.name, n, describe(&part.kind));
     }
+    if let Some(kernel) = problem.free.kernel() {
+        say!(
+            "floating   no dirichlet part: {} free before contact, held only by contact and friction (their \
+             equilibrium is solved exactly at every step; a step whose loads they cannot balance is refused)",
+            kernel.motions.names().join(", ")
+        );
+    }
     // two unknowns per free edge, one per contact edge (two with normal unknowns), none on Dirichlet edges
     let (dirichlet, contact) = (edges_of(sp.n_dirichlet), edges_of(sp.contact.len()));
     let contact = if s.has_normal_unknowns() { 2 * contact } else { contact };

@@ -14,7 +14,7 @@
 //! bounds balances the loads (the body would fly away or turn), the equality residual stops shrinking:
 //! the step is refused naming the rigid motion along which the loads are unbalanced.
 
-use super::{Friction, FrictionSolution};
+use super::{balance, Friction, FrictionSolution};
 use crate::error::{Error, Result};
 use crate::solve::kernel::Motions;
 use nalgebra::DMatrix;
@@ -27,6 +27,14 @@ const MAX_OUTER: usize = 200;
 /// Outer iterations in a row that reduce the equality residual by less than half: the loads are
 /// unbalanced (a feasible problem contracts much faster, see [`AUGMENT`]).
 const STALLED: usize = 8;
+
+/// A smallest unbalanced load (`balance`) below this fraction of the net load is the diagnosis's own
+/// error (its projected gradient iterations reach r* to about this accuracy): the loads are balanced.
+const BALANCED: f64 = 1e-3;
+
+/// An eigenvalue of G_IᵀG_I (G_I: G's rows where the force is within its bounds) below this is a rigid
+/// motion that nothing holds (G_I has orthonormal columns when every row holds).
+const FREE: f64 = 1e-10;
 
 /// The rigid motions of a floating body in the condensed problem.
 pub struct Floating {
@@ -89,6 +97,7 @@ impl Floating {
                 res = res.max(if r[j] == 0.0 { 0.0 } else { r[j].abs() / scale.max(f64::MIN_POSITIVE) });
             }
             if res <= fr.settings.tol {
+                self.determined(fr, &lam, n, t)?;
                 sol.rigid = alpha;
                 sol.iterations = iterations;
                 return Ok(sol);
@@ -99,14 +108,67 @@ impl Floating {
             }
             last = res;
         }
-        Err(self.unbalanced(&r, n, t))
+        // the equality stalled: is there a balance at all (`balance`)? If not, the refusal names the
+        // motion the smallest unbalanced load pushes along; if so, the iteration failed
+        let nm = fr.normal.as_ref();
+        let set = balance::Admissible {
+            w: &fr.w,
+            coulomb: nm.map_or(&[][..], |m| &m.coulomb[..]),
+            lo: nm.map_or(&[][..], |m| &m.lo[..]),
+        };
+        let unbalanced = balance::unbalanced(&self.g, e, &set, &lam);
+        let size = e.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if unbalanced.iter().any(|v| v.abs() > BALANCED * size) {
+            return Err(self.unbalanced(&unbalanced, n, t));
+        }
+        let last = if last.is_finite() { last } else { f64::NAN };
+        Err(Error::NotConverged {
+            step: n,
+            time: t,
+            solver: "the equilibrium of the rigid motions (method of multipliers)",
+            iterations,
+            residual: last,
+            tol: fr.settings.tol,
+        })
+    }
+
+    /// The rigid motion must be fixed by the solution: G's rows on the unknowns whose force lies strictly
+    /// within its bounds (where Δ = 0 holds as an equation) have rank k. Otherwise α is not unique (a
+    /// frictionless body free to slide, say): refused naming the motion nothing holds.
+    fn determined(&self, fr: &Friction, lam: &[f64], n: usize, t: f64) -> Result<()> {
+        let nc = fr.w.len();
+        let nm = fr.normal.as_ref();
+        let size = lam.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
+        let inside = |i: usize| -> bool {
+            let margin = 1e-9 * size;
+            if i >= nc {
+                let lo = nm.map_or(0.0, |m| m.lo[i - nc]);
+                return lam[i] > lo + margin;
+            }
+            let bound = match nm.and_then(|m| m.coulomb[i]) {
+                Some(f) => f * lam[nc + i].abs(),
+                None => fr.w[i],
+            };
+            lam[i].abs() < bound - margin
+        };
+        let rows: Vec<usize> = (0..lam.len()).filter(|&i| inside(i)).collect();
+        let gi = DMatrix::from_fn(rows.len(), self.len(), |a, j| self.g[(rows[a], j)]);
+        let eig = nalgebra::SymmetricEigen::new(gi.transpose() * gi);
+        let (j, low) =
+            eig.eigenvalues.iter().enumerate().fold((0, f64::INFINITY), |a, (j, &v)| if v < a.1 { (j, v) } else { a });
+        // G has orthonormal columns: an eigenvalue ≪ 1 is a motion the holding unknowns do not see
+        if low > FREE {
+            return Ok(());
+        }
+        let v: Vec<f64> = eig.eigenvectors.column(j).iter().copied().collect();
+        Err(Error::Unheld { step: n, time: t, motion: self.motions.describe(&v) })
     }
 
     /// The refusal of a step whose loads no contact force within the bounds balances: the motion along
     /// the residual e − Gᵀλ, with the net force and moment it leaves.
     fn unbalanced(&self, r: &[f64], n: usize, t: f64) -> Error {
         // r_j = (f, M)·m_j for the motions m_j = (a_j, b_j, θ_j): the smallest (f, M) doing that work,
-        // w = m z with (mᵀm) z = r, and the motion it pushes along, Σ_j z_j R_j
+        // w = m z with (mᵀm) z = r; the motion it pushes along most (per unit of G's norm) is Σ_j r_j R_j
         let m = &self.motions.m;
         let z = (m.transpose() * m)
             .cholesky()
@@ -116,7 +178,7 @@ impl Floating {
         Error::Unbalanced {
             step: n,
             time: t,
-            motion: self.motions.describe(&z),
+            motion: self.motions.describe(r),
             force: [w[0], w[1]],
             moment: w[2],
             centre: self.motions.centre,

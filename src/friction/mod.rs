@@ -18,6 +18,7 @@
 //! A floating body (no Dirichlet part) adds the equilibrium of its rigid motions, Gᵀλ = e, with
 //! multiplier α ([`floating`]).
 
+pub mod balance;
 pub mod coulomb;
 pub mod floating;
 pub mod normal;

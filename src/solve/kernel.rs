@@ -136,10 +136,10 @@ impl Kernel {
         let sym = k.symbolic();
         let mut val = k.val().to_vec();
         for j in 0..k.ncols() {
-            for idx in sym.col_ptr()[j]..sym.col_ptr()[j + 1] {
-                let i = sym.row_idx()[idx];
+            let range = sym.col_ptr()[j]..sym.col_ptr()[j + 1];
+            for (&i, v) in sym.row_idx()[range.clone()].iter().zip(&mut val[range]) {
                 if i != j && (pinned[i] || pinned[j]) {
-                    val[idx] = 0.0;
+                    *v = 0.0;
                 }
             }
         }
@@ -210,6 +210,9 @@ impl Motions {
 
     /// The free rigid motions named, one per column (for `check`).
     pub fn names(&self) -> Vec<String> {
+        if self.len() == 3 {
+            return ["the translation in x", "the translation in y", "the rotation"].map(String::from).to_vec();
+        }
         let unit = |j: usize| (0..self.len()).map(|i| f64::from(u8::from(i == j))).collect::<Vec<f64>>();
         (0..self.len()).map(|j| self.describe(&unit(j))).collect()
     }
