@@ -14,9 +14,9 @@ the current P is ≤ 1e-13 of the force scale; that residual is reported.
 ḡ_e is the edge mean (3-point Gauss) of the gap at tₙ. An edge is *separated* when it is unilateral, P_e = 0
 and its gap is open, r_e − ḡ_e < −1e-9 · max(|Δ|, |d|) (the rule of the Rust solver; stick and slip by
 ``friction.classify`` with the scale max(|Δs|, |d|)). ``status`` is 0 stick, 1 slip, 2 separated; ``state`` keeps
-stick/slip. Step 0 has P = 0, the gap of u⁰ and status "separated" where it is open by more
-than 1e-9 of max(|u⁰·n|, |ḡ|) over Γ_C (rounding of the interpolant is not a gap); an initial state that
-penetrates a unilateral part is refused, naming the part and the point.
+stick/slip. Step 0 has P = 0, the gap of u⁰ and status "separated" on a unilateral edge whose gap is open by
+more than 1e-9 of max(|u⁰·n|, |ḡ|) over Γ_C (the Rust solver's step-0 rule; rounding of the interpolant is not a
+gap); an initial state that penetrates a unilateral part is refused, naming the part and the point.
 """
 import numpy as np
 
@@ -93,7 +93,7 @@ def initial_state(disc, u0, t0):
                          f"({m[0]:.6f}, {m[1]:.6f}): u0·n = {un[k]:e} > gap {un[k] - gap[k]:e} at t0 = {t0} "
                          "(edge means)")
     scale = max(np.max(np.abs(un)), np.max(np.abs(gbar)))
-    return gap, np.where(gap < -PENETRATION_TOL * scale, SEPARATED, 0).astype(np.uint8)
+    return gap, np.where(disc.unilateral & (gap < -PENETRATION_TOL * scale), SEPARATED, 0).astype(np.uint8)
 
 
 class UnilateralStepSolver(StepSolver):
