@@ -99,10 +99,11 @@ def test_the_system_shall_refuse_contact_keys_that_do_not_fit(tmp_path, bottom, 
 
 
 def test_the_system_shall_refuse_unilateral_scenes_in_the_bilateral_solvers(tmp_path):
-    """The system shall refuse a unilateral scene in a solver that models bilateral contact only (dolfinx)."""
+    """The system shall refuse a unilateral scene in a solver that models bilateral contact only (the distributed
+    dolfinx solver)."""
     s = load_scene(write(tmp_path, bottom='law = "unilateral"\ng_a = "0.1"'))
     with pytest.raises(SceneError, match="'bottom'.*bilateral Tresca contact only"):
-        s.refuse_contact_extensions("dolfinx_cr")
+        s.refuse_contact_extensions("distributed dolfinx")
 
 
 @pytest.mark.parametrize("coulomb,message", [("x-1", "coulomb = -0.9"), ("sqrt(x-5)", "has the value nan")])
