@@ -28,6 +28,15 @@ pub enum Error {
     )]
     NotConverged { step: usize, time: f64, solver: &'static str, iterations: usize, residual: f64, tol: f64 },
 
+    /// A floating body's loads that no contact force within its bounds balances (`friction::floating`).
+    #[error(
+        "step {step} (t = {time}): the loads have a net force ({:.3e}, {:.3e}) and moment {moment:.3e} about \
+         ({:.4e}, {:.4e}) along {motion}, a rigid motion of the body that contact and friction cannot balance \
+         (it would fly away or turn freely; add a dirichlet part or change the loads)",
+        force[0], force[1], centre[0], centre[1]
+    )]
+    Unbalanced { step: usize, time: f64, motion: String, force: [f64; 2], moment: f64, centre: [f64; 2] },
+
     /// Reading or writing a file failed.
     #[error("{path}: {msg}")]
     Io { path: PathBuf, msg: String },

@@ -14,8 +14,12 @@
 //! With normal unknowns (a unilateral or a Coulomb part, [`normal`]) the condensed problem has one more
 //! unknown per Γ_C edge, the normal force P_e, with its own bounds; the QP's bounds are then per unknown,
 //! [lo_e, hi_e] with hi_e = +∞ allowed (module [`normal`] states the problem).
+//!
+//! A floating body (no Dirichlet part) adds the equilibrium of its rigid motions, Gᵀλ = e, with
+//! multiplier α ([`floating`]).
 
 pub mod coulomb;
+pub mod floating;
 pub mod normal;
 pub mod pdas;
 pub mod ssn;
@@ -41,6 +45,8 @@ pub struct Friction {
     zeroed: std::sync::atomic::AtomicUsize,
     /// The normal unknowns (`None`: the bilateral Tresca problem, tangential unknowns only).
     normal: Option<Normal>,
+    /// The rigid motions of a floating body (`None`: a Dirichlet part fixes them).
+    floating: Option<floating::Floating>,
 }
 
 /// What a step's friction solve produced.
@@ -59,6 +65,8 @@ pub struct FrictionSolution {
     pub gap: Vec<f64>,
     /// Separated (no pressure, open gap) per normal unknown (empty without).
     pub separated: Vec<bool>,
+    /// α, the rigid motion of a floating body (u = K⁺(l − Eλ) + Rα; empty otherwise).
+    pub rigid: Vec<f64>,
 }
 
 /// Stick or slip of one contact edge.
@@ -98,7 +106,35 @@ impl Friction {
 
     /// The problem of operator C, weights w and mean bounds ḡ (Uzawa's c_τ).
     pub(crate) fn from_parts(c: DMatrix<f64>, w: Vec<f64>, g_mean: Vec<f64>, settings: SolverSettings) -> Friction {
-        Friction { c, w, g_mean, settings, zeroed: Default::default(), normal: None }
+        Friction { c, w, g_mean, settings, zeroed: Default::default(), normal: None, floating: None }
+    }
+
+    /// The problem of a floating body whose rigid motions have the trace `g` on the contact unknowns
+    /// (G = EᵀR, orthonormal columns; [`floating`]).
+    pub fn with_floating(mut self, g: DMatrix<f64>, motions: crate::solve::kernel::Motions) -> Friction {
+        self.floating = Some(floating::Floating::new(&self.c, g, motions));
+        self
+    }
+
+    /// True for a floating body (its steps need the net load e = Rᵀlⁿ: [`Friction::solve_rigid`]).
+    pub fn is_floating(&self) -> bool {
+        self.floating.is_some()
+    }
+
+    /// [`Friction::solve`] for a floating body: `alpha0` warm-starts α, `e` = Rᵀlⁿ; without rigid
+    /// motions it is [`Friction::solve`].
+    pub fn solve_rigid(
+        &self,
+        d: &[f64],
+        (lam0, alpha0): (&[f64], &[f64]),
+        e: &[f64],
+        n: usize,
+        t: f64,
+    ) -> Result<FrictionSolution> {
+        match &self.floating {
+            Some(fl) => fl.solve(self, (d, lam0, alpha0), e, n, t),
+            None => self.solve(d, lam0, n, t),
+        }
     }
 
     /// The normal unknowns, if any.
@@ -110,10 +146,15 @@ impl Friction {
     /// natural residual ≤ tol. With normal unknowns d and μ₀ hold the normal entries after the
     /// tangential ones (d_n = s_f,n − ḡ, `normal`).
     pub fn solve(&self, d: &[f64], mu0: &[f64], n: usize, t: f64) -> Result<FrictionSolution> {
+        self.solve_on(&self.c, d, mu0, n, t)
+    }
+
+    /// [`Friction::solve`] with the operator `c` in place of C (`floating`: C + ρGGᵀ).
+    fn solve_on(&self, c: &DMatrix<f64>, d: &[f64], mu0: &[f64], n: usize, t: f64) -> Result<FrictionSolution> {
         if let Some(nm) = &self.normal {
-            return nm.solve(self, d, mu0, n, t);
+            return nm.solve(self, c, d, mu0, n, t);
         }
-        let (k, zeroed, w, d, mu0) = scaled(&self.c, &self.w, d, mu0);
+        let (k, zeroed, w, d, mu0) = scaled(c, &self.w, d, mu0);
         if zeroed {
             self.zeroed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         }
@@ -123,7 +164,7 @@ impl Friction {
             self.g_mean.clone()
         };
         let lo: Vec<f64> = w.iter().map(|w| -w).collect();
-        let qp = Qp { c: &self.c, d: &d, lo: &lo, hi: &w };
+        let qp = Qp { c, d: &d, lo: &lo, hi: &w };
         let s = &self.settings;
         let sol = match s.method {
             Method::Ssn => ssn::solve(&qp, &mu0, s.tol, s.max_iter()),
@@ -146,6 +187,7 @@ impl Friction {
             normal: vec![],
             gap: vec![],
             separated: vec![],
+            rigid: vec![],
         })
     }
 

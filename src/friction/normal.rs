@@ -23,6 +23,7 @@ use crate::fem::gap::GapMeans;
 use crate::fem::space::CrSpace;
 use crate::mesh::Mesh;
 use crate::scene::{Method, Scene};
+use nalgebra::DMatrix;
 
 /// The normal unknowns of a run: their bounds, Coulomb's coefficients and the gaps.
 pub struct Normal {
@@ -58,15 +59,24 @@ impl Normal {
     }
 
     /// Solve step n (time t): d and λ₀ = (μ₀, P₀) in the order of the module doc.
-    pub(super) fn solve(&self, fr: &Friction, d: &[f64], mu0: &[f64], n: usize, t: f64) -> Result<FrictionSolution> {
+    /// `c` is C (C + ρGGᵀ for a floating body, `super::floating`).
+    pub(super) fn solve(
+        &self,
+        fr: &Friction,
+        c: &DMatrix<f64>,
+        d: &[f64],
+        mu0: &[f64],
+        n: usize,
+        t: f64,
+    ) -> Result<FrictionSolution> {
         let nc = fr.w.len();
-        let (k, zeroed, w, d, mu0) = scaled(&fr.c, &fr.w, d, mu0);
+        let (k, zeroed, w, d, mu0) = scaled(c, &fr.w, d, mu0);
         if zeroed {
             fr.zeroed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         }
         let lo: Vec<f64> = w.iter().map(|w| -w).chain(self.lo.iter().copied()).collect();
         let hi: Vec<f64> = w.iter().copied().chain(std::iter::repeat_n(f64::INFINITY, nc)).collect();
-        let qp = Qp { c: &fr.c, d: &d, lo: &lo, hi: &hi };
+        let qp = Qp { c, d: &d, lo: &lo, hi: &hi };
         let s = &fr.settings;
         let sol = if self.has_coulomb() {
             coulomb::solve(&qp, &self.coulomb, &w, &mu0, s.tol, s.max_iter())
@@ -92,6 +102,7 @@ impl Normal {
             normal: back(&lam[nc..]),
             gap: back(&ds[nc..]),
             separated,
+            rigid: vec![],
         })
     }
 }

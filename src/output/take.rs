@@ -80,6 +80,7 @@ impl Unknowns {
             slip: r.slip.clone(),
             state: r.state.clone(),
             normal: r.normal.clone(),
+            rigid: r.rigid.clone(),
             ..*r
         };
         Ok(Unknowns { r, mid, dof })

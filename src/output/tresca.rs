@@ -416,6 +416,7 @@ impl Tresca {
             wall: self.wall.read::<f64>(n)?[0],
             audit: None,
             normal: Default::default(),
+            rigid: vec![],
         })
     }
 

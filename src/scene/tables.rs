@@ -83,15 +83,9 @@ pub(super) fn parts(file: &str, boundary: &[RawBoundary]) -> Result<Vec<Part>> {
             c.normal_unknown = normal;
         }
     }
-    if !parts.iter().any(|p| p.kind.is_dirichlet()) {
-        if parts.iter().any(|p| p.kind.contact().is_some()) {
-            return Err(Error::scene(
-                file,
-                "boundary",
-                "no dirichlet part: a body held only by contact and symmetry parts is not supported yet \
-                 (its rigid motions are not fixed; add a dirichlet part)",
-            ));
-        }
+    // a body held only by contact and symmetry parts floats: its rigid motions are balanced by the contact
+    // forces (`solve::kernel`, `friction::floating`)
+    if !parts.iter().any(|p| p.kind.is_dirichlet() || p.kind.contact().is_some()) {
         return Err(Error::scene(
             file,
             "boundary",

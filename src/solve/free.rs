@@ -31,6 +31,7 @@
 pub use super::block::Block;
 use super::cholesky::Factor;
 use super::condense::Condensation;
+use super::kernel::Kernel;
 use super::superpose::LoadBasis;
 use crate::error::{Error, Result};
 use crate::fem::loads::Loads;
@@ -65,6 +66,9 @@ pub struct FreeResponse {
     /// everywhere μ stays the same from step to step, and K⁻¹Eμ is reused instead of recomputed
     /// (keyed on bit-equal μ, so the result does not depend on the cache).
     friction_cache: RefCell<(Vec<f64>, Vec<f64>)>,
+    /// The rigid motions of a floating body (`None`: K is nonsingular). The factor is then K_#'s, and
+    /// every solve above is K⁺'s once [`FreeResponse::complete`] has zeroed the pinned unknowns.
+    kernel: Option<Kernel>,
 }
 
 /// One step's free response. `u` is u_f when formed, else empty (with Γ_C, a wanted u is formed by
@@ -75,6 +79,8 @@ pub struct Free {
     pub trace: Vec<f64>,
     /// y = L⁻¹Pᵀlⁿ, when u is wanted and was left half-solved.
     forward: Option<Vec<f64>>,
+    /// e = Rᵀlⁿ, the net load on the rigid motions of a floating body (empty otherwise).
+    pub net: Vec<f64>,
 }
 
 impl FreeResponse {
@@ -88,6 +94,7 @@ impl FreeResponse {
         assembled: Vec<(usize, Vec<f64>)>,
         condensation: Option<Condensation>,
         space: &CrSpace,
+        kernel: Option<Kernel>,
     ) -> (FreeResponse, Option<DMatrix<f64>>) {
         let n = space.n_dofs;
         let contact_dofs: Vec<usize> = space.contact_dofs();
@@ -104,6 +111,7 @@ impl FreeResponse {
             contact_dofs,
             w,
             friction_cache: RefCell::new((vec![], vec![])),
+            kernel,
         };
         (free, c)
     }
@@ -117,7 +125,30 @@ impl FreeResponse {
         Ok(())
     }
 
-    /// The factor of K.
+    /// The rigid motions of a floating body (`None`: K is nonsingular).
+    pub fn kernel(&self) -> Option<&Kernel> {
+        self.kernel.as_ref()
+    }
+
+    /// u ← K⁺(lⁿ − Eλ) + Rα from the solve with K_# (no-op without rigid motions).
+    pub fn complete(&self, u: &mut [f64], alpha: &[f64]) {
+        if let Some(k) = &self.kernel {
+            k.complete(u, alpha);
+        }
+    }
+
+    /// e = Rᵀlⁿ of step n in the block (empty without rigid motions).
+    pub fn block_net(&self, block: &Block, n: usize) -> Vec<f64> {
+        let Some(k) = &self.kernel else {
+            return vec![];
+        };
+        match &self.basis {
+            Some(b) => b.net(n, k),
+            None => k.net_full(&block.loads[block.col(n)]),
+        }
+    }
+
+    /// The factor of K (of K_# for a floating body, `kernel`).
     pub fn factor(&self) -> &Factor {
         &self.factor
     }
@@ -309,11 +340,15 @@ impl FreeResponse {
         let contact = !self.contact_dofs.is_empty();
         let mut u = Vec::new();
         let mut forward = None;
+        let mut net = Vec::new();
         let trace = match &self.basis {
             Some(b) => {
                 if want_u || !contact {
                     b.load(n, dofs, load);
                     b.response(n, dofs, &mut u);
+                }
+                if let Some(k) = &self.kernel {
+                    net = b.net(n, k);
                 }
                 if contact {
                     b.response_at(n, &self.contact_dofs)
@@ -324,6 +359,9 @@ impl FreeResponse {
             None => {
                 let mut on_support = Vec::new();
                 self.load_on_support(n, t, &mut on_support)?;
+                if let Some(k) = &self.kernel {
+                    net = k.net(self.loads.support(), &on_support);
+                }
                 self.loads.expand(&on_support, load);
                 if contact {
                     let mut y = load.clone();
@@ -340,7 +378,7 @@ impl FreeResponse {
                 }
             }
         };
-        Ok(Free { u, trace, forward })
+        Ok(Free { u, trace, forward, net })
     }
 
     /// uⁿ = K⁻¹(lⁿ − Eμ) from the step's free response and the friction force μ.

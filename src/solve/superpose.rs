@@ -224,6 +224,15 @@ impl LoadBasis {
         idx.iter().map(|&k| self.responses.iter().zip(&self.coef[n]).map(|(w, c)| c * w[k]).sum()).collect()
     }
 
+    /// e = Rᵀl(tₙ) = Σ_j cₙⱼ Rᵀb_j for the rigid motions R of a floating body.
+    pub fn net(&self, n: usize, kernel: &super::kernel::Kernel) -> Vec<f64> {
+        let mut e = vec![0.0; kernel.len()];
+        for (bj, c) in self.b.iter().zip(&self.coef[n]) {
+            e.iter_mut().zip(kernel.net(&self.support, bj)).for_each(|(ei, v)| *ei += c * v);
+        }
+        e
+    }
+
     /// K⁻¹ l(tₙ) = Σ_j cₙⱼ w_j.
     pub fn response(&self, n: usize, dofs: usize, out: &mut Vec<f64>) {
         Self::combine(&self.responses, &self.coef[n], dofs, out);

@@ -116,6 +116,8 @@ pub struct StepResult {
     pub audit: Option<Audit>,
     /// The normal condition per Γ_C edge (empty without normal unknowns).
     pub normal: NormalState,
+    /// α, the rigid motion of a floating body in u = K⁺(l − Eλ) + Rα (`solve::kernel`; empty otherwise).
+    pub rigid: Vec<f64>,
 }
 
 impl StepResult {
@@ -239,13 +241,15 @@ impl Problem {
                 wall: start.elapsed().as_secs_f64(),
                 audit: None,
                 normal: NormalState::default(),
+                rigid: vec![],
             };
             return self.finish(r);
         };
-        let (sol, slip) = contact(friction, &free.trace, prev, n, t)?;
+        let (sol, slip) = contact(friction, (&free.trace, &free.net), prev, n, t)?;
         let mut r = contact_result(n, t, sol, slip, Vec::new(), f64::NAN, 0.0);
         if want_u {
             r.u = self.free.with_friction(free, &r.forces())?;
+            self.free.complete(&mut r.u, &r.rigid);
             r.energy = self.energy_of(load, &r);
         }
         r.wall = start.elapsed().as_secs_f64();
@@ -255,22 +259,24 @@ impl Problem {
 
 /// The friction problem of step n for the free trace s_f: its solution and the slip
 /// sⁿ = sⁿ⁻¹ + Δs (with d = s_f − sⁿ⁻¹ and Δs = d − Cμ; with normal unknowns d also holds
-/// r_f − ḡ(tₙ), `friction::normal`).
+/// r_f − ḡ(tₙ), `friction::normal`). A floating body's net load e = Rᵀlⁿ comes with the trace
+/// (`friction::floating`; empty otherwise).
 fn contact(
     friction: &Friction,
-    trace: &[f64],
+    (trace, net): (&[f64], &[f64]),
     prev: &StepResult,
     n: usize,
     t: f64,
 ) -> Result<(FrictionSolution, Vec<f64>)> {
     let mut d: Vec<f64> = trace.iter().zip(&prev.slip).map(|(f, s)| f - s).collect();
     let sol = match friction.normal() {
+        None if friction.is_floating() => friction.solve_rigid(&d, (&prev.mu, &prev.rigid), net, n, t)?,
         None => friction.solve(&d, &prev.mu, n, t)?,
         Some(nm) => {
             let nc = prev.slip.len();
             d.truncate(nc);
             d.extend(trace[nc..].iter().zip(nm.gaps(t)?).map(|(r, g)| r - g));
-            friction.solve(&d, &prev.forces(), n, t)?
+            friction.solve_rigid(&d, (&prev.forces(), &prev.rigid), net, n, t)?
         }
     };
     let slip = prev.slip.iter().zip(&sol.slip_increment).map(|(a, b)| a + b).collect();
@@ -301,6 +307,7 @@ fn contact_result(
         wall,
         audit: None,
         normal: NormalState { force: sol.normal, gap: sol.gap, separated: sol.separated },
+        rigid: sol.rigid,
     }
 }
 
@@ -334,6 +341,7 @@ fn initial_state(
         wall: 0.0,
         audit: None,
         normal,
+        rigid: vec![],
     };
     finish(r, d, errors)
 }

@@ -114,7 +114,8 @@ impl Problem {
                 let start = Instant::now();
                 let t = self.scene.times[n];
                 let trace = self.free.block_trace(&block, n);
-                match contact(friction, &trace, done.last().unwrap_or(&prev), n, t) {
+                let net = self.free.block_net(&block, n);
+                match contact(friction, (&trace, &net), done.last().unwrap_or(&prev), n, t) {
                     Ok((sol, slip)) => {
                         let wall = start.elapsed().as_secs_f64();
                         done.push(contact_result(n, t, sol, slip, vec![], f64::NAN, wall));
@@ -136,6 +137,7 @@ impl Problem {
             for r in done.iter_mut() {
                 if want(r.n) {
                     r.u = us.next().unwrap_or_default();
+                    self.free.complete(&mut r.u, &r.rigid);
                     r.energy = self.energy_of(block.load(r.n), r);
                 }
                 r.wall += share;

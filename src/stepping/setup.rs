@@ -19,10 +19,12 @@ use crate::solve::cholesky::{Graph, ND_MIN_SIZE};
 use crate::solve::condense::{condense, Condensation};
 use crate::solve::condition;
 use crate::solve::free::{FreeResponse, BLOCK_BYTES};
+use crate::solve::kernel::Kernel;
 use crate::solve::superpose::LoadBasis;
 use crate::sparse::{lower_pattern, lower_values};
 use faer::sparse::SparseColMat;
 use faer::sparse::SymbolicSparseColMat;
+use nalgebra::DMatrix;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -130,6 +132,8 @@ pub struct Discretised {
     pub law: Elasticity,
     /// Whether the set-up estimates K's condition number.
     pub guard: Guard,
+    /// The rigid motions of a floating body (`None` with a Dirichlet part: K is nonsingular).
+    pub kernel: Option<Kernel>,
 }
 
 impl Discretised {
@@ -139,7 +143,8 @@ impl Discretised {
         let space = crate::fem::validate::on_mesh(&scene, &mesh)?;
         let data = BoundaryData::of(&mesh, &scene.parts, &space);
         let law = Elasticity::new(&scene.material);
-        Ok(Discretised { scene, mesh, space, data, law, guard })
+        let kernel = Kernel::of(&mesh, &space);
+        Ok(Discretised { scene, mesh, space, data, law, guard, kernel })
     }
 }
 
@@ -275,8 +280,8 @@ impl Discretised {
         let t4 = Instant::now();
         let condensation = self.condense(&factor)?;
         let t5 = Instant::now();
-        let (free, c) = FreeResponse::new(factor, loads, basis, assembled, condensation, space);
-        let friction = c.map(|c| Friction::new(scene, &self.mesh, space, c)).transpose()?;
+        let (free, c) = FreeResponse::new(factor, loads, basis, assembled, condensation, space, self.kernel.clone());
+        let friction = contact_problem(scene, &self.mesh, space, c, self.kernel.as_ref())?;
         let ends = PhaseEnds { assembly: t2, factorisation: t3, superposition: t4, condensation: t5 };
         Ok(Operators { stiffness, free, friction, errors, conditioning, step0, ends })
     }
@@ -289,7 +294,9 @@ impl Discretised {
         if space.n_dofs >= RELEASE_MIN {
             crate::machine::release_freed_memory();
         }
-        let (factor, aside) = Factor::numeric_beside(symbolic, stiffness, || {
+        // a floating body: K_# (the rigid motions pinned, `solve::kernel`), K itself stays a_h's matrix
+        let pinned = self.kernel.as_ref().map(|k| k.pin(stiffness));
+        let (factor, aside) = Factor::numeric_beside(symbolic, pinned.as_ref().unwrap_or(stiffness), || {
             let top = (self.guard == Guard::Estimate).then(|| condition::largest_eigenvalue(stiffness, LAMBDA_ITERS));
             let has_data = self.data.is_some();
             let errors =
@@ -298,6 +305,7 @@ impl Discretised {
             (top, errors, step0)
         });
         let factor = factor?;
+        drop(pinned);
         let (top, errors, step0) = aside.unwrap_or((Some(f64::NAN), None, None));
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
         // ranges) factorises without complaint but returns meaningless displacements: it is refused
@@ -316,5 +324,34 @@ impl Discretised {
     pub(super) fn condense(&self, factor: &Factor) -> Result<Option<Condensation>> {
         let contact: Vec<usize> = self.space.contact_dofs();
         (!contact.is_empty()).then(|| condense(&contact, factor)).transpose()
+    }
+}
+
+/// The friction problem on Γ_C with operator `c` (`None` without Γ_C), with the equilibrium of the rigid
+/// motions of a floating body (`friction::floating`); a floating body that no contact edge can hold is
+/// refused, naming its free motions.
+pub(super) fn contact_problem(
+    scene: &Scene,
+    mesh: &Mesh,
+    space: &CrSpace,
+    c: Option<DMatrix<f64>>,
+    kernel: Option<&Kernel>,
+) -> Result<Option<Friction>> {
+    let friction = c.map(|c| Friction::new(scene, mesh, space, c)).transpose()?;
+    let Some(k) = kernel else {
+        return Ok(friction);
+    };
+    let dofs = space.contact_dofs();
+    match friction {
+        Some(f) if !k.unseen(&dofs) => Ok(Some(f.with_floating(k.rows(&dofs), k.motions.clone()))),
+        _ => Err(Error::scene(
+            &scene.file,
+            "boundary",
+            format!(
+                "no dirichlet part, and the contact parts cannot hold the body's rigid motions ({}): \
+                 add a dirichlet part or a contact part that holds them",
+                k.motions.names().join(", ")
+            ),
+        )),
     }
 }

@@ -10,12 +10,12 @@ use crate::fem::lifting::BoundaryData;
 use crate::fem::loads::Loads;
 use crate::fem::norms::ErrorEvaluator;
 use crate::fem::space::CrSpace;
-use crate::friction::Friction;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::solve::cholesky::Factor;
 use crate::solve::condense::Condensation;
 use crate::solve::free::FreeResponse;
+use crate::solve::kernel::Kernel;
 use crate::solve::superpose::LoadBasis;
 use faer::sparse::SparseColMat;
 use std::sync::Arc;
@@ -44,8 +44,9 @@ impl Problem {
             assembled,
             m.condensation.clone(),
             &m.space,
+            m.kernel.clone(),
         );
-        let friction = c.map(|c| Friction::new(&scene, &m.mesh, &m.space, c)).transpose()?;
+        let friction = super::setup::contact_problem(&scene, &m.mesh, &m.space, c, m.kernel.as_ref())?;
         Ok(Problem {
             setup: SetupTimes { superposition: (t4 - t3).as_secs_f64(), ..SetupTimes::default() },
             reused: Some(m.times),
@@ -78,6 +79,8 @@ pub struct MeshSetUp {
     loads: Loads,
     factor: Arc<Factor>,
     condensation: Option<Condensation>,
+    /// The rigid motions of a floating body (`Discretised::kernel`).
+    kernel: Option<Kernel>,
     conditioning: Arc<Pending>,
     errors: Option<Arc<ErrorEvaluator>>,
     step0: Option<StepResult>,
@@ -101,7 +104,7 @@ impl MeshSetUp {
         let t3 = Instant::now();
         let condensation = p0.condense(&f.factor)?;
         let t5 = Instant::now();
-        let Discretised { mesh, space, data, law, .. } = p0;
+        let Discretised { mesh, space, data, law, kernel, .. } = p0;
         let d = |a: Instant, b: Instant| (b - a).as_secs_f64();
         Ok(MeshSetUp {
             mesh,
@@ -112,6 +115,7 @@ impl MeshSetUp {
             loads,
             factor: f.factor,
             condensation,
+            kernel,
             conditioning: f.conditioning,
             errors: f.errors,
             step0: f.step0,
