@@ -98,7 +98,7 @@ class TaoStepSolver:
         self.disc = disc
         self.P, self.ic = disc.reduction()
         Kr = (self.P.T @ K @ self.P).tocsr()
-        Kr = (0.5 * (Kr + Kr.T)).tocsr()
+        Kr = self._factored((0.5 * (Kr + Kr.T)).tocsr()).tocsr()
         Kr.sort_indices()
         self.A = PETSc.Mat().createAIJ(size=Kr.shape, csr=(Kr.indptr.astype(PETSc.IntType),
                                                            Kr.indices.astype(PETSc.IntType), Kr.data),
@@ -125,6 +125,10 @@ class TaoStepSolver:
         self.C = 0.5 * (Cm + Cm.T)
         self.mu = np.zeros(nc)
         self.qp = self._qp() if nc else None
+
+    def _factored(self, Kr):
+        """The matrix factorised for K_r (K_r itself; a floating body's K_#, ``dolfinx_cr.unilateral``)."""
+        return Kr
 
     def _qp(self):
         """The step's bound-constrained dual problem (TAO)."""

@@ -10,7 +10,7 @@ from tresca_py.dolfinx_cr.assemble import DolfinxProblem
 from tresca_py.dolfinx_cr.edges import CrEdges
 from tresca_py.dolfinx_cr.friction import TaoStepSolver
 from tresca_py.dolfinx_cr.stepping import backward_euler, save
-from tresca_py.dolfinx_cr.unilateral import TaoUnilateralStepSolver
+from tresca_py.dolfinx_cr.unilateral import TaoFloatingStepSolver, TaoUnilateralStepSolver
 
 
 def main(argv=None):
@@ -19,6 +19,8 @@ def main(argv=None):
     root = comm.rank == 0
     scene, edges, out = open_scene(args, CrEdges, report=root, unilateral=True)   # every rank reads the scene
     stepper = TaoUnilateralStepSolver if edges.normal_unknowns else TaoStepSolver
+    if len(edges.dirichlet) == 0:
+        stepper = TaoFloatingStepSolver
     with exit_on_failure(report=root):   # the errors below are raised on every rank (collective checks)
         t0 = time.perf_counter()
         prob = DolfinxProblem(edges, comm)

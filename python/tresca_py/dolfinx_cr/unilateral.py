@@ -22,6 +22,7 @@ import numpy as np
 
 from tresca_py.dolfinx_cr.friction import TaoBoundQP, TaoStepSolver
 from tresca_py.errors import InputError
+from tresca_py.floating import kernel, multipliers, pin
 
 SEPARATED = 2
 POLISH_SWEEPS = 20
@@ -84,21 +85,71 @@ class TaoUnilateralStepSolver(TaoStepSolver):
         self.hi = np.concatenate([e.weight, np.full(len(e.weight), np.inf)])
         return TaoBoundQP(self.C, self.lo, self.hi)
 
+    def _contact(self, d, l_full):
+        """(λ, TAO iterations + polish sweeps, natural residual / force scale, the rigid motion in r: zero here)."""
+        lam, its = self.qp.solve(d, self.mu)
+        lam, sweeps = polish(self.C, d, self.lo, self.hi, lam)
+        residual = natural_residual(self.C, d, self.lo, self.hi, lam) / force_scale(self.C, d, self.lo, self.hi)
+        return lam, its + sweeps, residual, np.zeros(self.Z.shape[0])
+
     def step(self, l_full, u_prev_full, t=None):
         """One backward Euler step at time t; returns (u_full, info dict)."""
         e, nc = self.disc, len(self.disc.contact)
         r_free = self.solve(self.P.T @ l_full)
         s_old = np.einsum("ec,ec->e", u_prev_full.reshape(-1, 2)[e.contact], e.tangent)
         d = r_free[self.ic] - np.concatenate([s_old, e.gap_means(t)])
-        lam, its = self.qp.solve(d, self.mu)
-        lam, sweeps = polish(self.C, d, self.lo, self.hi, lam)
+        lam, its, residual, rigid = self._contact(d, l_full)
         self.mu = lam.copy()
-        r = r_free - self.Z @ lam
-        delta = d - self.C @ lam
+        r = r_free - self.Z @ lam + rigid
+        delta = d - self.C @ lam + rigid[self.ic]
         opening = delta[nc:]
         scale = max(np.max(np.abs(delta)), np.max(np.abs(d)))
         separated = e.unilateral & (lam[nc:] <= 0) & (opening < -OPEN * scale)
-        residual = natural_residual(self.C, d, self.lo, self.hi, lam) / force_scale(self.C, d, self.lo, self.hi)
-        return self.P @ r, dict(iterations=its + sweeps, residual=residual, mu=lam[:nc], d=d, ds=delta[:nc],
+        return self.P @ r, dict(iterations=its, residual=residual, mu=lam[:nc], d=d, ds=delta[:nc],
                                 dof=r[self.ic[:nc]], pressure=lam[nc:] / e.lengths[e.contact], gap=opening,
                                 separated=separated)
+
+
+class TaoFloatingStepSolver(TaoUnilateralStepSolver):
+    """A floating body (no Dirichlet part, ``tresca_py.floating``): K_# by MUMPS Cholesky, K⁺ with the pinned entries
+    zeroed, and each step's equilibrium of the rigid motions by the method of multipliers around TAO and the
+    polish (exact for each multiplier)."""
+
+    method = ("TAO TRON with bounds and the method of multipliers for the rigid motions, polished on the active "
+              "set; K_# by MUMPS Cholesky")
+
+    def __init__(self, disc, K):
+        if not disc.normal_unknowns:
+            raise InputError("[boundary] no dirichlet part: the re-implementations take a floating body with a "
+                             "unilateral part only")
+        P, ic = disc.reduction()
+        self.R, self.pinned = kernel(P, disc.points, disc.midpoints, ic)
+        self.alpha = np.zeros(self.R.shape[1])
+        self.rho_qp = None
+        super().__init__(disc, K)
+
+    def _factored(self, Kr):
+        return pin(Kr, self.pinned)
+
+    def solve(self, rhs):
+        rhs = np.array(rhs, dtype=float)
+        rhs[self.pinned] = 0.0
+        x = super().solve(rhs)
+        x[self.pinned] = 0.0
+        return x
+
+    def _contact(self, d, l_full):
+        G, e = self.R[self.ic], self.R.T @ (self.P.T @ l_full)
+
+        def inner(C, d, lam0):
+            if self.rho_qp is None:                          # C + ρGGᵀ is the same at every step
+                self.rho_qp = TaoBoundQP(C, self.lo, self.hi)
+            lam, its = self.rho_qp.solve(d, lam0)
+            lam, sweeps = polish(C, d, self.lo, self.hi, lam)
+            return lam, its + sweeps
+
+        try:
+            lam, self.alpha, its, eq = multipliers(inner, self.C, d, G, e, self.mu, self.alpha)
+        except RuntimeError as err:
+            raise InputError(str(err)) from None
+        return lam, its, eq, self.R @ self.alpha

@@ -104,6 +104,11 @@ class UnilateralStepSolver(StepSolver):
         self.normal = Normal(disc)
         self.mu = np.zeros(len(self.ic))
 
+    def _contact(self, d, l_full):
+        """(λ, iterations, residual, the rigid motion Rα in r: zero here, ``skfem_cr.floating``) of one step."""
+        lam, its, residual = solve_contact(self.C, d, self.normal, self.mu)
+        return lam, its, residual, np.zeros(self.Z.shape[0])
+
     def step(self, l_full, u_prev_full, t):
         """One backward Euler step at time t; returns (u_full, info dict)."""
         disc, nc = self.disc, len(self.disc.contact)
@@ -111,10 +116,10 @@ class UnilateralStepSolver(StepSolver):
         s_old = np.sum(u_prev_full.reshape(-1, 2)[disc.contact] * disc.tangent, axis=1)
         gbar = self.normal.gap(t)
         d = r_free[self.ic] - np.concatenate([s_old, gbar])
-        lam, its, residual = solve_contact(self.C, d, self.normal, self.mu)
+        lam, its, residual, rigid = self._contact(d, l_full)
         self.mu = lam.copy()
-        r = r_free - self.Z @ lam
-        delta = d - self.C @ lam
+        r = r_free - self.Z @ lam + rigid
+        delta = d - self.C @ lam + rigid[self.ic]
         state = classify(lam[:nc], delta[:nc], d, self.normal.bounds(lam[nc:])[1][:nc]).astype(np.int8)
         opening = delta[nc:]                                 # r_e - ḡ_e
         scale = max(np.max(np.abs(delta)), np.max(np.abs(d)))

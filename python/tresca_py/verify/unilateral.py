@@ -46,7 +46,8 @@ def level(name, refine, steps=STEPS):
     """Run the scikit-fem solver on case ``name`` at ``refine``; the row of the level's table."""
     out = os.path.join(out_dir(), "unilateral", f"{name}_r{refine}.h5")
     os.makedirs(os.path.dirname(out), exist_ok=True)
-    cmd = [PY, "scripts/skfem_solve.py", case(name), "--refine", str(refine), "--steps", str(steps), "-o", out, "-q"]
+    cmd = [PY, "scripts/skfem_solve.py", case(name), "--refine", str(refine), "--steps", str(steps), "-o", out, "-q",
+           "--force"]
     run(cmd)
     r = results.read(out)
     m = r.mesh
@@ -79,7 +80,8 @@ def energy_differences(name, refine, steps, ref):
     for n in list(steps) + [ref]:
         out = os.path.join(out_dir(), "unilateral", f"{name}_r{refine}_N{n}.h5")
         os.makedirs(os.path.dirname(out), exist_ok=True)
-        run([PY, "scripts/skfem_solve.py", case(name), "--refine", str(refine), "--steps", str(n), "-o", out, "-q"])
+        run([PY, "scripts/skfem_solve.py", case(name), "--refine", str(refine), "--steps", str(n), "-o", out, "-q",
+             "--force"])
         u[n] = results.read(out).u.reshape(n + 1, -1)
     coarse = steps[0]
     out = []
