@@ -164,7 +164,8 @@ REQUIREMENTS = (
         'solve the discrete unilateral problem as the same-scheme re-implementations do: tresca-cr, scikit-fem '
         '(exact active set) and, for unilateral Tresca, dolfinx (PETSc TAO, bound-constrained) agree pairwise in '
         'u, energies, tractions, pressures and true errors to ≤ 1e-8 (≤ κ(K_r)·κ(C)·u where rounding alone exceeds '
-        'it: the near-incompressible scene) with 0 differing stick/slip/separated flags, on 4 scenes at refine 2',
+        'it: the near-incompressible scene) with 0 differing stick/slip/separated flags, on the 4 manufactured '
+        'Signorini scenes and a floating block (no Dirichlet part) at refine 2',
         'verification/run_all.py --only same_scheme',
         None,
         pattern='U9-same-scheme-.+',
