@@ -38,12 +38,14 @@ def rigid_motions(points, midpoints):
 
 def kernel(P, points, midpoints, ic):
     """(R_r, pinned): the motions in the reduced unknowns u = P r (P has orthonormal columns), scaled so that
-    G = R_r[ic] has orthonormal columns, and k unknowns where R_r is nonsingular (QR with column pivoting)."""
+    G = R_r[ic] has orthonormal columns, and k unknowns off Γ_C where R_r is nonsingular (QR with column pivoting;
+    off Γ_C so that C = BᵀK⁺B keeps full rank)."""
     R = P.T @ rigid_motions(points, midpoints).reshape(-1, 3)
     _, t = np.linalg.qr(R[ic])
     R = la.solve_triangular(t, R.T, trans="T").T                   # R T⁻¹: G = R[ic] orthonormal
-    _, _, piv = la.qr(R.T, pivoting=True, mode="economic")
-    return R, np.sort(piv[:R.shape[1]])
+    off = np.setdiff1d(np.arange(R.shape[0]), ic)
+    _, _, piv = la.qr(R[off].T, pivoting=True, mode="economic")
+    return R, np.sort(off[piv[:R.shape[1]]])
 
 
 def pin(K, pinned):

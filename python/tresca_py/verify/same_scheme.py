@@ -93,7 +93,7 @@ def tolerance(scene, refine):
     kk, kc = conditioning(scene, refine)
     bound = kk * kc * UNIT_ROUNDOFF
     why = f"κ(K_r) {kk:.2e}, κ(C) {kc:.2e}, κ(K_r)·κ(C)·u = {bound:.1e}"
-    return max(TOL, bound), why
+    return (max(TOL, bound) if np.isfinite(bound) else 0.0), why          # a singular C fails the row
 
 
 def codes_of(name):
