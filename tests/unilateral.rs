@@ -276,3 +276,25 @@ fn contact_traction_is_a_surface_load_on_gamma_c() {
     let d = max_abs(a.iter().zip(&b).flat_map(|(x, y)| [x[0] - y[0], x[1] - y[1]]));
     assert!(d <= 1e-9 * scale, "|u_contact - u_neumann| = {d:e} (max |u| {scale:e})");
 }
+
+/// The system shall mark a unilateral edge separated at step 0 by the rule of the later steps: open by
+/// more than 1e-9 of the scale max_e max(|u⁰·n|, |ḡ_e|) (here 1e-3): u⁰·n = −1e-3 on Γ_C, so a gap
+/// −1e-3 + 1e-13 x leaves a rounding-sized opening (≤ 1e-13 < 1e-12): closed; −1e-3 + 1e-6 x opens every
+/// edge (x ≥ 1/16) by ≥ 6e-8 > 1e-12: separated. A bilateral edge is never separated.
+#[test]
+fn step_zero_separation_has_the_later_steps_tolerance() {
+    let at_start = |contact: &str| {
+        let text = BLOCK
+            .replace("TOP", r#"["0", "-0.01*t"]"#)
+            .replace("CONTACT", contact)
+            .replace("[time]", "[initial]\nu0 = [\"0\", \"0.001*(1 - y)\"]\n[time]");
+        let s = Scene::from_str(&text, "block.toml").unwrap_or_else(|e| panic!("{e}"));
+        run(s)[0].normal.separated.clone()
+    };
+    let closed = at_start("law = \"unilateral\"\ngap = \"-0.001 + 1e-13*x\"\ng_a = \"0.05\"");
+    assert!(!closed.is_empty() && closed.iter().all(|&s| !s), "rounding marked separated: {closed:?}");
+    let open = at_start("law = \"unilateral\"\ngap = \"-0.001 + 1e-6*x\"\ng_a = \"0.05\"");
+    assert!(open.iter().all(|&s| s), "an open gap not marked separated: {open:?}");
+    let bilateral = at_start("coulomb = \"0.3\"\ngap = \"-0.001 + 1e-6*x\"");
+    assert!(bilateral.iter().all(|&s| !s), "a bilateral edge marked separated: {bilateral:?}");
+}

@@ -99,10 +99,11 @@ def test_the_system_shall_refuse_contact_keys_that_do_not_fit(tmp_path, bottom, 
 
 
 def test_the_system_shall_refuse_unilateral_scenes_in_the_bilateral_solvers(tmp_path):
-    """The system shall refuse a unilateral scene in a solver that models bilateral contact only (dolfinx)."""
+    """The system shall refuse a unilateral scene in a solver that models bilateral contact only (the distributed
+    dolfinx solver)."""
     s = load_scene(write(tmp_path, bottom='law = "unilateral"\ng_a = "0.1"'))
     with pytest.raises(SceneError, match="'bottom'.*bilateral Tresca contact only"):
-        s.refuse_contact_extensions("dolfinx_cr")
+        s.refuse_contact_extensions("distributed dolfinx")
 
 
 @pytest.mark.parametrize("coulomb,message", [("x-1", "coulomb = -0.9"), ("sqrt(x-5)", "has the value nan")])
@@ -157,3 +158,20 @@ def test_the_system_shall_converge_to_the_manufactured_signorini_solution():
     _, (ok_e, m_e), (ok_l, m_l), _ = convergence("mms_signorini_moving", range(4))
     assert ok_e, m_e
     assert ok_l, m_l
+
+
+@pytest.mark.parametrize("bottom,separated", [('law = "unilateral"\ng_a = "0.1"\ngap = "-0.001 + 1e-13*x"', False),
+                                              ('law = "unilateral"\ng_a = "0.1"\ngap = "-0.001 + 1e-6*x"', True),
+                                              ('coulomb = "0.3"\ngap = "-0.001 + 1e-6*x"', False)])
+def test_the_system_shall_mark_step_zero_separated_by_the_later_steps_rule(tmp_path, bottom, separated):
+    """The system shall mark a unilateral edge separated at step 0 where its gap is open by more than 1e-9 of
+    max(|u0.n|, |gbar|) over Gamma_C (1e-3 here; the Rust solver's rule): an opening of <= 2e-13 is rounding
+    (closed), one of >= 2.5e-7 is separated; a bilateral edge is never separated."""
+    from tresca_py.skfem_cr.cr import Discretisation
+    from tresca_py.skfem_cr.unilateral import initial_state
+    scene = write(tmp_path, bottom=bottom)
+    scene.write_text(scene.read_text() + '[initial]\nu0 = ["0", "0.001*(1 - y)"]\n')
+    s = load_scene(scene)
+    disc = Discretisation(s)
+    _, status = initial_state(disc, disc.interpolate(s.u0, s.times[0]), s.times[0])
+    assert len(status) and np.all((status == SEPARATED) == separated), status

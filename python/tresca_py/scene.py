@@ -220,8 +220,9 @@ def _read_boundaries(doc):
         if kind == "symmetry":
             bd.kind, bd.g_a, bd.symmetry = "contact", Expr("0", f"boundary '{name}' (symmetry)"), True
         bnds.append(bd)
-    if not any(b.kind == "dirichlet" for b in bnds):
-        # a_h (even with the jump term) is singular on rigid motions unless a Dirichlet part fixes them
+    if not any(b.kind in ("dirichlet", "contact") for b in bnds):
+        # a_h (even with the jump term) is singular on rigid motions unless a Dirichlet part fixes them or contact
+        # forces balance them (a floating body, tresca_py.floating)
         raise SceneError("[boundary] no dirichlet part: rigid motions are not fixed "
                          "(the paper requires meas(Gamma_D) > 0)")
     return bnds

@@ -59,8 +59,18 @@ pub(super) fn initial_normal(d: Parts<'_>, u: &[f64]) -> Result<NormalState> {
     }
     crate::fem::gap::check_initial(d.scene, d.mesh, d.space, u)?;
     let g = crate::fem::gap::GapMeans::new(d.scene, d.mesh, d.space).at(d.scene.times[0])?;
-    let gap: Vec<f64> =
-        normal.iter().zip(&g).map(|(&j, g)| u[d.space.contact[j].normal_dof.expect("normal")] - g).collect();
-    let separated = gap.iter().map(|&g| g < 0.0).collect();
+    let un: Vec<f64> = normal.iter().map(|&j| u[d.space.contact[j].normal_dof.expect("normal")]).collect();
+    let gap: Vec<f64> = un.iter().zip(&g).map(|(un, g)| un - g).collect();
+    let unilateral: Vec<bool> = normal.iter().map(|&j| d.space.contact[j].unilateral).collect();
+    let separated = initially_separated(&unilateral, &un, &g);
     Ok(NormalState { force: vec![0.0; normal.len()], gap, separated })
+}
+
+/// Step 0's separated edges: the rule of the later steps (`friction::normal`: P_e = 0 and
+/// r_e − ḡ_e < −1e-9 max|d|) with P = 0 and, as there is no step problem d, the scale
+/// max_e max(|u⁰·n(m_e)|, |ḡ_e(t₀)|) over Γ_C: a unilateral edge whose gap is open by more than 1e-9 of
+/// it (rounding of the edge means of u⁰ and g is ~1e-16 of it, and is not a gap).
+pub(super) fn initially_separated(unilateral: &[bool], un: &[f64], g: &[f64]) -> Vec<bool> {
+    let scale = un.iter().chain(g).fold(0.0f64, |a, v| a.max(v.abs()));
+    unilateral.iter().zip(un.iter().zip(g)).map(|(&uni, (un, g))| uni && un - g < -1e-9 * scale).collect()
 }

@@ -4,7 +4,8 @@ Independent of the Rust crate and of the scikit-fem re-implementation (it import
 ``edges`` (its own edge table, boundary parts, Γ_C data, CR interpolant, lifting of the boundary data and the
 reduction u = P r), ``forms`` (sympy -> UFL, the load, data and error forms), ``assemble`` (distributed assembly
 gathered to rank 0), ``friction`` (K_r by MUMPS Cholesky, each step's dual friction problem by PETSc TAO TRON),
-``stepping`` (backward Euler with the boundary data, the stick/slip rule, the results file), ``main``
+``stepping`` (backward Euler with the boundary data, the stick/slip rule, the results file), ``unilateral``
+(normal unknowns: unilateral Tresca by TAO with bounds and an active-set polish, and floating bodies), ``main``
 (scripts/dolfinx_solve.py), ``distributed`` (scripts/dolfinx_distributed.py).
 
 What it shares with the scikit-fem re-implementation is the scene format and its reading

@@ -64,7 +64,13 @@ class CrEdges:
         c = self.contact
         self.tangent = d[c] / self.lengths[c, None]
         self.normal = np.column_stack([self.tangent[:, 1], -self.tangent[:, 0]])
+        if any(b.kind == "contact" and b.coulomb is not None for b in scene.boundaries):
+            raise SceneError("the dolfinx solver models Tresca friction only (TAO's bound-constrained QP): "
+                             "no coulomb")
         self.gbar = self._contact_means(lambda b, x, y: b.g_a(x, y, 0.0))
+        self.normal_unknowns = scene.normal_unknowns
+        part = self.part_of_edge[c]
+        self.unilateral = np.array([scene.boundaries[ip].law == "unilateral" for ip in part], dtype=bool)
         if np.any(self.gbar < 0):
             raise SceneError("a contact part's g_a is negative somewhere")
         self.weight = self.lengths[c] * self.gbar
@@ -120,9 +126,14 @@ class CrEdges:
         """I_CR v in the constrained space: edge means, zero on Γ_D, the tangential part on Γ_C."""
         mean = np.einsum("cep,p->ec", vexpr(*self.gauss3(np.arange(len(self.edges))), t), GAUSS3_W)
         mean[self.dirichlet] = 0.0
-        s = np.einsum("ec,ec->e", mean[self.contact], self.tangent)
-        mean[self.contact] = s[:, None] * self.tangent
+        if not self.normal_unknowns:
+            s = np.einsum("ec,ec->e", mean[self.contact], self.tangent)
+            mean[self.contact] = s[:, None] * self.tangent
         return mean.reshape(-1)
+
+    def gap_means(self, t):
+        """ḡ_e(t) of every Γ_C edge (zero without a gap)."""
+        return self._contact_means(lambda b, x, y: np.zeros_like(x) if b.gap is None else b.gap(x, y, t))
 
     def lifting(self, t):
         """u_L(t): the edge means of u_D on Dirichlet edges with data, ḡ_e n_e on Γ_C edges with a gap, zero
@@ -132,20 +143,25 @@ class CrEdges:
             if b.kind == "dirichlet" and b.u is not None:
                 e = self.dirichlet[self.part_of_edge[self.dirichlet] == ip]
                 u[e] = np.einsum("cep,p->ec", b.u(*self.gauss3(e), t), GAUSS3_W)
-        gap = self._contact_means(lambda b, x, y: np.zeros_like(x) if b.gap is None else b.gap(x, y, t))
-        u[self.contact] += gap[:, None] * self.normal
+        if not self.normal_unknowns:                 # with normal unknowns the gap is a constraint, not lifted
+            u[self.contact] += self.gap_means(t)[:, None] * self.normal
         return u.reshape(-1)
 
     def reduction(self):
-        """(P, contact positions in r): u = P r, two unknowns per free edge, then one s_e per Γ_C edge."""
+        """(P, contact positions in r): u = P r, two unknowns per free edge, then one s_e per Γ_C edge (and, with
+        normal unknowns, then one r_e = u·n(m_e) per Γ_C edge: the midpoint value s_e τ_e + r_e n_e)."""
         ne = len(self.edges)
         constrained = np.zeros(ne, bool)
         constrained[self.dirichlet] = constrained[self.contact] = True
         free = np.flatnonzero(~constrained)
         nf, nc = 2 * len(free), len(self.contact)
-        rows = np.concatenate(
-            [np.column_stack([2 * free, 2 * free + 1]).ravel(), 2 * self.contact, 2 * self.contact + 1]
-        )
-        cols = np.concatenate([np.arange(nf), nf + np.arange(nc), nf + np.arange(nc)])
-        vals = np.concatenate([np.ones(nf), self.tangent[:, 0], self.tangent[:, 1]])
-        return sp.coo_matrix((vals, (rows, cols)), shape=(2 * ne, nf + nc)).tocsr(), nf + np.arange(nc)
+        frames = [self.tangent] + ([self.normal] if self.normal_unknowns else [])
+        rows = [np.column_stack([2 * free, 2 * free + 1]).ravel()]
+        cols, vals = [np.arange(nf)], [np.ones(nf)]
+        for k, f in enumerate(frames):
+            rows += [2 * self.contact, 2 * self.contact + 1]
+            cols += [nf + k * nc + np.arange(nc)] * 2
+            vals += [f[:, 0], f[:, 1]]
+        n = nf + len(frames) * nc
+        P = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(2 * ne, n))
+        return P.tocsr(), nf + np.arange(len(frames) * nc)

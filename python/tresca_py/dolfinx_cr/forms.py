@@ -120,14 +120,15 @@ def error_forms(scene, uh, t, params, h, dS2, ds, dirichlet, data=False):
 
 def load_form(scene, msh, v, ds, t):
     """The load functional (l(t), v) as a compiled form (None without loads): the body force by the
-    6-point Dunavant rule, tractions on Neumann part i (measure ds(i + 1)) by 3-point Gauss (degree 5)."""
+    6-point Dunavant rule, tractions on Neumann part i (measure ds(i + 1)) and the given surface loads of contact
+    parts (issue 40: in addition to the contact reaction) by 3-point Gauss (degree 5)."""
     X = ufl.SpatialCoordinate(msh)
     dx4 = dunavant_dx(msh)
     L = None
     if not scene.f.is_zero:
         L = ufl.inner(vec_to_ufl(scene.f, X, t), v) * dx4
     for i, b in enumerate(scene.boundaries):
-        if b.kind == "neumann" and not b.traction.is_zero:
+        if b.kind in ("neumann", "contact") and b.traction is not None and not b.traction.is_zero:
             term = ufl.inner(vec_to_ufl(b.traction, X, t), v) * ds(i + 1, metadata={"quadrature_degree": 5})
             L = term if L is None else L + term
     return None if L is None else fem.form(L)

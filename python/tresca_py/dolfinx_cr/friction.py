@@ -34,24 +34,26 @@ def natural_residual(C, d, w, mu):
     return float(np.max(np.abs(r)) / max(np.max(w), 1e-300))
 
 
-class TaoBoxQP:
-    """min 1/2 mu^T C mu - mu^T d subject to |mu| <= w by TAO TRON (C SPD, dense, small; fixed per object)."""
+class TaoBoundQP:
+    """min 1/2 x^T C x - x^T d subject to lo <= x <= hi (entries may be infinite) by TAO TRON (C SPD, dense, small;
+    fixed per object), stopped when the projected gradient's norm is below GATOL of ``scale(d)``."""
 
-    def __init__(self, C, w):
-        nc = len(w)
-        self.C, self.w = C, w
-        self.H = PETSc.Mat().createDense((nc, nc), array=C.copy(), comm=PETSc.COMM_SELF)
+    def __init__(self, C, lo, hi):
+        n = len(lo)
+        self.C, self.lo, self.hi = C, lo, hi
+        self.H = PETSc.Mat().createDense((n, n), array=C.copy(), comm=PETSc.COMM_SELF)
         self.H.assemble()
         tao = PETSc.TAO().create(PETSc.COMM_SELF)
         tao.setType(PETSc.TAO.Type.TRON)
-        tao.setObjectiveGradient(self._objective_gradient, _seq_vec(np.zeros(nc)))
+        tao.setObjectiveGradient(self._objective_gradient, _seq_vec(np.zeros(n)))
         tao.setHessian(lambda tao, x, H, P: None, self.H, self.H)      # the Hessian C is constant
-        tao.setVariableBounds(_seq_vec(-w), _seq_vec(w))
-        tao.setMaximumIterations(50 * nc + 100)
+        big = PETSc.INFINITY
+        tao.setVariableBounds(_seq_vec(np.clip(lo, -big, big)), _seq_vec(np.clip(hi, -big, big)))
+        tao.setMaximumIterations(50 * n + 100)
         tao.getKSP().setType("cg")
         tao.getKSP().getPC().setType("jacobi")
         tao.getKSP().setTolerances(rtol=1e-14)
-        self.tao, self.sol, self.d = tao, _seq_vec(np.zeros(nc)), np.zeros(nc)
+        self.tao, self.sol, self.d = tao, _seq_vec(np.zeros(n)), np.zeros(n)
 
     def _objective_gradient(self, tao, x, g):
         m = x.getArray(readonly=True)
@@ -59,12 +61,17 @@ class TaoBoxQP:
         g.array[:] = cm - self.d
         return float(0.5 * m @ cm - m @ self.d)
 
-    def solve(self, d, mu0):
-        """Returns (mu, iterations); RuntimeError when TRON stops without convergence."""
+    def scale(self, d):
+        """The problem's size: |d|_inf + |C|_inf max|finite bound|."""
+        finite = np.abs(np.concatenate([self.lo, self.hi]))
+        finite = finite[np.isfinite(finite)]
+        return np.max(np.abs(d)) + np.max(np.abs(self.C)) * (np.max(finite) if finite.size else 0.0) + 1e-300
+
+    def solve(self, d, x0):
+        """Returns (x, iterations); RuntimeError when TRON stops without convergence."""
         self.d = d
-        scale = np.max(np.abs(d)) + np.max(np.abs(self.C)) * np.max(self.w) + 1e-300
-        self.tao.setTolerances(gatol=GATOL * scale, grtol=0.0, gttol=0.0)
-        self.sol.array[:] = np.clip(mu0, -self.w, self.w)
+        self.tao.setTolerances(gatol=GATOL * self.scale(d), grtol=0.0, gttol=0.0)
+        self.sol.array[:] = np.clip(x0, self.lo, self.hi)
         self.tao.setSolution(self.sol)
         self.tao.solve()
         reason = self.tao.getConvergedReason()
@@ -72,6 +79,14 @@ class TaoBoxQP:
             raise RuntimeError(f"TAO TRON did not converge (reason {reason}) in {self.tao.getIterationNumber()} "
                                f"iterations, projected gradient {self.tao.getGradientNorm():.3e}")
         return self.sol.getArray().copy(), self.tao.getIterationNumber()
+
+
+class TaoBoxQP(TaoBoundQP):
+    """min 1/2 mu^T C mu - mu^T d subject to |mu| <= w by TAO TRON (C SPD, dense, small; fixed per object)."""
+
+    def __init__(self, C, w):
+        super().__init__(C, -w, w)
+        self.w = w
 
 
 class TaoStepSolver:
@@ -83,7 +98,7 @@ class TaoStepSolver:
         self.disc = disc
         self.P, self.ic = disc.reduction()
         Kr = (self.P.T @ K @ self.P).tocsr()
-        Kr = (0.5 * (Kr + Kr.T)).tocsr()
+        Kr = self._factored((0.5 * (Kr + Kr.T)).tocsr()).tocsr()
         Kr.sort_indices()
         self.A = PETSc.Mat().createAIJ(size=Kr.shape, csr=(Kr.indptr.astype(PETSc.IntType),
                                                            Kr.indices.astype(PETSc.IntType), Kr.data),
@@ -109,7 +124,15 @@ class TaoStepSolver:
         Cm = self.Z[self.ic, :]
         self.C = 0.5 * (Cm + Cm.T)
         self.mu = np.zeros(nc)
-        self.qp = TaoBoxQP(self.C, self.w) if nc else None
+        self.qp = self._qp() if nc else None
+
+    def _factored(self, Kr):
+        """The matrix factorised for K_r (K_r itself; a floating body's K_#, ``dolfinx_cr.unilateral``)."""
+        return Kr
+
+    def _qp(self):
+        """The step's bound-constrained dual problem (TAO)."""
+        return TaoBoxQP(self.C, self.w)
 
     def solve(self, rhs):
         """K_r^{-1} rhs."""
@@ -119,8 +142,8 @@ class TaoStepSolver:
             raise RuntimeError(f"MUMPS solve failed: KSP reason {self.ksp.getConvergedReason()}")
         return self.x.getArray().copy()
 
-    def step(self, l_full, u_prev_full):
-        """One backward Euler step; returns (u_full, info dict)."""
+    def step(self, l_full, u_prev_full, t=None):
+        """One backward Euler step (at time t, unused: no normal unknowns); returns (u_full, info dict)."""
         disc = self.disc
         r_free = self.solve(self.P.T @ l_full)
         if len(self.ic) == 0:

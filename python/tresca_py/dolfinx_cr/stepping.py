@@ -20,6 +20,7 @@ import numpy as np
 
 from tresca_py import results
 from tresca_py.common import git_commit
+from tresca_py.dolfinx_cr.unilateral import SEPARATED, initial_state
 from tresca_py.errors import InputError
 
 #: the two 1e-9 of the stick/slip rule (module docstring): a force within 1e-9 of the bound is at it, an
@@ -41,8 +42,10 @@ class Series:
     def __init__(self, edges, n_times, with_errors):
         nc = len(edges.contact)
         self.u = np.zeros((n_times, len(edges.edges), 2))
-        self.contact = {k: np.zeros((n_times, nc)) for k in ("slip", "sigma_t", "mu", "dof")}
+        normal = ("pressure", "gap") if edges.normal_unknowns else ()
+        self.contact = {k: np.zeros((n_times, nc)) for k in ("slip", "sigma_t", "mu", "dof") + normal}
         self.state = np.zeros((n_times, nc), dtype=np.int8)
+        self.status = np.zeros((n_times, nc), dtype=np.uint8) if edges.normal_unknowns else None
         self.steps = {"iterations": np.zeros(n_times, dtype=np.int64), "residual": np.zeros(n_times),
                       "n_stick": np.zeros(n_times, dtype=np.int64), "n_slip": np.zeros(n_times, dtype=np.int64),
                       "wall_time": np.zeros(n_times)}
@@ -61,6 +64,9 @@ def _record(series, edges, n, u, info):
         return
     slip = slipping(info["mu"], info["ds"], info["d"], edges.weight)
     series.state[n] = slip
+    if series.status is not None:
+        series.status[n] = np.where(info["separated"], SEPARATED, slip)
+        series.contact["pressure"][n], series.contact["gap"][n] = info["pressure"], info["gap"]
     series.contact["mu"][n] = info["mu"]
     series.contact["sigma_t"][n] = -info["mu"] / edges.lengths[edges.contact]
     series.contact["dof"][n] = info["dof"]
@@ -91,9 +97,11 @@ def backward_euler(edges, prob, stepper_class, comm, log):
         if root:
             if n == 0:
                 u, info = edges.interpolate(scene.u0, t), None
+                if series.status is not None:
+                    series.contact["gap"][0], series.status[0] = initial_state(edges, u, t)
             else:
                 rhs = load if u_l is None else load + b_d - K @ u_l
-                u, info = stepper.step(rhs, u)
+                u, info = stepper.step(rhs, u, t)
             if u_l is not None:
                 u = u + u_l
             _record(series, edges, n, u, info)
@@ -132,7 +140,7 @@ def save(path, edges, series, attrs):
     if len(edges.contact):
         c = series.contact
         contact = results.Contact(edges.contact, edges.normal, edges.tangent, edges.gbar, c["slip"], c["sigma_t"],
-                                  series.state, c["mu"], c["dof"])
+                                  series.state, c["mu"], c["dof"], c.get("pressure"), c.get("gap"), series.status)
     mesh = results.Mesh(edges.points, edges.triangles, edges.edges, edges.midpoints)
     base = {"scene": scene.text, "scene_path": os.path.abspath(scene.path), "title": scene.title,
             "version": "python-2", "git_commit": git_commit(), "solver": "dolfinx",

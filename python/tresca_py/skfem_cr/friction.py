@@ -86,7 +86,7 @@ class StepSolver:
         self.disc = disc
         self.P, self.ic = disc.reduction()
         Kr = (self.P.T @ K @ self.P).tocsc()
-        Kr = (0.5 * (Kr + Kr.T)).tocsc()
+        Kr = self._factored((0.5 * (Kr + Kr.T)).tocsc())
         self.Kr = Kr
         # K_r is SPD: symmetric minimum-degree ordering and diagonal pivots (SuperLU symmetric mode)
         self.lu = spla.splu(Kr, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
@@ -103,6 +103,10 @@ class StepSolver:
             self.Z = np.zeros((Kr.shape[0], 0))
             self.C = np.zeros((0, 0))
         self.mu = np.zeros(C)
+
+    def _factored(self, Kr):
+        """The matrix factorised for K_r (K_r itself; a floating body's K_#, ``skfem_cr.floating``)."""
+        return Kr
 
     def _solve(self, b):
         x = self.lu.solve(b)

@@ -9,8 +9,16 @@ from tresca_py.common import git_commit
 from tresca_py.errors import InputError
 from tresca_py.skfem_cr.cr import Discretisation
 from tresca_py.skfem_cr.friction import StepSolver, classify
+from tresca_py.skfem_cr.floating import FloatingStepSolver
 from tresca_py.skfem_cr.unilateral import UnilateralStepSolver, initial_state
 
+
+
+def step_solver(disc, K):
+    """The step solver of ``disc``: a floating body's (no Dirichlet part), with normal unknowns, or bilateral."""
+    if len(disc.dirichlet) == 0:
+        return FloatingStepSolver(disc, K)
+    return UnilateralStepSolver(disc, K) if disc.normal_unknowns else StepSolver(disc, K)
 
 def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
     """Backward Euler over ``scene.times`` with the exact friction step (``friction.StepSolver``); returns the
@@ -27,7 +35,7 @@ def run(disc: Discretisation, K, load, errors=None, log=True, lifting=None):
     N = len(times) - 1
     C = len(disc.contact)
     t0 = time.perf_counter()
-    stepper = UnilateralStepSolver(disc, K) if disc.normal_unknowns else StepSolver(disc, K)
+    stepper = step_solver(disc, K)
     res = dict(u=np.zeros((N + 1, len(disc.edges), 2)), slip=np.zeros((N + 1, C)), mu=np.zeros((N + 1, C)),
                dof=np.zeros((N + 1, C)), sigma_t=np.zeros((N + 1, C)), state=np.zeros((N + 1, C), dtype=np.int8),
                iterations=np.zeros(N + 1, dtype=np.int64), residual=np.zeros(N + 1),

@@ -14,9 +14,9 @@ the current P is ≤ 1e-13 of the force scale; that residual is reported.
 ḡ_e is the edge mean (3-point Gauss) of the gap at tₙ. An edge is *separated* when it is unilateral, P_e = 0
 and its gap is open, r_e − ḡ_e < −1e-9 · max(|Δ|, |d|) (the rule of the Rust solver; stick and slip by
 ``friction.classify`` with the scale max(|Δs|, |d|)). ``status`` is 0 stick, 1 slip, 2 separated; ``state`` keeps
-stick/slip. Step 0 has P = 0, the gap of u⁰ and status "separated" where it is open by more
-than 1e-9 of max(|u⁰·n|, |ḡ|) over Γ_C (rounding of the interpolant is not a gap); an initial state that
-penetrates a unilateral part is refused, naming the part and the point.
+stick/slip. Step 0 has P = 0, the gap of u⁰ and status "separated" on a unilateral edge whose gap is open by
+more than 1e-9 of max(|u⁰·n|, |ḡ|) over Γ_C (the Rust solver's step-0 rule; rounding of the interpolant is not a
+gap); an initial state that penetrates a unilateral part is refused, naming the part and the point.
 """
 import numpy as np
 
@@ -93,7 +93,7 @@ def initial_state(disc, u0, t0):
                          f"({m[0]:.6f}, {m[1]:.6f}): u0·n = {un[k]:e} > gap {un[k] - gap[k]:e} at t0 = {t0} "
                          "(edge means)")
     scale = max(np.max(np.abs(un)), np.max(np.abs(gbar)))
-    return gap, np.where(gap < -PENETRATION_TOL * scale, SEPARATED, 0).astype(np.uint8)
+    return gap, np.where(disc.unilateral & (gap < -PENETRATION_TOL * scale), SEPARATED, 0).astype(np.uint8)
 
 
 class UnilateralStepSolver(StepSolver):
@@ -104,6 +104,11 @@ class UnilateralStepSolver(StepSolver):
         self.normal = Normal(disc)
         self.mu = np.zeros(len(self.ic))
 
+    def _contact(self, d, l_full):
+        """(λ, iterations, residual, the rigid motion Rα in r: zero here, ``skfem_cr.floating``) of one step."""
+        lam, its, residual = solve_contact(self.C, d, self.normal, self.mu)
+        return lam, its, residual, np.zeros(self.Z.shape[0])
+
     def step(self, l_full, u_prev_full, t):
         """One backward Euler step at time t; returns (u_full, info dict)."""
         disc, nc = self.disc, len(self.disc.contact)
@@ -111,10 +116,10 @@ class UnilateralStepSolver(StepSolver):
         s_old = np.sum(u_prev_full.reshape(-1, 2)[disc.contact] * disc.tangent, axis=1)
         gbar = self.normal.gap(t)
         d = r_free[self.ic] - np.concatenate([s_old, gbar])
-        lam, its, residual = solve_contact(self.C, d, self.normal, self.mu)
+        lam, its, residual, rigid = self._contact(d, l_full)
         self.mu = lam.copy()
-        r = r_free - self.Z @ lam
-        delta = d - self.C @ lam
+        r = r_free - self.Z @ lam + rigid
+        delta = d - self.C @ lam + rigid[self.ic]
         state = classify(lam[:nc], delta[:nc], d, self.normal.bounds(lam[nc:])[1][:nc]).astype(np.int8)
         opening = delta[nc:]                                 # r_e - ḡ_e
         scale = max(np.max(np.abs(delta)), np.max(np.abs(d)))

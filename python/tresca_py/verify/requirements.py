@@ -162,6 +162,42 @@ REQUIREMENTS = (
         "discretisation error of the half-width at every level",
         '.venv/bin/python verification/run_all.py --only hertz',
         'reference/hertz.md',
+        'U5-rust-signorini',
+        'converge with order 1 ± 0.1 (energy) and 2 ± 0.15 (L²) on `mms_signorini_moving` itself (tresca-cr, the '
+        'levels and N of U1: true errors against the exact solution of tresca_py.mms)',
+        'tresca-cr study verification/cases/mms_signorini_moving.toml --levels 0:8,…,4:8',
+        'reference/h_rust_mms_signorini_moving.md',
+    ),
+    Requirement(
+        'U6-rust-signorini-incompressible',
+        '… the same near-incompressible, free of locking (`mms_signorini_incompressible`, refine 1..5, tresca-cr)',
+        'tresca-cr study verification/cases/mms_signorini_incompressible.toml --levels 1:8,…,5:8',
+        'reference/h_rust_mms_signorini_incompressible.md',
+    ),
+    Requirement(
+        'U7-rust-coulomb',
+        '… the same with Coulomb friction (`mms_signorini_coulomb`, tresca-cr\'s semismooth Newton method): it '
+        'converges to the manufactured solution with the same orders, not merely to some fixed point',
+        'tresca-cr study verification/cases/mms_signorini_coulomb.toml --levels 0:8,…,4:8',
+        'reference/h_rust_mms_signorini_coulomb.md',
+    ),
+    Requirement(
+        'U8-rust-signorini-k',
+        'converge with order 1 ± 0.1 in k when the slip stops abruptly on a unilateral contact part (tresca-cr, '
+        '`mms_signorini_stop`, N = 4^j against N = 4096 on the same mesh at refine 3)',
+        'tresca-cr study verification/cases/mms_signorini_stop.toml --levels 3:4,3:16,3:64,3:256 --reference 3:4096',
+        'reference/k_study_mms_signorini_stop.md',
+    ),
+    Requirement(
+        'U9-same-scheme…',
+        'solve the discrete unilateral problem as the same-scheme re-implementations do: tresca-cr, scikit-fem '
+        '(exact active set) and, for unilateral Tresca, dolfinx (PETSc TAO, bound-constrained) agree pairwise in '
+        'u, energies, tractions, pressures and true errors to ≤ 1e-8 (≤ κ(K_r)·κ(C)·u where rounding alone exceeds '
+        'it: the near-incompressible scene) with 0 differing stick/slip/separated flags, on the 4 manufactured '
+        'Signorini scenes and a floating block (no Dirichlet part) at refine 2',
+        'verification/run_all.py --only same_scheme',
+        None,
+        pattern='U9-same-scheme-.+',
     ),
     Requirement(
         'P1-paper-orders',

@@ -18,8 +18,8 @@ import subprocess
 import time
 
 from tresca_py.common import BIN, PY
-from tresca_py.verify import (adaptive, audits, checks, estimates, hertz, paper, pool, studies, study_tests,
-                               unilateral)
+from tresca_py.verify import (adaptive, audits, checks, estimates, hertz, paper, pool, same_scheme, studies,
+                               study_tests, unilateral)
 from tresca_py.verify.harness import Harness, out_dir
 from tresca_py.verify.pool import Study
 
@@ -37,6 +37,7 @@ WRITES = {
     "audit": ("audit/*",),
     "unilateral": ("unilateral/*",),
     "hertz": ("hertz/*.h5",),
+    "same_scheme": ("same_scheme/*",),
 }
 #: studies that run with no other study beside them: `distributed` measures peak memory (D2) and runs
 #: mpirun -n 3 on every core; `tests` (T1) runs verification/interrupted_runs.py into out/interrupted/, as
@@ -80,6 +81,7 @@ def study_table(quick):
         "joint": lambda hs: studies.joint_study(hs, quick),
         "unilateral": lambda hs: unilateral.study(hs, quick),
         "hertz": lambda hs: hertz.study(hs, quick),
+        "same_scheme": lambda hs: same_scheme.study(hs, quick),
         "paper": lambda hs: paper.paper_tables(hs, quick),
         "estimates": lambda hs: estimates.run(hs, quick),
         "adaptive": adaptive.study,
