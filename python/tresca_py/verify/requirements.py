@@ -162,6 +162,8 @@ REQUIREMENTS = (
         "discretisation error of the half-width at every level",
         '.venv/bin/python verification/run_all.py --only hertz',
         'reference/hertz.md',
+    ),
+    Requirement(
         'U5-rust-signorini',
         'converge with order 1 ± 0.1 (energy) and 2 ± 0.15 (L²) on `mms_signorini_moving` itself (tresca-cr, the '
         'levels and N of U1: true errors against the exact solution of tresca_py.mms)',
