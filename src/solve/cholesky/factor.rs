@@ -120,9 +120,10 @@ impl Factor {
             return (Err(Error::Linear(e.into())), None);
         }
         let oom = || Error::Linear("out of memory for the Cholesky factorisation".into());
-        if let Err(e) = Symbolic::fits_with(&symbolic, pattern_nnz, 0) {
-            return (Err(e), None);
-        }
+        let par = match Symbolic::par_that_fits(&symbolic, pattern_nnz, 0, par) {
+            Ok(p) => p,
+            Err(e) => return (Err(e), None),
+        };
         let scratch = numeric_scratch(&symbolic, pattern_nnz, par);
         let Some(mut values) = Pages::zeroed(symbolic.len_val()) else { return (Err(oom()), None) };
         let Ok(mut buf) = MemBuffer::try_new(scratch) else {

@@ -75,15 +75,15 @@ impl Symbolic {
         Symbolic { ordering, ..self }
     }
 
-    /// Bytes the numeric factorisation allocates: L's values and its scratch (with several threads, that
-    /// of the factorisation by subtrees too).
-    fn need_of(symbolic: &SymbolicSupernodalCholesky<usize>, pattern_nnz: usize) -> u64 {
-        let scratch = numeric_scratch(symbolic, pattern_nnz, crate::threads::par());
-        let threads = crate::threads::count();
-        let subtrees = if threads > 1 && symbolic.len_val() >= super::subtrees::MIN_ENTRIES {
-            super::subtrees::scratch_bytes(symbolic, threads)
-        } else {
-            0
+    /// Bytes the numeric factorisation allocates with `par`: L's values and its scratch (with several
+    /// threads, that of the factorisation by subtrees too).
+    fn need_of(symbolic: &SymbolicSupernodalCholesky<usize>, pattern_nnz: usize, par: Par) -> u64 {
+        let scratch = numeric_scratch(symbolic, pattern_nnz, par);
+        let subtrees = match par {
+            Par::Rayon(t) if t.get() > 1 && symbolic.len_val() >= super::subtrees::MIN_ENTRIES => {
+                super::subtrees::scratch_bytes(symbolic, t.get())
+            }
+            _ => 0,
         };
         (symbolic.len_val() as u64)
             .saturating_mul(8)
@@ -91,18 +91,30 @@ impl Symbolic {
     }
 
     /// Whether the numeric factorisation, and `more` bytes the caller will allocate beside it, fit in the
-    /// memory this machine has now (MemAvailable; `true` where the machine does not say).
+    /// memory this machine has now (MemAvailable; `true` where the machine does not say), on the threads in
+    /// force or else on one ([`Symbolic::par_that_fits`]).
     pub fn fits(&self, more: u64) -> bool {
-        Symbolic::fits_with(&self.symbolic, self.pattern_nnz, more).is_ok()
+        Symbolic::par_that_fits(&self.symbolic, self.pattern_nnz, more, crate::threads::par()).is_ok()
     }
 
-    /// Refuse a factor whose values and scratch (and `more` bytes beside them) do not fit in the memory
-    /// this machine has now: L's pages are mapped lazily, so an allocation that does not fit would
-    /// succeed and the process be killed later. The sizes are exact once the symbolic factorisation is
-    /// done, where the pre-run estimate (`scene::budget`) is a fit.
-    pub(super) fn fits_with(symbolic: &SymbolicSupernodalCholesky<usize>, pattern_nnz: usize, more: u64) -> Result<()> {
-        let need = Symbolic::need_of(symbolic, pattern_nnz).saturating_add(more);
-        refuse_beyond(need, crate::machine::available_memory(), symbolic.nrows(), symbolic.len_val())
+    /// The parallelism the numeric factorisation can afford: `par` when its values and scratch (and `more`
+    /// bytes beside them) fit in the memory this machine has now, else one thread when that fits (the
+    /// factor is the same bit for bit for every thread count: docs/model.md "Threads"; one thread needs
+    /// no scratch of the factorisation by subtrees), else the refusal. L's pages are mapped lazily, so an
+    /// allocation that does not fit would succeed and the process be killed later. The sizes are exact
+    /// once the symbolic factorisation is done, where the pre-run estimate (`scene::budget`) is a fit.
+    pub(super) fn par_that_fits(
+        symbolic: &SymbolicSupernodalCholesky<usize>,
+        pattern_nnz: usize,
+        more: u64,
+        par: Par,
+    ) -> Result<Par> {
+        let have = crate::machine::available_memory();
+        let need = |p| Symbolic::need_of(symbolic, pattern_nnz, p).saturating_add(more);
+        if refuse_beyond(need(par), have, symbolic.nrows(), symbolic.len_val()).is_ok() {
+            return Ok(par);
+        }
+        refuse_beyond(need(Par::Seq), have, symbolic.nrows(), symbolic.len_val()).map(|()| Par::Seq)
     }
 }
 
