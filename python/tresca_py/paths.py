@@ -226,15 +226,11 @@ def write_new(path, write, what="output file", force=False):
     first), renamed over ``path``. A failure leaves no temporary and an old file as it was."""
     path = new_output(path, what, force)
     tmp, fd = _fresh_tmp(path, what)
-    try:
+
+    def fill():
         with os.fdopen(fd, "wb") as f:
             write(f)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.lexists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
+    return _into_place(tmp, path, fill)
 
 
 def write_named(path, write, what="output file", force=False):
@@ -246,12 +242,21 @@ def write_named(path, write, what="output file", force=False):
     root, ext = os.path.splitext(path)
     tmp, fd = _fresh_tmp(path, what, f"{root}.tmp{ext}")
     os.close(fd)
-    try:
+
+    def fill():
         write(tmp)
         st = os.lstat(tmp)
         if not stat.S_ISREG(st.st_mode) or st.st_nlink > 1:
             raise PathError(f"{tmp}: the temporary of the {what} was replaced by {kind_of(st.st_mode)} while it was "
                             "written; nothing was renamed into place")
+    return _into_place(tmp, path, fill)
+
+
+def _into_place(tmp, path, fill):
+    """``fill()`` the temporary ``tmp``, then rename it over ``path``; on any failure the temporary is removed
+    and ``path`` left as it was."""
+    try:
+        fill()
         os.replace(tmp, path)
     except BaseException:
         if os.path.lexists(tmp):
