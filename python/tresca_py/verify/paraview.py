@@ -118,8 +118,17 @@ def compare(ss, label, h5, reader, data):
         slip, state_ = g["contact/slip"][:S], g["contact/state"][:S]
         T, C = len(g["mesh/triangles"]), len(g["contact/edges"])
         normal = {k: g["contact/" + k][:S] for k in NORMAL_ARRAYS if "contact/" + k in g}
-    ok = ss.check(len(data["times"]) == len(frames) and np.allclose(data["times"], times, rtol=0, atol=1e-12),
-               f"{label} / {reader}: {len(data['times'])} time steps, expected the {len(frames)} committed frames")
+        running = str(g.attrs["status"]) == "running"
+    # A killed run's sidecar may lag its HDF5 file by the frames of the last commit: the writer flushes the
+    # steps, then rewrites run.xdmf (src/output/xdmf.rs), so a SIGKILL between the two leaves a sidecar that
+    # names a prefix of the committed frames, never a frame the file does not hold. A finished run's sidecar
+    # names every frame.
+    m = len(data["times"])
+    want = (m <= len(frames) and m >= 3) if running else m == len(frames)
+    ok = ss.check(want and np.allclose(data["times"], times[:m], rtol=0, atol=1e-12),
+               f"{label} / {reader}: {m} time steps, expected "
+               + (f"a prefix (at least 3) of the {len(frames)} committed frames" if running
+                  else f"the {len(frames)} committed frames"))
     for k, blocks in data["frames"].items():
         n = frames[int(k)]
         b, c = blocks.get("body"), blocks.get("contact")
@@ -237,5 +246,7 @@ def main(argv=None):
     hs.require("V1-paraview", not ss.failed, measured)
     if args.json:
         hs.dump(args.json)
-    print(f"ParaView check: {'all passed' if not ss.failed else f'{len(ss.failed)} FAILED'}")
+    # the failures again at the end, where a caller that keeps only the tail of the output sees them
+    print(f"ParaView check: {'all passed' if not ss.failed else f'{len(ss.failed)} FAILED'}"
+          + "".join(f"\n  FAIL  {m}" for m in ss.failed))
     return 1 if ss.failed else 0
