@@ -43,7 +43,10 @@ pub fn solve(qp: &Qp, nm: Coefficients, w: &[f64], lam0: &[f64], tol: f64, max_i
         if it == max_iter {
             return Err(stalled("coulomb ssn", it, res));
         }
-        let (set, sigma_p) = active_sets(qp, nm, w, &lam, &ds);
+        let (set, sigma_p) = match (it, warm_sets(qp, nm, w, &lam)) {
+            (0, Some(warm)) => warm,
+            _ => active_sets(qp, nm, w, &lam, &ds),
+        };
         if !seen.insert(set.clone()) {
             return Err(stalled("coulomb ssn (cycling: an active set repeated)", it, res));
         }
@@ -52,6 +55,41 @@ pub fn solve(qp: &Qp, nm: Coefficients, w: &[f64], lam0: &[f64], tol: f64, max_i
     }
     unreachable!("the loop returns at it == max_iter")
 }
+
+/// The sets of the warm start λ₀ itself, read from the forces alone (`None` if λ₀ = 0): separated
+/// where a unilateral normal force is 0, slip where the friction force is at its threshold θ(P₀)
+/// (to [`AT_BOUND`]), stick elsewhere; the sets of the step that λ₀ solved.
+fn warm_sets(qp: &Qp, nm: Coefficients, w: &[f64], lam: &[f64]) -> Option<(Vec<i8>, Vec<f64>)> {
+    if lam.iter().all(|v| *v == 0.0) {
+        return None;
+    }
+    let nc = lam.len() / 2;
+    let mut set = vec![0i8; lam.len()];
+    let mut sign = vec![1.0; nc];
+    for e in 0..nc {
+        let p = lam[nc + e];
+        let separated = qp.lo[nc + e] == 0.0 && p <= 0.0;
+        set[nc + e] = i8::from(separated);
+        sign[e] = if p < 0.0 { -1.0 } else { 1.0 };
+        let theta = if separated && nm[e].is_some() { 0.0 } else { threshold(nm, w, e, p) };
+        set[e] = if theta == 0.0 {
+            2
+        } else if lam[e].abs() >= theta * (1.0 - AT_BOUND) {
+            if lam[e] > 0.0 {
+                1
+            } else {
+                -1
+            }
+        } else {
+            0
+        };
+    }
+    Some((set, sign))
+}
+
+/// A friction force within this fraction of its threshold is at it (a slipping edge's force is its
+/// threshold up to the rounding of the Newton step's LU solve).
+const AT_BOUND: f64 = 1e-12;
 
 /// Per unknown its set: tangential 0 stick, ±1 slip, 2 free (μ = 0); normal 0 closed, 1 separated. And
 /// per edge the sign s of the normal force in the threshold F̄ s P.
