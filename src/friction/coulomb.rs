@@ -11,6 +11,16 @@
 //! in 2D the tangent is a line and this linearisation is exact). Iterated until the natural residual
 //! (`Qp::residual` with the bounds of the current P) is ≤ tol; a repeated active set (the iteration
 //! cycles, as for a large F̄) or the iteration limit stops it, reported as non-convergence.
+//!
+//! The start. λ₀ is the previous step's solution, as HSW start each load step; the first iteration takes
+//! the active sets of λ₀ itself, read from its forces (`warm_sets`: separated where a unilateral P₀ is 0,
+//! slip where μ₀ is at its threshold, stick elsewhere), not those of λ₀'s residual against the new load.
+//! That residual counts the whole increment of the step as predicted slip and penetration, which inflates
+//! the threshold F̄(P + cΔ_n) and moves the sets far from the solution's; the iteration then walks the
+//! stick/slip boundary back a few edges per iteration, a number that grows with 1/h. From the previous
+//! sets, a step whose sets did not change is solved by one Newton step (checked at the next iteration),
+//! at every h; where they changed, the iteration goes on from there. The first step starts from λ = 0
+//! and so from the sets of its residual.
 
 use super::{stalled, Qp, Solved};
 use nalgebra::{DMatrix, DVector};
