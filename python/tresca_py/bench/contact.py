@@ -10,7 +10,8 @@ from refine 0 up, and the cost of a unilateral Tresca run against the bilateral 
   block) runs at refine 0, 1, … (solve only, ``--json``); per level the mean and the largest iteration count of
   the steps 1…N (step 0 is the initial state, solved by none), step 1's (from λ = 0) and the largest of steps
   2…N (from the previous step's solution). The levels stop at ``--max-refine``, or after a level whose run took
-  more than a quarter of ``--level-budget`` seconds (the next one takes about four times as long). Issue 40 asks that they do not grow with the mesh.
+  more than a quarter of ``--level-budget`` seconds (the next one takes about four times as long). Issue 40 asks
+  that they do not grow with the mesh.
 * **Cost ratio**: Example 5.1 at ``--ratio-refine`` as it is (bilateral bottom) and with ``law = "unilateral"``
   on its bottom, solve only, interleaved ``--rounds`` times; the ratio of the median wall times (and of the
   set-up and the steps apart). Issue 40 asks ≤ 1.5 at 1.57 M unknowns (refine 8).
