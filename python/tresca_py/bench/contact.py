@@ -53,7 +53,7 @@ def iterations(path, max_refine, level_budget):
         t = timed([BIN, "run", path, "--refine", str(k), "-q"], summary=True)
         r = t.summary["run"]
         its = [s["iterations"] for s in r["step_stats"] if s["n"] > 0]
-        rows.append((k, r["unknowns"], len(its), statistics.mean(its), max(its), its[0], max(its[1:], default=0),
+        rows.append((k, r["unknowns"], len(its), statistics.mean(its), max(its), its[0], max(its[1:], default="—"),
                      t.wall))
         print(f"  refine {k}: {r['unknowns']} unknowns, {statistics.mean(its):.2f} iterations a step "
               f"(max {max(its)}), {t.wall:.2f} s", flush=True)
