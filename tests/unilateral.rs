@@ -298,3 +298,27 @@ fn step_zero_separation_has_the_later_steps_tolerance() {
     let bilateral = at_start("coulomb = \"0.3\"\ngap = \"-0.001 + 1e-6*x\"");
     assert!(bilateral.iter().all(|&s| !s), "a bilateral edge marked separated: {bilateral:?}");
 }
+
+/// The system shall solve the Coulomb block (verification/cases/coulomb_block.toml: pressed and sheared
+/// at once, proportionally) at refine 0..4 with per-step Newton iterations that do not grow with the mesh:
+/// every step after the first is solved to the tolerance in at most as many iterations at refine 4 as at
+/// refine 0. The bound is exact, not fitted: under proportional loading each step's active sets are the
+/// previous step's, and the first Newton step of a step takes the sets of its warm start (that previous
+/// solution, `friction::coulomb`), so it lands on the solution and the next iteration only checks it,
+/// at every h. The first step starts from λ = 0 and is not bounded here (docs/model.md).
+#[test]
+fn coulomb_block_iterations_do_not_grow_with_the_mesh() {
+    let text = std::fs::read_to_string(common::root("verification/cases/coulomb_block.toml")).unwrap();
+    assert!(text.contains("refine   = 2"), "coulomb_block.toml: its refine line is not where this test expects it");
+    let per_level: Vec<usize> = (0..=4)
+        .map(|k| {
+            let s = Scene::from_str(&text.replace("refine   = 2", &format!("refine = {k}")), "b.toml").unwrap();
+            let steps = run(s);
+            for r in &steps[1..] {
+                assert!(r.residual <= 1e-12, "refine {k} step {}: residual {:e}", r.n, r.residual);
+            }
+            steps.iter().skip(2).map(|r| r.iterations).max().unwrap()
+        })
+        .collect();
+    assert!(per_level.iter().all(|&m| m <= per_level[0]), "max iterations of steps 2.. per refine: {per_level:?}");
+}

@@ -11,6 +11,16 @@
 //! in 2D the tangent is a line and this linearisation is exact). Iterated until the natural residual
 //! (`Qp::residual` with the bounds of the current P) is ≤ tol; a repeated active set (the iteration
 //! cycles, as for a large F̄) or the iteration limit stops it, reported as non-convergence.
+//!
+//! The start. λ₀ is the previous step's solution, as HSW start each load step; the first iteration takes
+//! the active sets of λ₀ itself, read from its forces (`warm_sets`: separated where a unilateral P₀ is 0,
+//! slip where μ₀ is at its threshold, stick elsewhere), not those of λ₀'s residual against the new load.
+//! That residual counts the whole increment of the step as predicted slip and penetration, which inflates
+//! the threshold F̄(P + cΔ_n) and moves the sets far from the solution's; the iteration then walks the
+//! stick/slip boundary back a few edges per iteration, a number that grows with 1/h. From the previous
+//! sets, a step whose sets did not change is solved by one Newton step (checked at the next iteration),
+//! at every h; where they changed, the iteration goes on from there. The first step starts from λ = 0
+//! and so from the sets of its residual.
 
 use super::{stalled, Qp, Solved};
 use nalgebra::{DMatrix, DVector};
@@ -43,7 +53,10 @@ pub fn solve(qp: &Qp, nm: Coefficients, w: &[f64], lam0: &[f64], tol: f64, max_i
         if it == max_iter {
             return Err(stalled("coulomb ssn", it, res));
         }
-        let (set, sigma_p) = active_sets(qp, nm, w, &lam, &ds);
+        let (set, sigma_p) = match (it, warm_sets(qp, nm, w, &lam)) {
+            (0, Some(warm)) => warm,
+            _ => active_sets(qp, nm, w, &lam, &ds),
+        };
         if !seen.insert(set.clone()) {
             return Err(stalled("coulomb ssn (cycling: an active set repeated)", it, res));
         }
@@ -53,24 +66,40 @@ pub fn solve(qp: &Qp, nm: Coefficients, w: &[f64], lam0: &[f64], tol: f64, max_i
     unreachable!("the loop returns at it == max_iter")
 }
 
-/// Per unknown its set: tangential 0 stick, ±1 slip, 2 free (μ = 0); normal 0 closed, 1 separated. And
-/// per edge the sign s of the normal force in the threshold F̄ s P.
+/// The sets of the warm start λ₀ itself, read from the forces alone (`None` if λ₀ = 0): separated
+/// where a unilateral normal force is 0, slip where the friction force is at its threshold θ(P₀)
+/// (to [`AT_BOUND`]), stick elsewhere; the sets of the step that λ₀ solved.
+fn warm_sets(qp: &Qp, nm: Coefficients, w: &[f64], lam: &[f64]) -> Option<(Vec<i8>, Vec<f64>)> {
+    (!lam.iter().all(|v| *v == 0.0)).then(|| sets_of(qp, nm, w, lam, 1.0 - AT_BOUND))
+}
+
+/// A friction force within this fraction of its threshold is at it (a slipping edge's force is its
+/// threshold up to the rounding of the Newton step's LU solve).
+const AT_BOUND: f64 = 1e-12;
+
+/// The sets of the iterate λ with Δ = `ds`: those of y = λ + cΔ ([`sets_of`]).
 fn active_sets(qp: &Qp, nm: Coefficients, w: &[f64], lam: &[f64], ds: &[f64]) -> (Vec<i8>, Vec<f64>) {
-    let n = lam.len();
+    let y: Vec<f64> = (0..lam.len()).map(|k| lam[k] + ds[k] / qp.c[(k, k)]).collect();
+    sets_of(qp, nm, w, &y, 1.0)
+}
+
+/// Per unknown its set, from y (one value per unknown, tangential first): tangential 0 stick, ±1 slip
+/// (|y_e| > `at` θ(y_n,e)), 2 free (θ = 0: μ = 0); normal 0 closed, 1 separated (unilateral, y_n,e ≤ 0).
+/// And per edge the sign s of the normal force in the threshold F̄ s P.
+fn sets_of(qp: &Qp, nm: Coefficients, w: &[f64], y: &[f64], at: f64) -> (Vec<i8>, Vec<f64>) {
+    let n = y.len();
     let nc = n / 2;
     let mut set = vec![0i8; n];
     let mut sign = vec![1.0; nc];
     for e in 0..nc {
-        let k = nc + e;
-        let yn = lam[k] + ds[k] / qp.c[(k, k)];
-        let separated = qp.lo[k] == 0.0 && yn <= 0.0;
-        set[k] = i8::from(separated);
+        let (yt, yn) = (y[e], y[nc + e]);
+        let separated = qp.lo[nc + e] == 0.0 && yn <= 0.0;
+        set[nc + e] = i8::from(separated);
         sign[e] = if yn < 0.0 { -1.0 } else { 1.0 };
         let theta = if separated && nm[e].is_some() { 0.0 } else { threshold(nm, w, e, yn) };
-        let yt = lam[e] + ds[e] / qp.c[(e, e)];
         set[e] = if theta == 0.0 {
             2
-        } else if yt.abs() > theta {
+        } else if yt.abs() > at * theta {
             if yt > 0.0 {
                 1
             } else {
