@@ -11,7 +11,7 @@
 //! the thread count (test: `solve::cholesky::factor::tests::two_threads_factorise_bit_identically_run_after_run`).
 
 use super::queue::{Guard, Queue};
-use super::schedule::{self, Job, Tasks, Tree, NONE};
+use super::schedule::{self, Job, Tasks, Tree};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
 use faer::linalg::solvers::LltError;
@@ -28,10 +28,14 @@ pub(crate) const MIN_ENTRIES: usize = 1 << 16;
 
 type Numeric = std::result::Result<(), LltError>;
 
-/// Whether this machine has faer's update kernel (x86-64 with AVX2 and FMA); elsewhere faer's own
-/// numeric factorisation is used.
-pub(super) fn available() -> bool {
-    instr_set().is_some()
+/// The threads of the factorisation by subtrees with faer's parallelism `par` for a matrix of n rows:
+/// `None` where it is not used (one thread; a machine without faer's update kernel, x86-64 with AVX2 and
+/// FMA; rows beyond `u32`), and faer's own numeric factorisation computes the factor.
+pub(super) fn threads_of(par: Par, n: usize) -> Option<usize> {
+    match par {
+        Par::Rayon(t) if t.get() > 1 && instr_set().is_some() && schedule::fits_u32(n) => Some(t.get()),
+        _ => None,
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -82,14 +86,27 @@ struct Ctx<'a> {
     tree: Tree,
 }
 
-/// Bytes [`factorize`] allocates with `threads` threads beside L and faer's scratch, at most: a row map of
-/// n entries per thread and one for the tree, each supernode's updaters and the work of their updates (at
-/// most one per row index of L's supernodal pattern, kept as triples then as two lists), the tree and
-/// the tasks (about 24 words a supernode).
-pub(crate) fn scratch_bytes(symbolic: &SymbolicSupernodalCholesky<usize>, threads: usize) -> u64 {
+/// Bytes [`factorize`] allocates with `threads` threads beside L and the permuted matrix, at most, where the
+/// supernodal tree has `updates` updates ([`schedule::count_updates`]): the tree (two words a supernode, a
+/// `u32` and an `f64` an update), the supernode of each column (a `u32` each) and the pointers to the
+/// updates (a word a supernode) while it is built, then the tasks (about five words a supernode) and
+/// each thread's row map (a `u32` a row) and dense scratch (and the indices of one update, a few words).
+pub(crate) fn scratch_bytes(symbolic: &SymbolicSupernodalCholesky<usize>, threads: usize, updates: usize) -> u64 {
     let word = std::mem::size_of::<usize>() as u64;
-    let (n, ns, rows) = (symbolic.nrows() as u64, symbolic.n_supernodes() as u64, symbolic.row_idx().len() as u64);
-    word * ((threads as u64 + 1) * n + 5 * rows + 24 * ns)
+    let (n, ns, updates) = (symbolic.nrows() as u64, symbolic.n_supernodes() as u64, updates as u64);
+    let tree = word * (3 * ns + 2) + 12 * updates;
+    let building = 4 * n + word * (ns + 1);
+    let widest = (0..symbolic.n_supernodes()).map(|s| width(symbolic, s)).max().unwrap_or(0);
+    let dense = cholesky_in_place_scratch::<f64>(widest, Par::rayon(threads), Default::default());
+    let running = 5 * word * ns + threads as u64 * (4 * n + dense.unaligned_bytes_required() as u64);
+    tree + building.max(running)
+}
+
+/// The number of updates of the supernodal tree of `symbolic` (see [`scratch_bytes`]).
+pub(crate) fn count_updates(symbolic: &SymbolicSupernodalCholesky<usize>) -> usize {
+    schedule::count_updates(symbolic.supernode_begin(), symbolic.supernode_end(), symbolic.nrows(), |s| {
+        pattern(symbolic, s)
+    })
 }
 
 /// L's values of the lower triangle `a` (permuted) with `threads` threads (≥ 2), as faer's
@@ -132,7 +149,7 @@ fn worker(ctx: &Ctx, tasks: &Tasks, queue: &Queue, threads: usize) {
     let n = ctx.symbolic.nrows();
     let widest = (0..ctx.symbolic.n_supernodes()).map(|s| width(ctx.symbolic, s)).max().unwrap_or(0);
     let mut scratch = Scratch {
-        g2l: vec![NONE; n],
+        g2l: vec![u32::MAX; n],
         idx: (Vec::new(), Vec::new()),
         mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(widest, Par::rayon(threads), Default::default())),
     };
@@ -144,10 +161,10 @@ fn worker(ctx: &Ctx, tasks: &Tasks, queue: &Queue, threads: usize) {
     }
 }
 
-/// A thread's scratch: the row map (global row → row in the supernode's block, `NONE` elsewhere), the
+/// A thread's scratch: the row map (global row → row in the supernode's block, `u32::MAX` elsewhere), the
 /// update's indices, the dense factor's memory.
 struct Scratch {
-    g2l: Vec<usize>,
+    g2l: Vec<u32>,
     idx: (Vec<usize>, Vec<usize>),
     mem: MemBuffer,
 }
@@ -194,19 +211,20 @@ fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Pa
     let s_ncols = s_end - s_start;
     let (g2l, (row_idx, col_idx)) = (&mut sc.g2l, &mut sc.idx);
     for (i, &row) in s_pattern.iter().enumerate() {
-        g2l[row] = i + s_ncols;
+        g2l[row] = (i + s_ncols) as u32;
     }
     let mut ls = block(ctx, s);
     if first {
         for j in s_start..s_end {
             for (i, &v) in ctx.a.row_idx_of_col(j).zip(ctx.a.val_of_col(j)) {
                 if i >= j {
-                    ls[(if i >= s_end { g2l[i] } else { i - s_start }, j - s_start)] += v;
+                    ls[(if i >= s_end { g2l[i] as usize } else { i - s_start }, j - s_start)] += v;
                 }
             }
         }
     }
     for &d in &ctx.tree.updaters[from..to] {
+        let d = d as usize;
         let d_pattern = pattern(sym, d);
         let d_ncols = width(sym, d);
         // SAFETY: d is below s in the tree: done before this task started, and no longer written
@@ -216,12 +234,12 @@ fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Pa
         let mid = d_pattern[lo..].partition_point(|&r| r < s_end);
         let ld_mid_bot = ld.subrows(d_ncols + lo, d_pattern.len() - lo);
         row_idx.clear();
-        row_idx.extend(d_pattern[lo..].iter().enumerate().map(|(i, &r)| if i < mid { r - s_start } else { g2l[r] }));
+        row_idx.extend(d_pattern[lo..].iter().enumerate().map(|(i, &r)| if i < mid { r - s_start } else { g2l[r] as usize }));
         col_idx.clear();
         col_idx.extend(d_pattern[lo..lo + mid].iter().map(|&r| r - s_start));
         update(ls.rb_mut(), row_idx, col_idx, ld_mid_bot, ld_mid_bot.subrows(0, mid).transpose(), par);
     }
-    s_pattern.iter().for_each(|&row| g2l[row] = NONE);
+    s_pattern.iter().for_each(|&row| g2l[row] = u32::MAX);
 }
 
 /// Of supernode s, once its updates are done: the dense Cholesky factor of its diagonal block and the
@@ -247,7 +265,7 @@ fn update(c: MatMut<'_, f64>, row_idx: &[usize], col_idx: &[usize], a: MatRef<'_
     if nrows == 0 || ncols == 0 {
         return;
     }
-    let Some(instr) = instr_set() else { unreachable!("subtrees::factorize is used only where available()") };
+    let Some(instr) = instr_set() else { unreachable!("subtrees::factorize is used only where threads_of gives threads") };
     let par = if (nrows * ncols).saturating_mul(depth) > 32 * 32 * 32 { par } else { Par::Seq };
     let alpha = -1.0f64;
     // SAFETY: the shapes, strides and indices are those checked above, as faer's spicy_matmul passes them
@@ -284,5 +302,5 @@ fn update(c: MatMut<'_, f64>, row_idx: &[usize], col_idx: &[usize], a: MatRef<'_
 
 #[cfg(not(target_arch = "x86_64"))]
 fn update(_: MatMut<'_, f64>, _: &[usize], _: &[usize], _: MatRef<'_, f64>, _: MatRef<'_, f64>, _: Par) {
-    unreachable!("subtrees::factorize is used only where available()")
+    unreachable!("subtrees::factorize is used only where threads_of gives threads")
 }
