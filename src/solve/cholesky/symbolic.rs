@@ -100,7 +100,7 @@ impl Symbolic {
 
     /// Bytes the numeric factorisation allocates with `par`: L's values and its scratch (with several
     /// threads, that of the factorisation by subtrees too: `None`).
-    fn need(&self, par: Par) -> (u64, Option<u64>) {
+    pub(super) fn need(&self, par: Par) -> (u64, Option<u64>) {
         let symbolic = &self.symbolic;
         let scratch = numeric_scratch(symbolic, self.pattern_nnz, par).unaligned_bytes_required() as u64;
         let subtrees = super::subtrees::threads_of(par, symbolic.nrows()).map(|t| {
