@@ -380,7 +380,10 @@ fn numeric_llt(
         stack,
     );
     match super::subtrees::threads_of(par, n) {
-        Some(threads) => super::subtrees::factorize(values, a.rb(), symbolic, threads),
+        Some(threads) => {
+            let (mut maps, _) = stack.make_with(super::subtrees::maps_len(n, threads), |_| u32::MAX);
+            super::subtrees::factorize(values, a.rb(), symbolic, (threads, &mut maps))
+        }
         None => factorize_supernodal_numeric_llt(
             values,
             a.rb(),

@@ -35,13 +35,11 @@ pub(super) fn fits_u32(count: usize) -> bool {
     count < u32::MAX as usize
 }
 
-/// The supernode of each of the n columns, supernodes `begin[s]..end[s]`.
-fn supernode_of_column(begin: &[usize], end: &[usize], n: usize) -> Vec<u32> {
-    let mut of_col = vec![0u32; n];
+/// `of_col` ← the supernode of each column, supernodes `begin[s]..end[s]`.
+fn supernode_of_column(begin: &[usize], end: &[usize], of_col: &mut [u32]) {
     for s in 0..begin.len() {
         of_col[begin[s]..end[s]].fill(s as u32);
     }
-    of_col
 }
 
 /// Each update that supernode d sends, in increasing order of the supernode s it updates, from its row
@@ -59,17 +57,20 @@ fn updates_of(p: &[usize], of_col: &[u32], end: &[usize], mut f: impl FnMut(usiz
 
 /// The number of updates between the supernodes `begin[s]..end[s]` (pairs of a supernode and one it updates).
 pub(super) fn count_updates<'p>(begin: &[usize], end: &[usize], n: usize, pattern: impl Fn(usize) -> &'p [usize]) -> usize {
-    let of_col = supernode_of_column(begin, end, n);
+    let mut of_col = vec![0u32; n];
+    supernode_of_column(begin, end, &mut of_col);
     let mut count = 0;
     (0..begin.len()).for_each(|d| updates_of(pattern(d), &of_col, end, |_, _, _| count += 1));
     count
 }
 
 impl Tree {
-    /// The tree of supernodes `begin[s]..end[s]` whose row patterns below their columns are `pattern(s)`.
-    pub fn new<'p>(begin: &[usize], end: &[usize], n: usize, pattern: impl Fn(usize) -> &'p [usize]) -> Tree {
+    /// The tree of supernodes `begin[s]..end[s]` whose row patterns below their columns are `pattern(s)`,
+    /// with `of_col` (one entry a column) as scratch.
+    pub fn new<'p>(begin: &[usize], end: &[usize], of_col: &mut [u32], pattern: impl Fn(usize) -> &'p [usize]) -> Tree {
         let ns = begin.len();
-        let of_col = supernode_of_column(begin, end, n);
+        supernode_of_column(begin, end, of_col);
+        let of_col = &*of_col;
         let parent: Vec<usize> = (0..ns).map(|d| pattern(d).first().map_or(NONE, |&r| of_col[r] as usize)).collect();
         let dense: Vec<f64> = (0..ns)
             .map(|s| {
@@ -80,13 +81,13 @@ impl Tree {
         // two passes over the patterns: the updates each supernode receives counted, then listed (in
         // increasing order of the updater, as d increases)
         let mut update_ptr = vec![0; ns + 1];
-        (0..ns).for_each(|d| updates_of(pattern(d), &of_col, end, |s, _, _| update_ptr[s + 1] += 1));
+        (0..ns).for_each(|d| updates_of(pattern(d), of_col, end, |s, _, _| update_ptr[s + 1] += 1));
         (0..ns).for_each(|s| update_ptr[s + 1] += update_ptr[s]);
         let mut next = update_ptr.clone();
         let (mut updaters, mut update_work) = (vec![0u32; update_ptr[ns]], vec![0.0; update_ptr[ns]]);
         for d in 0..ns {
             let (p, width) = (pattern(d), (end[d] - begin[d]) as f64);
-            updates_of(p, &of_col, end, |s, lo, mid| {
+            updates_of(p, of_col, end, |s, lo, mid| {
                 // C[rows below, mid columns] −= A Bᵀ, its lower triangle: depth `width`
                 let (rows, cols) = ((p.len() - lo) as f64, mid as f64);
                 updaters[next[s]] = d as u32;

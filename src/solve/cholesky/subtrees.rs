@@ -86,20 +86,26 @@ struct Ctx<'a> {
     tree: Tree,
 }
 
-/// Bytes [`factorize`] allocates with `threads` threads beside L and the permuted matrix, at most, where the
-/// supernodal tree has `updates` updates ([`schedule::count_updates`]): the tree (two words a supernode, a
-/// `u32` and an `f64` an update), the supernode of each column (a `u32` each) and the pointers to the
-/// updates (a word a supernode) while it is built, then the tasks (about five words a supernode) and
-/// each thread's row map (a `u32` a row) and dense scratch (and the indices of one update, a few words).
+/// Bytes [`factorize`] allocates with `threads` threads beside L, the permuted matrix and the row maps
+/// ([`maps_len`]), where the supernodal tree has `updates` updates ([`schedule::count_updates`]): the tree
+/// (three words a supernode, a `u32` and an `f64` an update), the pointers to the updates while it is
+/// built (a word a supernode), then the tasks (at most five words a supernode) and each thread's dense
+/// scratch (and the indices of one update, a few words).
 pub(crate) fn scratch_bytes(symbolic: &SymbolicSupernodalCholesky<usize>, threads: usize, updates: usize) -> u64 {
     let word = std::mem::size_of::<usize>() as u64;
-    let (n, ns, updates) = (symbolic.nrows() as u64, symbolic.n_supernodes() as u64, updates as u64);
+    let (ns, updates) = (symbolic.n_supernodes() as u64, updates as u64);
     let tree = word * (3 * ns + 2) + 12 * updates;
-    let building = 4 * n + word * (ns + 1);
     let widest = (0..symbolic.n_supernodes()).map(|s| width(symbolic, s)).max().unwrap_or(0);
     let dense = cholesky_in_place_scratch::<f64>(widest, Par::rayon(threads), Default::default());
-    let running = 5 * word * ns + threads as u64 * (4 * n + dense.unaligned_bytes_required() as u64);
-    tree + building.max(running)
+    let running = 5 * word * ns + threads as u64 * dense.unaligned_bytes_required() as u64;
+    tree + (word * (ns + 1)).max(running)
+}
+
+/// The `u32`s of the row maps that [`factorize`] is given: one a row for each thread (the first also holds
+/// the supernode of each column while the tree is built). `numeric_scratch` gives them the space of the
+/// permutation's scratch, free once K is permuted.
+pub(crate) fn maps_len(n: usize, threads: usize) -> usize {
+    n * threads
 }
 
 /// The number of updates of the supernodal tree of `symbolic` (see [`scratch_bytes`]).
@@ -117,10 +123,12 @@ pub(super) fn factorize(
     values: &mut [f64],
     a: SparseColMatRef<'_, usize, f64>,
     symbolic: &SymbolicSupernodalCholesky<usize>,
-    threads: usize,
+    (threads, maps): (usize, &mut [u32]),
 ) -> Numeric {
-    let tree =
-        Tree::new(symbolic.supernode_begin(), symbolic.supernode_end(), symbolic.nrows(), |s| pattern(symbolic, s));
+    let n = symbolic.nrows();
+    assert!(maps.len() >= maps_len(n, threads));
+    let tree = Tree::new(symbolic.supernode_begin(), symbolic.supernode_end(), &mut maps[..n], |s| pattern(symbolic, s));
+    maps.fill(u32::MAX);
     let tasks = Tasks::new(&tree, threads);
     if std::env::var_os(schedule::ENV).is_some() {
         let [total, critical, makespan, alone] = tasks.figures(threads);
@@ -136,20 +144,20 @@ pub(super) fn factorize(
     let ctx = Ctx { symbolic, a, values: Values(values.as_mut_ptr(), values.len()), tree };
     let queue = Queue::new(&tasks);
     std::thread::scope(|sc| {
-        for _ in 0..threads {
-            sc.spawn(|| worker(&ctx, &tasks, &queue, threads));
+        for g2l in maps.chunks_exact_mut(n).take(threads) {
+            let (ctx, tasks, queue) = (&ctx, &tasks, &queue);
+            sc.spawn(move || worker(ctx, tasks, queue, (threads, g2l)));
         }
     });
     queue.result()
 }
 
 /// One thread's share: the ready tasks it takes, until none is left.
-fn worker(ctx: &Ctx, tasks: &Tasks, queue: &Queue, threads: usize) {
+fn worker(ctx: &Ctx, tasks: &Tasks, queue: &Queue, (threads, g2l): (usize, &mut [u32])) {
     let _guard = Guard(queue);
-    let n = ctx.symbolic.nrows();
     let widest = (0..ctx.symbolic.n_supernodes()).map(|s| width(ctx.symbolic, s)).max().unwrap_or(0);
     let mut scratch = Scratch {
-        g2l: vec![u32::MAX; n],
+        g2l,
         idx: (Vec::new(), Vec::new()),
         mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(widest, Par::rayon(threads), Default::default())),
     };
@@ -163,14 +171,14 @@ fn worker(ctx: &Ctx, tasks: &Tasks, queue: &Queue, threads: usize) {
 
 /// A thread's scratch: the row map (global row → row in the supernode's block, `u32::MAX` elsewhere), the
 /// update's indices, the dense factor's memory.
-struct Scratch {
-    g2l: Vec<u32>,
+struct Scratch<'m> {
+    g2l: &'m mut [u32],
     idx: (Vec<usize>, Vec<usize>),
     mem: MemBuffer,
 }
 
 /// Compute `job` with the parallelism `par` in its dense work: `Ok(true)` once done.
-fn job(ctx: &Ctx, job: &Job, par: Par, sc: &mut Scratch) -> Result<bool, LltError> {
+fn job(ctx: &Ctx, job: &Job, par: Par, sc: &mut Scratch<'_>) -> Result<bool, LltError> {
     match *job {
         Job::Whole(ref list) => {
             for &s in list {
@@ -203,7 +211,7 @@ fn block<'a>(ctx: &'a Ctx, s: usize) -> MatMut<'a, f64> {
 
 /// Of supernode s, as faer's kernel computes it: K's columns (if `first`), then the updates of the
 /// supernodes `updaters[from..to]`, in order.
-fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Par, sc: &mut Scratch) {
+fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Par, sc: &mut Scratch<'_>) {
     let sym = ctx.symbolic;
     let cpv = sym.col_ptr_for_val();
     let (s_start, s_end) = (sym.supernode_begin()[s], sym.supernode_end()[s]);

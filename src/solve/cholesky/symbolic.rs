@@ -210,7 +210,8 @@ fn supernodal_structure(
 }
 
 /// The scratch of the numeric factorisation: K permuted (values, column pointers, row indices), as
-/// faer's `SymbolicCholesky::factorize_numeric_llt` allocates it, then the supernodal kernel's.
+/// faer's `SymbolicCholesky::factorize_numeric_llt` allocates it, then the supernodal kernel's (or, on
+/// several threads, the row maps of the factorisation by subtrees).
 pub(super) fn numeric_scratch(
     symbolic: &SymbolicSupernodalCholesky<usize>,
     pattern_nnz: usize,
@@ -223,10 +224,10 @@ pub(super) fn numeric_scratch(
         StackReq::new::<usize>(n + 1),
         StackReq::new::<usize>(pattern_nnz),
     ]);
-    // the permutation's scratch (n words), then the kernel's, which the factorisation by subtrees does
-    // not use (it allocates its own: `subtrees::scratch_bytes`)
+    // the permutation's scratch (n words), then the kernel's, or the row maps of the factorisation by
+    // subtrees (which allocates the rest of its scratch: `subtrees::scratch_bytes`)
     let kernel = match super::subtrees::threads_of(par, n) {
-        Some(_) => StackReq::empty(),
+        Some(t) => StackReq::new::<u32>(super::subtrees::maps_len(n, t)),
         None => factorize_supernodal_numeric_llt_scratch::<usize, f64>(symbolic, par, Default::default()),
     };
     StackReq::all_of(&[permuted, StackReq::or(StackReq::new::<usize>(n), kernel)])
