@@ -56,7 +56,12 @@ fn updates_of(p: &[usize], of_col: &[u32], end: &[usize], mut f: impl FnMut(usiz
 }
 
 /// The number of updates between the supernodes `begin[s]..end[s]` (pairs of a supernode and one it updates).
-pub(super) fn count_updates<'p>(begin: &[usize], end: &[usize], n: usize, pattern: impl Fn(usize) -> &'p [usize]) -> usize {
+pub(super) fn count_updates<'p>(
+    begin: &[usize],
+    end: &[usize],
+    n: usize,
+    pattern: impl Fn(usize) -> &'p [usize],
+) -> usize {
     let mut of_col = vec![0u32; n];
     supernode_of_column(begin, end, &mut of_col);
     let mut count = 0;

@@ -127,7 +127,8 @@ pub(super) fn factorize(
 ) -> Numeric {
     let n = symbolic.nrows();
     assert!(maps.len() >= maps_len(n, threads));
-    let tree = Tree::new(symbolic.supernode_begin(), symbolic.supernode_end(), &mut maps[..n], |s| pattern(symbolic, s));
+    let tree =
+        Tree::new(symbolic.supernode_begin(), symbolic.supernode_end(), &mut maps[..n], |s| pattern(symbolic, s));
     maps.fill(u32::MAX);
     let tasks = Tasks::new(&tree, threads);
     if std::env::var_os(schedule::ENV).is_some() {
@@ -242,7 +243,9 @@ fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Pa
         let mid = d_pattern[lo..].partition_point(|&r| r < s_end);
         let ld_mid_bot = ld.subrows(d_ncols + lo, d_pattern.len() - lo);
         row_idx.clear();
-        row_idx.extend(d_pattern[lo..].iter().enumerate().map(|(i, &r)| if i < mid { r - s_start } else { g2l[r] as usize }));
+        row_idx.extend(
+            d_pattern[lo..].iter().enumerate().map(|(i, &r)| if i < mid { r - s_start } else { g2l[r] as usize }),
+        );
         col_idx.clear();
         col_idx.extend(d_pattern[lo..lo + mid].iter().map(|&r| r - s_start));
         update(ls.rb_mut(), row_idx, col_idx, ld_mid_bot, ld_mid_bot.subrows(0, mid).transpose(), par);
@@ -273,7 +276,9 @@ fn update(c: MatMut<'_, f64>, row_idx: &[usize], col_idx: &[usize], a: MatRef<'_
     if nrows == 0 || ncols == 0 {
         return;
     }
-    let Some(instr) = instr_set() else { unreachable!("subtrees::factorize is used only where threads_of gives threads") };
+    let Some(instr) = instr_set() else {
+        unreachable!("subtrees::factorize is used only where threads_of gives threads")
+    };
     let par = if (nrows * ncols).saturating_mul(depth) > 32 * 32 * 32 { par } else { Par::Seq };
     let alpha = -1.0f64;
     // SAFETY: the shapes, strides and indices are those checked above, as faer's spicy_matmul passes them
