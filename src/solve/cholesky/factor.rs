@@ -90,7 +90,7 @@ impl Factor {
     /// As [`Factor::numeric`], with faer's parallelism `par` instead of the thread count in force
     /// ([`crate::threads::par`]).
     pub fn numeric_with(symbolic: Symbolic, k: &SparseColMat<usize, f64>, par: Par) -> Result<Factor> {
-        Factor::numeric_par(symbolic, k, par, || (), crate::machine::available_memory()).0
+        Factor::numeric_par(par, symbolic, k, || (), crate::machine::available_memory()).0
     }
 
     /// As [`Factor::numeric`], running `beside` on the second thread that maps the factor's pages
@@ -102,16 +102,15 @@ impl Factor {
         k: &SparseColMat<usize, f64>,
         beside: impl FnOnce() -> R + Send,
     ) -> (Result<Factor>, Option<R>) {
-        let par = symbolic.par_in_force();
-        Factor::numeric_par(symbolic, k, par, beside, crate::machine::available_memory())
+        Factor::numeric_par(symbolic.par_in_force(), symbolic, k, beside, crate::machine::available_memory())
     }
 
     /// The numeric factorisation with the parallelism `par`, or on one thread when `par`'s scratch does not
     /// fit in `have` bytes, refused when neither fits ([`Symbolic::par_that_fits`]).
     pub(super) fn numeric_par<R: Send>(
+        par: Par,
         symbolic: Symbolic,
         k: &SparseColMat<usize, f64>,
-        par: Par,
         beside: impl FnOnce() -> R + Send,
         have: Option<u64>,
     ) -> (Result<Factor>, Option<R>) {

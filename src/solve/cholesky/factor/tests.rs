@@ -291,7 +291,7 @@ fn without_the_memory_for_two_threads_one_factorises_and_without_that_it_is_refu
         return; // no factorisation by subtrees on this machine: nothing to fall back from
     }
     assert!(schedule.is_some_and(|b| b > 0) && two > one, "two threads need {two} B, one {one} B");
-    let factor = |have: Option<u64>| Factor::numeric_par(symbolic(), &k, Par::rayon(2), || (), have).0;
+    let factor = |have: Option<u64>| Factor::numeric_par(Par::rayon(2), symbolic(), &k, || (), have).0;
     let reference = factor(None).unwrap();
     assert_eq!(reference.threads(), 2);
     assert_eq!(factor(Some(two)).unwrap().threads(), 2, "exactly the bytes of two threads");
