@@ -47,6 +47,8 @@ pub struct Factor {
     fwd: Vec<usize>,
     /// How that permutation was made ([`Symbolic::ordered_by`]).
     ordering: &'static str,
+    /// The threads that computed it (one where the scratch of several did not fit: [`Factor::threads`]).
+    threads: usize,
 }
 
 impl Factor {
@@ -88,7 +90,7 @@ impl Factor {
     /// As [`Factor::numeric`], with faer's parallelism `par` instead of the thread count in force
     /// ([`crate::threads::par`]).
     pub fn numeric_with(symbolic: Symbolic, k: &SparseColMat<usize, f64>, par: Par) -> Result<Factor> {
-        Factor::numeric_par(symbolic, k, par, || ()).0
+        Factor::numeric_par(par, symbolic, k, || (), crate::machine::available_memory()).0
     }
 
     /// As [`Factor::numeric`], running `beside` on the second thread that maps the factor's pages
@@ -100,30 +102,31 @@ impl Factor {
         k: &SparseColMat<usize, f64>,
         beside: impl FnOnce() -> R + Send,
     ) -> (Result<Factor>, Option<R>) {
-        // a small factor's work is over before threads would have started
-        let par = if symbolic.len_val() < super::subtrees::MIN_ENTRIES { Par::Seq } else { crate::threads::par() };
-        Factor::numeric_par(symbolic, k, par, beside)
+        Factor::numeric_par(symbolic.par_in_force(), symbolic, k, beside, crate::machine::available_memory())
     }
 
-    fn numeric_par<R: Send>(
+    /// The numeric factorisation with the parallelism `par`, or on one thread when `par`'s scratch does not
+    /// fit in `have` bytes, refused when neither fits ([`Symbolic::par_that_fits`]).
+    pub(super) fn numeric_par<R: Send>(
+        par: Par,
         symbolic: Symbolic,
         k: &SparseColMat<usize, f64>,
-        par: Par,
         beside: impl FnOnce() -> R + Send,
+        have: Option<u64>,
     ) -> (Result<Factor>, Option<R>) {
-        let Symbolic { symbolic, fwd, inv, last, pattern_nnz, ordering } = symbolic;
         let n = k.nrows();
         // K kept as its lower triangle (a run's) has as many entries as the pattern's; both triangles stored, more
-        let same = k.compute_nnz() == pattern_nnz || lower_nnz(k.symbolic()) == pattern_nnz;
-        if symbolic.nrows() != n || !same {
+        let same = k.compute_nnz() == symbolic.pattern_nnz || lower_nnz(k.symbolic()) == symbolic.pattern_nnz;
+        if symbolic.symbolic.nrows() != n || !same {
             let e = "internal: the matrix does not have the pattern of its symbolic factorisation";
             return (Err(Error::Linear(e.into())), None);
         }
-        let oom = || Error::Linear("out of memory for the Cholesky factorisation".into());
-        let par = match Symbolic::par_that_fits(&symbolic, pattern_nnz, 0, par) {
+        let par = match symbolic.par_that_fits(0, par, have) {
             Ok(p) => p,
             Err(e) => return (Err(e), None),
         };
+        let Symbolic { symbolic, fwd, inv, last, pattern_nnz, ordering, .. } = symbolic;
+        let oom = || Error::Linear("out of memory for the Cholesky factorisation".into());
         let scratch = numeric_scratch(&symbolic, pattern_nnz, par);
         let Some(mut values) = Pages::zeroed(symbolic.len_val()) else { return (Err(oom()), None) };
         let Ok(mut buf) = MemBuffer::try_new(scratch) else {
@@ -140,7 +143,8 @@ impl Factor {
             let numeric = numeric_llt(&symbolic, &mut values, (k, pattern_nnz), (&fwd, &inv), par, stack);
             (numeric, r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
         });
-        let factor = Factor::finish(symbolic, values, numeric, n, last, fwd).map(|f| Factor { ordering, ..f });
+        let threads = super::subtrees::threads_of(par, n).unwrap_or(1);
+        let factor = Factor::finish(symbolic, values, numeric, n, last, fwd).map(|f| Factor { ordering, threads, ..f });
         (factor, Some(r))
     }
 
@@ -159,12 +163,19 @@ impl Factor {
         })?;
         let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
             .map_err(|_| Error::Linear("out of memory for the solve scratch".into()))?;
-        Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last, fwd, ordering: "given" })
+        Ok(Factor { symbolic, values, scratch: Mutex::new((1, scratch)), n, last, fwd, ordering: "given", threads: 1 })
     }
 
     /// How the fill-reducing ordering was made (AMD, nested dissection by coordinates, METIS).
     pub fn ordering(&self) -> &'static str {
         self.ordering
+    }
+
+    /// The threads of the numeric factorisation: the thread count in force, or one where the factor is
+    /// small or the scratch of several threads did not fit in the memory available (the factor is the
+    /// same bit for bit).
+    pub fn threads(&self) -> usize {
+        self.threads
     }
 
     /// Entries of L kept (supernodal blocks included).
@@ -367,11 +378,12 @@ fn numeric_llt(
         Side::Lower,
         stack,
     );
-    match par {
-        Par::Rayon(t) if t.get() > 1 && super::subtrees::available() => {
-            super::subtrees::factorize(values, a.rb(), symbolic, t.get())
+    match super::subtrees::threads_of(par, n) {
+        Some(threads) => {
+            let (mut maps, _) = stack.make_with(super::subtrees::maps_len(n, threads), |_| u32::MAX);
+            super::subtrees::factorize(values, a.rb(), symbolic, (threads, &mut maps))
         }
-        _ => factorize_supernodal_numeric_llt(
+        None => factorize_supernodal_numeric_llt(
             values,
             a.rb(),
             Default::default(),

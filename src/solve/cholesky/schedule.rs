@@ -17,55 +17,88 @@ pub(super) const NONE: usize = usize::MAX;
 const GRAIN: f64 = 16.0;
 
 /// The supernodal elimination tree with, for each supernode, the supernodes that update it and its work.
+/// Supernodes are counted in `u32` ([`fits_u32`]).
 pub(super) struct Tree {
     /// The parent of each supernode, `NONE` at roots.
     pub parent: Vec<usize>,
     /// The supernodes that update supernode s, increasing: `updaters[update_ptr[s]..update_ptr[s + 1]]`,
     /// and the multiply-adds of each of these updates.
     pub update_ptr: Vec<usize>,
-    pub updaters: Vec<usize>,
+    pub updaters: Vec<u32>,
     pub update_work: Vec<f64>,
     /// The multiply-adds of each supernode's dense factor and solve.
     pub dense: Vec<f64>,
 }
 
+/// Whether `count` rows or supernodes can be numbered in `u32` with `u32::MAX` free for "none".
+pub(super) fn fits_u32(count: usize) -> bool {
+    count < u32::MAX as usize
+}
+
+/// `of_col` ← the supernode of each column, supernodes `begin[s]..end[s]`.
+fn supernode_of_column(begin: &[usize], end: &[usize], of_col: &mut [u32]) {
+    for s in 0..begin.len() {
+        of_col[begin[s]..end[s]].fill(s as u32);
+    }
+}
+
+/// Each update that supernode d sends, in increasing order of the supernode s it updates, from its row
+/// pattern `p` below its columns: `f(s, lo, mid)`, s's rows being `p[lo..]` of which `p[lo..lo + mid]` are
+/// s's columns.
+fn updates_of(p: &[usize], of_col: &[u32], end: &[usize], mut f: impl FnMut(usize, usize, usize)) {
+    let mut lo = 0;
+    while lo < p.len() {
+        let s = of_col[p[lo]] as usize;
+        let mid = p[lo..].partition_point(|&r| r < end[s]);
+        f(s, lo, mid);
+        lo += mid;
+    }
+}
+
+/// The number of updates between the supernodes `begin[s]..end[s]` (pairs of a supernode and one it updates).
+pub(super) fn count_updates<'p>(
+    begin: &[usize],
+    end: &[usize],
+    n: usize,
+    pattern: impl Fn(usize) -> &'p [usize],
+) -> usize {
+    let mut of_col = vec![0u32; n];
+    supernode_of_column(begin, end, &mut of_col);
+    let mut count = 0;
+    (0..begin.len()).for_each(|d| updates_of(pattern(d), &of_col, end, |_, _, _| count += 1));
+    count
+}
+
 impl Tree {
-    /// The tree of supernodes `begin[s]..end[s]` whose row patterns below their columns are `pattern(s)`.
-    pub fn new<'p>(begin: &[usize], end: &[usize], n: usize, pattern: impl Fn(usize) -> &'p [usize]) -> Tree {
+    /// The tree of supernodes `begin[s]..end[s]` whose row patterns below their columns are `pattern(s)`,
+    /// with `of_col` (one entry a column) as scratch.
+    pub fn new<'p>(begin: &[usize], end: &[usize], of_col: &mut [u32], pattern: impl Fn(usize) -> &'p [usize]) -> Tree {
         let ns = begin.len();
-        let mut of_col = vec![0; n];
-        for s in 0..ns {
-            of_col[begin[s]..end[s]].fill(s);
-        }
-        let parent: Vec<usize> = (0..ns).map(|d| pattern(d).first().map_or(NONE, |&r| of_col[r])).collect();
+        supernode_of_column(begin, end, of_col);
+        let of_col = &*of_col;
+        let parent: Vec<usize> = (0..ns).map(|d| pattern(d).first().map_or(NONE, |&r| of_col[r] as usize)).collect();
         let dense: Vec<f64> = (0..ns)
             .map(|s| {
                 let (w, below) = ((end[s] - begin[s]) as f64, pattern(s).len() as f64);
                 w * w * w / 6.0 + w * w * below / 2.0
             })
             .collect();
-        let mut pairs = Vec::with_capacity((0..ns).map(|d| pattern(d).len()).sum());
-        for d in 0..ns {
-            let (p, width) = (pattern(d), (end[d] - begin[d]) as f64);
-            let mut lo = 0;
-            while lo < p.len() {
-                let s = of_col[p[lo]];
-                let mid = p[lo..].partition_point(|&r| r < end[s]);
-                // C[rows below, mid columns] −= A Bᵀ, its lower triangle: depth `width`
-                let (rows, cols) = ((p.len() - lo) as f64, mid as f64);
-                pairs.push((s, d, width * cols * (rows - (cols - 1.0) / 2.0)));
-                lo += mid;
-            }
-        }
+        // two passes over the patterns: the updates each supernode receives counted, then listed (in
+        // increasing order of the updater, as d increases)
         let mut update_ptr = vec![0; ns + 1];
-        pairs.iter().for_each(|&(s, _, _)| update_ptr[s + 1] += 1);
+        (0..ns).for_each(|d| updates_of(pattern(d), of_col, end, |s, _, _| update_ptr[s + 1] += 1));
         (0..ns).for_each(|s| update_ptr[s + 1] += update_ptr[s]);
         let mut next = update_ptr.clone();
-        let (mut updaters, mut update_work) = (vec![0; pairs.len()], vec![0.0; pairs.len()]);
-        for (s, d, w) in pairs {
-            updaters[next[s]] = d;
-            update_work[next[s]] = w;
-            next[s] += 1;
+        let (mut updaters, mut update_work) = (vec![0u32; update_ptr[ns]], vec![0.0; update_ptr[ns]]);
+        for d in 0..ns {
+            let (p, width) = (pattern(d), (end[d] - begin[d]) as f64);
+            updates_of(p, of_col, end, |s, lo, mid| {
+                // C[rows below, mid columns] −= A Bᵀ, its lower triangle: depth `width`
+                let (rows, cols) = ((p.len() - lo) as f64, mid as f64);
+                updaters[next[s]] = d as u32;
+                update_work[next[s]] = width * cols * (rows - (cols - 1.0) / 2.0);
+                next[s] += 1;
+            });
         }
         Tree { parent, update_ptr, updaters, update_work, dense }
     }
@@ -106,50 +139,36 @@ impl Tasks {
     /// computed its updaters (its updates from them, in order, as soon as they are done), then its dense work.
     pub fn new(tree: &Tree, threads: usize) -> Tasks {
         let own = tree.work();
+        let (head, split) = cut(tree, &own, threads);
         let ns = own.len();
-        let mut sub = own.clone();
-        let mut children = vec![Vec::new(); ns];
-        for s in 0..ns {
-            if tree.parent[s] != NONE {
-                sub[tree.parent[s]] += sub[s];
-                children[tree.parent[s]].push(s);
-            }
-        }
-        let limit = own.iter().sum::<f64>() / (GRAIN * threads as f64);
-        // the head of each supernode's subtree task, or itself when taken off
-        let (mut head, mut split) = (vec![NONE; ns], vec![false; ns]);
-        let mut stack: Vec<usize> = (0..ns).filter(|&s| tree.parent[s] == NONE).collect();
-        while let Some(r) = stack.pop() {
-            head[r] = r;
-            if sub[r] > limit && !children[r].is_empty() {
-                split[r] = true;
-                stack.extend_from_slice(&children[r]);
-            }
-        }
-        for s in (0..ns).rev() {
-            if head[s] == NONE {
-                head[s] = head[tree.parent[s]];
-            }
-        }
         let mut tasks =
             Tasks { jobs: Vec::new(), next: Vec::new(), below: Vec::new(), priority: Vec::new(), work: Vec::new() };
-        // the task after which each supernode is done
+        // the task after which each supernode is done: first that of each subtree's head, in increasing order
         let mut done = vec![NONE; ns];
-        let mut whole: Vec<Vec<usize>> = vec![Vec::new(); ns];
-        (0..ns).filter(|&s| !split[s]).for_each(|s| whole[head[s]].push(s));
-        for (h, list) in whole.into_iter().enumerate().filter(|(_, l)| !l.is_empty()) {
-            let work = list.iter().map(|&m| own[m]).sum();
-            list.iter().for_each(|&m| done[m] = tasks.jobs.len());
-            debug_assert!(list.last() == Some(&h));
-            tasks.add(Job::Whole(list), &[], work);
+        let mut sizes = Vec::new();
+        for h in (0..ns).filter(|&h| head[h] as usize == h && !split[h]) {
+            done[h] = sizes.len();
+            sizes.push(0);
         }
+        (0..ns).filter(|&s| !split[s]).for_each(|s| sizes[done[head[s] as usize]] += 1);
+        for size in sizes {
+            tasks.add(Job::Whole(Vec::with_capacity(size)), &[], 0.0);
+        }
+        for s in (0..ns).filter(|&s| !split[s]) {
+            let t = done[head[s] as usize];
+            done[s] = t;
+            let Job::Whole(list) = &mut tasks.jobs[t] else { unreachable!("the first tasks are whole subtrees") };
+            list.push(s);
+            tasks.work[t] += own[s];
+        }
+        drop((head, own));
         for s in (0..ns).filter(|&s| split[s]) {
             let (mut from, end) = (tree.update_ptr[s], tree.update_ptr[s + 1]);
             let mut prev =
                 if from == end { tasks.add(Job::Update { s, from, to: end, first: true }, &[], 0.0) } else { NONE };
             while from < end {
-                let by = done[tree.updaters[from]];
-                let to = from + tree.updaters[from..end].iter().take_while(|&&d| done[d] == by).count();
+                let by = done[tree.updaters[from] as usize];
+                let to = from + tree.updaters[from..end].iter().take_while(|&&d| done[d as usize] == by).count();
                 let work = tree.update_work[from..to].iter().sum();
                 let job = Job::Update { s, from, to, first: prev == NONE };
                 prev = tasks.add(job, &[by, prev], work);
@@ -225,4 +244,33 @@ impl Tasks {
         }
         [total, critical, now, alone]
     }
+}
+
+/// The cut of `tree` (supernodes of work `own`) for `threads` threads: the head of each supernode's task,
+/// and whether it is taken off. A subtree is split (its root taken off, its children's subtrees cut
+/// again) while it holds more than 1/(GRAIN · threads) of the work and its root has children; a root
+/// taken off is its own head, the supernodes of a subtree not split have its root as head. Parents are
+/// numbered after their children, so a walk down the numbers meets a parent's cut before its children.
+fn cut(tree: &Tree, own: &[f64], threads: usize) -> (Vec<u32>, Vec<bool>) {
+    let ns = own.len();
+    let mut sub = own.to_vec();
+    let mut has_child = vec![false; ns];
+    for s in 0..ns {
+        if tree.parent[s] != NONE {
+            sub[tree.parent[s]] += sub[s];
+            has_child[tree.parent[s]] = true;
+        }
+    }
+    let limit = own.iter().sum::<f64>() / (GRAIN * threads as f64);
+    let (mut head, mut split) = (vec![0u32; ns], vec![false; ns]);
+    for s in (0..ns).rev() {
+        let p = tree.parent[s];
+        if p == NONE || split[p] {
+            head[s] = s as u32;
+            split[s] = sub[s] > limit && has_child[s];
+        } else {
+            head[s] = head[p];
+        }
+    }
+    (head, split)
 }

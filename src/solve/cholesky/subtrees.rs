@@ -11,7 +11,7 @@
 //! the thread count (test: `solve::cholesky::factor::tests::two_threads_factorise_bit_identically_run_after_run`).
 
 use super::queue::{Guard, Queue};
-use super::schedule::{self, Job, Tasks, Tree, NONE};
+use super::schedule::{self, Job, Tasks, Tree};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
 use faer::linalg::solvers::LltError;
@@ -28,10 +28,14 @@ pub(crate) const MIN_ENTRIES: usize = 1 << 16;
 
 type Numeric = std::result::Result<(), LltError>;
 
-/// Whether this machine has faer's update kernel (x86-64 with AVX2 and FMA); elsewhere faer's own
-/// numeric factorisation is used.
-pub(super) fn available() -> bool {
-    instr_set().is_some()
+/// The threads of the factorisation by subtrees with faer's parallelism `par` for a matrix of n rows:
+/// `None` where it is not used (one thread; a machine without faer's update kernel, x86-64 with AVX2 and
+/// FMA; rows beyond `u32`), and faer's own numeric factorisation computes the factor.
+pub(super) fn threads_of(par: Par, n: usize) -> Option<usize> {
+    match par {
+        Par::Rayon(t) if t.get() > 1 && instr_set().is_some() && schedule::fits_u32(n) => Some(t.get()),
+        _ => None,
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -82,14 +86,33 @@ struct Ctx<'a> {
     tree: Tree,
 }
 
-/// Bytes [`factorize`] allocates with `threads` threads beside L and faer's scratch, at most: a row map of
-/// n entries per thread and one for the tree, each supernode's updaters and the work of their updates (at
-/// most one per row index of L's supernodal pattern, kept as triples then as two lists), the tree and
-/// the tasks (about 24 words a supernode).
-pub(crate) fn scratch_bytes(symbolic: &SymbolicSupernodalCholesky<usize>, threads: usize) -> u64 {
+/// Bytes [`factorize`] allocates with `threads` threads beside L, the permuted matrix and the row maps
+/// ([`maps_len`]), where the supernodal tree has `updates` updates ([`schedule::count_updates`]): the tree
+/// (three words a supernode, a `u32` and an `f64` an update), the pointers to the updates while it is
+/// built (a word a supernode), then the tasks (at most five words a supernode) and each thread's dense
+/// scratch (and the indices of one update, a few words).
+pub(crate) fn scratch_bytes(symbolic: &SymbolicSupernodalCholesky<usize>, threads: usize, updates: usize) -> u64 {
     let word = std::mem::size_of::<usize>() as u64;
-    let (n, ns, rows) = (symbolic.nrows() as u64, symbolic.n_supernodes() as u64, symbolic.row_idx().len() as u64);
-    word * ((threads as u64 + 1) * n + 5 * rows + 24 * ns)
+    let (ns, updates) = (symbolic.n_supernodes() as u64, updates as u64);
+    let tree = word * (3 * ns + 2) + 12 * updates;
+    let widest = (0..symbolic.n_supernodes()).map(|s| width(symbolic, s)).max().unwrap_or(0);
+    let dense = cholesky_in_place_scratch::<f64>(widest, Par::rayon(threads), Default::default());
+    let running = 5 * word * ns + threads as u64 * dense.unaligned_bytes_required() as u64;
+    tree + (word * (ns + 1)).max(running)
+}
+
+/// The `u32`s of the row maps that [`factorize`] is given: one a row for each thread (the first also holds
+/// the supernode of each column while the tree is built). `numeric_scratch` gives them the space of the
+/// permutation's scratch, free once K is permuted.
+pub(crate) fn maps_len(n: usize, threads: usize) -> usize {
+    n * threads
+}
+
+/// The number of updates of the supernodal tree of `symbolic` (see [`scratch_bytes`]).
+pub(crate) fn count_updates(symbolic: &SymbolicSupernodalCholesky<usize>) -> usize {
+    schedule::count_updates(symbolic.supernode_begin(), symbolic.supernode_end(), symbolic.nrows(), |s| {
+        pattern(symbolic, s)
+    })
 }
 
 /// L's values of the lower triangle `a` (permuted) with `threads` threads (≥ 2), as faer's
@@ -100,10 +123,13 @@ pub(super) fn factorize(
     values: &mut [f64],
     a: SparseColMatRef<'_, usize, f64>,
     symbolic: &SymbolicSupernodalCholesky<usize>,
-    threads: usize,
+    (threads, maps): (usize, &mut [u32]),
 ) -> Numeric {
+    let n = symbolic.nrows();
+    assert!(maps.len() >= maps_len(n, threads));
     let tree =
-        Tree::new(symbolic.supernode_begin(), symbolic.supernode_end(), symbolic.nrows(), |s| pattern(symbolic, s));
+        Tree::new(symbolic.supernode_begin(), symbolic.supernode_end(), &mut maps[..n], |s| pattern(symbolic, s));
+    maps.fill(u32::MAX);
     let tasks = Tasks::new(&tree, threads);
     if std::env::var_os(schedule::ENV).is_some() {
         let [total, critical, makespan, alone] = tasks.figures(threads);
@@ -119,20 +145,20 @@ pub(super) fn factorize(
     let ctx = Ctx { symbolic, a, values: Values(values.as_mut_ptr(), values.len()), tree };
     let queue = Queue::new(&tasks);
     std::thread::scope(|sc| {
-        for _ in 0..threads {
-            sc.spawn(|| worker(&ctx, &tasks, &queue, threads));
+        for g2l in maps.chunks_exact_mut(n).take(threads) {
+            let (ctx, tasks, queue) = (&ctx, &tasks, &queue);
+            sc.spawn(move || worker(ctx, tasks, queue, (threads, g2l)));
         }
     });
     queue.result()
 }
 
 /// One thread's share: the ready tasks it takes, until none is left.
-fn worker(ctx: &Ctx, tasks: &Tasks, queue: &Queue, threads: usize) {
+fn worker(ctx: &Ctx, tasks: &Tasks, queue: &Queue, (threads, g2l): (usize, &mut [u32])) {
     let _guard = Guard(queue);
-    let n = ctx.symbolic.nrows();
     let widest = (0..ctx.symbolic.n_supernodes()).map(|s| width(ctx.symbolic, s)).max().unwrap_or(0);
     let mut scratch = Scratch {
-        g2l: vec![NONE; n],
+        g2l,
         idx: (Vec::new(), Vec::new()),
         mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(widest, Par::rayon(threads), Default::default())),
     };
@@ -144,16 +170,16 @@ fn worker(ctx: &Ctx, tasks: &Tasks, queue: &Queue, threads: usize) {
     }
 }
 
-/// A thread's scratch: the row map (global row → row in the supernode's block, `NONE` elsewhere), the
+/// A thread's scratch: the row map (global row → row in the supernode's block, `u32::MAX` elsewhere), the
 /// update's indices, the dense factor's memory.
-struct Scratch {
-    g2l: Vec<usize>,
+struct Scratch<'m> {
+    g2l: &'m mut [u32],
     idx: (Vec<usize>, Vec<usize>),
     mem: MemBuffer,
 }
 
 /// Compute `job` with the parallelism `par` in its dense work: `Ok(true)` once done.
-fn job(ctx: &Ctx, job: &Job, par: Par, sc: &mut Scratch) -> Result<bool, LltError> {
+fn job(ctx: &Ctx, job: &Job, par: Par, sc: &mut Scratch<'_>) -> Result<bool, LltError> {
     match *job {
         Job::Whole(ref list) => {
             for &s in list {
@@ -186,7 +212,7 @@ fn block<'a>(ctx: &'a Ctx, s: usize) -> MatMut<'a, f64> {
 
 /// Of supernode s, as faer's kernel computes it: K's columns (if `first`), then the updates of the
 /// supernodes `updaters[from..to]`, in order.
-fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Par, sc: &mut Scratch) {
+fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Par, sc: &mut Scratch<'_>) {
     let sym = ctx.symbolic;
     let cpv = sym.col_ptr_for_val();
     let (s_start, s_end) = (sym.supernode_begin()[s], sym.supernode_end()[s]);
@@ -194,19 +220,20 @@ fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Pa
     let s_ncols = s_end - s_start;
     let (g2l, (row_idx, col_idx)) = (&mut sc.g2l, &mut sc.idx);
     for (i, &row) in s_pattern.iter().enumerate() {
-        g2l[row] = i + s_ncols;
+        g2l[row] = (i + s_ncols) as u32;
     }
     let mut ls = block(ctx, s);
     if first {
         for j in s_start..s_end {
             for (i, &v) in ctx.a.row_idx_of_col(j).zip(ctx.a.val_of_col(j)) {
                 if i >= j {
-                    ls[(if i >= s_end { g2l[i] } else { i - s_start }, j - s_start)] += v;
+                    ls[(if i >= s_end { g2l[i] as usize } else { i - s_start }, j - s_start)] += v;
                 }
             }
         }
     }
     for &d in &ctx.tree.updaters[from..to] {
+        let d = d as usize;
         let d_pattern = pattern(sym, d);
         let d_ncols = width(sym, d);
         // SAFETY: d is below s in the tree: done before this task started, and no longer written
@@ -216,12 +243,14 @@ fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Pa
         let mid = d_pattern[lo..].partition_point(|&r| r < s_end);
         let ld_mid_bot = ld.subrows(d_ncols + lo, d_pattern.len() - lo);
         row_idx.clear();
-        row_idx.extend(d_pattern[lo..].iter().enumerate().map(|(i, &r)| if i < mid { r - s_start } else { g2l[r] }));
+        row_idx.extend(
+            d_pattern[lo..].iter().enumerate().map(|(i, &r)| if i < mid { r - s_start } else { g2l[r] as usize }),
+        );
         col_idx.clear();
         col_idx.extend(d_pattern[lo..lo + mid].iter().map(|&r| r - s_start));
         update(ls.rb_mut(), row_idx, col_idx, ld_mid_bot, ld_mid_bot.subrows(0, mid).transpose(), par);
     }
-    s_pattern.iter().for_each(|&row| g2l[row] = NONE);
+    s_pattern.iter().for_each(|&row| g2l[row] = u32::MAX);
 }
 
 /// Of supernode s, once its updates are done: the dense Cholesky factor of its diagonal block and the
@@ -247,7 +276,9 @@ fn update(c: MatMut<'_, f64>, row_idx: &[usize], col_idx: &[usize], a: MatRef<'_
     if nrows == 0 || ncols == 0 {
         return;
     }
-    let Some(instr) = instr_set() else { unreachable!("subtrees::factorize is used only where available()") };
+    let Some(instr) = instr_set() else {
+        unreachable!("subtrees::factorize is used only where threads_of gives threads")
+    };
     let par = if (nrows * ncols).saturating_mul(depth) > 32 * 32 * 32 { par } else { Par::Seq };
     let alpha = -1.0f64;
     // SAFETY: the shapes, strides and indices are those checked above, as faer's spicy_matmul passes them
@@ -284,5 +315,5 @@ fn update(c: MatMut<'_, f64>, row_idx: &[usize], col_idx: &[usize], a: MatRef<'_
 
 #[cfg(not(target_arch = "x86_64"))]
 fn update(_: MatMut<'_, f64>, _: &[usize], _: &[usize], _: MatRef<'_, f64>, _: MatRef<'_, f64>, _: Par) {
-    unreachable!("subtrees::factorize is used only where available()")
+    unreachable!("subtrees::factorize is used only where threads_of gives threads")
 }

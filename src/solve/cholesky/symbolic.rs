@@ -19,6 +19,7 @@ use faer::sparse::linalg::cholesky::supernodal::{
 use faer::sparse::linalg::cholesky::CholeskySymbolicParams;
 use faer::sparse::SymbolicSparseColMatRef;
 use faer::Par;
+use std::sync::OnceLock;
 
 /// The symbolic factorisation of a sparsity pattern: the ordering (fill-reducing, with the unknowns
 /// `last` moved to its end) and the structure of L. It needs only K's pattern, so it is computed
@@ -33,6 +34,8 @@ pub struct Symbolic {
     pub(super) pattern_nnz: usize,
     /// How the fill-reducing ordering was made, as a run reports it ("given" unless named).
     pub(super) ordering: &'static str,
+    /// The updates between L's supernodes, counted once asked for (the factorisation by subtrees' scratch).
+    updates: OnceLock<usize>,
 }
 
 impl Symbolic {
@@ -44,7 +47,7 @@ impl Symbolic {
         let (fwd, inv) = ordering_with_last(pattern.nrows(), last, base)?;
         let sym = symmetric(pattern);
         let (symbolic, pattern_nnz) = supernodal_structure(sym.cols(), (&fwd, &inv))?;
-        Ok(Symbolic { symbolic, fwd, inv, last: last.to_vec(), pattern_nnz, ordering: "given" })
+        Ok(Symbolic::of_parts(symbolic, (fwd, inv), last, pattern_nnz))
     }
 
     /// As [`Symbolic::new`], from a symmetric pattern with both triangles stored (compact: without
@@ -57,7 +60,17 @@ impl Symbolic {
         let cols = Cols::of(sym).ok_or_else(|| Error::Linear("internal: the pattern is not compact".into()))?;
         let (fwd, inv) = ordering_with_last(sym.nrows(), last, base)?;
         let (symbolic, pattern_nnz) = supernodal_structure(cols, (&fwd, &inv))?;
-        Ok(Symbolic { symbolic, fwd, inv, last: last.to_vec(), pattern_nnz, ordering: "given" })
+        Ok(Symbolic::of_parts(symbolic, (fwd, inv), last, pattern_nnz))
+    }
+
+    fn of_parts(
+        symbolic: SymbolicSupernodalCholesky<usize>,
+        (fwd, inv): (Vec<usize>, Vec<usize>),
+        last: &[usize],
+        pattern_nnz: usize,
+    ) -> Symbolic {
+        let (last, updates) = (last.to_vec(), OnceLock::new());
+        Symbolic { symbolic, fwd, inv, last, pattern_nnz, ordering: "given", updates }
     }
 
     /// Entries of the lower triangle of the pattern it was made from (of the matrix factorised).
@@ -75,46 +88,67 @@ impl Symbolic {
         Symbolic { ordering, ..self }
     }
 
+    /// The parallelism of the numeric factorisation with the thread count in force: one thread for a
+    /// small factor, whose work is over before threads would have started (`subtrees::MIN_ENTRIES`).
+    pub(super) fn par_in_force(&self) -> Par {
+        if self.len_val() < super::subtrees::MIN_ENTRIES {
+            Par::Seq
+        } else {
+            crate::threads::par()
+        }
+    }
+
     /// Bytes the numeric factorisation allocates with `par`: L's values and its scratch (with several
-    /// threads, that of the factorisation by subtrees too).
-    fn need_of(symbolic: &SymbolicSupernodalCholesky<usize>, pattern_nnz: usize, par: Par) -> u64 {
-        let scratch = numeric_scratch(symbolic, pattern_nnz, par);
-        let subtrees = match par {
-            Par::Rayon(t) if t.get() > 1 && symbolic.len_val() >= super::subtrees::MIN_ENTRIES => {
-                super::subtrees::scratch_bytes(symbolic, t.get())
-            }
-            _ => 0,
-        };
-        (symbolic.len_val() as u64)
-            .saturating_mul(8)
-            .saturating_add(scratch.unaligned_bytes_required() as u64 + subtrees)
+    /// threads, that of the factorisation by subtrees too: `None`).
+    pub(super) fn need(&self, par: Par) -> (u64, Option<u64>) {
+        let symbolic = &self.symbolic;
+        let scratch = numeric_scratch(symbolic, self.pattern_nnz, par).unaligned_bytes_required() as u64;
+        let subtrees = super::subtrees::threads_of(par, symbolic.nrows()).map(|t| {
+            let updates = *self.updates.get_or_init(|| super::subtrees::count_updates(symbolic));
+            super::subtrees::scratch_bytes(symbolic, t, updates)
+        });
+        let bytes = (symbolic.len_val() as u64).saturating_mul(8).saturating_add(scratch);
+        (bytes.saturating_add(subtrees.unwrap_or(0)), subtrees)
     }
 
     /// Whether the numeric factorisation, and `more` bytes the caller will allocate beside it, fit in the
-    /// memory this machine has now (MemAvailable; `true` where the machine does not say), on the threads in
-    /// force or else on one ([`Symbolic::par_that_fits`]).
+    /// memory this machine has now (`machine::available_memory`; `true` where the machine does not say), on
+    /// the threads in force or else on one ([`Symbolic::par_that_fits`]).
     pub fn fits(&self, more: u64) -> bool {
-        Symbolic::par_that_fits(&self.symbolic, self.pattern_nnz, more, crate::threads::par()).is_ok()
+        self.par_that_fits(more, self.par_in_force(), crate::machine::available_memory()).is_ok()
     }
 
-    /// The parallelism the numeric factorisation can afford: `par` when its values and scratch (and `more`
-    /// bytes beside them) fit in the memory this machine has now, else one thread when that fits (the
-    /// factor is the same bit for bit for every thread count: docs/model.md "Threads"; one thread needs
-    /// no scratch of the factorisation by subtrees), else the refusal. L's pages are mapped lazily, so an
-    /// allocation that does not fit would succeed and the process be killed later. The sizes are exact
-    /// once the symbolic factorisation is done, where the pre-run estimate (`scene::budget`) is a fit.
-    pub(super) fn par_that_fits(
-        symbolic: &SymbolicSupernodalCholesky<usize>,
-        pattern_nnz: usize,
-        more: u64,
-        par: Par,
-    ) -> Result<Par> {
-        let have = crate::machine::available_memory();
-        let need = |p| Symbolic::need_of(symbolic, pattern_nnz, p).saturating_add(more);
-        if refuse_beyond(need(par), have, symbolic.nrows(), symbolic.len_val()).is_ok() {
-            return Ok(par);
+    /// The parallelism the numeric factorisation can afford in `have` bytes (the memory available; `None`:
+    /// unknown): `par` when its values and scratch (and `more` bytes beside them) fit, else one thread when
+    /// that fits (the factor is the same bit for bit for every thread count: docs/model.md "Threads"; one
+    /// thread needs no scratch of the factorisation by subtrees), else the refusal, naming the bytes
+    /// needed on one thread and those available. L's pages are mapped lazily, so an allocation that does
+    /// not fit would succeed and the process be killed later. The sizes are exact once the symbolic
+    /// factorisation is done, where the pre-run estimate (`scene::budget`) is a fit. With
+    /// `TRESCA_SCHEDULE` set (`solve::cholesky::schedule`) the figures go to standard error.
+    pub(super) fn par_that_fits(&self, more: u64, par: Par, have: Option<u64>) -> Result<Par> {
+        let (n, len_val) = (self.symbolic.nrows(), self.symbolic.len_val());
+        let (need, subtrees) = self.need(par);
+        let need = need.saturating_add(more);
+        let chosen = match refuse_beyond(need, have, n, len_val) {
+            Ok(()) => Ok(par),
+            Err(_) => refuse_beyond(self.need(Par::Seq).0.saturating_add(more), have, n, len_val).map(|()| Par::Seq),
+        };
+        if std::env::var_os(super::schedule::ENV).is_some() {
+            let threads = chosen.as_ref().map_or("refused".into(), |p| format!("{} thread(s)", p.degree()));
+            let sym = &self.symbolic;
+            eprintln!(
+                "memory: {n} rows, {} supernodes, {} pattern rows, {:?} updates; factor {} B, need {need} B on {} \
+                 thread(s) (of which the schedule's {} B) with {more} B beside, available {have:?} B: {threads}",
+                sym.n_supernodes(),
+                sym.row_idx().len(),
+                self.updates.get(),
+                8 * len_val as u64,
+                par.degree(),
+                subtrees.unwrap_or(0)
+            );
         }
-        refuse_beyond(need(Par::Seq), have, symbolic.nrows(), symbolic.len_val()).map(|()| Par::Seq)
+        chosen
     }
 }
 
@@ -176,7 +210,8 @@ fn supernodal_structure(
 }
 
 /// The scratch of the numeric factorisation: K permuted (values, column pointers, row indices), as
-/// faer's `SymbolicCholesky::factorize_numeric_llt` allocates it, then the supernodal kernel's.
+/// faer's `SymbolicCholesky::factorize_numeric_llt` allocates it, then the supernodal kernel's (or, on
+/// several threads, the row maps of the factorisation by subtrees).
 pub(super) fn numeric_scratch(
     symbolic: &SymbolicSupernodalCholesky<usize>,
     pattern_nnz: usize,
@@ -189,7 +224,12 @@ pub(super) fn numeric_scratch(
         StackReq::new::<usize>(n + 1),
         StackReq::new::<usize>(pattern_nnz),
     ]);
-    let kernel = factorize_supernodal_numeric_llt_scratch::<usize, f64>(symbolic, par, Default::default());
+    // the permutation's scratch (n words), then the kernel's, or the row maps of the factorisation by
+    // subtrees (which allocates the rest of its scratch: `subtrees::scratch_bytes`)
+    let kernel = match super::subtrees::threads_of(par, n) {
+        Some(t) => StackReq::new::<u32>(super::subtrees::maps_len(n, t)),
+        None => factorize_supernodal_numeric_llt_scratch::<usize, f64>(symbolic, par, Default::default()),
+    };
     StackReq::all_of(&[permuted, StackReq::or(StackReq::new::<usize>(n), kernel)])
 }
 

@@ -273,3 +273,39 @@ fn block_solves_are_the_same_with_two_threads() {
     assert_eq!(solve(Par::rayon(2)), seq);
     assert_eq!(solve(Par::rayon(2)), seq);
 }
+
+/// The system shall factorise on one thread, giving the factor of two bit for bit, when the memory
+/// available holds the factor and one thread's scratch but not that of two (`Symbolic::par_that_fits`), and
+/// refuse with a typed error naming the bytes needed and those available when not even one thread's fits.
+#[test]
+fn without_the_memory_for_two_threads_one_factorises_and_without_that_it_is_refused() {
+    let k = grid(160);
+    let n = k.nrows();
+    let base = fill_order(&Graph::of_matrix(&k, &pairs(n)), true).unwrap();
+    let symbolic = || Symbolic::new(k.symbolic(), &[0, 2], base.clone()).unwrap();
+    let two_threads = super::super::subtrees::threads_of(Par::rayon(2), n);
+    assert!(two_threads.is_some() || !cfg!(target_arch = "x86_64") || !std::arch::is_x86_feature_detected!("avx2"));
+    let ((two, schedule), (one, none)) = (symbolic().need(Par::rayon(2)), symbolic().need(Par::Seq));
+    assert!(none.is_none());
+    if two_threads.is_none() {
+        return; // no factorisation by subtrees on this machine: nothing to fall back from
+    }
+    assert!(schedule.is_some_and(|b| b > 0) && two > one, "two threads need {two} B, one {one} B");
+    let factor = |have: Option<u64>| Factor::numeric_par(Par::rayon(2), symbolic(), &k, || (), have).0;
+    let reference = factor(None).unwrap();
+    assert_eq!(reference.threads(), 2);
+    assert_eq!(factor(Some(two)).unwrap().threads(), 2, "exactly the bytes of two threads");
+    for have in [two - 1, one] {
+        let fallback = factor(Some(have)).unwrap();
+        assert_eq!(fallback.threads(), 1, "{have} B available");
+        assert_eq!(value_bits(&fallback), value_bits(&reference), "{have} B available");
+    }
+    match factor(Some(one - 1)) {
+        Err(e @ Error::TooLarge { need, have, .. }) => {
+            assert_eq!((need, have), (one, one - 1));
+            let text = e.to_string();
+            assert!(text.contains("memory for the Cholesky factor") && text.contains("is available"), "{text}");
+        }
+        other => panic!("expected TooLarge, got {:?}", other.map(|f| f.threads())),
+    }
+}
