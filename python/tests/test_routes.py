@@ -1,0 +1,65 @@
+"""What each re-implementation route models (``tresca_py.verify.routes``), the refusals of the scenes outside a
+route, and the size of u_h that ``tresca_py.compare`` measures true errors against (issue 40)."""
+import os
+
+import numpy as np
+import pytest
+
+from tresca_py import compare, results
+from tresca_py.common import BIN, CASES, PY, ROOT, case, run
+from tresca_py.verify import routes
+
+SCRIPTS = {"dolfinx": "dolfinx_solve.py", "distributed": "dolfinx_distributed.py", "skfem": "skfem_solve.py"}
+
+
+def test_the_system_shall_state_what_each_route_models_for_every_case():
+    """The system shall place every scene of verification/cases in or out of each route by what it declares:
+    Coulomb friction outside dolfinx and the distributed route (TAO takes fixed thresholds), unilateral contact and
+    floating bodies outside the distributed route, everything inside scikit-fem (whose floating bodies all have a
+    unilateral or Coulomb part here); the reason names the part."""
+    seen = set()
+    for f in sorted(os.listdir(CASES)):
+        if not f.endswith(".toml"):
+            continue
+        path = os.path.join(CASES, f)
+        text = open(path).read()
+        coulomb, unilateral = "coulomb =" in text, 'law = "unilateral"' in text
+        floating = 'kind = "dirichlet"' not in text
+        assert routes.unsupported("skfem", path) is None, f
+        dx = routes.unsupported("dolfinx", path)
+        assert (dx is not None) == coulomb, f
+        dist = routes.unsupported("distributed", path)
+        assert (dist is not None) == (coulomb or unilateral or floating), f
+        for why in (dx, dist):
+            if why is not None and why[0] is not None:
+                assert f"'{why[0]}'" in why[1], f
+        seen.add((coulomb, unilateral, floating))
+    assert {(True, True, False), (False, True, False), (False, False, False), (False, True, True)} <= seen
+
+
+@pytest.mark.parametrize("route, name", [("dolfinx", "coulomb_block"), ("distributed", "mms_signorini_stop"),
+                                         ("distributed", "floating_block")])
+def test_the_system_shall_refuse_a_scene_outside_a_route_naming_the_part(tmp_path, route, name):
+    """The system shall refuse a scene a route does not model with exit status 2, an ``error:`` line naming the part
+    (or, for a floating body, the missing Dirichlet part) and no results file, as ``routes.refused`` requires."""
+    out = tmp_path / "out.h5"
+    p, _ = run([PY, os.path.join(ROOT, "scripts", SCRIPTS[route]), case(name), "-o", str(out), "-q"], check=False)
+    part, _why = routes.unsupported(route, case(name))
+    assert routes.refused(p.returncode, p.stderr, part), (p.returncode, p.stderr)
+    assert not out.exists()
+
+
+def test_the_system_shall_measure_the_size_of_u_h_exactly(tmp_path):
+    """The system shall measure u_h's broken H¹ seminorm and L² norm exactly for CR (the floor of the true errors'
+    comparison, ``compare.ERR_REL``): on the floating block, whose u = (0.039 t x, −0.091 t y) on the unit square is
+    in the CR space, |u|₁ = t·√(0.039² + 0.091²) and ‖u‖₀ = t·√((0.039² + 0.091²)/3), to the solver's 1e-9
+    (tests/floating.rs)."""
+    out = tmp_path / "fb.h5"
+    run([BIN, "run", case("floating_block"), "-o", str(out), "-q"])
+    r = results.read(str(out))
+    energy, h1, l2 = compare.norms(r)
+    s = 0.039 ** 2 + 0.091 ** 2
+    t = r.times
+    assert np.allclose(h1, t * np.sqrt(s), rtol=1e-9, atol=0)
+    assert np.allclose(l2, t * np.sqrt(s / 3), rtol=1e-9, atol=0)
+    assert np.allclose(energy, np.sqrt(np.maximum(r.energy, 0)), rtol=0, atol=0)
