@@ -63,3 +63,44 @@ def test_the_system_shall_measure_the_size_of_u_h_exactly(tmp_path):
     assert np.allclose(h1, t * np.sqrt(s), rtol=1e-9, atol=0)
     assert np.allclose(l2, t * np.sqrt(s / 3), rtol=1e-9, atol=0)
     assert np.allclose(energy, np.sqrt(np.maximum(r.energy, 0)), rtol=0, atol=0)
+
+
+FLOATING_BILATERAL = """title = "a floating block on a bilateral Tresca foundation and a symmetry plane"
+[mesh]
+corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+cells = [2, 2]
+[material]
+E = 10.0
+nu = 0.3
+[[boundary]]
+name = "bottom"
+kind = "contact"
+g_a = "0.5"
+[[boundary]]
+name = "left"
+kind = "symmetry"
+[[boundary]]
+name = "right"
+kind = "neumann"
+traction = ["0", "0"]
+[[boundary]]
+name = "top"
+kind = "neumann"
+traction = ["0.1*t", "-t"]
+[time]
+T = 1.0
+steps = 2
+"""
+
+
+@pytest.mark.parametrize("route", routes.ROUTES)
+def test_the_system_shall_refuse_a_floating_body_without_normal_unknowns_in_every_route(tmp_path, route):
+    """The system shall refuse, in every re-implementation route, a floating body (no Dirichlet part) held by
+    bilateral contact and a symmetry plane only (no normal unknowns, which the routes' floating solvers need;
+    the distributed route has no rigid motions at all): exit status 2 naming the missing Dirichlet part, no file."""
+    scene, out = tmp_path / "floating.toml", tmp_path / "out.h5"
+    scene.write_text(FLOATING_BILATERAL)
+    assert routes.unsupported(route, str(scene)) is not None
+    p, _ = run([PY, os.path.join(ROOT, "scripts", SCRIPTS[route]), str(scene), "-o", str(out), "-q"], check=False)
+    assert routes.refused(p.returncode, p.stderr, None), (p.returncode, p.stderr)
+    assert not out.exists()
