@@ -13,8 +13,7 @@ files may number vertices and edges differently.  For every time node n it repor
     flags  = number of contact edges whose stick/slip state differs (with normal unknowns in both files: whose
              stick/slip/separated status differs)
     derr_* = relative difference of the true errors (energy, h1, l2), when both files have them
-             (0 when both are below --err-floor, or below ERR_REL times the size of u_h in that norm: the
-             errors of a solution exact in the CR space, as in patch tests and the floating blocks, are rounding)
+             (0 when both are below --err-floor, as in patch tests)
 
 and exits with status 1 if max(du, dE, dsig, derr) > tol or is NaN; with status 2 and one ``error:`` line if
 a file is not a valid results file (``tresca_py.results``: NaN/Inf in a series is refused there) or the
@@ -30,11 +29,6 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from . import results
-
-
-#: A true error below this fraction of the size of u_h in its norm is rounding, not an error: the solvers stop at
-#: 1e-12 relative to the forces and a_h's condition on these meshes is ~1e3 (the bound of tests/floating.rs).
-ERR_REL = 1e-9
 
 
 class CompareError(ValueError):
@@ -54,28 +48,7 @@ def load(path):
                    pressure=c.pressure, status=c.status)
     if r.errors is not None:
         out["errors"] = dict(r.errors)
-        out["size"] = dict(zip(("energy", "h1", "l2"), norms(r), strict=True))
     return out
-
-
-def norms(r):
-    """The size of u_h at every node in the norms of the true errors: sqrt(a_h(u_h, u_h)), the broken H¹ seminorm
-    and the L² norm, the last two exact for CR (its gradient is constant on a triangle, and the edge-midpoint rule
-    integrates its square exactly)."""
-    m = r.mesh
-    te = m.triangle_edges()
-    p = m.points[m.triangles]                                   # (T, 3, 2)
-    # ∇λ_i = (y_j − y_k, x_k − x_j) / 2A with (i, j, k) cyclic; CR's basis function of edge i is 1 − 2λ_i
-    j, k = p[:, [1, 2, 0]], p[:, [2, 0, 1]]
-    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-    area2 = e1[:, 0] * e2[:, 1] - e2[:, 0] * e1[:, 1]
-    glam = np.stack([j[..., 1] - k[..., 1], k[..., 0] - j[..., 0]], -1) / area2[:, None, None]
-    ut = r.u[:, te]                                             # (N+1, T, 3, 2): u(m_e) of each triangle's edges
-    grad = -2.0 * np.einsum("ntic,tid->ntcd", ut, glam)
-    area = 0.5 * np.abs(area2)
-    h1 = np.sqrt(np.einsum("ntcd,ntcd,t->n", grad, grad, area))
-    l2 = np.sqrt(np.einsum("ntic,ntic,t->n", ut, ut, area / 3.0))
-    return np.sqrt(np.maximum(r.energy, 0.0)), h1, l2
 
 
 def match(ref, other, what):
@@ -139,8 +112,7 @@ def compare_files(path_a, path_b, err_floor=1e-12):
             dsig = max(dsig, float(np.max(np.abs(A["pressure"][n] - pB[n]))) / gscale)
         fl = int(np.sum(A[flag][n] != stB[n])) if has_c else 0
         de = [abs(A["errors"][k][n] - B["errors"][k][n]) / max(abs(A["errors"][k][n]), abs(B["errors"][k][n]))
-              if max(abs(A["errors"][k][n]), abs(B["errors"][k][n])) > max(err_floor, ERR_REL * A["size"][k][n])
-              else 0.0 for k in errs]
+              if max(abs(A["errors"][k][n]), abs(B["errors"][k][n])) > err_floor else 0.0 for k in errs]
         # np.maximum propagates NaN (Python's max(0.0, nan) is 0.0, which would pass a NaN difference)
         worst["du"] = float(np.maximum(worst["du"], du))
         worst["dE"] = float(np.maximum(worst["dE"], dE))
