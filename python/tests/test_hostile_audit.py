@@ -126,3 +126,19 @@ def test_the_system_shall_check_the_covered_audit_of_a_stopped_run(rust_bin, tmp
     assert results.read(str(out)).audit_checksummed
     r = check_results(out)
     assert r.returncode == 0 and "not covered" not in r.stdout, r.stdout + r.stderr
+
+
+@pytest.mark.parametrize("name", ["floating_block", "floating_coulomb_block"])
+def test_the_system_shall_check_a_unilateral_floating_run_and_its_contact_work(rust_bin, tmp_path, name):
+    """The system shall find the audit and the views of a valid floating run with normal unknowns and no boundary
+    data equal to its fields, every term recomputed (the work of the contact reaction −Σ Pⁿ δuⁿ·n, the Dirichlet
+    edges counted with one normal unknown a Γ_C edge, σxx of a uniaxial state measured against the stress's size),
+    and report its boundary work forged by moving the external work there, checksums recomputed."""
+    out = tmp_path / f"{name}.h5"
+    subprocess.run([rust_bin, "run", f"{CASES}/{name}.toml", "-q", "-o", str(out)], check=True, capture_output=True)
+    r = check_results(out)
+    assert r.returncode == 0 and "not recomputed" not in r.stdout, r.stdout + r.stderr
+    forge(out, "work moved to the boundary")
+    rechecksum(out)
+    r = check_results(out)
+    assert r.returncode == 1 and "boundary_work" in r.stdout, r.stdout + r.stderr

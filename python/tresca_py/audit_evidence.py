@@ -4,14 +4,17 @@ when its checksums were recomputed: what the file allows of ``src/stepping/audit
 * ``friction_dissipation`` j_h(δuⁿ) = Σ_{e ⊂ Γ_C} |e| ḡ_e |sⁿ_e − sⁿ⁻¹_e| from ``contact/g``, ``contact/slip`` and the
   mesh (every run with Γ_C); on a Coulomb edge (``contact/coulomb`` not NaN) F̄_e |Pⁿ_e| in place of |e| ḡ_e, from
   ``contact/force``;
-* ``boundary_work`` W_Γ: exactly 0 in a scene without boundary data (no ``u`` or ``gap`` key in its parts), where
-  the file does not hold the loads that the external work needs;
+* ``boundary_work`` W_Γ: in a scene without boundary data (no ``u`` or ``gap`` key in its parts), where the file
+  does not hold the loads that the external work needs, exactly 0, or with normal unknowns (a unilateral or
+  Coulomb part) the work of the contact reaction, −Σ_e Pⁿ_e δuⁿ(m_e)·n_e, from ``contact/force``, ``u`` and
+  ``contact/normal`` (``contact_work``);
 * ``stored_energy`` Eⁿ = ½a_h(uⁿ, uⁿ) and ``euler_dissipation`` ½a_h(δuⁿ, δuⁿ) from ``u``, the mesh, E, ν and ρ:
   a_h(U, U) = Σ_T |T| σ(∇U):∇U + 2ρμ Σ_{e interior ∪ Γ_D} |J_e|²/3, where J_e is the jump of U at an end of e
   (on a Dirichlet edge the trace: the jump is linear along e and vanishes at its midpoint, so its mean square is
   |J_e|²/3, what the 2-point Gauss rule of ``src/fem/forms.rs`` gives). The Dirichlet edges are not stored; without
   Dirichlet data (no ``u`` key in the scene's dirichlet parts) they are the boundary edges off Γ_C whose ``u`` is
-  exactly zero at every step, and their number is known from ``n_dofs`` = 2(E − D − C) + C: when the two agree the
+  exactly zero at every step, and their number is known from ``n_dofs`` = 2(E − D − C) + C (+ C with normal
+  unknowns, one on every Γ_C edge then): when the two agree the
   set is exactly Γ_D (every Dirichlet edge is zero, so the zero edges include it, and there are no more of them).
   Otherwise (Dirichlet data, or a Neumann edge that stayed zero) the energy is not recomputed, and ``recompute``
   says so.
@@ -50,6 +53,19 @@ def friction(r):
     return j, (ct.slip.shape[1] + TERM_ROUNDINGS) * EPS * j
 
 
+def contact_work(r):
+    """W_Γ per step of a scene without boundary data (0 at step 0) and its rounding bound: −Σ_e Pⁿ_e δuⁿ(m_e)·n_e
+    with normal unknowns, else exact zeros."""
+    ct, n1 = r.contact, len(r.times)
+    if ct is None or ct.force is None:
+        return np.zeros(n1), np.zeros(n1)
+    du = np.diff(r.u[:, ct.edges], axis=0)                      # (N, C, 2)
+    terms = ct.force[1:, :, None] * du * ct.normal[None]
+    w = np.concatenate([[0.0], -terms.sum(axis=(1, 2))])
+    mag = np.concatenate([[0.0], np.abs(terms).sum(axis=(1, 2))])
+    return w, (2 * ct.force.shape[1] + TERM_ROUNDINGS) * EPS * mag
+
+
 def _parts(r):
     """The scene's ``[[boundary]]`` tables as stored in the file, or None when they cannot be read."""
     try:
@@ -80,7 +96,8 @@ def dirichlet_edges(r):
     if C:
         off[r.contact.edges] = False
     zero = off & np.all(r.u == 0.0, axis=(0, 2))
-    d = E - C - (int(r.attrs["n_dofs"]) - C) // 2
+    normal = C if r.contact is not None and r.contact.force is not None else 0    # one normal unknown an edge
+    d = E - C - (int(r.attrs["n_dofs"]) - C - normal) // 2
     if int(zero.sum()) != d:
         return f"{int(zero.sum())} boundary edges off Γ_C stay zero, but the run had {d} Dirichlet edges"
     return np.flatnonzero(zero)
@@ -149,8 +166,8 @@ def recompute(r, a):
         compare("friction_dissipation", *j)
     parts = _parts(r)
     if parts is not None and not has_data(parts, "dirichlet", "u") and not has_data(parts, "contact", "gap"):
-        # without boundary data the reactions do no work: the audit adds exact zeros
-        compare("boundary_work", np.zeros(len(a["boundary_work"])), np.zeros(len(a["boundary_work"])))
+        # without boundary data the reactions do no work (the audit adds exact zeros), but the contact reaction
+        compare("boundary_work", *contact_work(r))
     d = dirichlet_edges(r)
     if isinstance(d, str):
         notes.append(f"stored and Euler energies not recomputed: {d}")

@@ -21,8 +21,8 @@ from . import checksum, paths
 from . import results_layout as layout
 # the layout's names, also read as tresca_py.results.X
 from .results_layout import ATTRIBUTES as ATTRIBUTES
-from .results_layout import (CONTACT_SERIES, CONTACT_STATIC, DATASETS, ERRORS, F8, LEGACY_MISSING, NORMAL_SERIES,
-                             REQUIRED, SPEC, STEP_FIELDS, ResultsError)
+from .results_layout import (CONTACT_SERIES, CONTACT_STATIC, DATASETS, ERRORS, F8, FLOATING_SERIES, LEGACY_MISSING,
+                             NORMAL_SERIES, REQUIRED, SPEC, STEP_FIELDS, ResultsError)
 
 
 @dataclass(eq=False)
@@ -208,7 +208,8 @@ def _read_group(f, where, verify):
             raise ResultsError(f"{where}: tresca/{name} has {ds[name].ndim} dimensions, the layout wants "
                                f"{len(SPEC[name][1])}")
     sizes = {"P": ds["mesh/points"].shape[0], "T": ds["mesh/triangles"].shape[0], "E": ds["mesh/edges"].shape[0],
-             "R": ds["times"].shape[0], "C": ds["contact/edges"].shape[0] if has_contact else 0}
+             "R": ds["times"].shape[0], "C": ds["contact/edges"].shape[0] if has_contact else 0,
+             "K": g["rigid"].shape[-1] if isinstance(g.get("rigid"), h5py.Dataset) else 0}
     if not has_contact and attrs.get("n_contact", 0) > 0:
         raise ResultsError(f"{where}: n_contact = {attrs['n_contact']} but there is no tresca/contact group: "
                            "the contact part of the run is missing")
@@ -217,7 +218,8 @@ def _read_group(f, where, verify):
     parts = {"contact": has_contact, "errors": "errors" in g}
     wanted = [n for n, *_ in DATASETS if parts.get(n.split("/")[0], True)]
     for name in wanted:
-        optional = name == "steps/checksum" or name in NORMAL_SERIES or (legacy and name in LEGACY_MISSING)
+        optional = (name == "steps/checksum" or name in NORMAL_SERIES or name in FLOATING_SERIES
+                    or (legacy and name in LEGACY_MISSING))
         if optional and name not in g:
             continue
         ds[name] = layout.dataset(where, g, name)

@@ -38,6 +38,7 @@ DATASETS = (
     ("contact/force", F8, ("R", "C"), "normal force P_e, exact (scenes with normal unknowns only)"),
     ("contact/normal_dof", F8, ("R", "C"), "the normal unknown, exact (scenes with normal unknowns only)"),
     ("contact/coulomb", F8, ("C",), "F̄_e of a Coulomb edge, NaN on a Tresca one (scenes with normal unknowns only)"),
+    ("rigid", F8, ("R", "K"), "α, the rigid motions of a floating body, exact; NaN at step 0 (floating bodies only)"),
     ("errors/energy", F8, ("R",), "true energy error"),
     ("errors/h1", F8, ("R",), "true broken H1 error"),
     ("errors/l2", F8, ("R",), "true L2 error"),
@@ -50,6 +51,9 @@ CONTACT_SERIES = ("slip", "sigma_t", "state", "mu", "dof", "pressure", "gap", "s
 # of the step checksums (tresca_py.checksum.SERIES), as src/output/tresca.rs writes them.
 NORMAL_SERIES = ("contact/pressure", "contact/gap", "contact/status", "contact/force", "contact/normal_dof",
                  "contact/coulomb")
+# Written only for a floating body (no Dirichlet part; K its number of rigid motions), for the warm start of
+# --resume; not part of the step checksums.
+FLOATING_SERIES = ("rigid",)
 ERRORS = ("energy", "h1", "l2")
 
 # /tresca attributes as the Rust binary writes them: name -> type ("floats": a 1-D float array)

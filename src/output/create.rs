@@ -167,7 +167,7 @@ impl Writer {
         prev_slip: Option<Vec<f64>>,
     ) -> Writer {
         let frames_done = o.frames.before(completed);
-        let mut rows = Rows::default();
+        let mut rows = Rows { rigid_width: run.rigid, ..Rows::default() };
         rows.reset(completed);
         let mut frame_rows = FrameRows::default();
         frame_rows.reset(frames_done);

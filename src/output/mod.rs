@@ -56,6 +56,7 @@ mod normal_series;
 mod paths;
 mod reserve;
 mod resume;
+mod rigid_series;
 mod rows;
 mod take;
 pub mod tresca;
@@ -128,18 +129,23 @@ pub struct Run<'a> {
     pub data: Option<&'a BoundaryData>,
     pub law: Elasticity,
     pub meta: RunMeta,
+    /// The number of rigid motions of a floating body (`solve::kernel`; 0 when a Dirichlet part fixes
+    /// them): the width of `tresca/rigid`, α of every step, for the warm start of `--resume`.
+    pub rigid: usize,
 }
 
 impl<'a> Run<'a> {
     /// The run of `p` with this build's version and commit.
     pub fn of(p: &'a Problem) -> Run<'a> {
-        Run::new(&p.scene, &p.mesh, (&p.space, p.data.as_ref()), p.law, p.setup)
+        let rigid = p.free.kernel().map_or(0, |k| k.r.ncols());
+        Run::new(&p.scene, &p.mesh, (&p.space, p.data.as_ref()), p.law, (p.setup, rigid))
     }
 
     /// The run of a problem whose set-up is still under way ([`Problem::new_beside`]): its set-up times
     /// are zeros until [`Writer::set_setup_times`].
     pub fn before_setup(p: &'a Discretised) -> Run<'a> {
-        Run::new(&p.scene, &p.mesh, (&p.space, p.data.as_ref()), p.law, SetupTimes::default())
+        let rigid = p.kernel.as_ref().map_or(0, |k| k.r.ncols());
+        Run::new(&p.scene, &p.mesh, (&p.space, p.data.as_ref()), p.law, (SetupTimes::default(), rigid))
     }
 
     /// With this build's version and commit; true errors are computed when the scene gives `[exact]`.
@@ -148,7 +154,7 @@ impl<'a> Run<'a> {
         mesh: &'a Mesh,
         (space, data): (&'a CrSpace, Option<&'a BoundaryData>),
         law: Elasticity,
-        setup: SetupTimes,
+        (setup, rigid): (SetupTimes, usize),
     ) -> Run<'a> {
         let meta = RunMeta {
             version: env!("CARGO_PKG_VERSION"),
@@ -156,7 +162,7 @@ impl<'a> Run<'a> {
             setup,
             true_errors: scene.exact.is_some(),
         };
-        Run { scene, mesh, space, data, law, meta }
+        Run { scene, mesh, space, data, law, meta, rigid }
     }
 
     /// Number of time steps N.

@@ -54,6 +54,17 @@ impl Writer {
                     .into(),
             });
         }
+        if tresca.rigid_width() != run.rigid {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: format!(
+                    "--resume: the file holds α for {} rigid motions (tresca/rigid), this floating body has {}: \
+                     it was written by an older version or for another run; rerun with --force",
+                    tresca.rigid_width(),
+                    run.rigid
+                ),
+            });
+        }
         let mut vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
         let (completed, times) = completed_steps(&mut tresca, run, path)?;
         let every = int(&tresca.group, "frame_every").max(1) as usize;

@@ -56,6 +56,9 @@ pub struct Rows {
     /// The exact normal forces P_e and normal unknowns (for `--resume`).
     pub(super) force: Vec<f64>,
     pub(super) normal_dof: Vec<f64>,
+    /// α of a floating body (`super::rigid_series`), `rigid_width` values a step (none without).
+    pub(super) rigid: Vec<f64>,
+    pub(super) rigid_width: usize,
 }
 
 impl Rows {
@@ -84,6 +87,7 @@ impl Rows {
             append(&mut self.force, &r.normal.force);
             append(&mut self.normal_dof, normal_dof);
         }
+        super::rigid_series::push(&mut self.rigid, r, self.rigid_width);
         let audit = r.audit.map_or([f64::NAN; 6], |a| a.as_array());
         self.audit.iter_mut().zip(audit).for_each(|(v, a)| v.push(a));
         if let Some(e) = &r.errors {
@@ -96,7 +100,7 @@ impl Rows {
     /// Bytes buffered in the per-unknown and per-contact-edge rows.
     pub fn bytes(&self) -> usize {
         bytes([&self.u, &self.slip, &self.sigma_t, &self.mu, &self.dof, &self.pressure, &self.gap, &self.force])
-            + bytes([&self.normal_dof])
+            + bytes([&self.normal_dof, &self.rigid])
             + self.state.len()
             + self.status.len()
     }
@@ -116,6 +120,7 @@ impl Rows {
         self.state.clear();
         self.status.clear();
         self.normal_dof.clear();
+        self.rigid.clear();
         self.errors.iter_mut().for_each(Vec::clear);
         self.audit.iter_mut().for_each(Vec::clear);
     }

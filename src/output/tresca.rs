@@ -65,6 +65,8 @@ pub struct Tresca {
     audit_checksummed: bool,
     /// [`NORMAL`] (`None` without normal unknowns).
     normal: Option<[Series; 5]>,
+    /// α of a floating body (`super::rigid_series`; `None` without rigid motions).
+    rigid: Option<Series>,
 }
 
 pub use super::checksum::AUDIT;
@@ -136,6 +138,7 @@ impl Tresca {
             ])
         };
         let normal = super::normal_series::create(&g, space, sc)?;
+        let rigid = super::rigid_series::create(&g, p.rigid, sc)?;
         let errors = if p.meta.true_errors {
             let eg = g.create_group("errors")?;
             Some([
@@ -153,6 +156,7 @@ impl Tresca {
         attr_str(&checksum.ds, COVERS, &covered(contact.is_some(), errors.is_some()))?;
         Ok(Tresca {
             normal,
+            rigid,
             audit: Some(audit),
             audit_checksummed: true,
             checksum: Some(checksum),
@@ -193,6 +197,7 @@ impl Tresca {
         let normal = super::normal_series::open(&g);
         Ok(Tresca {
             normal,
+            rigid: super::rigid_series::open(&g),
             audit: AUDIT.iter().map(|a| Series::open(&sg, a, 1)).collect::<hdf5::Result<_>>().ok(),
             audit_checksummed: checksum.as_ref().is_some_and(|c| c.ds.attr(COVERS).is_ok()),
             checksum,
@@ -283,6 +288,9 @@ impl Tresca {
             f.write_steps(raw, n, k, &b.force)?;
             nd.write_steps(raw, n, k, &b.normal_dof)?;
         }
+        if let Some(s) = &self.rigid {
+            s.write_steps(raw, n, k, &b.rigid)?;
+        }
         if let Some(a) = &self.audit {
             for (s, v) in a.iter().zip(&b.audit) {
                 s.write_steps(raw, n, k, v)?;
@@ -305,7 +313,7 @@ impl Tresca {
             c.set_steps(raw, steps, kept)?;
             covers.map_or(Ok(()), |v| attr_str(&c.ds, COVERS, &v))?;
         }
-        for a in self.normal.iter_mut().flatten() {
+        for a in self.normal.iter_mut().flatten().chain(self.rigid.as_mut()) {
             a.set_steps(raw, steps, kept)?;
         }
         self.series(true).into_iter().try_for_each(|s| s.set_steps(raw, steps, kept))
@@ -360,12 +368,20 @@ impl Tresca {
         if let Some(s) = &self.normal {
             super::normal_series::read_into(s, space, n, &mut r)?;
         }
+        if let Some(s) = &self.rigid {
+            super::rigid_series::read_into(s, n, &mut r)?;
+        }
         Ok(r)
     }
 
     /// True when the file holds the normal unknowns a resumed run needs ([`super::normal_series`]).
     pub fn has_normal(&self) -> bool {
         self.normal.is_some()
+    }
+
+    /// The number of rigid motions whose α the file holds ([`super::rigid_series`]; 0 without).
+    pub fn rigid_width(&self) -> usize {
+        self.rigid.as_ref().map_or(0, |s| s.ds.shape().get(1).copied().unwrap_or(0))
     }
 
     /// Overwrite the values of `setup_times` (a file created beside the set-up holds zeros until then).

@@ -64,9 +64,10 @@ class CrEdges:
         c = self.contact
         self.tangent = d[c] / self.lengths[c, None]
         self.normal = np.column_stack([self.tangent[:, 1], -self.tangent[:, 0]])
-        if any(b.kind == "contact" and b.coulomb is not None for b in scene.boundaries):
-            raise SceneError("the dolfinx solver models Tresca friction only (TAO's bound-constrained QP): "
-                             "no coulomb")
+        for b in scene.boundaries:
+            if b.kind == "contact" and b.coulomb is not None:
+                raise SceneError(f"boundary '{b.name}': the dolfinx solver models Tresca friction only (TAO's "
+                                 "bound-constrained QP takes fixed thresholds, Coulomb's F·P moves with P): no coulomb")
         self.gbar = self._contact_means(lambda b, x, y: b.g_a(x, y, 0.0))
         self.normal_unknowns = scene.normal_unknowns
         part = self.part_of_edge[c]

@@ -61,6 +61,9 @@ def set_up(comm, args, log):
         try:
             scene = load_scene(args.scene, refine=args.refine, steps=args.steps)
             scene.refuse_contact_extensions("distributed dolfinx")
+            if not any(b.kind == "dirichlet" for b in scene.boundaries):
+                raise Fail("no dirichlet part: the distributed dolfinx solver takes a body held by a Dirichlet part "
+                           "only (a floating body's rigid motions are not modelled)")
         except InputError as e:
             raise Fail(str(e)) from None
         try:

@@ -35,8 +35,8 @@ def write_report(hs, args, self_cmd, rows, commands, meas, total):
         if r is None:
             md.append("| "
                       f"{row['case']} | "
-                      f"{row['refine']} | {row['steps'] or '–'} | {row['ranks']} | – | – | – | – | – | – | FAIL: "
-                      f"{(row.get('err') or '')[:120]} |")
+                      f"{row['refine']} | {row['steps'] or '–'} | {row['ranks']} | – | – | – | – | – | – | "
+                      f"{row['outside'] if row.get('outside') else 'FAIL: ' + (row.get('err') or '')[:120]} |")
             continue
         derr = f"{r['derr']:.1e}" if r["has_errors"] else "–"
         md.append(
