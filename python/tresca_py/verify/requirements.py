@@ -21,7 +21,7 @@ from tresca_py.verify.requirements_estimates import ESTIMATES
 from tresca_py.verify.requirements_orders import ORDERS
 from tresca_py.verify.requirements_tools import TOOLS
 
-__all__ = ["Requirement", "REQUIREMENTS", "find"]
+__all__ = ("Requirement", "REQUIREMENTS", "find")
 
 #: every requirement, in the order of verification/README.md's table
 REQUIREMENTS = ORDERS + ESTIMATES + TOOLS
