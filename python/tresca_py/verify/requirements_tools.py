@@ -27,7 +27,7 @@ TOOLS = (
         "and `Xdmf3ReaderT` as a body block and a contact-line block showing exactly the committed frames, with von "
         "Mises, displacement, slip and stick/slip equal to `/tresca` at two times (≤ 2e-5 relative, f32), and "
         "`scripts/paraview_view.py` renders a PNG whose pixels show a coloured body and the red/blue contact line "
-        "(also in `make test`, skipped with a message where pvpython is absent)",
+        "(`make test` renders a finished run's PNG, skipped with a message where pvpython is absent)",
         'verification/paraview_check.py',
         'out/paraview/*.png',
     ),
