@@ -145,7 +145,7 @@ def test_the_system_shall_refuse_a_gap_that_contradicts_the_initial_normal_displ
 def test_the_system_shall_accept_data_that_vanish_at_t0_up_to_rounding(tmp_path):
     """The gap's terms cancel at t0 = 0 ((0.1 + t)² − 0.01 − 0.2t − t² = 1.7e-18 there, 0 in exact arithmetic)
     while u0 = 0 and u_D(t0) = 0, so the relative tolerance alone is 0: accepted as Rust's
-    tests/boundary_data.rs does; a mismatch of 1e-6 on the same data still refused."""
+    tests/library/boundary_data.rs does; a mismatch of 1e-6 on the same data still refused."""
     gap = "0.02*t*x + (0.1 + t)*(0.1 + t) - 0.01 - 0.2*t - t*t"
     _check(PATCH.replace('gap = "0.02*t*x"', f'gap = "{gap}"'), tmp_path)
     with pytest.raises(SceneError, match=r"u0·n and part `bottom`'s gap"):

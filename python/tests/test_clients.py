@@ -34,6 +34,9 @@ def test_the_system_shall_leave_readable_files_after_killed_stopped_and_resumed_
     check([PY, "verification/interrupted_runs.py"])
 
 
+# study-sized (pvpython on three runs and three readers): make verify runs it as V1 and T1; make test keeps
+# paraview_view.py on a finished run (test_hostile_tools.py, TestParaviewView)
+@pytest.mark.study
 def test_the_system_shall_write_files_paraview_opens(rust_bin):
     check([PY, "verification/paraview_check.py", "--skip-missing"])
 

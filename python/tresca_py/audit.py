@@ -8,7 +8,7 @@ and a_h(uⁿ, δuⁿ) = ½a_h(uⁿ,uⁿ) − ½a_h(uⁿ⁻¹,uⁿ⁻¹) + ½a_h(
 ``external_work`` (lⁿ, δuⁿ), ``boundary_work`` W_Γⁿ (the reactions' work on imposed data, 0 without it),
 ``stored_energy`` ½a_h(uⁿ,uⁿ), ``friction_dissipation`` j_h(δuⁿ), ``euler_dissipation`` ½a_h(δuⁿ,δuⁿ) and
 ``balance_residual`` = ΔE + D + j − W − W_Γ. A wrong slip direction or friction force breaks the balance
-(the Rust test ``tests/energy_audit.rs`` shows it can fail).
+(the Rust test ``tests/library/energy_audit.rs`` shows it can fail).
 
 Checks, each with its reason:
 * the stored residual is the residual of the stored terms (1e-12 of the largest term: sums of a few f64

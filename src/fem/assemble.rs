@@ -65,7 +65,7 @@ impl EdgePattern {
     /// Equal to the graph read from K as long as no 2 × 2 block of two coupled edges vanishes entirely
     /// (on each side e of their triangles, two CR basis functions whose traces are ±(1, −1) have
     /// ∫_e φ_a φ_b = ∓h_e/3 ≠ 0), so the ordering, hence every result, is the same either way
-    /// (tests/elasticity.rs checks the equality).
+    /// (tests/library/elasticity.rs checks the equality).
     pub fn unknown_graph(&self, space: &CrSpace) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
         let first = space.unknown_groups();
         let mut vertex = vec![usize::MAX; space.edge_dof.len()];

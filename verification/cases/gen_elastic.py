@@ -1,4 +1,4 @@
-"""Generate the manufactured plain-elasticity scenes used by tests/elasticity.rs.
+"""Generate the manufactured plain-elasticity scenes used by tests/library/elasticity.rs.
 
 Exact solutions vanish on the clamped side; f = -div sigma(u) and the tractions sigma(u) n on the other
 sides are derived with sympy (tresca_py.mms) and printed in the solver's expression syntax (exmex: ^ for

@@ -1,4 +1,4 @@
-"""The plain-elasticity manufactured scenes (verification/cases/elastic_*.toml, read by tests/elasticity.rs):
+"""The plain-elasticity manufactured scenes (verification/cases/elastic_*.toml, read by tests/library/elasticity.rs):
 exact u vanishing on the clamped side, f = -div sigma(u) and sigma(u) n on the other sides, printed with
 the float printer ``exmex.sstr``."""
 import sympy as sp

@@ -1,7 +1,7 @@
 //! Bad input never panics or lies: every invalid scene, mesh or expression gives an error naming the
 //! problem (and the key, line or location), checked here message by message.
 
-mod common;
+use crate::common;
 
 use tresca_cr::{Problem, Scene};
 

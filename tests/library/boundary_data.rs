@@ -1,6 +1,6 @@
 //! Boundary data (issue 30): dirichlet `u` and contact `gap` (`fem::lifting`).
 
-mod common;
+use crate::common;
 use common::*;
 use tresca_cr::Scene;
 

@@ -2,7 +2,7 @@
 //! to the friction solver's tolerance and rounding on every contact scene, and a wrong friction sign
 //! breaks it.
 
-mod common;
+use crate::common;
 use common::*;
 use tresca_cr::{Problem, Scene, StepResult};
 

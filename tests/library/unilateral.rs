@@ -2,7 +2,7 @@
 //! `law`, `coulomb`, `gap`, contact `traction` and `kind = "symmetry"` (docs/scene.md), the discrete
 //! problem of docs/model.md ("Unilateral contact and Coulomb friction") and its refusals.
 
-mod common;
+use crate::common;
 
 use tresca_cr::{Problem, Scene, StepResult};
 
@@ -162,7 +162,7 @@ fn refusals_name_the_part() {
         &t.replace("name = \"left\"\nkind = \"neumann\"", "name = \"left\"\nkind = \"symmetry\"\ng_a = \"0.1\""),
     );
     assert!(e.contains("left") && e.contains("symmetry part takes no keys"), "{e}");
-    // a body held only by contact floats (tests/floating.rs); frictionless, nothing holds it in x
+    // a body held only by contact floats (tests/library/floating.rs); frictionless, nothing holds it in x
     let e = refusal(
         &t.replace("kind = \"dirichlet\"\nu = [\"0\", \"-0.01\"]", "kind = \"neumann\"\ntraction = [\"0\", \"-1\"]"),
     );

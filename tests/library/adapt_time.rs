@@ -1,7 +1,7 @@
 //! The time indicator with Dirichlet data (src/adapt/time.rs, issue 42): its load term measures the
 //! full displacement w + u_L, not the unknowns' load with the lifting's part in it.
 
-mod common;
+use crate::common;
 
 use common::scene;
 use tresca_cr::adapt::{adapt, Options};

@@ -1,6 +1,6 @@
 //! Requirements of the contact issue: Tresca friction on Γ_C, backward Euler, Uzawa and semismooth Newton.
 
-mod common;
+use crate::common;
 use common::*;
 use faer::sparse::{SparseColMat, Triplet};
 use tresca_cr::friction::EdgeState;

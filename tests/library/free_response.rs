@@ -3,7 +3,7 @@
 //! (s_f = Wᵀy_c) followed by one backward half — against a direct solve of the assembled load with a
 //! fresh factor of K.
 
-mod common;
+use crate::common;
 use common::*;
 use tresca_cr::solve::cholesky::Factor;
 use tresca_cr::solve::free::Free;

@@ -1,6 +1,6 @@
 //! Requirements of the core issue: the stabilised CR elasticity solver without contact.
 
-mod common;
+use crate::common;
 use common::*;
 use tresca_cr::fem::assemble::stiffness;
 use tresca_cr::fem::elasticity::Elasticity;

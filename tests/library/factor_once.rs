@@ -1,7 +1,7 @@
 //! Factor once per mesh (issue 32): the levels of a study and the pilots of a plan that share a mesh
 //! share one assembly and one numeric factorisation of K. Counted, not timed, so these cannot flake.
 
-mod common;
+use crate::common;
 
 use common::scene;
 use tresca_cr::plan::pilot::Quantity;

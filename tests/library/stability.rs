@@ -1,7 +1,7 @@
 //! Stability at the extremes (issue 7): cheap library-level checks; the full study is
 //! verification/stability.py (reference/stability.md).
 
-mod common;
+use crate::common;
 use common::*;
 use tresca_cr::{Problem, Scene};
 

@@ -2,7 +2,7 @@
 //! Dirichlet part) is solved exactly, and loads that contact cannot balance are refused naming the step
 //! and the rigid motion (`solve::kernel`, `friction::floating`).
 
-mod common;
+use crate::common;
 use common::*;
 use tresca_cr::{Error, Problem, Scene, StepResult};
 

@@ -2,7 +2,7 @@
 //! Richardson estimate in the unknowns at the optimal rate N^(−1/2), held to an effectivity (estimate / true
 //! error) in [0.8, 1.25] past the first four levels, and the loop stopped by it.
 
-mod common;
+use crate::common;
 
 use common::scene;
 use tresca_cr::adapt::estimate::TRUSTED_FROM;
