@@ -9,7 +9,8 @@ bit for bit, as the planned level of `plan --run`).
 The questions, and the runs they need:
 * the sweep's finest target: the finest configuration (refine R, the most steps N_max);
 * PL5, the cheapest configuration meeting a bound: the configurations in increasing work W(n, N)
-  (:func:`tresca_py.verify.planner_md.work`; n from `tresca-cr check`, which costs no solve) up to the
+  (:func:`tresca_py.verify.planner_md.work`; n from `tresca-cr check`, which costs no solve, up to the level
+  it assembles, ~1e5 unknowns; a finer level's from a run, :meth:`Grid.unknowns`) up to the
   first one that meets it. Every configuration of less work is run and found not to meet it, so the answer is
   exactly the full grid's;
 * with --costs (`make bench`: the cheapest configuration by CPU time, which no order predicts), every one.
@@ -79,13 +80,14 @@ class Runner:
         self.cache.put(key, row)
         return row
 
-    def unknowns(self, r):
-        """The unknowns at refinement ``r`` (`tresca-cr check`: the mesh, no solve; cached)."""
-        key = f"{self.name}:{r}:unknowns"
+    def mesh(self, r):
+        """(unknowns, triangles) of the mesh `tresca-cr check --refine r` assembles (no solve; cached). Above
+        ASSEMBLED_UNKNOWNS (src/cli/check.rs) it assembles a coarser level: see :meth:`Grid.unknowns`."""
+        key = f"{self.name}:{r}:mesh"
         if self.cache.get(key) is None:
             s, _ = cli_summary.run([BIN, "check", self.full, "--refine", r])
-            self.cache.put(key, s["check"]["unknowns"])
-        return self.cache.get(key)
+            self.cache.put(key, [s["check"]["unknowns"], s["check"]["triangles"]])
+        return tuple(self.cache.get(key))
 
 
 class Grid:
@@ -109,9 +111,21 @@ class Grid:
     def everything(self):
         return [self.at(r, n) for r in self.refines for n in self.steps]
 
+    def unknowns(self, r):
+        """The unknowns at refinement ``r``: a run's; else `check`'s where it assembled level r (its triangles
+        4^r times the coarsest level's; a finer level it only counts from a coarser one), else a run's of
+        (r, the fewest steps)."""
+        known = [g["unknowns"] for (q, _), g in self.run.items() if q == r]
+        if known:
+            return known[0]
+        n, triangles = self.runner.mesh(r)
+        if triangles == self.runner.mesh(0)[1] * 4 ** r:
+            return n
+        return self.at(r, self.steps[0])["unknowns"]
+
     def by_work(self):
         """The configurations (work, r, N), least work first."""
-        return sorted((work(self.runner.unknowns(r), n), r, n) for r in self.refines for n in self.steps)
+        return sorted((work(self.unknowns(r), n), r, n) for r in self.refines for n in self.steps)
 
     def cheapest(self, bound):
         """The configuration of least work whose true error is at most ``bound`` (with its work), or None."""
