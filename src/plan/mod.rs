@@ -14,6 +14,8 @@
 //! The space pilot grows one level at a time while the plan lies more than [`MAX_EXTRAPOLATION`] levels
 //! beyond it and the next level costs at most [`EXTENSION_SHARE`] of the planned run: the fewer levels a
 //! prediction is extrapolated, the less an order error δ costs (a factor 2^{δm} after m levels).
+//! It also grows while it is not in the asymptotic range, or while the order bound stands in for its
+//! order only because its estimates are not yet consistent ([`pilot::Fit::unsettled`]).
 //!
 //! Solver: semismooth Newton (its iterations per step do not grow with refinement: 1–3 here, printed;
 //! Uzawa's grow like 1/h, `reference/work_precision.md`). Tolerance: the natural residual is relative to
@@ -238,7 +240,8 @@ fn space_pilot(
                 Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, order_limit, wall: spent + run.spent };
             let draft = decide(s, options, &pilots, vec![])?;
             let extend = match draft.best.first() {
-                _ if draft.space_fit.not_in_range().is_some() => true, // not yet in the asymptotic range
+                // not yet in the asymptotic range, or bounded only for want of consistent estimates
+                _ if draft.space_fit.not_in_range().is_some() || draft.space_fit.unsettled => true,
                 Some(b) => b.refine > r - 1 + MAX_EXTRAPOLATION && predicted(r) <= EXTENSION_SHARE * b.wall,
                 // refused for the budget: a pilot level closer to the configuration may bring it within
                 None => draft.over_budget.as_ref().is_some_and(|b| {

@@ -75,6 +75,10 @@ pub struct Fit {
     /// bound), with the smooth part's order: [smooth, singular, its order], where the observed order is
     /// above the bound and not falling ([`super::two_term`]).
     pub two_term: Option<[f64; 3]>,
+    /// The order bound replaced the observed order only because the estimates are not yet consistent (the
+    /// order not falling, and CR's optimal): a further level may make them so, and then the split applies
+    /// (the space pilot grows by a level, as it does while not in the asymptotic range: `plan::space_pilot`).
+    pub unsettled: bool,
 }
 
 impl Fit {
@@ -119,6 +123,7 @@ pub fn fit(study: &Study, q: &Quantity, limit: Option<f64>) -> Result<Fit> {
                 distances,
                 bounded: None,
                 two_term: None,
+                unsettled: false,
             };
             if let (Some(limit), Some(model), Axis::H) = (limit, e.model, size) {
                 bound_order(&mut f, study, model, limit);
@@ -149,6 +154,7 @@ pub fn fit(study: &Study, q: &Quantity, limit: Option<f64>) -> Result<Fit> {
                 distances,
                 bounded: None,
                 two_term: None,
+                unsettled: false,
             })
         }
     }
@@ -163,7 +169,8 @@ pub fn fit(study: &Study, q: &Quantity, limit: Option<f64>) -> Result<Fit> {
 /// with Galerkin orthogonality (β = 1) the finest level's error is the sum of the increments still to
 /// come, |e_L|² = Σ_{j>L} d_j², and increments decaying at least like h^limit give
 /// |e_L| ≤ d_L/√(r^{2·limit} − 1), the estimate at p = `limit` (a smaller β only raises it). So the
-/// prediction is a bound, not a hope.
+/// prediction is a bound, not a hope. Where only the consistency is missing (the order not falling, and
+/// CR's optimal) the fit is `unsettled`: the pilot grows, and with consistent estimates the split applies.
 fn bound_order(f: &mut Fit, study: &Study, model: NormModel, limit: f64) {
     if model.p <= limit {
         f.verdicts = asymptotic(&f.x, model.p, &f.errors, limit);
@@ -181,6 +188,7 @@ fn bound_order(f: &mut Fit, study: &Study, model: NormModel, limit: f64) {
             super::two_term::split(&f.x, &f.distances, *f.errors.last().expect("levels"), orders)
         })
         .flatten();
+    f.unsettled = !falling && !consistent && optimal;
     let how = if let Some([g, s]) = split {
         f.two_term = Some([g, s, model.p.min(1.0)]);
         format!(

@@ -13,17 +13,21 @@ against 0.2 by noise alone).
 
 For each manufactured case (exact solution known):
  1. Brute-force grid, the work-precision data of this check: refine r = 0..R and steps N = N_s·2^j (N_s the
-    scene's steps: the fewest a plan offers). Every configuration is run once with the scene's [exact] for
-    its true error (the CLI's "max over time nodes: energy error") and on the scene without [exact] for its
+    scene's steps: the fewest a plan offers), each configuration run as a plan runs it (semismooth Newton,
+    tol 1e-6: `tresca_py/verify/planner_grid.py`), once, with the scene's [exact] for its true error (the
+    CLI's "max over time nodes: energy error"), and only when a question of the check needs it (the finest
+    configuration; PL5's cheapest configuration meeting a target, searched in increasing work, so exactly the
+    full grid's answer). With --costs every configuration is also run on the scene without [exact] for its
     cost: CPU time (user + sys) of the process, median of 3 (one run when it takes over 2 s). CPU time, not
     wall, because the machine is shared: waiting for a core is not a cost of the method.
  2. Sweep: nine targets a quarter decade apart, spanning two decades and ending at the finest quarter-decade
-    value 10^(-j/4) that some grid configuration meets with a 10 % margin (MARGIN: so that the truth decides
-    every target robustly; for the default grids 3.16e-1 .. 3.16e-3, or 1.78e-1 .. 1.78e-3 where refine 6
-    reaches below 1.6e-3). For each,
-    `tresca-cr plan SCENE --target T --csv F` (its CPU time is the planner's own cost: all pilot runs;
-    median of 3 as above);
-    the plan (refine, steps, ssn, tol) is then run like a grid point (true error with [exact], cost without).
+    value 10^(-j/4) that the finest grid configuration (refine R, the most steps) meets with a 10 % margin
+    (MARGIN: so that the truth decides every target robustly; for the default grids 3.16e-1 .. 3.16e-3, or
+    1.78e-1 .. 1.78e-3 where refine 6 reaches below 1.6e-3). For each, `tresca-cr plan SCENE --target T`
+    (its CPU time is the planner's own cost: all pilot runs; median of 3 as above); the plan (refine,
+    steps, ssn, tol) is the grid's configuration when its tol is the grid's (true error with [exact], cost
+    without: the same command as the planned level of `plan --run`), else run like one. Where the adaptive
+    route is recommended, `plan --target T --run` runs it and its last level's true error is the plan's.
  3. Requirements (per case):
     PL1 the plan meets the target in truth (true error <= target) for every target (issue 42: 0 misses; with
         --run the route `plan --run` recommends and runs, uniform or adaptive, is the one checked);
@@ -38,7 +42,6 @@ For each manufactured case (exact solution known):
 import argparse
 import atexit
 import csv
-import json
 import math
 import os
 import shutil
@@ -46,9 +49,10 @@ import statistics
 import tempfile
 import time
 
-from tresca_py.common import BIN, REF, ROOT, case, cmdline, load1, run, strip_exact
+from tresca_py.common import BIN, REF, ROOT, case, cmdline, load1, run
 from tresca_py.verify import summary as cli_summary
 from tresca_py.verify.harness import Harness, out_dir
+from tresca_py.verify.planner_grid import GRID_TOL, Cache, Grid, Runner
 from tresca_py.verify.planner_md import case_md, csv_rows, work
 from tresca_py.bench.timing import timed
 
@@ -89,10 +93,10 @@ WORK_RATIO = 2.0
 MARGIN = 0.9
 
 
-def targets(grid, count):
-    """`count` targets a quarter decade apart ending at the finest 10^(-j/4) that a grid point meets with
-    the margin MARGIN."""
-    j = math.floor(-4 * math.log10(min(g["error"] for g in grid) / MARGIN) + 1e-9)
+def targets(finest, count):
+    """`count` targets a quarter decade apart ending at the finest 10^(-j/4) that the grid's finest
+    configuration (error ``finest``) meets with the margin MARGIN."""
+    j = math.floor(-4 * math.log10(finest / MARGIN) + 1e-9)
     return [10 ** (-(j - i) / 4) for i in reversed(range(count))]
 EX51 = case("paper_example_5_1")
 
@@ -118,61 +122,6 @@ def scene_steps(path):
 
 def binary_version():
     return run([BIN, "--version"])[0].stdout.strip()
-
-
-class Cache:
-    """Measured configurations, kept in a JSON file as they are measured, so an interrupted check resumes
-    where it stopped. Valid only for the binary that measured them: a file written by another version
-    (``tresca-cr --version``, which names the commit) is ignored and replaced."""
-
-    def __init__(self, path, version):
-        self.path, self.rows, self.version = path, {}, version
-        if path and os.path.exists(path):
-            data = json.load(open(path))
-            if data.get("version") == version:
-                self.rows = data["rows"]
-
-    def get(self, key):
-        return self.rows.get(key)
-
-    def put(self, key, row):
-        self.rows[key] = row
-        if self.path:
-            with open(self.path + ".tmp", "w") as f:
-                json.dump(dict(version=self.version, rows=self.rows), f)
-            os.replace(self.path + ".tmp", self.path)
-
-
-class Runner:
-    """Runs configurations of one case (cached): true error with [exact]; with ``costs`` also the cost, on
-    the scene without [exact]."""
-
-    def __init__(self, name, tmp, cache, costs):
-        self.name = name
-        self.full = case(name)
-        self.bare = os.path.join(tmp, f"{name}_noexact.toml")
-        open(self.bare, "w").write(strip_exact(open(self.full).read()))
-        # a mesh file the scene names resolves beside the copy too (mms_lshape's lshape_sides.msh)
-        here = os.path.dirname(self.full)
-        for f in os.listdir(here):
-            if f.endswith(".msh") and not os.path.exists(os.path.join(tmp, f)):
-                os.symlink(os.path.join(here, f), os.path.join(tmp, f))
-        self.cache, self.costs = cache, costs
-
-    def config(self, r, n, tol=None):
-        key = f"{self.name}:{r}:{n}:{tol}"
-        row = self.cache.get(key)
-        extra = ["--solver", "ssn", "--tol", f"{tol:g}"] if tol else []
-        cmd = [BIN, "run", self.full, "--refine", r, "--steps", n, "-q"] + extra
-        if row is None:
-            s, _ = cli_summary.run(cmd)
-            row = dict(refine=r, steps=n, tol=tol, error=s["run"]["max_errors"]["energy"], cmd=cmdline(cmd),
-                       unknowns=s["run"]["unknowns"])
-        if self.costs and "cpu" not in row:
-            cpu, wall, load = median_cost([BIN, "run", self.bare, "--refine", r, "--steps", n, "-q"] + extra)
-            row.update(cpu=cpu, wall=wall, load=load)
-        self.cache.put(key, row)
-        return row
 
 
 def plan(scene, target, extra=(), costs=False):
@@ -203,48 +152,52 @@ def adaptive_run(runner, p, costs):
     return row
 
 
+def plan_row(runner, grid, t, costs, run_plans):
+    """One target of the sweep: the plan and the truth about it. The plan is made without ``--run``; the
+    uniform route's run is the grid's configuration (the same command, module doc of planner_grid); only
+    where the adaptive route is recommended does `plan --run` run it (its loop's true errors)."""
+    p, pcpu, pwall, cmd, _ = plan(runner.full, t, costs=costs)
+    if run_plans and (p.get("adaptive") or {}).get("choice") == "adaptive":
+        p, _, _, cmd, _ = plan(runner.full, t, ["--run"])
+    meets = [g for g in grid.rows() if g["error"] <= t]
+    cheapest = min(meets, key=lambda g: g["cpu"], default=None) if costs else None
+    # PL5 compares with the cheapest configuration meeting the target with the margin MARGIN: one that meets
+    # it by less is found only by a prediction better than the pilots' 10 % (the sweep's targets, above)
+    row = dict(case=runner.name, target=t, planner_cpu=pcpu, planner_wall=pwall, plan_cmd=cmdline(cmd),
+               cheapest=cheapest, cheapest_work=grid.cheapest(MARGIN * t))
+    best, adaptive = p["plan"], adaptive_run(runner, p, costs) if run_plans else None
+    if adaptive is not None:
+        row.update(refused=False, pilot_wall=p["pilot_wall"], pred_wall=p["adaptive"]["adaptive_wall"],
+                   run_cmd=cmdline(cmd), **adaptive)
+    elif best is None:
+        row.update(refused=True)
+    else:
+        r, n, tol = best["refine"], best["steps"], p["tol"]
+        got = grid.at(r, n) if tol == GRID_TOL and n in grid.steps and r in grid.refines else runner.config(r, n, tol)
+        row.update(refused=False, route="uniform", refine=r, steps=n, tol=tol, pred_error=best["error"],
+                   pred_wall=best["wall"], work=work(got["unknowns"], n),
+                   pilot_wall=p["pilot_wall"], error=got["error"], cpu=got.get("cpu"), wall=got.get("wall"),
+                   run_cmd=got["cmd"])
+    return row
+
+
 def sweep_case(name, spec, tmp, quick, cache, costs, run_plans=False):
-    runner = Runner(name, tmp, cache, costs)
+    """The grid (run on demand: planner_grid) and the sweep of one case."""
+    runner = Runner(name, tmp, cache, median_cost if costs else None)
     ns = scene_steps(runner.full)
     rmax = 4 if quick else spec["R"]
     steps = [ns * 2 ** j for j in range(min(spec["doublings"], 3) if quick else spec["doublings"])]
-    grid = []
-    for r in range(rmax + 1):
-        for n in steps:
-            row = runner.config(r, n)
-            grid.append(row)
-            print(f"  grid {name} r={r} N={n}: error {row['error']:.4e}" +
-                  (f", CPU {row['cpu']:.3f} s" if costs else ""), flush=True)
+    grid = Grid(runner, rmax, steps)
+    if costs:
+        grid.everything()  # the cheapest configuration by CPU time: every one is measured
     sweep = []
-    for t in targets(grid, 5 if quick else 9):
-        p, pcpu, pwall, cmd, _ = plan(runner.full, t, ["--run"] if run_plans else [], costs=costs)
-        meets = [g for g in grid if g["error"] <= t]
-        cheapest = min(meets, key=lambda g: g["cpu"], default=None) if costs else None
-        # PL5 compares with the cheapest configuration meeting the target with the margin MARGIN: one that meets
-        # it by less is found only by a prediction better than the pilots' 10 % (the sweep's targets, above)
-        robust = [g for g in grid if g["error"] <= MARGIN * t]
-        cheapest_work = min((dict(g, work=work(g["unknowns"], g["steps"])) for g in robust), key=lambda g: g["work"],
-                            default=None)
-        row = dict(case=name, target=t, planner_cpu=pcpu, planner_wall=pwall, plan_cmd=cmdline(cmd), cheapest=cheapest,
-                   cheapest_work=cheapest_work)
-        best, adaptive = p["plan"], adaptive_run(runner, p, costs) if run_plans else None
-        if adaptive is not None:
-            row.update(refused=False, pilot_wall=p["pilot_wall"], pred_wall=p["adaptive"]["adaptive_wall"],
-                       run_cmd=cmdline(cmd), **adaptive)
-        elif best is None:
-            row.update(refused=True)
-        else:
-            r, n, tol = best["refine"], best["steps"], p["tol"]
-            got = runner.config(r, n, tol)
-            row.update(refused=False, route="uniform", refine=r, steps=n, tol=tol, pred_error=best["error"],
-                       pred_wall=best["wall"], work=work(got["unknowns"], n),
-                       pilot_wall=p["pilot_wall"], error=got["error"], cpu=got.get("cpu"), wall=got.get("wall"),
-                       run_cmd=got["cmd"])
+    for t in targets(grid.finest()["error"], 5 if quick else 9):
+        row = plan_row(runner, grid, t, costs, run_plans)
         sweep.append(row)
         print(f"  sweep {name} target {t:.3e}: " + ("refused" if row["refused"] else
               f"{row['route']} r={row['refine']} N={row['steps']} tol={row['tol']:g}: true {row['error']:.4e} "
               f"({row['error'] / t:.3f} of target)"), flush=True)
-    return grid, sweep, steps
+    return grid.rows(), sweep, steps
 
 
 def requirements(hs, name, sweep, grid_cmd):

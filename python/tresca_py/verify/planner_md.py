@@ -66,11 +66,13 @@ def case_md(name, grid, sweep, steps, costs):
         md.append(row)
     what = "true energy error / CPU seconds" if costs else "true energy error"
     md += ["", f"Plan command: `tresca-cr plan verification/cases/{name}.toml --target T`. Grid ({what}; steps as "
-           "columns):", "", "| r | " + " | ".join(f"N = {n}" for n in steps) + " |", "|" + "---|" * (len(steps) + 1)]
+           "columns; – : not run, no question of the check needed it: `tresca_py/verify/planner_grid.py`):", "",
+           "| r | " + " | ".join(f"N = {n}" for n in steps) + " |", "|" + "---|" * (len(steps) + 1)]
+    cell = {(g["refine"], g["steps"]): g for g in grid}
     for r in sorted({g["refine"] for g in grid}):
-        cells = [next(g for g in grid if g["refine"] == r and g["steps"] == n) for n in steps]
-        md.append(f"| {r} | " + " | ".join(f"{c['error']:.3e}" + (f" / {c['cpu']:.3f}" if costs else "")
-                                          for c in cells) + " |")
+        cells = [cell.get((r, n)) for n in steps]
+        md.append(f"| {r} | " + " | ".join("–" if c is None else f"{c['error']:.3e}" +
+                                          (f" / {c['cpu']:.3f}" if costs else "") for c in cells) + " |")
     md.append("")
     if costs:
         md += ["Benchmark rows (CPU times; not requirements):", ""] + [f"* {line}" for line in cost_rows(sweep)] + [""]
