@@ -35,7 +35,7 @@ from tresca_py.verify.cross_scenes import generated_scenes
 from tresca_py.verify.harness import Harness, out_dir
 
 # the names other modules read here: the cases directory, the quick plan, the scenes written, the runs
-__all__ = ["CASES_DIR", "FULL", "QUICK", "TOL", "compare_pair", "fmt_pair", "generated_scenes", "main", "run_code"]
+__all__ = ("CASES_DIR", "FULL", "QUICK", "TOL", "compare_pair", "fmt_pair", "generated_scenes", "main", "run_code")
 
 # case -> (levels, steps override or None) ; quick: one level each
 FULL = {
