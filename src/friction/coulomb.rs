@@ -53,10 +53,8 @@ pub fn solve(qp: &Qp, nm: Coefficients, w: &[f64], lam0: &[f64], tol: f64, max_i
         if it == max_iter {
             return Err(stalled("coulomb ssn", it, res));
         }
-        let (set, sigma_p) = match (it, warm_sets(qp, nm, w, &lam)) {
-            (0, Some(warm)) => warm,
-            _ => active_sets(qp, nm, w, &lam, &ds),
-        };
+        let warm = if it == 0 { warm_sets(qp, nm, w, &lam) } else { None };
+        let (set, sigma_p) = warm.unwrap_or_else(|| active_sets(qp, nm, w, &lam, &ds));
         if !seen.insert(set.clone()) {
             return Err(stalled("coulomb ssn (cycling: an active set repeated)", it, res));
         }
