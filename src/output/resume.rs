@@ -45,6 +45,12 @@ impl Writer {
         let mut tresca = Tresca::open(&file).map_err(io(path, "not a tresca-cr results file"))?;
         check_settings(&tresca.group, run, path)?;
         check_points(&tresca.group, run, path)?;
+        if let Some(what) = tresca.wrong_width(run.space) {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: format!("--resume: {what}: the file was damaged after it was written; rerun with --force"),
+            });
+        }
         let contact = (!run.space.contact.is_empty(), !run.space.normal_edges().is_empty());
         if contact.1 && !tresca.has_normal() {
             return Err(Error::Io {
