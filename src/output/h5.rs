@@ -179,7 +179,7 @@ impl Series {
     fn wrap(ds: Dataset, block: usize) -> hdf5::Result<Series> {
         let shape = ds.shape();
         let Some((&rows, rest)) = shape.split_first() else {
-            return Err(hdf5::Error::from(format!("{}: a scalar, not a series with a time axis", ds.name())));
+            return Err(hdf5::Error::from(format!("{}: a scalar, not a series with a time axis (damaged)", ds.name())));
         };
         let rest = rest.to_vec();
         let capacity = rows / block.max(1);
