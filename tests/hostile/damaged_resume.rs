@@ -30,7 +30,8 @@ fn series_of_the_wrong_shape_are_refused_on_resume() {
         ("tresca/contact", "normal_dof", vec![41, 1], "/tresca/contact/normal_dof holds rows of shape [1]"),
         ("tresca/contact", "pressure", vec![41, 5], "/tresca/contact/pressure holds rows of shape [5]"),
         ("tresca/contact", "status", vec![41, 1], "/tresca/contact/status holds rows of shape [1]"),
-        ("VTKHDF/body", "Types", vec![], "/VTKHDF/body/Types: a scalar"),
+        ("VTKHDF/body", "Types", vec![], "VTKHDF/body/Types holds a scalar, this run's mesh has 8"),
+        ("VTKHDF/contact", "Points", vec![2, 3], "VTKHDF/contact/Points holds 2 rows, this run's mesh has 4"),
         ("VTKHDF/body/CellData", "strain", vec![328, 5], "/VTKHDF/body/CellData/strain: rows of shape [5], not [6]"),
     ] {
         let _ = std::fs::remove_file(&out);
