@@ -196,6 +196,11 @@ impl Series {
         &self.rest
     }
 
+    /// The steps it has room for.
+    pub fn capacity(&self) -> usize {
+        self.capacity
+    }
+
     /// Open an existing series.
     pub fn open(g: &Group, name: &str, block: usize) -> hdf5::Result<Series> {
         Series::wrap(g.dataset(name)?, block)
@@ -254,7 +259,11 @@ impl Series {
     }
 
     fn rewrite<T: H5Type + bytemuck::Pod>(&mut self, raw: &Raw, steps: usize, kept: usize) -> hdf5::Result<()> {
-        let keep = steps.min(kept).min(self.capacity);
+        let keep = steps.min(kept);
+        if keep > self.capacity {
+            let msg = format!("{}: room for {} steps, {keep} were committed (damaged)", self.ds.name(), self.capacity);
+            return Err(hdf5::Error::from(msg));
+        }
         let data: Vec<T> = if keep == 0 {
             vec![]
         } else {

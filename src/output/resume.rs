@@ -45,12 +45,6 @@ impl Writer {
         let mut tresca = Tresca::open(&file).map_err(io(path, "not a tresca-cr results file"))?;
         check_settings(&tresca.group, run, path)?;
         check_points(&tresca.group, run, path)?;
-        if let Some(what) = tresca.wrong_width(run.space) {
-            return Err(Error::Io {
-                path: path.to_path_buf(),
-                msg: format!("--resume: {what}: the file was damaged after it was written; rerun with --force"),
-            });
-        }
         let contact = (!run.space.contact.is_empty(), !run.space.normal_edges().is_empty());
         if contact.1 && !tresca.has_normal() {
             return Err(Error::Io {
@@ -78,6 +72,14 @@ impl Writer {
         let every = int(&tresca.group, "frame_every").max(1) as usize;
         let frames = Frames { every, last: run.n_steps() };
         let frames_done = frames.before(completed);
+        let misfit = tresca.misfit(run.space, completed);
+        let short = (vtk.room() < frames_done).then(|| format!("the VTKHDF frame arrays hold {} frames", vtk.room()));
+        if let Some(what) = misfit.or(short) {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: format!("--resume: {what}: the file was damaged after it was written; rerun with --force"),
+            });
+        }
         let frame_list: Vec<(usize, f64)> =
             (0..completed).filter(|&n| frames.is_frame(n)).map(|n| (n, times[n])).collect();
         // a stopped run's series are given back their full length below: their room first (`reserve`)

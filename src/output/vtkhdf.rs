@@ -280,6 +280,13 @@ impl VtkHdf {
         Ok(VtkHdf { body, contact })
     }
 
+    /// The frames every frame array has room for (the least).
+    pub fn room(&self) -> usize {
+        let series =
+            std::iter::once(&self.body).chain(&self.contact).flat_map(|b| b.cells.iter().chain([&b.displacement]));
+        series.map(Series::capacity).min().unwrap_or(0)
+    }
+
     /// Append buffered frames (NSteps is not changed).
     pub fn write_frames(&self, raw: &Raw, b: &FrameRows) -> hdf5::Result<()> {
         let (f, k) = (b.first, b.count());

@@ -32,6 +32,8 @@ fn series_of_the_wrong_shape_are_refused_on_resume() {
         ("tresca/contact", "status", vec![41, 1], "/tresca/contact/status holds rows of shape [1]"),
         ("VTKHDF/body", "Types", vec![], "VTKHDF/body/Types holds a scalar, this run's mesh has 8"),
         ("VTKHDF/contact", "Points", vec![2, 3], "VTKHDF/contact/Points holds 2 rows, this run's mesh has 4"),
+        ("VTKHDF/body/PointData", "displacement", vec![24, 3], "the VTKHDF frame arrays hold 1 frames"),
+        ("tresca/contact", "gap", vec![7, 2], "/tresca/contact/gap holds 7 steps, 20 were committed"),
         ("VTKHDF/body/CellData", "strain", vec![328, 5], "/VTKHDF/body/CellData/strain: rows of shape [5], not [6]"),
     ] {
         let _ = std::fs::remove_file(&out);
