@@ -67,6 +67,13 @@ pub enum Error {
     /// The thread count (`--threads`, `TRESCA_THREADS`) is not a whole number ≥ 1.
     #[error("the thread count (--threads, TRESCA_THREADS) must be a whole number ≥ 1, not {0:?}")]
     Threads(String),
+
+    /// A thread count beyond the threads a run starts (`threads::MAX`, or the cores if more).
+    #[error(
+        "the thread count (--threads, TRESCA_THREADS) {asked} is more than a run starts: at most {max} (more \
+         threads than cores only share them; the results do not depend on the count)"
+    )]
+    TooManyThreads { asked: usize, max: usize },
 }
 
 /// Bytes in a readable unit (decimal: kB, MB, GB, TB).

@@ -24,8 +24,13 @@ pub fn available() -> usize {
     std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
 }
 
-/// The count asked for: `flag`, else `TRESCA_THREADS`, else [`available`]. Zero and text that is not a
-/// count are refused.
+/// The most threads a run starts when the machine has fewer cores: every one is an OS thread of rayon's
+/// pool, so a count such as 10⁶ would spend its time (or the process limit) starting threads, and more
+/// threads than cores only share them (the results do not depend on the count).
+pub const MAX: usize = 1024;
+
+/// The count asked for: `flag`, else `TRESCA_THREADS`, else [`available`]. Zero, text that is not a
+/// count and more than [`MAX`] (or the available cores, if more) are refused.
 pub fn requested(flag: Option<usize>) -> Result<usize> {
     let n = match (flag, std::env::var(ENV)) {
         (Some(n), _) => n,
@@ -34,6 +39,10 @@ pub fn requested(flag: Option<usize>) -> Result<usize> {
     };
     if n == 0 {
         return Err(bad("0"));
+    }
+    let max = MAX.max(available());
+    if n > max {
+        return Err(Error::TooManyThreads { asked: n, max });
     }
     Ok(n)
 }
@@ -74,11 +83,15 @@ pub fn par() -> Par {
 mod tests {
     use super::*;
 
-    /// The system shall take the thread count from `--threads`, refusing zero.
+    /// The system shall take the thread count from `--threads`, refusing zero and more than `MAX`.
     #[test]
     fn the_flag_sets_the_count_and_zero_is_refused() {
         assert_eq!(requested(Some(3)).unwrap(), 3);
         assert!(requested(Some(0)).is_err());
         assert!(available() >= 1);
+        let max = MAX.max(available());
+        assert_eq!(requested(Some(max)).unwrap(), max);
+        let e = requested(Some(max + 1)).unwrap_err().to_string();
+        assert!(e.contains(&format!("at most {max}")), "{e}");
     }
 }

@@ -4,9 +4,13 @@
 //! (§3), inputs that would be read forever (§4), and messages that blamed the wrong cause (§5). The
 //! inputs that are scenes are also in `tests/fuzz_corpus/` (replayed by `tests/fuzz.rs`).
 
+#[path = "hostile/beyond_machine.rs"]
+mod beyond_machine;
 #[path = "hostile/budget.rs"]
 mod budget;
 mod common;
+#[path = "hostile/damaged_resume.rs"]
+mod damaged_resume;
 #[path = "hostile/faults.rs"]
 mod faults;
 #[path = "hostile/outputs.rs"]

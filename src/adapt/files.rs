@@ -22,17 +22,17 @@ fn level_of(name: &std::ffi::OsStr) -> Option<usize> {
 }
 
 /// The levels whose names a loop of `levels` levels (unbounded: `None`, a loop run to a target) may write
-/// in `dir`: 0..levels, and, since an unbounded loop may reach any level, every level named by an entry
-/// of `dir` or by one of `others` (the command's other paths) in `dir`.
+/// in `dir` and that need checking: level 0 (whose names check the directory) and every level below
+/// `levels` named by an entry of `dir` or by one of `others` (the command's other paths) in `dir`. A name
+/// that is neither passes every check but the directory's, so `--levels 10^19` lists no more than these.
 pub fn levels_to_check(dir: &Path, levels: Option<usize>, others: &[&Path]) -> Vec<usize> {
-    let mut ks: Vec<usize> = (0..levels.unwrap_or(1)).collect();
-    if levels.is_none() {
-        let named = std::fs::read_dir(dir).into_iter().flatten().flatten().map(|e| e.file_name());
-        let beside = others.iter().filter(|p| same_dir(p, dir)).filter_map(|p| p.file_name().map(|n| n.to_owned()));
-        ks.extend(named.chain(beside).filter_map(|n| level_of(&n)));
-        ks.sort_unstable();
-        ks.dedup();
-    }
+    let named = std::fs::read_dir(dir).into_iter().flatten().flatten().map(|e| e.file_name());
+    let beside = others.iter().filter(|p| same_dir(p, dir)).filter_map(|p| p.file_name().map(|n| n.to_owned()));
+    let below = |k: &usize| levels.is_none_or(|n| *k < n);
+    let mut ks: Vec<usize> =
+        std::iter::once(0).chain(named.chain(beside).filter_map(|n| level_of(&n))).filter(below).collect();
+    ks.sort_unstable();
+    ks.dedup();
     ks
 }
 

@@ -303,10 +303,9 @@ pub fn adapt(scene: &Scene, opts: &Options, mut report: impl FnMut(&Row)) -> Res
         }
     }
     if let (Some(g), Some(finest)) = (opts.reference, levels.last()) {
-        let (ref_mesh, _) = overlay(finest.mesh.clone(), last_root, g)?;
-        match reference_refusal(scene, &ref_mesh, opts, &levels) {
-            Some(why) => stopped = Some(why),
-            None => {
+        match reference_mesh(scene, finest, last_root, g, opts, &levels)? {
+            Err(why) => stopped = Some(why),
+            Ok(ref_mesh) => {
                 let rf = solve(scene, ref_mesh, None, false, false, false)?;
                 let law = crate::fem::elasticity::Elasticity::new(&scene.material);
                 for (row, kept) in rows.iter_mut().zip(&levels) {
@@ -333,11 +332,40 @@ fn not_finer(scene: &Scene, g: u32, level: usize, coarsest: u32) -> Error {
     Error::scene(&scene.file, "adapt", msg)
 }
 
-/// Why the reference solve on `mesh` is not run: its memory, beside the fields of every level kept for
-/// the comparison and its own (8 bytes a value, every time node), does not fit.
-fn reference_refusal(scene: &Scene, mesh: &Mesh, opts: &Options, levels: &[Kept]) -> Option<String> {
+/// The reference mesh of generation `g` over the finest level ([`overlay`]), or why its solve is not run
+/// ([`reference_refusal`]): first for the triangles it has at least (one of generation k < g becomes
+/// 2^(g−k)), so that a reference far beyond the machine is refused before it is built, then for its own.
+fn reference_mesh(
+    scene: &Scene,
+    finest: &Kept,
+    root_area: Vec<f64>,
+    g: u32,
+    opts: &Options,
+    levels: &[Kept],
+) -> Result<std::result::Result<Mesh, String>> {
+    let gens = reference::generations(&finest.mesh, &root_area);
+    let least = gens.iter().map(|&k| 1u64 << g.saturating_sub(k).min(63)).fold(0, u64::saturating_add);
+    // each triangle has 3 edges and an edge at most 2 triangles
+    if let Some(why) = reference_refusal(scene, (least, least.saturating_mul(3) / 2, 0), "at least ", opts, levels) {
+        return Ok(Err(why));
+    }
+    let (mesh, _) = overlay(finest.mesh.clone(), root_area, g)?;
+    let sizes = (mesh.tris.len() as u64, mesh.edges.len() as u64, contact_edges(scene, &mesh));
+    Ok(reference_refusal(scene, sizes, "", opts, levels).map_or(Ok(mesh), Err))
+}
+
+/// Why the reference solve on a mesh of `sizes` (triangles, edges, contact edges; `least`: "at least "
+/// when they are a lower bound) is not run: its memory,
+/// beside the fields of every level kept for the comparison and its own (8 bytes a value, every time
+/// node), does not fit.
+fn reference_refusal(
+    scene: &Scene,
+    sizes: (u64, u64, u64),
+    least: &str,
+    opts: &Options,
+    levels: &[Kept],
+) -> Option<String> {
     let steps = scene.times.len() - 1;
-    let sizes = (mesh.tris.len() as u64, mesh.edges.len() as u64, contact_edges(scene, mesh));
     let mut estimate = Estimate::of_sizes(sizes, steps, false);
     let fields = |unknowns: u64| unknowns.saturating_mul(8).saturating_mul(steps as u64 + 1);
     let kept: u64 = levels.iter().map(|k| fields(k.space.n_dofs as u64)).sum();
@@ -345,7 +373,7 @@ fn reference_refusal(scene: &Scene, mesh: &Mesh, opts: &Options, levels: &[Kept]
     estimate.memory = estimate.memory.saturating_add(more);
     estimate.memory_metis = estimate.memory_metis.map(|m| m.saturating_add(more));
     let e = estimate.check(opts.max_memory, None, None).err()?;
-    Some(format!("the reference solve ({} unknowns) does not fit: {e}", estimate.unknowns))
+    Some(format!("the reference solve ({least}{} unknowns) does not fit: {e}", estimate.unknowns))
 }
 
 /// Why level `level` on `mesh` is not run: its memory or results file does not fit, or the budget would

@@ -206,7 +206,8 @@ impl Writer {
         if let Some(Pending { partial, old }) = self.pending.take() {
             std::fs::rename(&partial, &self.path).map_err(ioerr(&self.path, "cannot move the new file into place"))?;
             if let Some(old) = old {
-                std::thread::spawn(move || drop(old));
+                // where no thread can be started, the refused closure drops the old file here instead
+                let _ = std::thread::Builder::new().spawn(move || drop(old));
             }
             self.xdmf.publish().map_err(ioerr(&self.path, "cannot move the XDMF sidecar into place"))?;
         }

@@ -178,14 +178,27 @@ impl Series {
 
     fn wrap(ds: Dataset, block: usize) -> hdf5::Result<Series> {
         let shape = ds.shape();
-        let rest = shape[1..].to_vec();
-        let capacity = shape[0] / block.max(1);
+        let Some((&rows, rest)) = shape.split_first() else {
+            return Err(hdf5::Error::from(format!("{}: a scalar, not a series with a time axis (damaged)", ds.name())));
+        };
+        let rest = rest.to_vec();
+        let capacity = rows / block.max(1);
         let dtype = ds.dtype()?.to_descriptor()?;
         let row_bytes = block * rest.iter().product::<usize>() * dtype.size();
         let contiguous = matches!(ds.layout(), hdf5::plist::dataset_create::Layout::Contiguous);
         let direct =
             if cfg!(target_endian = "little") && contiguous { ds.offset().map(|o| (o, row_bytes)) } else { None };
         Ok(Series { ds, block, rest, capacity, direct, dtype })
+    }
+
+    /// The shape of a step's rows after the time axis (empty for a scalar series).
+    pub fn rest(&self) -> &[usize] {
+        &self.rest
+    }
+
+    /// The steps it has room for.
+    pub fn capacity(&self) -> usize {
+        self.capacity
     }
 
     /// Open an existing series.
@@ -246,7 +259,11 @@ impl Series {
     }
 
     fn rewrite<T: H5Type + bytemuck::Pod>(&mut self, raw: &Raw, steps: usize, kept: usize) -> hdf5::Result<()> {
-        let keep = steps.min(kept).min(self.capacity);
+        let keep = steps.min(kept);
+        if keep > self.capacity {
+            let msg = format!("{}: room for {} steps, {keep} were committed (damaged)", self.ds.name(), self.capacity);
+            return Err(hdf5::Error::from(msg));
+        }
         let data: Vec<T> = if keep == 0 {
             vec![]
         } else {

@@ -65,11 +65,21 @@ impl Writer {
                 ),
             });
         }
+        let fields = Fields::new(run);
+        check_views(&file, &fields, path)?;
         let mut vtk = VtkHdf::open(&file, contact).map_err(io(path, "VTKHDF group"))?;
         let (completed, times) = completed_steps(&mut tresca, run, path)?;
         let every = int(&tresca.group, "frame_every").max(1) as usize;
         let frames = Frames { every, last: run.n_steps() };
         let frames_done = frames.before(completed);
+        let misfit = tresca.misfit(run.space, completed);
+        let short = (vtk.room() < frames_done).then(|| format!("the VTKHDF frame arrays hold {} frames", vtk.room()));
+        if let Some(what) = misfit.or(short) {
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                msg: format!("--resume: {what}: the file was damaged after it was written; rerun with --force"),
+            });
+        }
         let frame_list: Vec<(usize, f64)> =
             (0..completed).filter(|&n| frames.is_frame(n)).map(|n| (n, times[n])).collect();
         // a stopped run's series are given back their full length below: their room first (`reserve`)
@@ -92,7 +102,6 @@ impl Writer {
             .map_err(ioerr(path, "rewriting the XDMF sidecar"))?;
         file.flush().map_err(io(path, "flush"))?;
         xdmf.publish().map_err(ioerr(path, "cannot move the XDMF sidecar into place"))?;
-        let fields = Fields::new(run);
         let prev_slip = Some(last.slip.clone());
         let opened = Opened { file, raw, tresca, vtk, xdmf, frames };
         let mut w = Writer::from_opened(path, run, fields, opened, completed, prev_slip);
@@ -171,6 +180,29 @@ fn check_points(g: &hdf5::Group, run: &Run, path: &Path) -> Result<()> {
             .into(),
     };
     Err(Error::Io { path: path.to_path_buf(), msg })
+}
+
+/// Refuse a file whose ParaView view (`VTKHDF/{body,contact}`) lists other numbers of points or cells than
+/// `fields` has: its frames' rows, a block of points or cells each, would be written out of place.
+fn check_views(file: &hdf5::File, fields: &Fields, path: &Path) -> Result<()> {
+    for (block, np, per_cell) in [("body", fields.points.len(), 3), ("contact", fields.contact_points.len(), 2)] {
+        for (list, want) in [("Points", np), ("Types", np / per_cell)] {
+            let name = format!("VTKHDF/{block}/{list}");
+            let have = file.dataset(&name).map(|d| d.shape().first().copied());
+            if np > 0 && !matches!(have, Ok(Some(n)) if n == want) {
+                let have =
+                    have.map_or("nothing (missing)".into(), |n| n.map_or("a scalar".into(), |n| format!("{n} rows")));
+                return Err(Error::Io {
+                    path: path.to_path_buf(),
+                    msg: format!(
+                        "--resume: {name} holds {have}, this run's mesh has {want}: the file was damaged after \
+                         it was written; rerun with --force"
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The file's committed steps and its time nodes, refused when there are none, more than it has room

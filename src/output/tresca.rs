@@ -236,6 +236,27 @@ impl Tresca {
         v
     }
 
+    /// The first series whose rows are not as wide as `space` needs (`u` 2 values an edge, the contact
+    /// series one a Γ_C edge, the rest one a step) or that has no room for the `completed` steps, named
+    /// with both figures; a file damaged or forged after it was written, whose rows a warm start would
+    /// misread.
+    pub fn misfit(&self, space: &CrSpace, completed: usize) -> Option<String> {
+        let (ne, nc) = (space.edge_dof.len(), space.contact.len());
+        let one =
+            [&self.times, &self.energy, &self.iterations, &self.residual, &self.n_stick, &self.n_slip, &self.wall];
+        let one = one.into_iter().chain(self.errors.iter().flatten()).chain(self.audit.iter().flatten());
+        let per_edge = self.contact.iter().chain(&self.normal).flatten().map(|s| (s, vec![nc]));
+        let all = std::iter::once((&self.u, vec![ne, 2])).chain(per_edge);
+        let mut all = all.chain(one.chain(&self.checksum).map(|s| (s, vec![])));
+        all.find_map(|(s, want)| match (s.rest() != want.as_slice(), s.capacity() < completed) {
+            (true, _) => {
+                Some(format!("{} holds rows of shape {:?}, this run's mesh needs {want:?}", s.ds.name(), s.rest()))
+            }
+            (_, true) => Some(format!("{} holds {} steps, {completed} were committed", s.ds.name(), s.capacity())),
+            _ => None,
+        })
+    }
+
     /// The first of the `completed` stored steps whose rows do not match their checksum, if any; an
     /// error if the file has no checksums.
     pub fn first_corrupt_step(&mut self, completed: usize) -> hdf5::Result<Option<usize>> {

@@ -212,18 +212,26 @@ impl Block {
         })
     }
 
+    /// Open the block of an existing file; a list stored as a scalar, or a frame array whose rows are not
+    /// as wide as its components, is an error naming it (a damaged file), not a panic or misplaced rows.
     fn open(g: &Group, arrays: &[(&str, usize)]) -> hdf5::Result<Block> {
-        let np = g.dataset("Points")?.shape()[0];
-        let ncell = g.dataset("Types")?.shape()[0];
+        let rows = |name: &str| {
+            let scalar = || hdf5::Error::from(format!("{}/{name}: a scalar, not a list (damaged)", g.name()));
+            g.dataset(name)?.shape().first().copied().ok_or_else(scalar)
+        };
+        let (np, ncell) = (rows("Points")?, rows("Types")?);
         let cd = g.group("CellData")?;
         let cells = arrays.iter().map(|(name, _)| Series::open(&cd, name, ncell)).collect::<hdf5::Result<Vec<_>>>()?;
+        let displacement = Series::open(&g.group("PointData")?, "displacement", np)?;
+        let widths = arrays.iter().map(|&(_, nc)| if nc == 1 { vec![] } else { vec![nc] });
+        for (s, want) in cells.iter().zip(widths).chain([(&displacement, vec![3])]) {
+            if s.rest() != want.as_slice() {
+                let msg = format!("{}: rows of shape {:?}, not {want:?} (damaged)", s.ds.name(), s.rest());
+                return Err(hdf5::Error::from(msg));
+            }
+        }
         let steps = g.group("Steps")?;
-        Ok(Block {
-            nsteps: steps.attr("NSteps")?,
-            values: steps.dataset("Values")?,
-            displacement: Series::open(&g.group("PointData")?, "displacement", np)?,
-            cells,
-        })
+        Ok(Block { nsteps: steps.attr("NSteps")?, values: steps.dataset("Values")?, displacement, cells })
     }
 
     fn write_times(&self, b: &FrameRows) -> hdf5::Result<()> {
@@ -270,6 +278,13 @@ impl VtkHdf {
         let body = Block::open(&root.group("body")?, &BODY_CELLS)?;
         let contact = if contact { Some(Block::open(&root.group("contact")?, contact_cells(normal))?) } else { None };
         Ok(VtkHdf { body, contact })
+    }
+
+    /// The frames every frame array has room for (the least).
+    pub fn room(&self) -> usize {
+        let series =
+            std::iter::once(&self.body).chain(&self.contact).flat_map(|b| b.cells.iter().chain([&b.displacement]));
+        series.map(Series::capacity).min().unwrap_or(0)
     }
 
     /// Append buffered frames (NSteps is not changed).

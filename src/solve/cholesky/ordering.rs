@@ -171,6 +171,7 @@ pub(super) fn nested_dissection(q: &Graph) -> Option<(Vec<usize>, Vec<usize>)> {
     let mut nvtxs = i32::try_from(ng).ok()?;
     let (mut perm, mut iperm) = (vec![0i32; ng], vec![0i32; ng]);
     let status = {
+        // poisoned only by a panic of another holder: the lock guards no state (METIS reseeds at each call)
         let _guard = METIS_LOCK.lock().unwrap_or_else(|e| e.into_inner());
         // SAFETY: `options` has METIS_NOPTIONS entries; xadj has ng + 1 entries, adjncy xadj[ng] (all
         // in 0..ng, no self loops, symmetric), vwgt, perm and iperm ng each. METIS reads the graph and
