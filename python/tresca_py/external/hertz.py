@@ -5,8 +5,8 @@ circle, h halving everywhere from level to level) with the displacement-driven l
 scene ``verification/cases/NAME.toml`` (the cut y = R pushed down by ``tresca_py.hertz.levels.DELTA``), written
 into the run's work directory by :func:`tresca_py.hertz.levels.write_level`. The cut's Dirichlet data keeps the
 body from floating: the study's P-driven form has a singular stiffness in y that GetFEM's and scikit-fem's
-Newton do not handle. Level L's h is the nominal bulk size R·h_max·2^(−L), which halves exactly (the longest
-edge of each level's Delaunay triangulation halves only to ±5 %), for the Richardson ratio.
+Newton do not handle. Level L's h is the nominal point spacing in the bulk, R·h_max·2^(−L), which halves exactly
+for the Richardson ratio (the longest edge of each level's Delaunay triangulation, ≈ 1.7 h, halves only to ±5 %).
 """
 from __future__ import annotations
 

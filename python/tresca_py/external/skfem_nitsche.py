@@ -75,7 +75,7 @@ class Solver:
                 self.contact = part
                 self.fb = self.parts[part["name"]][2]
         if pr.get("curved"):  # each contact facet's own outward normal (a polygonal Γ_C such as Hertz's arc)
-            nrm = np.array(self.fb.normals.value, dtype=float)
+            nrm = np.array(self.fb.normals, dtype=float)
             self.n, self.tau = nrm, np.stack([-nrm[1], nrm[0]])
         self._setup_dofs()
         self.nu = self.ndof = self.basis.N  # u unknowns; all unknowns (the mixed variant appends p)
