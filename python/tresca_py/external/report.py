@@ -192,7 +192,9 @@ def markdown(rows, scenes, notes, reqs, elapsed, lims, ref_dir):
            "P2 solver extended to Signorini (`tresca_py/external/skfem_signorini.py`, Chouly–Hild–Renard Nitsche",
            "θ = 0, semismooth Newton) and tresca-cr. Two more quantities: normal_force = ∫_{Γ_C} p and",
            "max_pressure = max p (Nitsche: at the contact quadrature points; tresca-cr: over the edges, p_e),",
-           "the latter with theoretical order k − ½ (a stress trace).", ""]
+           "the latter with theoretical order k − ½ (a stress trace). Hertz (`hertz`): the Hertz study's meshes as",
+           "levels (not `refine`), symmetry on the axis, a curved Γ_C (each edge's own normal), its own quantities",
+           "(with half_width = 2√(∫p x²/∫p)) and no XO (no exact solution; verification/external/README.md).", ""]
     for sc in scenes:
         L = lims[sc.name]
         codes = sorted(L)
