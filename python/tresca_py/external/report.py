@@ -199,7 +199,9 @@ def markdown(rows, scenes, notes, reqs, elapsed, lims, ref_dir):
         L = lims[sc.name]
         codes = sorted(L)
         out += [f"## {sc.name}: {sc.note}", "",
-                f"`{sc.path}`, refine {', '.join(map(str, sc.levels))}, {sc.steps} step(s). "
+                (f"`{sc.path}`, refine {', '.join(map(str, sc.levels))}, " if sc.mesh_levels is None else
+                 f"`{sc.path}` is level 0 of the mesh levels {', '.join(map(str, sc.levels))} (new meshes), ")
+                + f"{sc.steps} step(s). "
                 f"Command: `{ENTRY} --scene {sc.name}` (one code: add `--code CODE`).", ""]
         scene_notes = list(notes.get(sc.name, [])) + ([sc.remark] if sc.remark else [])
         if sc.locking:
