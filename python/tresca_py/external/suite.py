@@ -108,13 +108,13 @@ SCENES = (
           mesh_levels=partial(hertz.level_scene, "hertz_a10"),
           remark="levels are the Hertz study's new meshes (tresca_py.hertz.mesh, arc vertices on the circle; P2 "
                  "codes one level lower), not `refine`; the cut y = R is pushed down by delta = 0.015 (Dirichlet), "
-                 "not loaded by P: the floating body's singular stiffness would stop GetFEM's and scikit-fem's "
-                 "Newton; every code imposes u·n ≤ y R/(R − y) along each polygon edge's own normal. No exact "
-                 "solution, so no XO row: Hertz's formulas are not the limit (the half-space model's own error, "
-                 "≈ 1.5 % in a at a/R = 0.1, reference/hertz.md). ∫σ_τ, u·τ, the stick ends and the slip are "
-                 "not compared: frictionless, and Γ_C is curved; half_width = 2√(∫p x²/∫p) (Hertz: a); "
-                 "theoretical orders capped at 3/2 (Signorini: u ∈ H^{5/2−ε}); tresca-cr's `study --csv` is not "
-                 "run (its levels refine one mesh)"),
+                 "not loaded by P (a floating body: GetFEM's and scikit-fem's first Newton tangent, with no contact "
+                 "point active at u = 0, would be singular in the vertical translation); every code imposes "
+                 "u·n ≤ y R/(R − y) along each polygon edge's own normal. No exact solution, so no XO row: Hertz's "
+                 "formulas are not the limit (the half-space model's own error, ≈ 1.5 % in a at a/R = 0.1, "
+                 "reference/hertz.md). ∫σ_τ, u·τ, the stick ends and the slip are not compared: frictionless, and "
+                 "Γ_C is curved; half_width = 2√(∫p x²/∫p) (Hertz: a); theoretical orders capped at 3/2 "
+                 "(Signorini: u ∈ H^{5/2−ε}); tresca-cr's `study --csv` is not run (its levels refine one mesh)"),
 )
 
 
