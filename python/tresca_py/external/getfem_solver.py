@@ -13,6 +13,7 @@ GetFEM's machinery does the work:
 * ``add_isotropic_linearized_elasticity_brick`` (a(u, v)), ``add_source_term_brick`` (f and tractions),
   ``add_Dirichlet_condition_with_multipliers`` (u = u_D weakly on the trace space of mfu; the variant "with
   simplification" clears matrix rows at every assembly and made the assembly grow ~30× per refinement);
+* ``add_normal_Dirichlet_condition_with_multipliers`` for a symmetry part (u·n = 0, no tangential traction);
 * ``add_normal_Dirichlet_condition_with_Nitsche_method`` (θ = 1) for the bilateral condition u·n = g_n with
   Neumann term ``Model.Neumann_term`` (σ(u)n) and γ = γ₀ h_T, γ₀ = 1/(γ_N (λ + 2μ));
 * Tresca friction on the slip increment as a Nitsche term in GWFL with GetFEM's ``Ball_projection``
@@ -104,6 +105,8 @@ class Solver:
                 md.add_initialized_fem_data(f"UD{i}", self.mfu, np.zeros(self.mfu.nbdof()))
                 self.data.append((f"UD{i}", "u", part["u"], None))
                 md.add_Dirichlet_condition_with_multipliers(self.mim, "u", self.mfu, rg, f"UD{i}")
+            elif part["kind"] == "symmetry":  # u·n = 0 (multiplier of degree k), zero tangential traction
+                md.add_normal_Dirichlet_condition_with_multipliers(self.mim, "u", k, rg)
             else:
                 self.contact = part
         self._scalar_data("GAP", self.contact["gap"])
@@ -221,6 +224,8 @@ class Solver:
         if self.unilateral:
             sig = gf.asm("generic", mim, 0, "[-Normal(2);Normal(1)]." + self.cfp, CONTACT, md)
             extra = {"normal_force": float(gf.asm("generic", mim, 0, "-Normal." + self.cfp, CONTACT, md)),
+                     "pressure_x2": float(gf.asm("generic", mim, 0, "-Normal." + self.cfp + "*X(1)*X(1)",
+                                                 CONTACT, md)),
                      "max_pressure": float(np.max(md.interpolation("-Normal." + self.cfp, mimd1, CONTACT)))}
             margin = np.zeros(0)
         else:
@@ -233,6 +238,8 @@ class Solver:
         s_q = (xq[0] - start[0]) * tau[0] + (xq[1] - start[1]) * tau[1]
 
         def probe(points):
+            if pr.get("curved"):  # u·τ along the chord of a curved Γ_C means nothing (problem.contact_probes)
+                return np.full(len(points), np.nan)
             v = np.asarray(md.interpolation("u", np.asarray(points).T, self.m)).reshape(-1, 2).T
             return v[0] * tau[0] + v[1] * tau[1]
         out = {"h1_norm": float(np.hypot(l2, semi)), "energy": float(energy), "sigma_t_integral": float(sig),

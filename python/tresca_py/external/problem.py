@@ -189,8 +189,8 @@ def load(path):
             part["g_a"] = code(b.get("g_a", "0"), f"boundary[{k}].g_a")
             part["gap"] = code(b.get("gap", "0"), f"boundary[{k}].gap")
             part.update(_contact_law(b, k))
-        else:
-            raise ProblemError(f"boundary[{k}].kind: {kind!r} is not dirichlet/neumann/contact")
+        elif kind != "symmetry":  # symmetry: u·n = 0 with zero tangential traction (a roller)
+            raise ProblemError(f"boundary[{k}].kind: {kind!r} is not dirichlet/neumann/contact/symmetry")
         parts.append(part)
     if n_contact != 1:
         raise ProblemError(f"{path}: exactly one contact part is supported, found {n_contact}")
@@ -241,14 +241,18 @@ def build(path, refine, steps=None, degree=2, gamma_n=10.0):
 
 def contact_probes(pts, segs, n_samples=513):
     """Γ_C's parametrisation (start point, unit tangent τ = (−n_y, n_x) with n the outward normal, length),
-    the three probe points at 1/4, 1/2, 3/4 of its length and ``n_samples`` uniform sample points (a straight
-    contact side is assumed)."""
+    the three probe points at 1/4, 1/2, 3/4 of its length and ``n_samples`` uniform sample points, for a
+    straight contact side; ``curved`` says that Γ_C's vertices leave its chord (a polygon such as Hertz's arc):
+    then the solvers take each edge's own normal and the probes along the chord mean nothing (u·τ there: NaN)."""
     a, b = pts[segs[0][0]], pts[segs[-1][1]]
     length = float(np.hypot(*(b - a)))
+    verts = pts[np.asarray(segs).ravel()] - a
+    chord = (b - a) / length
+    curved = bool(np.max(np.abs(verts[:, 0] * chord[1] - verts[:, 1] * chord[0])) > 1e-10 * length)
     tau = (b - a) / length  # counter-clockwise boundary direction = (−n_y, n_x) for the outward normal n
     s = np.linspace(0.0, length, n_samples)
     normal = np.array([tau[1], -tau[0]])
     inward = -1e-10 * length * normal  # keeps probes inside the mesh against rounding on a rotated side
-    return {"start": a.tolist(), "tangent": tau.tolist(), "normal": normal.tolist(),
+    return {"start": a.tolist(), "tangent": tau.tolist(), "normal": normal.tolist(), "curved": curved,
             "length": length, "points": [(a + f * (b - a) + inward).tolist() for f in (0.25, 0.5, 0.75)],
             "samples": (a[None, :] + s[:, None] * tau[None, :] + inward[None, :]).tolist()}

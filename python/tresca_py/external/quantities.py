@@ -39,6 +39,10 @@ QUANTITIES = ("h1_norm", "energy", "u_tau_1", "u_tau_2", "u_tau_3", "sigma_t_int
 #: quantities only the unilateral codes report (NaN on bilateral scenes): the total normal force ∫_{Γ_C} p and
 #: the maximal contact pressure max p (Nitsche: at the contact quadrature points; tresca-cr: over the edges)
 UNILATERAL = ("normal_force", "max_pressure")
+#: a quantity compared on Hertz only (``Scene.quantities``): the pressure's width 2√(∫p x²/∫p) about the symmetry
+#: axis x = 0, a smooth functional of the pressure equal to Hertz's half-width a (∫p x² = a²∫p/4 for
+#: p₀√(1 − x²/a²)); the codes report ∫_{Γ_C} p x² as ``pressure_x2``
+HALF_WIDTH = "half_width"
 ERRORS = ("err_h1_semi", "err_l2")
 
 
@@ -77,6 +81,8 @@ def summarise(raw, probes):
     row["stick_a"], row["stick_b"] = stick_ends(s_q[keep], dslip[keep], eta)
     for k in UNILATERAL:
         row[k] = float(raw.get(k, math.nan))
+    force, x2 = row["normal_force"], float(raw.get("pressure_x2", math.nan))
+    row[HALF_WIDTH] = 2.0 * math.sqrt(x2 / force) if force > 0 and x2 >= 0 else math.nan
     for k in ERRORS:
         if k in raw:
             row[k] = float(raw[k])

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from tresca_py.common import orders
 
-from .quantities import ERRORS, QUANTITIES, UNILATERAL
+from .quantities import ERRORS, HALF_WIDTH, QUANTITIES, UNILATERAL
 from .richardson import limit
 from .suite import ORDER, SCENES
 
@@ -26,23 +26,26 @@ def by_code(rows, scene):
 
 
 def theory_order(code, scene, q):
-    """The theoretical order of quantity q for a code: its H1 order k, except the stick–slip endpoints on a
-    scene whose slip grows like the cube of the distance to the fronts (``Scene.cubic_front``): the
-    threshold η_h ∝ h² (and a slip error O(h²) or smaller) moves the threshold's crossing by O(h^{2/3})
-    (``quantities``), so the endpoints converge at order 2/3 there."""
+    """The theoretical order of quantity q for a code: its H1 order k (capped by the scene's ``order_cap``),
+    except the stick–slip endpoints on a scene whose slip grows like the cube of the distance to the fronts
+    (``Scene.cubic_front``): the threshold η_h ∝ h² (and a slip error O(h²) or smaller) moves the threshold's
+    crossing by O(h^{2/3}) (``quantities``), so the endpoints converge at order 2/3 there."""
     sc = next((s for s in SCENES if s.name == scene), None)
-    k = ORDER[code]
+    k = min(ORDER[code], sc.order_cap) if sc is not None else ORDER[code]
     if q == "max_pressure":  # a trace of the stress: ‖σ − σ_h‖ on Γ_C ≲ h^{-1/2} ‖σ − σ_h‖_{L2(Ω)} = O(h^{k−½})
         return k - 0.5
     return 2 / 3 if sc is not None and sc.cubic_front and q in ("stick_a", "stick_b") else k
 
 
 def limits(rows, scene):
-    """{code: {quantity: Limit}} from each code's finest levels (three, and a fourth for the check)."""
+    """{code: {quantity: Limit}} from each code's finest levels (three, and a fourth for the check), for the
+    scene's compared quantities (``Scene.quantities``)."""
+    sc = next((s for s in SCENES if s.name == scene), None)
+    compared = sc.quantities if sc is not None else QUANTITIES
     res = {}
     for code, rs in by_code(rows, scene).items():
         h = [r["h"] for r in rs]
-        res[code] = {q: limit(h, [r[q] for r in rs], p_th=theory_order(code, scene, q)) for q in QUANTITIES}
+        res[code] = {q: limit(h, [r[q] for r in rs], p_th=theory_order(code, scene, q)) for q in compared}
     return res
 
 
@@ -64,7 +67,7 @@ def common_limit(lims, q="h1_norm"):
 
 
 def write_csv(rows, path):
-    keys = ["scene", "code", "refine", "steps", "h", "dofs", "wall_s", "process_s", *QUANTITIES, *ERRORS]
+    keys = ["scene", "code", "refine", "steps", "h", "dofs", "wall_s", "process_s", *QUANTITIES, HALF_WIDTH, *ERRORS]
     with open(path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=keys, extrasaction="ignore")
         w.writeheader()
@@ -189,12 +192,16 @@ def markdown(rows, scenes, notes, reqs, elapsed, lims, ref_dir):
            "P2 solver extended to Signorini (`tresca_py/external/skfem_signorini.py`, Chouly–Hild–Renard Nitsche",
            "θ = 0, semismooth Newton) and tresca-cr. Two more quantities: normal_force = ∫_{Γ_C} p and",
            "max_pressure = max p (Nitsche: at the contact quadrature points; tresca-cr: over the edges, p_e),",
-           "the latter with theoretical order k − ½ (a stress trace).", ""]
+           "the latter with theoretical order k − ½ (a stress trace). Hertz (`hertz`): the Hertz study's meshes as",
+           "levels (not `refine`), symmetry on the axis, a curved Γ_C (each edge's own normal), its own quantities",
+           "(with half_width = 2√(∫p x²/∫p)) and no XO (no exact solution; verification/external/README.md).", ""]
     for sc in scenes:
         L = lims[sc.name]
         codes = sorted(L)
         out += [f"## {sc.name}: {sc.note}", "",
-                f"`{sc.path}`, refine {', '.join(map(str, sc.levels))}, {sc.steps} step(s). "
+                (f"`{sc.path}`, refine {', '.join(map(str, sc.levels))}, " if sc.mesh_levels is None else
+                 f"`{sc.path}` is level 0 of the mesh levels {', '.join(map(str, sc.levels))} (new meshes), ")
+                + f"{sc.steps} step(s). "
                 f"Command: `{ENTRY} --scene {sc.name}` (one code: add `--code CODE`).", ""]
         scene_notes = list(notes.get(sc.name, [])) + ([sc.remark] if sc.remark else [])
         if sc.locking:
@@ -203,7 +210,7 @@ def markdown(rows, scenes, notes, reqs, elapsed, lims, ref_dir):
                                "but not XO; the Taylor–Hood codes carry XO (verification/external/README.md)")
         out += [f"- {n}" for n in scene_notes] + ([""] if scene_notes else [])
         out += ["| quantity | " + " | ".join(codes) + " |", "|---|" + "---|" * len(codes)]
-        for q in QUANTITIES:
+        for q in sc.quantities:
             if q in UNILATERAL and not any(math.isfinite(L[c][q].value) for c in codes):
                 continue  # a bilateral scene: no normal force or pressure reported
             out.append(f"| {q} | " + " | ".join(_fmt(L[c][q]) for c in codes) + " |")

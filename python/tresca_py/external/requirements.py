@@ -27,7 +27,6 @@ from __future__ import annotations
 import math
 from itertools import combinations
 
-from .quantities import QUANTITIES
 from .report import ENTRY, error_orders, limits
 from .richardson import agree
 from .suite import DISPLACEMENT_ONLY, ORDER
@@ -45,7 +44,7 @@ def evaluate(rows, scenes):
             lims.pop(code, None)
         cmd = f"{ENTRY} --scene {sc.name}"
         for a, b in combinations(sorted(lims), 2):
-            bad = [q for q in QUANTITIES if not agree(lims[a][q], lims[b][q])
+            bad = [q for q in lims[a] if not agree(lims[a][q], lims[b][q])
                    and not (math.isnan(lims[a][q].value) and math.isnan(lims[b][q].value))]
             detail = "all agree" if not bad else "disagree: " + ", ".join(
                 f"{q} ({lims[a][q].value:.6g}±{lims[a][q].gci:.2g} vs {lims[b][q].value:.6g}±{lims[b][q].gci:.2g})"

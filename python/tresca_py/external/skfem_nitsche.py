@@ -7,7 +7,8 @@ Each backward-Euler step n solves, for u = uⁿ in P2 (nodal interpolant of u_D 
     P(u)    = proj_[−g_a, g_a]( σ_τ(u) − p (u_τ − u_τⁿ⁻¹) )       (Tresca on the slip increment)
 
 with σ_n = n·σn, σ_τ = τ·σn, τ = (−n_y, n_x) written out as a constant vector of the straight contact side
-(no ``w.n`` DiscreteField arithmetic, whose item assignment silently yields τ = n on scikit-fem ≥ 8).
+(no ``w.n`` DiscreteField arithmetic, whose item assignment silently yields τ = n on scikit-fem ≥ 8), or on a
+curved (polygonal) Γ_C as plain arrays of each facet's normal. A symmetry part holds its normal component at 0.
 P is the consistent tangential traction: the exact solution has P(u) = σ_τ(u). The step is solved by
 semismooth Newton: the generalized derivative of the projection is χ·(σ_τ(du) − p du_τ) with χ = 1 where
 |σ_τ − p δu_τ| < g_a (stick), 0 where it is projected (slip). It imports nothing from tresca-cr's solvers.
@@ -73,6 +74,9 @@ class Solver:
             if part["kind"] == "contact":
                 self.contact = part
                 self.fb = self.parts[part["name"]][2]
+        if pr.get("curved"):  # each contact facet's own outward normal (a polygonal Γ_C such as Hertz's arc)
+            nrm = np.array(self.fb.normals, dtype=float)
+            self.n, self.tau = nrm, np.stack([-nrm[1], nrm[0]])
         self._setup_dofs()
         self.nu = self.ndof = self.basis.N  # u unknowns; all unknowns (the mixed variant appends p)
         self.K = asm(linear_elasticity(self.lam, self.mu), self.basis)
@@ -89,7 +93,20 @@ class Solver:
             self.comp[b.nodal_dofs[c]] = c
             self.comp[b.facet_dofs[c]] = c
         dd = [b.get_dofs(facets=fac).all() for part, fac, _ in self.parts.values() if part["kind"] == "dirichlet"]
+        dd += [self._symmetry_dofs(part, fac) for part, fac, _ in self.parts.values() if part["kind"] == "symmetry"]
         self.D = np.unique(np.concatenate(dd)) if dd else np.zeros(0, dtype=np.int64)
+
+    def _symmetry_dofs(self, part, fac):
+        """The dofs held at 0 by a symmetry part (u·n = 0, zero tangential traction): its normal component,
+        which must be a coordinate axis (the part straight and axis-parallel) for the constraint to be a dof's."""
+        pts = self.mesh.p[:, np.asarray(part["segments"]).ravel()]
+        spread = np.ptp(pts, axis=1)
+        if np.min(spread) > 1e-12 * np.max(spread):
+            raise ValueError(f"symmetry part {part['name']!r}: this solver needs it on a line x = const or "
+                             f"y = const (its points span {spread[0]:.3g} × {spread[1]:.3g})")
+        c = int(np.argmin(spread))  # the normal's component
+        dofs = self.basis.get_dofs(facets=fac).all()
+        return dofs[self.comp[dofs] == c]
 
     def _normal_form(self, u, v, w):
         lam, mu, n, p = self.lam_s, self.mu, self.n, self.pen
@@ -288,6 +305,8 @@ class Solver:
         return float(asm(form, self.basis, u=self.basis.interpolate(u[:self.nu])))
 
     def _probe(self, u, pts):
+        if self.prob["probes"].get("curved"):  # u·τ along the chord of a curved Γ_C means nothing
+            return np.full(len(pts), np.nan)
         P = self.basis.probes(np.asarray(pts).T)
         vals = (P @ u[:self.nu]).reshape(2, -1) if P.shape[0] == 2 * len(pts) else None
         if vals is None:

@@ -113,10 +113,12 @@ class SignoriniSolver(Solver):
                            f"(relative residual {rnorm:.3e})")
 
     def quantities(self, u, u_prev, t):
-        """The base quantities plus the total normal force ∫ −[P_n]₋ and the maximal pressure."""
+        """The base quantities plus the total normal force ∫ −[P_n]₋, its moment ∫ −[P_n]₋ x² and the maximal
+        pressure."""
         out = super().quantities(u, u_prev, t)
         pn, _, _ = self.augmented(u, u_prev, t)
         p = -np.minimum(0.0, pn)
         out["normal_force"] = float(asm(Functional(lambda w: p), self.fb))
+        out["pressure_x2"] = float(asm(Functional(lambda w: p * w.x[0] ** 2), self.fb))
         out["max_pressure"] = float(np.max(p))
         return out

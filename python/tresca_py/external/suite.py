@@ -8,14 +8,19 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import math
 import os
 import shutil
 import subprocess
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
-from . import problem, quantities, skfem_mixed, skfem_nitsche, skfem_signorini, tresca
+import numpy as np
+
+from . import hertz, problem, quantities, skfem_mixed, skfem_nitsche, skfem_signorini, tresca
 
 GETFEM_PYTHON = "/usr/bin/python3"
 CODES = ("getfem-P1", "getfem-P2", "skfem-P2-nitsche", "getfem-TH", "skfem-TH-nitsche", "tresca-cr")
@@ -50,6 +55,13 @@ class Scene:
     #: codes kept in the tables but left out of XA, with the reason in ``remark`` (printed under the scene)
     xa_exclude: tuple = ()
     remark: str = ""
+    #: the compared quantities (``quantities``); Hertz compares its own
+    quantities: tuple = quantities.QUANTITIES
+    #: the solution's regularity caps every code's theoretical order (Hertz: u ∈ H^{5/2−ε}, order ≤ 3/2)
+    order_cap: float = math.inf
+    #: levels that are new meshes: level ↦ (scene path, h) written into the work directory (``hertz``);
+    #: None: the levels are ``refine`` values of ``path``
+    mesh_levels: Callable | None = None
 
     def levels_of(self, code):
         return tuple(r + P2_SHIFT for r in self.levels) if ORDER[code] == 2 else self.levels
@@ -74,8 +86,8 @@ SCENES = (
           "Dirichlet data on two sides, Neumann on one"),
 ) + (
     # unilateral contact (issue 40 item 5): the GetFEM codes use Coulomb_friction_coupled_projection, the
-    # scikit-fem code skfem_signorini. Hook: a further unilateral scene (Hertz) is one more entry here,
-    # Scene(name, path, levels, steps, note), and then shows in `run.py --scene NAME`, the tables and make verify.
+    # scikit-fem code skfem_signorini; a scene is one more entry here, Scene(name, path, levels, steps, note), and
+    # then shows in `run.py --scene NAME`, the tables and make verify (Hertz: levels that are new meshes).
     Scene("sig_moving", "verification/cases/mms_signorini_moving.toml", (0, 1, 2, 3, 4), 8,
           "manufactured Signorini-Tresca, moving contact/separation and stick/slip points", cubic_front=True),
     Scene("sig_coulomb", "verification/cases/mms_signorini_coulomb.toml", (0, 1, 2, 3, 4), 8,
@@ -90,6 +102,19 @@ SCENES = (
           remark="getfem-P1 is out of XA: its θ = 0 Nitsche stick zone carries slip increments above the "
                  "threshold (h/|Γ_C|)² max|δu_τ|, so its stick–slip endpoints are not found (NaN at refine 3, "
                  "one short zone elsewhere); its other quantities are in the table"),
+    Scene("hertz", "verification/cases/hertz_a10.toml", (0, 1, 2, 3, 4), 1,
+          "Hertz, a/R = 0.1: quarter cylinder on a rigid plane, frictionless, the cut pushed down by delta",
+          quantities=("h1_norm", "energy", "normal_force", "max_pressure", quantities.HALF_WIDTH), order_cap=1.5,
+          mesh_levels=partial(hertz.level_scene, "hertz_a10"),
+          remark="levels are the Hertz study's new meshes (tresca_py.hertz.mesh, arc vertices on the circle; P2 "
+                 "codes one level lower), not `refine`; the cut y = R is pushed down by delta = 0.015 (Dirichlet), "
+                 "not loaded by P (a floating body: GetFEM's and scikit-fem's first Newton tangent, with no contact "
+                 "point active at u = 0, would be singular in the vertical translation); every code imposes "
+                 "u·n ≤ y R/(R − y) along each polygon edge's own normal. No exact solution, so no XO row: Hertz's "
+                 "formulas are not the limit (the half-space model's own error, ≈ 1.5 % in a at a/R = 0.1, "
+                 "reference/hertz.md). ∫σ_τ, u·τ, the stick ends and the slip are not compared: frictionless, and "
+                 "Γ_C is curved; half_width = 2√(∫p x²/∫p) (Hertz: a); theoretical orders capped at 3/2 "
+                 "(Signorini: u ∈ H^{5/2−ε}); tresca-cr's `study --csv` is not run (its levels refine one mesh)"),
 )
 
 
@@ -124,14 +149,47 @@ def tresca_reads(binary, path):
     return proc.returncode == 0, (proc.stderr or proc.stdout).strip().splitlines()[-1:] or [""]
 
 
+def _levels(sc: Scene, code, work, cache):
+    """(refine, problem dict, scene path for tresca-cr) per level of a code; mesh levels generated once."""
+    k = 1 if code == "getfem-P1" else 2
+    for r in sc.levels_of(code):
+        if sc.mesh_levels is None:
+            if "" not in cache:
+                cache[""] = problem.load(sc.path)
+            yield r, problem.at_level(cache[""], r, sc.steps, degree=k), sc.path, r
+            continue
+        if r not in cache:
+            path, h = sc.mesh_levels(work, r)
+            cache[r] = (problem.load(path), path, h)
+        scene, path, h = cache[r]
+        prob = problem.at_level(scene, 0, sc.steps, degree=k)
+        prob["h"], prob["refine"] = h, r  # the level's nominal size (``hertz``); the level names GetFEM's files
+        yield r, prob, path, 0
+
+
+def solve_level(code, prob, work, binary, path, refine, steps, level):
+    """The raw result of one code on one level's problem (``level``: the row's level, names tresca-cr's file)."""
+    if code.startswith("getfem"):
+        return run_getfem(prob, work)
+    if code == "skfem-P2-nitsche":
+        return skfem_nitsche.solve(prob, skfem_signorini.SignoriniSolver if unilateral(prob) else skfem_nitsche.Solver)
+    if code == "skfem-TH-nitsche":
+        return skfem_nitsche.solve(prob, skfem_mixed.MixedSolver)
+    pts = np.asarray(prob["points"])
+    contact = next(p for p in prob["parts"] if p["kind"] == "contact")
+    symmetric = any(p["kind"] == "symmetry" for p in prob["parts"])  # its edges are among tresca-cr's contact edges
+    mids = pts[np.asarray(contact["segments"])].mean(axis=1) if symmetric else None
+    return tresca.run_level(binary, path, refine, steps, work, prob["probes"],
+                            prob["gamma_n"] * (prob["lam"] + 2 * prob["mu"]), mids, f"tresca_{level}")
+
+
 def run_scene(sc: Scene, codes, out_dir, binary, log=print):
     """Rows (dicts) for one scene: code, level, h, dofs, wall, quantities, errors; and notes on skipped codes."""
-    scene = problem.load(sc.path)
     work = Path(out_dir) / sc.name
     if work.exists():
         shutil.rmtree(work)
     work.mkdir(parents=True)
-    rows, notes = [], []
+    rows, notes, cache = [], [], {}
     use_tresca = "tresca-cr" in codes
     if use_tresca:
         ok, msg = tresca_reads(binary, sc.path)
@@ -144,21 +202,10 @@ def run_scene(sc: Scene, codes, out_dir, binary, log=print):
     for code in (c for c in codes if c in sc.codes):
         if code == "tresca-cr" and not use_tresca:
             continue
-        for r in sc.levels_of(code):
-            k = 1 if code == "getfem-P1" else 2
-            prob = problem.at_level(scene, r, sc.steps, degree=k)
+        for r, prob, path, refine in _levels(sc, code, work, cache):
             prob["mixed"] = "-TH" in code
             t0 = time.perf_counter()
-            if code.startswith("getfem"):
-                raw = run_getfem(prob, work)
-            elif code == "skfem-P2-nitsche":
-                raw = skfem_nitsche.solve(prob, skfem_signorini.SignoriniSolver if unilateral(prob)
-                                          else skfem_nitsche.Solver)
-            elif code == "skfem-TH-nitsche":
-                raw = skfem_nitsche.solve(prob, skfem_mixed.MixedSolver)
-            else:
-                raw = tresca.run_level(binary, sc.path, r, sc.steps, work, prob["probes"],
-                                       prob["gamma_n"] * (prob["lam"] + 2 * prob["mu"]))
+            raw = solve_level(code, prob, work, binary, path, refine, sc.steps, f"r{r}")
             raw["h"] = prob["h"]
             row = quantities.summarise(raw, prob["probes"])
             row.update({"scene": sc.name, "code": code, "refine": r, "steps": sc.steps,
@@ -167,6 +214,6 @@ def run_scene(sc: Scene, codes, out_dir, binary, log=print):
             log(f"  {sc.name:12s} {code:17s} refine {r:2d}  dofs {row['dofs']:7d}  wall {row['wall_s']:7.3f} s  "
                 f"H1 {row['h1_norm']:.6e}" + (f"  err_H1 {row['err_h1_semi']:.3e}" if "err_h1_semi" in row else ""),
                 flush=True)
-    if use_tresca:
+    if use_tresca and sc.mesh_levels is None:
         tresca.study_csv(binary, sc.path, sc.levels, sc.steps, work / "tresca_study.csv")
     return rows, notes

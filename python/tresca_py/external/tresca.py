@@ -4,9 +4,11 @@
 The CR field is evaluated from the results file: on a triangle with vertices v₀ v₁ v₂ and edge-midpoint values
 U_i on the edge opposite vᵢ, u(x) = Σᵢ U_i (1 − 2λᵢ(x)) (λ the barycentric coordinates); ‖u‖²_L2 is exact by the
 midpoint rule (|T|/3 Σ|U_i|²), ∇u = −2 Σᵢ U_i ⊗ ∇λᵢ (broken H1). Along Γ_C the trace is taken in the triangle
-owning the contact edge. ½a_h(u,u) = ½ ``tresca/energy`` (with the jump term); ∫σ_τ = Σ_e σ_τ,e |e|; the stick
-flag of a contact edge (its midpoint) is its last-step state 0, its stick margin (``quantities.stick_ends``)
-φ_e = g_e − |σ_τ,e − p_e δu_τ,e| with the last step's slip increment δu_τ,e and p_e = γ_N (λ + 2μ)/|e|.
+owning the contact edge (no trace on a curved Γ_C: NaN). ½a_h(u,u) = ½ ``tresca/energy`` (with the jump term);
+∫σ_τ = Σ_e σ_τ,e |e|; the stick flag of a contact edge (its midpoint) is its last-step state 0, its stick
+margin (``quantities.stick_ends``) φ_e = g_e − |σ_τ,e − p_e δu_τ,e| with the last step's slip increment
+δu_τ,e and p_e = γ_N (λ + 2μ)/|e|; on a unilateral scene ∫p = Σ_e p_e|e| and
+∫p x² = Σ_e p_e |e| (x₀² + x₀x₁ + x₁²)/3 (p_e constant on the edge).
 """
 from __future__ import annotations
 
@@ -34,8 +36,10 @@ def _bary_grads(P):
     return np.stack([-g1 - g2, g1, g2], 1), 0.5 * np.abs(det)
 
 
-def read_results(path, probes, pen_scale):
-    """The raw result dict (``quantities.summarise`` format) at the last time of a results file."""
+def read_results(path, probes, pen_scale, contact_mids=None):
+    """The raw result dict (``quantities.summarise`` format) at the last time of a results file; with
+    ``contact_mids`` (the contact part's edge midpoints) only the contact edges there: tresca-cr writes a
+    symmetry part's edges among its contact edges (a symmetry part is a frictionless bilateral contact part)."""
     with h5py.File(path, "r") as f:
         g = f["tresca"]
         pts, tri, edges = g["mesh/points"][:], g["mesh/triangles"][:], g["mesh/edges"][:]
@@ -47,6 +51,10 @@ def read_results(path, probes, pen_scale):
         energy = 0.5 * float(g["energy"][-1])
         err = {k: float(g[f"errors/{k}"][-1]) for k in ("h1", "l2")} if "errors" in g else {}
         pressure = g["contact/pressure"][-1] if "contact/pressure" in g else None
+    if contact_mids is not None:
+        keep = _on_part(pts[edges[cedges]].mean(axis=1), np.asarray(contact_mids, dtype=float))
+        cedges, sig, state, slip, g_mean = cedges[keep], sig[keep], state[keep], slip[:, keep], g_mean[keep]
+        pressure = None if pressure is None else pressure[keep]
     te = _tri_edges(tri, edges)
     P = pts[tri]
     grads, area = _bary_grads(P)
@@ -64,6 +72,8 @@ def read_results(path, probes, pen_scale):
     lengths = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
 
     def trace(points):
+        if probes.get("curved"):  # u·τ along the chord of a curved Γ_C means nothing (problem.contact_probes)
+            return np.full(len(points), np.nan)
         points = np.asarray(points)
         s = (points - start) @ tau
         out = np.zeros(len(points))
@@ -85,14 +95,25 @@ def read_results(path, probes, pen_scale):
            "quad_dslip": np.abs(slip[-1] - slip[0]).tolist()}
     if pressure is not None:  # a unilateral scene: p_e = P_e/|e| per contact edge
         raw["normal_force"], raw["max_pressure"] = float(np.sum(pressure * lengths)), float(np.max(pressure))
+        x0, x1 = ends[:, 0, 0], ends[:, 1, 0]  # ∫_e x² ds of the edge-constant pressure, exactly
+        raw["pressure_x2"] = float(np.sum(pressure * lengths * (x0 * x0 + x0 * x1 + x1 * x1) / 3.0))
     if err:
         raw["err_h1_semi"], raw["err_l2"] = err["h1"], err["l2"]
     return raw
 
 
-def run_level(binary, scene, refine, steps, out_dir, probes, pen_scale):
-    """``tresca-cr run`` at one level; the raw result with its wall time (the run's own ``wall_time`` sum)."""
-    out = Path(out_dir) / f"tresca_r{refine}.h5"
+def _on_part(mids, part_mids):
+    """Which of the points ``mids`` are (to rounding) among ``part_mids``."""
+    from scipy.spatial import cKDTree
+    scale = float(np.max(np.ptp(part_mids, axis=0))) or 1.0
+    dist, _ = cKDTree(part_mids).query(mids)
+    return dist <= 1e-9 * scale
+
+
+def run_level(binary, scene, refine, steps, out_dir, probes, pen_scale, contact_mids=None, stem=None):
+    """``tresca-cr run`` at one level (results file ``STEM.h5``, default ``tresca_rREFINE``); the raw result
+    (``read_results``) with its wall time (the run's own ``wall_time`` sum)."""
+    out = Path(out_dir) / f"{stem or f'tresca_r{refine}'}.h5"
     cmd = [str(binary), "run", str(scene), "--refine", str(refine), "--steps", str(steps), "-o", str(out),
            "--force", "-q"]
     t0 = time.perf_counter()
@@ -100,7 +121,7 @@ def run_level(binary, scene, refine, steps, out_dir, probes, pen_scale):
     wall = time.perf_counter() - t0
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({proc.returncode}): {proc.stderr.strip()[-400:]}")
-    raw = read_results(out, probes, pen_scale)
+    raw = read_results(out, probes, pen_scale, contact_mids)
     raw.update({"wall_s": wall, "code": "tresca-cr (CR)", "cmd": cmd})
     return raw
 

@@ -32,6 +32,10 @@ def load(name, a_over_R, R=1.0, E=1.0, nu=0.3):
 
 #: the loads of the study
 LOADS = (load("hertz_a10", 0.1), load("hertz_a05", 0.05))
+#: the approach δ of each load's cut in the displacement-driven form (``variant(ld, P=None, delta=…)``: the
+#: committed level-0 scenes verification/cases/hertz_a*.toml and the external comparison), chosen for about the
+#: load's a/R (measured: a/R = 0.099 and 0.047)
+DELTA = {"hertz_a10": 0.015, "hertz_a05": 0.0042}
 
 
 def write_level(directory, ld: Load, level, stem=None, header=""):

@@ -27,7 +27,7 @@ def fuzz(hs, quick):
 
 
 def external(hs, quick):
-    """XA/XO: the external codes (GetFEM, a scikit-fem Nitsche solver) against tresca-cr on five scenes
+    """XA/XO: the external codes (GetFEM, a scikit-fem Nitsche solver) against tresca-cr on every scene
     (verification/external/run.py), its report staged with the others (make reference publishes it)."""
     path = os.path.join(hs.out, "external_requirements.json")
     cmd = [PY, "verification/external/run.py", "--out", os.path.join(hs.out, "external"), "--reference", hs.staged,

@@ -98,9 +98,12 @@ TOOLS = (
         'XA…',
         'reach the same continuous solution as established external codes: on six scenes (Example 5.1, `mms_front`, '
         'the near-incompressible Chouly–Ern–Pignet case, an imposed normal displacement, `mms_rotated`, the '
-        'Chouly–Ern–Pignet solution at λ = 3 on a Gmsh pentagon) the Richardson limits of GetFEM P1/P2/Taylor–Hood, an '
-        'independent scikit-fem P2 Nitsche solver and tresca-cr (‖u‖_H1, ½a(u,u), u·τ at three points, ∫σ_τ, '
-        'stick-zone ends, max slip) agree pairwise within the sum of their GCI bands (about 6 min)',
+        'Chouly–Ern–Pignet solution at λ = 3 on a Gmsh pentagon) and four unilateral ones (the manufactured '
+        'Signorini–Tresca and Signorini–Coulomb cases, a Coulomb block, Hertz on its own mesh levels) the Richardson '
+        'limits of GetFEM P1/P2/Taylor–Hood, an independent scikit-fem P2 Nitsche solver and tresca-cr (‖u‖_H1, '
+        '½a(u,u), u·τ at three points, ∫σ_τ, stick-zone ends, max slip; on unilateral scenes also ∫p and max p; on '
+        'Hertz ‖u‖_H1, ½a(u,u), ∫p, max p and the half-width 2√(∫p x²/∫p)) agree pairwise within the sum of their '
+        'GCI bands',
         'verification/external/run.py',
         'reference/external.md',
         pattern='XA-.+',
