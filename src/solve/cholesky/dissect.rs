@@ -30,7 +30,15 @@ pub fn coordinate_dissection(q: &Graph, points: &[[f64; 2]]) -> Option<Vec<usize
     if points.len() != n || points.iter().flatten().any(|c| !c.is_finite()) {
         return None;
     }
-    let mut work = Work { q, points, mark: vec![0; n], slot: vec![0; n], stamp: 0, out: Vec::with_capacity(n) };
+    let mut work = Work {
+        q,
+        points,
+        mark: vec![0; n],
+        slot: vec![0; n],
+        scratch: Scratch::default(),
+        stamp: 0,
+        out: Vec::with_capacity(n),
+    };
     let mut verts: Vec<usize> = (0..n).collect();
     work.dissect(&mut verts);
     Some(work.out)
@@ -41,10 +49,21 @@ struct Work<'a> {
     points: &'a [[f64; 2]],
     /// The stamp of the lower half a vertex was last put in (0: a separator's).
     mark: Vec<u32>,
-    /// Scratch: a boundary vertex's index in the bipartite graph of [`Work::cover`].
+    /// Scratch of [`Work::cover`]: a boundary vertex's index in the bipartite graph, and the rest.
     slot: Vec<u32>,
+    scratch: Scratch,
     stamp: u32,
     out: Vec<usize>,
+}
+
+/// The buffers of [`Work::cover`], kept from one cut to the next: the vertices of each half adjacent to
+/// the other, and the bipartite graph between them as compressed rows.
+#[derive(Default)]
+struct Scratch {
+    a: Vec<usize>,
+    b: Vec<usize>,
+    ptr: Vec<usize>,
+    idx: Vec<u32>,
 }
 
 /// The vertices of `half` marked `stamp`, moved to its front: that front.
@@ -90,24 +109,26 @@ impl Work<'_> {
     /// the edges between them (König: from a maximum matching of the bipartite graph of those edges), so
     /// never larger than either half's vertices adjacent to the other.
     fn cover(&mut self, lower: &[usize], upper: &[usize], s: u32) -> Vec<usize> {
-        let q = self.q;
-        let touching = |half: &[usize], other: u32, mark: &[u32]| -> Vec<usize> {
-            half.iter().copied().filter(|&v| q.neighbours(v).iter().any(|&w| mark[w] == other)).collect()
+        let (q, mark) = (self.q, &self.mark);
+        let Scratch { a, b, ptr, idx } = &mut self.scratch;
+        let touching = |half: &[usize], other: u32, out: &mut Vec<usize>| {
+            out.clear();
+            out.extend(half.iter().copied().filter(|&v| q.neighbours(v).iter().any(|&w| mark[w] == other)));
         };
-        let a = touching(lower, s, &self.mark);
-        let b = touching(upper, s - 1, &self.mark);
-        for (i, &v) in a.iter().chain(&b).enumerate() {
+        touching(lower, s, a);
+        touching(upper, s - 1, b);
+        for (i, &v) in b.iter().enumerate() {
             self.slot[v] = i as u32;
         }
-        // the bipartite graph: a's vertices 0..a.len(), b's a.len()..; edges from a to b as local indices
-        let (mark, slot) = (&self.mark, &self.slot);
-        let adj: Vec<Vec<u32>> = a
-            .iter()
-            .map(|&v| q.neighbours(v).iter().filter(|&&w| mark[w] == s).map(|&w| slot[w] - a.len() as u32).collect())
-            .collect();
-        let reached = cover::konig(&adj, b.len());
-        let mut separator: Vec<usize> = a.iter().zip(&reached.0).filter(|(_, &r)| !r).map(|(&v, _)| v).collect();
-        separator.extend(b.iter().zip(&reached.1).filter(|(_, &r)| r).map(|(&v, _)| v));
+        // the bipartite graph of the edges from a's vertices to b's (local indices), compressed rows
+        (ptr.clear(), idx.clear(), ptr.push(0));
+        for &v in a.iter() {
+            idx.extend(q.neighbours(v).iter().filter(|&&w| mark[w] == s).map(|&w| self.slot[w]));
+            ptr.push(idx.len());
+        }
+        let (za, zb) = cover::konig(ptr, idx, b.len());
+        let mut separator: Vec<usize> = a.iter().zip(&za).filter(|(_, &r)| !r).map(|(&v, _)| v).collect();
+        separator.extend(b.iter().zip(&zb).filter(|(_, &r)| r).map(|(&v, _)| v));
         separator
     }
 
