@@ -52,9 +52,9 @@ impl Rows<'_> {
 /// an augmenting path searched from each unmatched first-side vertex.
 fn maximum_matching(adj: Rows<'_>, nb: usize) -> (Vec<u32>, Vec<u32>) {
     let (mut mate_a, mut mate_b) = (vec![NONE; adj.len()], vec![NONE; nb]);
-    for a in 0..adj.len() {
+    for (a, mate) in mate_a.iter_mut().enumerate() {
         if let Some(&b) = adj.row(a).iter().find(|&&b| mate_b[b as usize] == NONE) {
-            mate_a[a] = b;
+            *mate = b;
             mate_b[b as usize] = a as u32;
         }
     }

@@ -121,7 +121,9 @@ impl Work<'_> {
             self.slot[v] = i as u32;
         }
         // the bipartite graph of the edges from a's vertices to b's (local indices), compressed rows
-        (ptr.clear(), idx.clear(), ptr.push(0));
+        ptr.clear();
+        idx.clear();
+        ptr.push(0);
         for &v in a.iter() {
             idx.extend(q.neighbours(v).iter().filter(|&&w| mark[w] == s).map(|&w| self.slot[w]));
             ptr.push(idx.len());
