@@ -24,10 +24,11 @@ use std::cmp::Ordering;
 const LEAF: usize = 32;
 
 /// The nested-dissection ordering (position → vertex) of `q`'s vertices at `points`; `None` when the
-/// points do not fit the graph (their number, a non-finite coordinate).
+/// points do not fit the graph (their number, a non-finite coordinate) or the vertices are too many to
+/// be numbered in `u32` (as the separators' bipartite graphs number them).
 pub fn coordinate_dissection(q: &Graph, points: &[[f64; 2]]) -> Option<Vec<usize>> {
     let n = q.n_vertices();
-    if points.len() != n || points.iter().flatten().any(|c| !c.is_finite()) {
+    if points.len() != n || n >= u32::MAX as usize || points.iter().flatten().any(|c| !c.is_finite()) {
         return None;
     }
     let mut work = Work {
