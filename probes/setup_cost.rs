@@ -42,7 +42,7 @@ fn main() {
         Some(r) => r.1.push(d),
         None => rows.push((name, vec![d])),
     };
-    let mut sizes = (0, 0);
+    let mut sizes = (0, 0, 0.0, 0);
     for _ in 0..passes {
         let t = Clock::now();
         let mesh = Mesh::from_spec(&scene.mesh).unwrap();
@@ -70,7 +70,7 @@ fn main() {
         let t = Clock::now();
         let sym = Symbolic::from_symmetric(pat.as_ref(), &contact, order).unwrap();
         tm("symbolic", t.elapsed());
-        sizes = (sym.pattern_nnz(), sym.len_val());
+        sizes = (sym.pattern_nnz(), sym.len_val(), sym.flops_and_entries().0, sym.n_supernodes());
         if symbolic_only {
             continue;
         }
@@ -100,12 +100,15 @@ fn main() {
         tm("error evaluator", t.elapsed());
         std::hint::black_box((loads, top, inv, ev));
     }
-    println!("entries of K's lower triangle {}, of its factor {}", sizes.0, sizes.1);
-    println!("{:>17} {:>11} {:>12}", "stage", "CPU", "minor faults");
+    println!(
+        "entries of K's lower triangle {}, of its factor {}; flops Σ c² {:.4e}; supernodes {}",
+        sizes.0, sizes.1, sizes.2, sizes.3
+    );
+    println!("{:>17} {:>11} {:>12} {:>11}", "stage", "CPU", "minor faults", "CPU min");
     for (name, mut v) in rows {
         v.sort_by(|a, b| a.0.total_cmp(&b.0));
         let (cpu, faults) = v[v.len() / 2];
-        println!("{name:>17} {:8.2} ms {faults:12.0}", cpu * 1e3);
+        println!("{name:>17} {:8.2} ms {faults:12.0} {:8.2} ms", cpu * 1e3, v[0].0 * 1e3);
     }
 }
 

@@ -187,18 +187,7 @@ impl Factor {
     /// c_j entries each (diagonal included; the count CHOLMOD reports), and the entries of L without
     /// the supernodal blocks' upper triangles, Σ_j c_j.
     pub fn flops_and_entries(&self) -> (f64, f64) {
-        let Some(llt) = self.supernodal() else { return (f64::NAN, f64::NAN) };
-        let (mut flops, mut entries) = (0.0, 0.0);
-        for s in 0..llt.symbolic().n_supernodes() {
-            let sn = llt.supernode(s);
-            let (width, below) = (sn.val().ncols(), sn.pattern().len());
-            for jj in 0..width {
-                let c = (width - jj + below) as f64;
-                flops += c * c;
-                entries += c;
-            }
-        }
-        (flops, entries)
+        super::symbolic::flops_and_entries(&self.symbolic)
     }
 
     /// The unknowns ordered last (see [`Factor::with_last`]).

@@ -41,11 +41,12 @@
 //! # Ok::<(), tresca_cr::Error>(())
 //! ```
 //!
-//! Its modules: [`ordering`] (the graph, AMD and METIS) and [`dissect`] (coordinate bisection); [`etree`]
+//! Its modules: [`ordering`] (the graph, AMD and METIS) and [`dissect`] (coordinate bisection) with [`cover`] (its separators); [`etree`]
 //! (elimination tree, postorder, column counts) and [`symbolic`] (the symbolic factorisation); [`factor`]
 //! (numeric factorisation and solves), [`subtrees`], [`schedule`] and [`queue`] (the numeric factorisation on
 //! several threads) and [`pages`] (the factor's memory, mapped in huge pages).
 
+pub(crate) mod cover;
 pub(crate) mod dissect;
 pub(crate) mod etree;
 pub(crate) mod factor;

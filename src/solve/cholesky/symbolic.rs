@@ -83,6 +83,17 @@ impl Symbolic {
         self.symbolic.len_val()
     }
 
+    /// Floating-point operations of the numeric factorisation and entries of L, as
+    /// [`super::factor::Factor::flops_and_entries`] counts them (before the numeric factorisation).
+    pub fn flops_and_entries(&self) -> (f64, f64) {
+        flops_and_entries(&self.symbolic)
+    }
+
+    /// The supernodes of L (relaxed).
+    pub fn n_supernodes(&self) -> usize {
+        self.symbolic.n_supernodes()
+    }
+
     /// The same, its ordering named `ordering` (reported by runs: [`super::factor::Factor::ordering`]).
     pub fn ordered_by(self, ordering: &'static str) -> Symbolic {
         Symbolic { ordering, ..self }
@@ -267,6 +278,22 @@ pub fn fill_order_at(graph: &Graph, points: Option<&[[f64; 2]]>, nested: bool) -
         Some((fwd, _)) => Ok(fwd),
         None => amd_order(graph, CholeskySymbolicParams::default().amd_params),
     }
+}
+
+/// Σ_j c_j² and Σ_j c_j over the columns j of L's supernodes, c_j the entries of column j on and below
+/// the diagonal in its supernode's block (explicit zeros of the relaxed supernodes included).
+pub(super) fn flops_and_entries(symbolic: &SymbolicSupernodalCholesky<usize>) -> (f64, f64) {
+    let (begin, end, below) = (symbolic.supernode_begin(), symbolic.supernode_end(), symbolic.nnz_per_super());
+    let (mut flops, mut entries) = (0.0, 0.0);
+    for s in 0..symbolic.n_supernodes() {
+        let width = end[s] - begin[s];
+        for jj in 0..width {
+            let c = (width - jj + below[s]) as f64;
+            flops += c * c;
+            entries += c;
+        }
+    }
+    (flops, entries)
 }
 
 fn is_permutation(p: &[usize]) -> bool {
