@@ -83,7 +83,7 @@ impl Normal {
         let qp = Qp { c, d: &d, lo: &lo, hi: &hi };
         let s = &fr.settings;
         let sol = if self.has_coulomb() {
-            coulomb::solve(&qp, &self.coulomb, &w, &mu0, s.tol, s.max_iter())
+            coulomb::solve(&qp, &self.coulomb, &w, &mu0, s.tol, (&self.levels, s.max_iter()))
         } else if s.method == Method::Pdas {
             pdas::solve(&qp, &mu0, s.tol, s.max_iter())
         } else {
