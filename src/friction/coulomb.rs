@@ -19,8 +19,11 @@
 //! the threshold F̄(P + cΔ_n) and moves the sets far from the solution's; the iteration then walks the
 //! stick/slip boundary back a few edges per iteration, a number that grows with 1/h. From the previous
 //! sets, a step whose sets did not change is solved by one Newton step (checked at the next iteration),
-//! at every h; where they changed, the iteration goes on from there. The first step starts from λ = 0
-//! and so from the sets of its residual.
+//! at every h. Where they changed, and at the first step (λ₀ = 0), the iteration goes on from the sets
+//! of the nested iteration (`nested`: the same problem on groups of 2, 4, … Γ_C edges, coarse to fine),
+//! whose fronts are within a couple of edges of the solution's at every h; from λ₀'s sets alone it walks
+//! a moved stick/slip boundary about one edge per iteration. Where the iteration from the predicted sets
+//! stops short (it is not globalised), the plain iteration from λ₀ runs, with the iterations spent.
 
 use super::nested::{Levels, COARSE_ITER};
 use super::{stalled, Qp, Solved};
