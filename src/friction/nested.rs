@@ -50,6 +50,11 @@ impl Levels {
     /// law and friction kind, grouped 2, 4, … consecutive edges until at most [`COARSEST`] groups remain.
     pub fn new(mesh: &Mesh, space: &CrSpace) -> Levels {
         let (chain, pos) = chains(mesh, space);
+        Levels::of_chains(&chain, &pos, space.contact.iter().map(|c| c.length).collect())
+    }
+
+    /// The levels of edges with lengths `length` on chains `chain` at positions `pos` in them.
+    pub fn of_chains(chain: &[usize], pos: &[usize], length: Vec<f64>) -> Levels {
         let mut groups = Vec::new();
         let mut last = chain.len();
         for l in 1..usize::BITS {
@@ -69,7 +74,7 @@ impl Levels {
             last = ids.len();
             groups.push((g, last));
         }
-        Levels { groups, length: space.contact.iter().map(|c| c.length).collect() }
+        Levels { groups, length }
     }
 
     /// Number of coarse levels.
