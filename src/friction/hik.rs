@@ -5,15 +5,18 @@
 //! It is semismooth Newton on the NCP function λ − P_[lo,hi](λ + cΔ), Δ = d − Cλ, c_k = 1/C_kk: each
 //! iteration takes the sets of y = λ + cΔ (upper: y > hi, λ = hi; lower: y < lo, λ = lo; inactive: the
 //! rest, Δ = 0) and solves the linear system they give, C_II λ_I = d_I − C_IA λ_A (one Cholesky), so the
-//! whole set moves at once. After a Newton step Δ = 0 on I and λ is at its bound on A, so the next sets
+//! whole set may move at once. After a Newton step Δ = 0 on I and λ is at its bound on A, so the next sets
 //! depend on signs only (a force beyond its bound leaves I, a bound whose Δ pushes back into the box is
 //! released), not on c, whose diagonal scale C_kk misjudges the force a smooth Δ needs by a factor that
-//! grows with 1/h. The projected Newton method instead moves a front by the few unknowns its ε-active set
-//! and Armijo arc let go of per iteration, a count that grows with 1/h where a contact front moves.
+//! grows with 1/h. Where a front of the start is wrong, it still moves about one edge per Newton step (the
+//! forces of a too-large stick or contact zone exceed their bounds only next to its end); the projected
+//! Newton method moves it no faster, at several Armijo trials a step.
 //!
 //! The start. A warm start λ₀ ≠ 0 (the previous step's forces) gives the first sets from λ₀ itself (at a
-//! bound: that bound; otherwise inactive), the sets of the step it solved, as `coulomb` does; λ₀ = 0 gives
-//! those of y = cd.
+//! bound: that bound; otherwise inactive), the sets of the step it solved, as `coulomb` does: a step whose
+//! sets did not change is solved by one Newton step. Where that step does not solve it, and from λ₀ = 0,
+//! the iteration goes on from the sets of the nested iteration (`nested`), whose fronts are within a couple
+//! of edges of the solution's at every h (without coarse levels: those of y = λ + cΔ).
 //!
 //! The safeguard. Iterates need not be feasible; the one reported and tested is P(λ), to the scene's
 //! tolerance on the natural residual (`super::Qp::residual`). A set that repeats (plain PDAS can cycle
