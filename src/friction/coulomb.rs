@@ -19,9 +19,13 @@
 //! the threshold F̄(P + cΔ_n) and moves the sets far from the solution's; the iteration then walks the
 //! stick/slip boundary back a few edges per iteration, a number that grows with 1/h. From the previous
 //! sets, a step whose sets did not change is solved by one Newton step (checked at the next iteration),
-//! at every h; where they changed, the iteration goes on from there. The first step starts from λ = 0
-//! and so from the sets of its residual.
+//! at every h. Where they changed, and at the first step (λ₀ = 0), the iteration goes on from the sets
+//! of the nested iteration (`nested`: the same problem on groups of 2, 4, … Γ_C edges, coarse to fine),
+//! whose fronts are within a couple of edges of the solution's at every h; from λ₀'s sets alone it walks
+//! a moved stick/slip boundary about one edge per iteration. Where the iteration from the predicted sets
+//! stops short (it is not globalised), the plain iteration from λ₀ runs, with the iterations spent.
 
+use super::nested::{Levels, COARSE_ITER};
 use super::{stalled, Qp, Solved};
 use nalgebra::{DMatrix, DVector};
 use std::collections::HashSet;
@@ -38,8 +42,55 @@ pub fn threshold(f: Coefficients, w: &[f64], e: usize, p: f64) -> f64 {
 }
 
 /// Solve from λ₀ = (μ₀, P₀); `w` are the Tresca bounds (used on Tresca edges), the normal forces'
-/// bounds are those of `qp` (lower bound 0: unilateral).
-pub fn solve(qp: &Qp, nm: Coefficients, w: &[f64], lam0: &[f64], tol: f64, max_iter: usize) -> Solved {
+/// bounds are those of `qp` (lower bound 0: unilateral); `levels` give the predictor (`nested`).
+pub fn solve(qp: &Qp, nm: Coefficients, w: &[f64], lam0: &[f64], tol: f64, levels: (&Levels, usize)) -> Solved {
+    let predict = || predicted(qp, nm, w, levels.0, tol);
+    let warm = warm_sets(qp, nm, w, lam0);
+    let first = if warm.is_some() {
+        iterate(qp, (nm, w), lam0, warm.clone(), Some(&predict), tol, levels.1)
+    } else {
+        iterate(qp, (nm, w), lam0, predict(), None, tol, levels.1)
+    };
+    // the predicted sets are a start the iteration need not converge from (it is not globalised): where
+    // it stops short, the plain iteration from λ₀ (its own sets) runs, with the iterations spent added
+    first.or_else(|e| {
+        let budget = levels.1.saturating_sub(e.iterations);
+        iterate(qp, (nm, w), lam0, warm, None, tol, budget)
+            .map(|(l, k, r)| (l, e.iterations + k, r))
+            .map_err(|f| stalled(f.solver, e.iterations + f.iterations, f.residual))
+    })
+}
+
+/// Active sets: per unknown its set, per edge the sign of the normal force in the threshold.
+type Sets = (Vec<i8>, Vec<f64>);
+
+/// The nested iteration's sets for the fine problem (`nested`; `None` without coarse levels or where a
+/// level does not converge).
+fn predicted(qp: &Qp, nm: Coefficients, w: &[f64], levels: &Levels, tol: f64) -> Option<Sets> {
+    let nc = qp.d.len() / 2;
+    let mut sets: Option<Sets> = None;
+    for l in (1..=levels.len()).rev() {
+        let co = levels.coarse(l, qp.c, qp.d, &qp.lo[nc..], w, nm);
+        let cq = Qp { c: &co.c, d: &co.d, lo: &co.lo, hi: &co.hi };
+        let start = sets.map(|(s, g)| (levels.prolong(l + 1, l, &s), levels.prolong(l + 1, l, &g)));
+        let zero = vec![0.0; co.d.len()];
+        let (lam, _, _) = iterate(&cq, (&co.coulomb, &co.w), &zero, start, None, tol, COARSE_ITER).ok()?;
+        sets = Some(sets_of(&cq, &co.coulomb, &co.w, &lam, 1.0 - AT_BOUND));
+    }
+    sets.map(|(s, g)| (levels.prolong(1, 0, &s), levels.prolong(1, 0, &g)))
+}
+
+/// The iteration from λ₀ and the first sets `first` (`None`: those of λ₀'s residual); where the first
+/// Newton step does not solve the problem, `retry` gives the sets of the second.
+fn iterate(
+    qp: &Qp,
+    (nm, w): (Coefficients, &[f64]),
+    lam0: &[f64],
+    mut first: Option<Sets>,
+    retry: Option<&dyn Fn() -> Option<Sets>>,
+    tol: f64,
+    max_iter: usize,
+) -> Solved {
     let n = qp.d.len();
     let nc = n / 2;
     let mut lam: Vec<f64> = (0..n).map(|k| if k < nc { lam0[k] } else { lam0[k].max(qp.lo[k]) }).collect();
@@ -53,8 +104,10 @@ pub fn solve(qp: &Qp, nm: Coefficients, w: &[f64], lam0: &[f64], tol: f64, max_i
         if it == max_iter {
             return Err(stalled("coulomb ssn", it, res));
         }
-        let warm = if it == 0 { warm_sets(qp, nm, w, &lam) } else { None };
-        let (set, sigma_p) = warm.unwrap_or_else(|| active_sets(qp, nm, w, &lam, &ds));
+        if it == 1 {
+            first = retry.and_then(|r| r()).filter(|(s, _)| !seen.contains(s));
+        }
+        let (set, sigma_p) = first.take().unwrap_or_else(|| active_sets(qp, nm, w, &lam, &ds));
         if !seen.insert(set.clone()) {
             return Err(stalled("coulomb ssn (cycling: an active set repeated)", it, res));
         }

@@ -21,6 +21,8 @@
 pub mod balance;
 pub mod coulomb;
 pub mod floating;
+pub mod hik;
+pub mod nested;
 pub mod normal;
 pub mod pdas;
 pub mod ssn;

@@ -9,15 +9,16 @@
 //!   (P_e free: the reaction of u·n = g, of either sign);
 //! * Tresca: |μ_e| ≤ w_e = |e| ḡa_e with μ_e ∈ w_e ∂|·|(Δs_e), on every Γ_C edge (also where it is
 //!   separated: the Signorini–Tresca model). This is the dual QP min ½λᵀCλ − dᵀλ over the bounds
-//!   μ_e ∈ [−w_e, w_e], P_e ∈ [0, +∞) (unilateral) or (−∞, +∞) (bilateral), solved by `ssn` or
-//!   `pdas` as the bilateral problem is ([`super::Qp`]).
+//!   μ_e ∈ [−w_e, w_e], P_e ∈ [0, +∞) (unilateral) or (−∞, +∞) (bilateral), solved with `method = "ssn"`
+//!   by the safeguarded primal–dual active-set method of [`super::hik`], or by `pdas` ([`super::Qp`]).
 //! * Coulomb: the same with the threshold F̄_e |P_e| in place of w_e (zero on a separated edge):
 //!   no longer a QP; solved by the semismooth Newton method of [`super::coulomb`].
 //!
 //! An edge is *separated* when P_e = 0 and its gap is open, r_e − ḡ_e < −1e-9 · max|d| (the scale
 //! [`super::classify`] uses for a nonzero slip).
 
-use super::{classify_with, coulomb, not_converged, pdas, pow2_scale, scaled, ssn, Friction, FrictionSolution, Qp};
+use super::nested::Levels;
+use super::{classify_with, coulomb, hik, not_converged, pdas, pow2_scale, scaled, Friction, FrictionSolution, Qp};
 use crate::error::Result;
 use crate::fem::gap::GapMeans;
 use crate::fem::space::CrSpace;
@@ -32,6 +33,8 @@ pub struct Normal {
     /// F̄_e of each Γ_C edge (`None`: Tresca's bound).
     pub(super) coulomb: Vec<Option<f64>>,
     gaps: GapMeans,
+    /// The coarse levels of the active-set predictor (`super::nested`).
+    levels: Levels,
 }
 
 impl Normal {
@@ -45,6 +48,7 @@ impl Normal {
             lo: space.contact.iter().map(|c| if c.unilateral { 0.0 } else { f64::NEG_INFINITY }).collect(),
             coulomb: space.contact.iter().map(|c| c.coulomb).collect(),
             gaps: GapMeans::new(scene, mesh, space),
+            levels: Levels::new(mesh, space),
         })
     }
 
@@ -79,11 +83,11 @@ impl Normal {
         let qp = Qp { c, d: &d, lo: &lo, hi: &hi };
         let s = &fr.settings;
         let sol = if self.has_coulomb() {
-            coulomb::solve(&qp, &self.coulomb, &w, &mu0, s.tol, s.max_iter())
+            coulomb::solve(&qp, &self.coulomb, &w, &mu0, s.tol, (&self.levels, s.max_iter()))
         } else if s.method == Method::Pdas {
             pdas::solve(&qp, &mu0, s.tol, s.max_iter())
         } else {
-            ssn::solve(&qp, &mu0, s.tol, s.max_iter())
+            hik::solve(&qp, &mu0, s.tol, s.max_iter(), &self.levels)
         };
         let (lam, iterations, residual) = sol.map_err(|e| not_converged(e, n, t, s.tol))?;
         let ds = qp.slip_increment(&lam);

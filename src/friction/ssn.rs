@@ -6,6 +6,7 @@
 //! on q. The iterates are feasible and q decreases monotonically, so the method cannot cycle (a plain
 //! primal–dual active-set iteration can, see `pdas`); once the active set is identified the full Newton
 //! step is accepted and the iteration terminates at the exact solution (residual at rounding level).
+//! With normal unknowns it is the safeguard of the primal–dual active-set method of `hik`.
 
 use super::{stalled, Qp, Solved};
 use crate::scene::Method;

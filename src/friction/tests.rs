@@ -114,3 +114,46 @@ fn non_convergence_names_step_and_time() {
         other => panic!("unexpected error {other}"),
     }
 }
+
+/// A unilateral Tresca problem on a chain of `nc` edges at x_e = (e + ½)/nc: C the Laplace kernel
+/// exp(−|x − x'|/0.2) over the tangential and normal unknowns (the normal ones at x_e + 0.003) plus 0.05 I
+/// (SPD), w_e = 0.05 (1 + x_e), normal forces in [0, ∞), d = (sin 3x + a, cos 4x + a): several stick/slip
+/// and contact/separation fronts along the chain.
+fn chain_problem(nc: usize, a: f64) -> (DMatrix<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+    let x = |k: usize| (((k % nc) as f64 + 0.5) / nc as f64, if k < nc { 0.0 } else { 0.003 });
+    let c = DMatrix::from_fn(2 * nc, 2 * nc, |i, j| {
+        let ((xi, si), (xj, sj)) = (x(i), x(j));
+        (-((xi + si) - (xj + sj)).abs() / 0.2).exp() + if i == j { 0.05 } else { 0.0 }
+    });
+    let d = (0..2 * nc).map(|k| if k < nc { (3.0 * x(k).0).sin() + a } else { (4.0 * x(k).0).cos() + a }).collect();
+    let w: Vec<f64> = (0..nc).map(|e| 0.05 * (1.0 + x(e).0)).collect();
+    let lo = w.iter().map(|w| -w).chain(std::iter::repeat_n(0.0, nc)).collect();
+    let hi = w.iter().copied().chain(std::iter::repeat_n(f64::INFINITY, nc)).collect();
+    (c, d, lo, hi)
+}
+
+/// The system shall solve the QP with normal unknowns by the active-set method of `hik`, from λ = 0 (the
+/// nested predictor's sets, 40 edges: levels of 20, 10 and 5 groups) and from the solution of another load
+/// (a warm start), to the λ of the projected Newton method of `ssn` (a different method: the QP is strictly
+/// convex, its solution unique). Tolerance: both stop at natural residual 1e-12 relative to the force scale
+/// (≈ 1); cond(C) ≤ ~10³ leaves λ within ~1e-9.
+#[test]
+fn active_set_method_reaches_the_projected_newton_solution() {
+    let nc = 40;
+    let levels = nested::Levels::of_chains(&vec![0; nc], &(0..nc).collect::<Vec<_>>(), vec![1.0 / nc as f64; nc]);
+    assert_eq!(levels.len(), 3);
+    let (c, d0, lo, hi) = chain_problem(nc, 0.0);
+    let qp0 = Qp { c: &c, d: &d0, lo: &lo, hi: &hi };
+    let warm = hik::solve(&qp0, &vec![0.0; 2 * nc], 1e-12, 200, &levels).expect("hik from 0").0;
+    for a in [0.0, 0.3, -0.2] {
+        let (_, d, _, _) = chain_problem(nc, a);
+        let qp = Qp { c: &c, d: &d, lo: &lo, hi: &hi };
+        let want = ssn::solve(&qp, &vec![0.0; 2 * nc], 1e-12, 500).expect("ssn").0;
+        for start in [vec![0.0; 2 * nc], warm.clone()] {
+            let (got, _, res) = hik::solve(&qp, &start, 1e-12, 200, &levels).expect("hik");
+            assert!(res <= 1e-12);
+            let err = got.iter().zip(&want).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            assert!(err <= 1e-9, "a = {a}: |λ_hik − λ_ssn| = {err:e}");
+        }
+    }
+}
