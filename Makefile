@@ -95,6 +95,7 @@ reference: venv
 bench: build venv bench-env
 	$(PY) verification/bench/report.py
 	$(PY) verification/planner.py --costs
+	$(PY) verification/bench/costmodel.py --write reference/performance.md
 	$(PY) verification/bench/contact.py --write reference/performance.md
 	$(MAKE) bench-factorisation
 

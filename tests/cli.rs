@@ -278,3 +278,37 @@ fn results_do_not_depend_on_the_thread_count() {
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("TRESCA_THREADS"), "{}", stderr(&o));
 }
+
+/// The system shall report in `check --json` the counts of the asked level — `unknowns`, `paper_dofs`,
+/// `contact_unknowns`, `edges` — also above `check`'s assembly cap (100,000 unknowns), where the level is
+/// counted from a coarser one: the same numbers `run --json` reports at that level, for a scene without
+/// normal unknowns (one per contact edge) and one with a unilateral part (two per contact edge).
+#[test]
+fn check_json_counts_the_asked_level_beyond_the_cap() {
+    let read = |p: &Path| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap() };
+    for case in ["mms_stop", "mms_signorini_stop"] {
+        // 17 × 17 cells at refine 3: 136 × 136, 111,112 and 111,248 unknowns, above the cap; refine 2 below it
+        let text = std::fs::read_to_string(root(&format!("verification/cases/{case}.toml"))).unwrap();
+        assert!(text.contains("cells    = [4, 4]"), "{case}: the test edits the cells line");
+        let scene = tmp(&format!("{case}_17.toml"));
+        std::fs::write(&scene, text.replace("cells    = [4, 4]", "cells    = [17, 17]")).unwrap();
+        let (scene, cj, rj) =
+            (scene.display().to_string(), tmp(&format!("{case}_check.json")), tmp(&format!("{case}_run.json")));
+        let o = run(&["check", &scene, "--refine", "3", "--json", cj.to_str().unwrap(), "--force"]);
+        assert!(o.status.success(), "{case}: {}", stderr(&o));
+        assert!(
+            String::from_utf8_lossy(&o.stdout).contains("counted, not assembled"),
+            "{case}: refine 3 was assembled"
+        );
+        let o = run(&["run", &scene, "--refine", "3", "--steps", "1", "-q", "--json", rj.to_str().unwrap(), "--force"]);
+        assert!(o.status.success(), "{case}: {}", stderr(&o));
+        let (c, r) = (read(&cj)["check"].clone(), read(&rj)["run"].clone());
+        assert!(c["unknowns"].as_u64().unwrap() > 100_000, "{case}: {c}");
+        assert_eq!(c["unknowns"], r["unknowns"], "{case}");
+        assert_eq!(c["paper_dofs"], r["paper_dofs"], "{case}");
+        let per_edge = if case == "mms_signorini_stop" { 2 } else { 1 };
+        assert_eq!(c["contact_unknowns"].as_u64(), r["contact_edges"].as_u64().map(|e| per_edge * e), "{case}");
+        // 136 × 136 cells: 3·136² + 2·136 edges
+        assert_eq!(c["edges"].as_u64(), Some(3 * 136 * 136 + 2 * 136), "{case}");
+    }
+}

@@ -43,6 +43,43 @@ fn refined(mut v: u64, mut t: u64, mut e: u64, k: u32) -> (u64, u64, u64) {
     (v, t, e)
 }
 
+/// The counts of the asked level, from the level set up and the `k` red refinements beyond it (exact: the
+/// module doc), for the human lines and `--json` alike.
+struct Counts {
+    vertices: u64,
+    triangles: u64,
+    edges: u64,
+    h: f64,
+    unknowns: u64,
+    paper_dofs: u64,
+    contact_unknowns: u64,
+}
+
+impl Counts {
+    fn of(problem: &Problem, s: &Scene, k: u32) -> Counts {
+        let (m, sp) = (&problem.mesh, &problem.space);
+        let (vertices, triangles, edges) = refined(m.points.len() as u64, m.tris.len() as u64, m.edges.len() as u64, k);
+        // boundary edges double with each refinement
+        let (dirichlet, contact) = ((sp.n_dirichlet as u64) << k, (sp.contact.len() as u64) << k);
+        // two unknowns per free edge, one per contact edge (two with normal unknowns), none on Dirichlet edges
+        let paper_dofs = edges.saturating_sub(dirichlet).saturating_mul(2);
+        let (unknowns, contact_unknowns) = if s.has_normal_unknowns() {
+            (paper_dofs, 2 * contact)
+        } else {
+            (paper_dofs.saturating_sub(contact), contact)
+        };
+        Counts {
+            vertices,
+            triangles,
+            edges,
+            h: m.h_max() / f64::from(1u32 << k),
+            unknowns,
+            paper_dofs,
+            contact_unknowns,
+        }
+    }
+}
+
 pub fn check(scene: Scene, estimate: Estimate, reports: super::summary::Reports) -> Result<()> {
     let start = std::time::Instant::now();
     let (json, force) = (reports.json, reports.force);
@@ -53,11 +90,10 @@ pub fn check(scene: Scene, estimate: Estimate, reports: super::summary::Reports)
     let problem = Problem::new(built)?;
     // what `run` evaluates before its first step: u⁰ = I_CR u₀ and, with [exact], the errors at t₀
     problem.initial()?;
-    let (s, m, sp) = (&scene, &problem.mesh, &problem.space);
-    let (v, t, e) = refined(m.points.len() as u64, m.tris.len() as u64, m.edges.len() as u64, k);
-    let edges_of = |n: usize| (n as u64) << k; // boundary edges double with each refinement
+    let (s, sp) = (&scene, &problem.space);
+    let c = Counts::of(&problem, s, k);
     say!("scene      {} ({})", s.file, if s.title.is_empty() { "untitled" } else { &s.title });
-    say!("mesh       {v} vertices, {t} triangles, {e} edges, h = {:.4e}", m.h_max() / f64::from(1u32 << k));
+    say!("mesh       {} vertices, {} triangles, {} edges, h = {:.4e}", c.vertices, c.triangles, c.edges, c.h);
     if k > 0 {
         say!(
             "           (refine {level} is counted, not assembled: the scene was set up at refine {at}, and each of \
@@ -72,7 +108,7 @@ pub fn check(scene: Scene, estimate: Estimate, reports: super::summary::Reports)
         problem.law.mu
     );
     for (p, part) in s.parts.iter().enumerate() {
-        let n = edges_of(sp.edge_part.iter().filter(|&&q| q == Some(p)).count());
+        let n = (sp.edge_part.iter().filter(|&&q| q == Some(p)).count() as u64) << k;
         say!("part       {:<10} {:>6} edges  {}", part.name, n, describe(&part.kind));
     }
     if let Some(kernel) = problem.free.kernel() {
@@ -82,13 +118,11 @@ pub fn check(scene: Scene, estimate: Estimate, reports: super::summary::Reports)
             kernel.motions.names().join(", ")
         );
     }
-    // two unknowns per free edge, one per contact edge (two with normal unknowns), none on Dirichlet edges
-    let (dirichlet, contact) = (edges_of(sp.n_dirichlet), edges_of(sp.contact.len()));
-    let contact = if s.has_normal_unknowns() { 2 * contact } else { contact };
-    let unknowns = 2 * (e - dirichlet) - if s.has_normal_unknowns() { 0 } else { contact };
     say!(
-        "unknowns   {unknowns} (paper's count 2(edges - Dirichlet edges) = {}), {contact} contact unknowns",
-        2 * (e - dirichlet)
+        "unknowns   {} (paper's count 2(edges - Dirichlet edges) = {}), {} contact unknowns",
+        c.unknowns,
+        c.paper_dofs,
+        c.contact_unknowns
     );
     say!("assembled  {}", assembled_terms(s));
     say!(
@@ -101,11 +135,11 @@ pub fn check(scene: Scene, estimate: Estimate, reports: super::summary::Reports)
     say!("solver     {} (tol {:.1e}, max_iter {})", s.solver.method.name(), s.solver.tol, s.solver.max_iter());
     say!("exact      {}", if s.exact.is_some() { "given: true errors computed" } else { "none" });
     say!("estimate   {}", estimate.describe());
-    let points = tresca_cr::fem::singular::singularities(m, &sp.edge_part, &s.parts, s.material.nu);
+    let points = tresca_cr::fem::singular::singularities(&problem.mesh, &sp.edge_part, &s.parts, s.material.nu);
     let (lines, singular) = super::corners::describe(&points, &s.parts);
     lines.iter().for_each(|l| say!("{l}"));
     if let Some(j) = &json {
-        write_json(j, &problem, s, &estimate, singular, (start.elapsed().as_secs_f64(), force))?;
+        write_json(j, (&problem, &c), s, &estimate, singular, (start.elapsed().as_secs_f64(), force))?;
     }
     match super::out::stdout_error() {
         Some(e) => anyhow::bail!("cannot write to standard output: {e}"),
@@ -144,25 +178,25 @@ fn assembled_terms(s: &Scene) -> String {
     terms.join(", ")
 }
 
-/// The JSON summary of `check` (the assembled level's counts) to `j`.
+/// The JSON summary of `check` (the asked level's counts, [`Counts`]) to `j`.
 fn write_json(
     j: &std::path::Path,
-    problem: &Problem,
+    (problem, c): (&Problem, &Counts),
     s: &Scene,
     estimate: &Estimate,
     singular: super::summary::Singular,
     (wall, force): (f64, bool),
 ) -> Result<()> {
-    let (m, sp) = (&problem.mesh, &problem.space);
+    let count = |n: u64| usize::try_from(n).unwrap_or(usize::MAX);
     let mut summary = super::summary::Summary::new("check", &s.file, wall);
     summary.check = Some(super::summary::CheckSummary {
-        vertices: m.points.len(),
-        triangles: m.tris.len(),
-        edges: m.edges.len(),
-        h: m.h_max(),
-        unknowns: sp.n_dofs,
-        paper_dofs: sp.paper_dofs(),
-        contact_unknowns: sp.contact_dofs().len(),
+        vertices: count(c.vertices),
+        triangles: count(c.triangles),
+        edges: count(c.edges),
+        h: c.h,
+        unknowns: count(c.unknowns),
+        paper_dofs: count(c.paper_dofs),
+        contact_unknowns: count(c.contact_unknowns),
         steps: problem.n_steps(),
         solver: s.solver.method.name().into(),
         tol: s.solver.tol,

@@ -18,8 +18,10 @@
 //! | `check`, `run`, `study`, `plan`, `adapt` | the part of the subcommand that ran (the others `null`) |
 //!
 //! `check` ([`CheckSummary`]): `vertices`, `triangles`, `edges`, `h` (largest edge) of the mesh; `unknowns`,
-//! `paper_dofs` (the paper's count 2(edges − Dirichlet edges)), `contact_unknowns`; `steps`; `solver`, `tol`,
-//! `max_iter`; `exact` (true errors computed); `setup` ([`Phases`]); `memory`, `disk`: the pre-run estimate
+//! `paper_dofs` (the paper's count 2(edges − Dirichlet edges)), `contact_unknowns` — all of the asked level,
+//! also where it is counted from a coarser level set up (above `check`'s cap, `src/cli/check.rs`), as `run`
+//! would report them; `steps`; `solver`, `tol`,
+//! `max_iter`; `exact` (true errors computed); `setup` ([`Phases`], of the level set up); `memory`, `disk`: the pre-run estimate
 //! of the peak memory and of the results file (bytes); `singular` ([`Singular`]): every polygon corner and
 //! change of condition with its leading exponent α, `uniform_order` = min(1, min Re α), `adaptive_order` ½.
 //!

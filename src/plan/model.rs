@@ -12,12 +12,23 @@
 //!
 //! **Cost.** wall(n, N) = S(n) + N s(n) for n unknowns and N steps, S the set-up (assembly, the one
 //! factorisation, condensation) and s the cost of a step (load, one triangular-solve pair, the friction
-//! solve). S is a power law through the space pilot's finest level, its exponent from the two finest
-//! levels clamped to what the algorithms do at the plans' sizes: between n^1.2 (measured: [`SETUP_EXPONENT`])
-//! and O(n^1.5) (sparse Cholesky of a 2D mesh). s = c n ln n, the cost of the triangular solves with a fill-reducing factor of a 2D mesh
-//! (the friction work, O(n_c²) per iteration with n_c ∝ √n under uniform refinement, is smaller), with c
-//! from the time pilot's level with the most steps: per-step costs measured over a few steps are
-//! dominated by the first steps' extra Newton iterations and by start-up.
+//! solve). S = c_S n^a, its exponent a from the two finest space pilot levels where both set-ups are long
+//! enough to be timed ([`MEASURABLE_SETUP`]), else the least growth [`SETUP_EXPONENT`]`.0`, clamped to what
+//! the algorithms do at the plans' sizes: between n^1.2 (measured) and O(n^1.5) (sparse Cholesky of a 2D
+//! mesh). s = c n ln n, the cost of the triangular solves with a fill-reducing factor of a 2D mesh (the
+//! friction work, O(n_c²) per iteration with n_c ∝ √n under uniform refinement, is smaller), from the time
+//! pilot's levels with at least half the most steps: per-step costs measured over a few steps are dominated
+//! by the first steps' extra Newton iterations and by start-up.
+//!
+//! **Why minima.** Each sample gives the constant it implies, c_S = S/n^a or c = s/(n ln n), and the model
+//! takes the smallest over the samples that measure it (the two finest space levels; the longest time
+//! levels). Everything that separates a pilot's time from the model only adds to it: the fixed overheads of
+//! a small level (its set-up grows like n^0.8–1.0 there), the first steps' extra iterations, and the
+//! machine's noise (a process descheduled, caches shared with other processes: milliseconds scatter 1.5×
+//! between passes even on a quiet machine). So every implied constant is an upper bound of the plan's, and
+//! the smallest is the tightest; a single slow sample no longer moves the prediction. An exponent fitted
+//! through two millisecond set-ups amplified that noise (a 1.3× slow finest level raised it by 0.19, 1.7×
+//! after two levels of extrapolation); below [`MEASURABLE_SETUP`] it is not fitted.
 
 /// y = c xᵖ.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -123,6 +134,11 @@ impl ErrorModel {
 /// from them alone predicted refine 5 at half its set-up.
 pub const SETUP_EXPONENT: (f64, f64) = (1.2, 1.5);
 
+/// Seconds from which a pilot level's set-up is timed well enough for the set-up exponent to be fitted
+/// through it (module doc): a tenth of a second is many scheduler slices, against the milliseconds of the
+/// small levels whose times scatter 1.5× between passes.
+pub const MEASURABLE_SETUP: f64 = 0.1;
+
 /// One measured run: unknowns, set-up seconds, seconds per step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CostSample {
@@ -140,10 +156,10 @@ pub struct CostModel {
 }
 
 impl CostModel {
-    /// Fit S to the `space` samples: exponent from the two largest n, clamped to [`SETUP_EXPONENT`],
-    /// through the largest; and s(n) = c n ln n through the `time` sample with the most steps per
-    /// set-up (the most representative per-step cost: many steps of the size the plans take). None
-    /// without samples.
+    /// Fit S to the `space` samples: exponent from the two largest n where both set-ups are measurable
+    /// ([`MEASURABLE_SETUP`]; else the least, [`SETUP_EXPONENT`]`.0`), clamped to [`SETUP_EXPONENT`], the
+    /// constant the smallest the two imply; and s(n) = c n ln n with c the smallest the `time` samples with
+    /// at least half the most steps per set-up imply (module doc: why minima). None without samples.
     pub fn fit(space: &[CostSample], time: &[(CostSample, usize)]) -> Option<CostModel> {
         // a phase too fast for the clock still costs something
         fn floor(t: f64) -> f64 {
@@ -151,24 +167,27 @@ impl CostModel {
         }
         let mut s: Vec<CostSample> = space.iter().copied().filter(|c| c.n > 1.0).collect();
         s.sort_by(|a, b| a.n.total_cmp(&b.n));
-        let last = *s.last()?;
-        let alpha = match s.len() {
-            1 => SETUP_EXPONENT.0,
-            m => {
-                let (a, b) = (s[m - 2], s[m - 1]);
-                let e = (floor(b.setup) / floor(a.setup)).ln() / (b.n / a.n).ln();
+        let finest = &s[s.len().saturating_sub(2)..];
+        let alpha = match finest {
+            [a, b] if a.setup >= MEASURABLE_SETUP && b.setup >= MEASURABLE_SETUP => {
+                let e = (b.setup / a.setup).ln() / (b.n / a.n).ln();
                 if e.is_finite() {
                     e.clamp(SETUP_EXPONENT.0, SETUP_EXPONENT.1)
                 } else {
                     SETUP_EXPONENT.0
                 }
             }
+            _ => SETUP_EXPONENT.0,
         };
-        let (t, _) = time.iter().copied().filter(|(c, _)| c.n > 1.0).max_by_key(|&(_, steps)| steps)?;
-        Some(CostModel {
-            setup: PowerLaw::through(last.n, floor(last.setup), alpha),
-            step: floor(t.step) / (t.n * t.n.ln()),
-        })
+        let setup_c = finest.iter().map(|c| floor(c.setup) / c.n.powf(alpha)).reduce(f64::min)?;
+        let time: Vec<(CostSample, usize)> = time.iter().copied().filter(|(c, _)| c.n > 1.0).collect();
+        let most = time.iter().map(|&(_, steps)| steps).max()?;
+        let step = time
+            .iter()
+            .filter(|&&(_, steps)| 2 * steps >= most)
+            .map(|(c, _)| floor(c.step) / (c.n * c.n.ln()))
+            .reduce(f64::min)?;
+        Some(CostModel { setup: PowerLaw { c: setup_c, p: alpha }, step })
     }
 
     /// Seconds per step at n unknowns.
@@ -223,20 +242,38 @@ mod tests {
         }
     }
 
-    /// Samples of S = 1e-6 n^1.3 and s = 1e-8 n ln n give back those laws; a set-up slope outside the
-    /// allowed range is clamped (a flat, overhead-dominated set-up is taken as linear).
+    /// Samples of S = 1e-5 n^1.3 (set-ups of 0.08–3 s) and s = 1e-8 n ln n give back those laws; a set-up
+    /// slope outside the allowed range is clamped (a flat, overhead-dominated set-up is taken as linear).
     #[test]
     fn cost_fit_recovers_and_clamps() {
-        let sample = |n: f64| CostSample { n, setup: 1e-6 * n.powf(1.3), step: 1e-8 * n * n.ln() };
+        let sample = |n: f64| CostSample { n, setup: 1e-5 * n.powf(1.3), step: 1e-8 * n * n.ln() };
         let space: Vec<CostSample> = [1e3, 4e3, 1.6e4].iter().map(|&n| sample(n)).collect();
         let time = [(sample(1e3), 10), (sample(2e3), 400), (CostSample { step: 1.0, ..sample(5e2) }, 40)];
         let m = CostModel::fit(&space, &time).unwrap();
         assert!((m.setup.p - 1.3).abs() < 1e-12);
         let n: f64 = 1e6;
-        let want = 1e-6 * n.powf(1.3) + 10.0 * 1e-8 * n * n.ln();
+        let want = 1e-5 * n.powf(1.3) + 10.0 * 1e-8 * n * n.ln();
         assert!((m.predict(n, 10) / want - 1.0).abs() < 1e-12);
-        let flat = [CostSample { n: 1e3, setup: 0.01, step: 0.0 }, CostSample { n: 4e3, setup: 0.011, step: 0.0 }];
+        let flat = [CostSample { n: 1e3, setup: 0.2, step: 0.0 }, CostSample { n: 4e3, setup: 0.22, step: 0.0 }];
         assert_eq!(CostModel::fit(&flat, &time).unwrap().setup.p, SETUP_EXPONENT.0);
         assert!(CostModel::fit(&[], &time).is_none() && CostModel::fit(&space, &[]).is_none());
+    }
+
+    /// A slow sample does not move the model: the finest set-up timed 1.5× slow (noise only adds) leaves the
+    /// constant of the level below it, whose set-up of 22 ms is too short for an exponent (the least growth
+    /// is taken), and a long time level timed slow leaves the other long level's constant.
+    #[test]
+    fn a_slow_sample_does_not_move_the_fit() {
+        let law = |n: f64| 1e-6 * n.powf(1.2);
+        let step = |n: f64| 1e-8 * n * n.ln();
+        let sample = |n: f64, slow: f64| CostSample { n, setup: slow * law(n), step: slow * step(n) };
+        let space = [sample(1e3, 1.0), sample(4e3, 1.0), sample(1.6e4, 1.5)];
+        let time = [(sample(2e3, 1.0), 64), (sample(2e3, 1.5), 128), (sample(2e3, 0.5), 16)];
+        let m = CostModel::fit(&space, &time).unwrap();
+        assert_eq!(m.setup.p, SETUP_EXPONENT.0);
+        let n: f64 = 2.5e5;
+        assert!((m.setup.at(n) / law(n) - 1.0).abs() < 1e-12, "{m:?}");
+        // the 16-step level (less than half the most steps) is not a per-step sample
+        assert!((m.step_at(n) / step(n) - 1.0).abs() < 1e-12, "{m:?}");
     }
 }
