@@ -77,7 +77,7 @@ lint: venv
 # `make verify` (requirement T1). clippy runs in the release profile (`--release`) so that it reuses the
 # release build's build-script outputs (HDF5's CMake build) instead of building them again for `dev`.
 # pytest runs on one worker per CPU of the process's affinity (pytest-xdist `-n auto`, the count from
-# python/tests/conftest.py; PYTEST_JOBS=1 for one process), a test file's tests on one worker
+# python/tests/conftest.py; PYTEST_JOBS=0 for one process, no workers), a test file's tests on one worker
 # (`--dist loadfile`: its module-scoped runs are made once); `-ra` (pyproject.toml) still lists the failures.
 PYTEST_JOBS ?= auto
 test: build venv getfem
