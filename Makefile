@@ -76,10 +76,14 @@ lint: venv
 # `make test` leaves the study-sized tests (Rust `#[ignore = "study-sized …"]`, pytest marker `study`) to
 # `make verify` (requirement T1). clippy runs in the release profile (`--release`) so that it reuses the
 # release build's build-script outputs (HDF5's CMake build) instead of building them again for `dev`.
+# pytest runs on one worker per CPU of the process's affinity (pytest-xdist `-n auto`, the count from
+# python/tests/conftest.py; PYTEST_JOBS=0 for one process, no workers), a test file's tests on one worker
+# (`--dist loadfile`: its module-scoped runs are made once); `-ra` (pyproject.toml) still lists the failures.
+PYTEST_JOBS ?= auto
 test: build venv getfem
 	$(MAKE) --no-print-directory lint
 	cargo test --release --locked
-	$(PY) -m pytest python/tests -q -m "not study"
+	$(PY) -m pytest python/tests -q -m "not study" -n $(PYTEST_JOBS) --dist loadfile
 
 # make verify writes under out/verify/ only (a clean clone stays clean); make reference publishes what it
 # staged in out/verify/reference/ into the tracked reference/ and regenerates verification/README.md's table.

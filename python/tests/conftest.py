@@ -12,6 +12,16 @@ PY = sys.executable
 SCRIPTS = os.path.join(ROOT, "scripts")
 
 
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_auto_num_workers(config):
+    """`-n auto` (pytest-xdist, `make test`): one worker per CPU this process may run on (its affinity, as
+    `taskset` or a container's cpuset sets it), not the machine's count that xdist takes from psutil.
+    PYTEST_XDIST_AUTO_NUM_WORKERS, when set, still wins (None hands over to xdist's own hook)."""
+    if os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS"):
+        return None
+    return len(os.sched_getaffinity(0))
+
+
 def run(cmd, **kw):
     """Run a command from the repository root; returns the CompletedProcess (text, captured)."""
     return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, **kw)
