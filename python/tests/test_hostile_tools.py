@@ -178,7 +178,7 @@ class TestCompare:
 @pytest.fixture(scope="class")
 def pv():
     """pvpython scripts/paraview_view.py ARGS -> (exit code, stdout, stderr) on a virtual display of our own,
-    repeated once on a new server if pvpython lost its X server (``tresca_py.xvfb``)."""
+    repeated on a new server (up to `tresca_py.xvfb.ATTEMPTS` runs) if pvpython lost its X server."""
     with VirtualDisplay() as display:
         def run(*args, prefix=()):
             p = display.pvpython([os.path.join(SCRIPTS, "paraview_view.py"), *args], prefix=prefix, timeout=300)

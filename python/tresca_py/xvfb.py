@@ -4,13 +4,22 @@
 Other sessions on this machine start and stop X servers at the same time. ``xvfb-run -a pvpython`` per call
 aborted 3 times in 4 with "bad X server connection" while another Xvfb ran; a server of our own, on a display
 it picks itself and reports (``-displayfd``), lost the connection 3 times in about 40 runs. So every pvpython
-runs on our own server, and a run that lost its server (SIGABRT with that message) is repeated once on a new
-server: the outcome under test is the script's, not the X server's. Nothing else is retried.
+runs on our own server, and a run that lost its server (SIGABRT with that message) is repeated on a new
+server, up to ``ATTEMPTS`` runs in all: the outcome under test is the script's, not the X server's. Nothing else
+is retried. pvpython runs one at a time on the machine (an exclusive ``flock`` on ``LOCK``): ``make test``
+runs pytest on every core (pytest-xdist), and two ParaView tests of different workers at once lost their servers
+twice in a row in one of four runs.
 """
+import fcntl
 import os
 import subprocess
+import tempfile
 
 BAD_X = "bad X server connection"
+#: runs of one pvpython call at most, the first included (each further one on a restarted server)
+ATTEMPTS = 3
+#: the lock file that serialises pvpython calls between processes
+LOCK = os.path.join(tempfile.gettempdir(), "tresca-cr-pvpython.lock")
 
 
 class VirtualDisplay:
@@ -49,13 +58,16 @@ class VirtualDisplay:
 
     def pvpython(self, args, **kwargs):
         """``subprocess.run([*prefix, "pvpython", *args])`` on this display (keyword ``prefix``: e.g. a
-        setpriv command; the other keywords go to subprocess.run, output captured as text); repeated once on
-        a restarted server if pvpython lost its X server (``BAD_X``)."""
+        setpriv command; the other keywords go to subprocess.run, output captured as text); repeated on a
+        restarted server while pvpython lost its X server (``BAD_X``), ``ATTEMPTS`` runs at most; one
+        pvpython at a time (``LOCK``)."""
         prefix = kwargs.pop("prefix", ())
         kwargs.setdefault("timeout", 600)
-        for attempt in range(2):
-            p = subprocess.run([*prefix, "pvpython", *map(str, args)], capture_output=True, text=True,
-                               env=self.env, **kwargs)
-            if BAD_X not in p.stderr or attempt:
-                return p
-            self.restart()
+        with open(LOCK, "a") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            for attempt in range(ATTEMPTS):
+                p = subprocess.run([*prefix, "pvpython", *map(str, args)], capture_output=True, text=True,
+                                   env=self.env, **kwargs)
+                if BAD_X not in p.stderr or attempt == ATTEMPTS - 1:
+                    return p
+                self.restart()

@@ -47,7 +47,7 @@ class Session:
             self.display.stop()
 
     def pvpython(self, args, cwd):
-        """pvpython ARGS on the check's display, repeated once on a new server if it lost its X server."""
+        """pvpython ARGS on the check's display, repeated on a new server while it lost its X server (xvfb)."""
         return self.display.pvpython(args, cwd=cwd, timeout=600)
 
 
