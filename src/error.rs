@@ -74,6 +74,13 @@ pub enum Error {
          threads than cores only share them; the results do not depend on the count)"
     )]
     TooManyThreads { asked: usize, max: usize },
+
+    /// The system refused to start a thread the run needs (`threads::scoped`, `threads::set`).
+    #[error(
+        "cannot start a thread for {what}: {msg}; the process is at a limit of threads or of memory for their \
+         stacks (ulimit -u, a cgroup's pids.max, ulimit -v, RUST_MIN_STACK): raise it"
+    )]
+    Thread { what: &'static str, msg: String },
 }
 
 /// Bytes in a readable unit (decimal: kB, MB, GB, TB).

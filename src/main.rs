@@ -264,7 +264,7 @@ fn load(
 fn main() {
     cli::malloc::tune();
     let cli = Cli::parse();
-    let threads = tresca_cr::threads::requested(cli.threads).map(tresca_cr::threads::set);
+    let threads = tresca_cr::threads::requested(cli.threads).and_then(tresca_cr::threads::set);
     let result = threads.map_err(anyhow::Error::from).and_then(|()| match cli.cmd {
         Cmd::Check { scene, grid, limits, json } => check(&scene, grid, limits, json),
         Cmd::Run { scene, overrides, out, verbose, quiet, limits, json } => {

@@ -12,6 +12,7 @@
 use crate::error::{Error, Result};
 use faer::Par;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::thread::{Scope, ScopedJoinHandle};
 
 /// The environment variable that sets the thread count when `--threads` is not given.
 pub const ENV: &str = "TRESCA_THREADS";
@@ -52,11 +53,34 @@ fn bad(v: &str) -> Error {
 }
 
 /// Use `n` threads from now on: the count of [`count`] and, on its first call, the size of rayon's
-/// global pool (later calls change the count only; the pool keeps its size).
-pub fn set(n: usize) {
+/// global pool (later calls change the count only; the pool keeps its size). A pool whose threads the
+/// system refuses is an error ([`Error::Thread`]): rayon would panic at its first use.
+pub fn set(n: usize) -> Result<()> {
     let n = n.max(1);
     COUNT.store(n, Ordering::Relaxed);
-    let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
+    match rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
+        // only a refused thread has a source (an `io::Error`); a pool built before is kept
+        Err(e) => match std::error::Error::source(&e) {
+            Some(io) => Err(refused("rayon's pool of worker threads", io)),
+            None => Ok(()),
+        },
+        Ok(()) => Ok(()),
+    }
+}
+
+/// Start `f` on a thread of scope `s`, named `what` in the error if the system refuses it (which
+/// `Scope::spawn` would turn into a panic).
+pub fn scoped<'s, 'e, T: Send + 's>(
+    s: &'s Scope<'s, 'e>,
+    what: &'static str,
+    f: impl FnOnce() -> T + Send + 's,
+) -> Result<ScopedJoinHandle<'s, T>> {
+    std::thread::Builder::new().spawn_scoped(s, f).map_err(|e| refused(what, &e))
+}
+
+/// The error of a thread for `what` that the system refused with `e`.
+pub fn refused(what: &'static str, e: &dyn std::fmt::Display) -> Error {
+    Error::Thread { what, msg: e.to_string() }
 }
 
 /// The thread count in force: the last [`set`], else `TRESCA_THREADS` or the available cores.

@@ -21,6 +21,8 @@ use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
+#[path = "hostile/threads.rs"]
+mod threads;
 #[path = "hostile/validation.rs"]
 mod validation;
 

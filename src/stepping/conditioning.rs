@@ -34,21 +34,25 @@ pub(super) struct Pending {
     /// λ_max(K).
     top: f64,
     solves: Mutex<Option<JoinHandle<f64>>>,
+    /// λ_max(K⁻¹) computed on the caller's thread, where the system refused the solves a thread.
+    here: Option<f64>,
     /// `None` once K is accepted, else the message it was refused with.
     verdict: OnceLock<Option<String>>,
 }
 
 impl Pending {
-    /// Start the solves for λ_max(K⁻¹) with the factor of the n × n matrix K (λ_max(K) = `top`).
+    /// Start the solves for λ_max(K⁻¹) with the factor of the n × n matrix K (λ_max(K) = `top`); where
+    /// no thread can be started, they are done here.
     pub(super) fn start(factor: &Arc<Factor>, n: usize, top: f64) -> Pending {
         let f = Arc::clone(factor);
-        let solves = std::thread::spawn(move || condition::largest_inverse_eigenvalue(&f, n, 12));
-        Pending { top, solves: Mutex::new(Some(solves)), verdict: OnceLock::new() }
+        let solves = std::thread::Builder::new().spawn(move || condition::largest_inverse_eigenvalue(&f, n, 12));
+        let here = solves.is_err().then(|| condition::largest_inverse_eigenvalue(factor, n, 12));
+        Pending { top, solves: Mutex::new(solves.ok()), here, verdict: OnceLock::new() }
     }
 
     /// No estimate ([`Guard::Skip`]): K is accepted.
     pub(super) fn skipped() -> Pending {
-        Pending { top: f64::NAN, solves: Mutex::new(None), verdict: OnceLock::from(None) }
+        Pending { top: f64::NAN, solves: Mutex::new(None), here: None, verdict: OnceLock::from(None) }
     }
 
     /// Whether the estimate is in (or its thread ended): [`Pending::verdict`] would not wait.
@@ -61,8 +65,8 @@ impl Pending {
     pub(super) fn verdict(&self, scene: &Scene, mesh: &Mesh, space: &CrSpace) -> Result<()> {
         let v = self.verdict.get_or_init(|| {
             let solves = self.solves.lock().unwrap_or_else(|e| e.into_inner()).take();
-            match solves.map(|h| h.join()) {
-                Some(Ok(inverse)) => check(self.top * inverse, scene, mesh, space).err(),
+            match (solves.map(|h| h.join()), self.here) {
+                (Some(Ok(inverse)), _) | (None, Some(inverse)) => check(self.top * inverse, scene, mesh, space).err(),
                 _ => Some("the condition estimate failed".into()),
             }
         });

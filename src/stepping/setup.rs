@@ -184,22 +184,35 @@ impl Discretised {
     /// and 2 are where the time and the memory peak are (a third thread beside phase 1's two delays it;
     /// what it allocates beside phase 2 adds to the factor's peak: creating the results file took 0.2 s
     /// of CPU and 0.3 GB at 1.57 M unknowns). Its result is returned even when the set-up fails.
-    fn set_up<R: Send>(&self, beside: Option<impl FnOnce(&Discretised) -> R + Send>) -> (Result<Operators>, Option<R>) {
+    fn set_up<R: Send, B: FnOnce(&Discretised) -> R + Send>(
+        &self,
+        beside: Option<B>,
+    ) -> (Result<Operators>, Option<R>) {
         std::thread::scope(|s| {
             let (early, mut late) = match self.space.n_dofs < DEFER_BESIDE_MIN {
                 true => (beside, None),
                 false => (None, beside),
             };
-            let mut r = early.map(|f| s.spawn(|| f(self)));
-            let mut start_late = || {
-                if let Some(f) = late.take() {
-                    r = Some(s.spawn(|| f(self)));
-                }
+            let spawn = |f: Option<B>| {
+                f.map(|f| crate::threads::scoped(s, "the work beside the set-up", || f(self))).transpose()
+            };
+            let mut r = match spawn(early) {
+                Ok(r) => r,
+                Err(e) => return (Err(e), None),
+            };
+            let mut refused = None;
+            let mut start_late = || match spawn(late.take()) {
+                Ok(h) => r = h.or(r.take()),
+                Err(e) => refused = Some(e),
             };
             let rest =
                 self.assemble().and_then(|(k, loads, symbolic)| self.factorise(k, loads, symbolic, &mut start_late));
             // a set-up that failed before phase 3 still runs it (its result is returned)
             start_late();
+            let rest = match refused {
+                Some(e) => Err(e),
+                None => rest,
+            };
             (rest, r.map(|r| r.join().unwrap_or_else(|e| std::panic::resume_unwind(e))))
         })
     }
@@ -216,7 +229,7 @@ impl Discretised {
         let (tx, rx) = std::sync::mpsc::sync_channel::<Arc<SymbolicSparseColMat<usize>>>(1);
         let (val, loads, symbolic, k_pattern) = std::thread::scope(|s| {
             let (pattern, contact) = (&pattern, &contact);
-            let symbolic = s.spawn(move || {
+            let symbolic = crate::threads::scoped(s, "the ordering and symbolic factorisation", move || {
                 let (first, start, adj) = pattern.unknown_graph(space);
                 let graph = Graph::new(first, start, adj)
                     .ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
@@ -240,7 +253,7 @@ impl Discretised {
                 drop(symbolic);
                 Symbolic::from_symmetric(full.as_ref().as_ref(), contact, fill_order_at(&graph, None, true)?)
                     .map(|s| s.ordered_by("METIS nested dissection (the factor by coordinates did not fit in memory)"))
-            });
+            })?;
             // K is kept as its lower triangle, the one the factorisation reads (half the memory); its
             // values are assembled on the full pattern, which the symbolic factorisation reads meanwhile
             // (both triangles: no permuted copy of its lower triangle is needed there), and compacted

@@ -134,15 +134,19 @@ impl Factor {
         };
         // the factor's pages are mapped on a second thread while this one computes (solve::cholesky::pages)
         let range = values.range();
-        let (numeric, r) = std::thread::scope(|s| {
-            let r = s.spawn(move || {
+        let started = std::thread::scope(|s| {
+            let r = crate::threads::scoped(s, "mapping the factor's pages", move || {
                 Pages::populate(range);
                 beside()
-            });
+            })?;
             let stack = MemStack::new(&mut buf);
             let numeric = numeric_llt(&symbolic, &mut values, (k, pattern_nnz), (&fwd, &inv), par, stack);
-            (numeric, r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            Ok((numeric, r.join().unwrap_or_else(|e| std::panic::resume_unwind(e))))
         });
+        let (numeric, r) = match started {
+            Ok(done) => done,
+            Err(e) => return (Err(e), None),
+        };
         let threads = super::subtrees::threads_of(par, n).unwrap_or(1);
         let factor = Factor::finish(symbolic, values, numeric, n, last, fwd).map(|f| Factor { ordering, threads, ..f });
         (factor, Some(r))

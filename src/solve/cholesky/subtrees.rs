@@ -145,9 +145,18 @@ pub(super) fn factorize(
     let ctx = Ctx { symbolic, a, values: Values(values.as_mut_ptr(), values.len()), tree };
     let queue = Queue::new(&tasks);
     std::thread::scope(|sc| {
-        for g2l in maps.chunks_exact_mut(n).take(threads) {
-            let (ctx, tasks, queue) = (&ctx, &tasks, &queue);
-            sc.spawn(move || worker(ctx, tasks, queue, (threads, g2l)));
+        let (ctx, tasks, queue) = (&ctx, &tasks, &queue);
+        let mut maps = maps.chunks_exact_mut(n).take(threads);
+        while let Some(g2l) = maps.next() {
+            let start = std::thread::Builder::new().spawn_scoped(sc, move || worker(ctx, tasks, queue, (threads, g2l)));
+            // a thread the system refuses: this one works with the next map (any number of workers ends the
+            // queue; with none left, an earlier thread was started: `threads` ≥ 2)
+            if start.is_err() {
+                if let Some(g2l) = maps.next() {
+                    worker(ctx, tasks, queue, (threads, g2l));
+                }
+                break;
+            }
         }
     });
     queue.result()
