@@ -61,6 +61,7 @@ mod rows;
 mod take;
 pub mod tresca;
 pub mod vtkhdf;
+mod vtkhdf_lists;
 pub mod xdmf;
 
 use crate::error::{Error, Result};

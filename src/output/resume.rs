@@ -10,6 +10,7 @@ use super::paths;
 use super::reserve;
 use super::tresca::Tresca;
 use super::vtkhdf::{Frames, VtkHdf};
+use super::vtkhdf_lists;
 use super::xdmf::Xdmf;
 use super::{ioerr, partial_path, Opened, Options, Run, Writer};
 use crate::error::{Error, Result};
@@ -72,16 +73,18 @@ impl Writer {
         let every = int(&tresca.group, "frame_every").max(1) as usize;
         let frames = Frames { every, last: run.n_steps() };
         let frames_done = frames.before(completed);
+        let frame_list: Vec<(usize, f64)> =
+            (0..completed).filter(|&n| frames.is_frame(n)).map(|n| (n, times[n])).collect();
         let misfit = tresca.misfit(run.space, completed);
         let short = (vtk.room() < frames_done).then(|| format!("the VTKHDF frame arrays hold {} frames", vtk.room()));
-        if let Some(what) = misfit.or(short) {
+        let kept: Vec<f64> = frame_list.iter().map(|&(_, t)| t).collect();
+        let lists = || vtkhdf_lists::misfit(&file, &fields, contact, frames.total(), &kept);
+        if let Some(what) = misfit.or(short).or_else(lists) {
             return Err(Error::Io {
                 path: path.to_path_buf(),
                 msg: format!("--resume: {what}: the file was damaged after it was written; rerun with --force"),
             });
         }
-        let frame_list: Vec<(usize, f64)> =
-            (0..completed).filter(|&n| frames.is_frame(n)).map(|n| (n, times[n])).collect();
         // a stopped run's series are given back their full length below: their room first (`reserve`)
         let rows = tresca.group.dataset("times").map_err(io(path, "tresca/times"))?.shape()[0];
         let len = raw.0.metadata().map_err(ioerr(path, "cannot inspect the file"))?.len();

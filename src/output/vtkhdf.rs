@@ -22,6 +22,7 @@
 use super::fields::{Fields, StepFields, TENSOR};
 use super::h5::{attr, attr_fixed_ascii, attr_vec, put, Raw, Series};
 use super::rows::{append, bytes};
+use super::vtkhdf_lists::{cell_offsets, connectivity, frame_offsets};
 use hdf5::plist::group_create::LinkCreationOrder;
 use hdf5::{Attribute, Dataset, Extent, Extents, File, Group};
 
@@ -50,18 +51,18 @@ pub fn contact_cells(normal: bool) -> &'static [(&'static str, usize)] {
 
 /// What a block is: its name and index in the collection, its cells (points per cell and VTK cell
 /// type) and its cell arrays.
-struct BlockKind {
-    name: &'static str,
+pub(super) struct BlockKind {
+    pub(super) name: &'static str,
     index: i64,
-    per_cell: usize,
-    vtk_type: u8,
-    arrays: &'static [(&'static str, usize)],
+    pub(super) per_cell: usize,
+    pub(super) vtk_type: u8,
+    pub(super) arrays: &'static [(&'static str, usize)],
 }
 
 /// The body: triangles (VTK type 5).
-const BODY: BlockKind = BlockKind { name: "body", index: 0, per_cell: 3, vtk_type: 5, arrays: &BODY_CELLS };
+pub(super) const BODY: BlockKind = BlockKind { name: "body", index: 0, per_cell: 3, vtk_type: 5, arrays: &BODY_CELLS };
 /// The contact line: Γ_C edges as lines (VTK type 3), with the cell arrays of `contact_cells(normal)`.
-fn contact_kind(normal: bool) -> BlockKind {
+pub(super) fn contact_kind(normal: bool) -> BlockKind {
     BlockKind { name: "contact", index: 1, per_cell: 2, vtk_type: 3, arrays: contact_cells(normal) }
 }
 
@@ -175,8 +176,8 @@ impl Block {
         put(&g, "NumberOfCells", &[1], &[ncell as i64])?;
         put(&g, "NumberOfConnectivityIds", &[1], &[np as i64])?;
         put(&g, "Points", &[np, 3], points.as_flattened())?;
-        put(&g, "Connectivity", &[np], &(0..np as i64).collect::<Vec<_>>())?;
-        put(&g, "Offsets", &[ncell + 1], &(0..=ncell).map(|k| (per_cell * k) as i64).collect::<Vec<_>>())?;
+        put(&g, "Connectivity", &[np], &connectivity(np))?;
+        put(&g, "Offsets", &[ncell + 1], &cell_offsets(ncell, per_cell))?;
         put(&g, "Types", &[ncell], &vec![vtk_type; ncell])?;
         let pd = g.create_group("PointData")?;
         let cd = g.create_group("CellData")?;
@@ -187,12 +188,11 @@ impl Block {
             put(&steps, name, &[m], &zeros)?;
         }
         put(&steps, "NumberOfParts", &[m], &vec![1i64; m])?;
-        let off = |b: usize| (0..m).map(|n| (n * b) as i64).collect::<Vec<_>>();
-        put(&steps.create_group("PointDataOffsets")?, "displacement", &[m], &off(np))?;
+        put(&steps.create_group("PointDataOffsets")?, "displacement", &[m], &frame_offsets(m, np))?;
         let cdo = steps.create_group("CellDataOffsets")?;
         let mut cells = Vec::new();
         for &(name, nc) in arrays {
-            put(&cdo, name, &[m], &off(ncell))?;
+            put(&cdo, name, &[m], &frame_offsets(m, ncell))?;
             let rest: &[usize] = if nc == 1 { &[] } else { &[nc] };
             cells.push(if is_byte(name) {
                 Series::create::<u8>(&cd, name, ncell, rest, m)?
@@ -212,8 +212,9 @@ impl Block {
         })
     }
 
-    /// Open the block of an existing file; a list stored as a scalar, or a frame array whose rows are not
-    /// as wide as its components, is an error naming it (a damaged file), not a panic or misplaced rows.
+    /// Open the block of an existing file; a list stored as a scalar, a frame array whose rows are not as
+    /// wide as its components, or frame times that cannot grow, is an error naming it (a damaged file), not
+    /// a panic, misplaced rows or a file changed before the error.
     fn open(g: &Group, arrays: &[(&str, usize)]) -> hdf5::Result<Block> {
         let rows = |name: &str| {
             let scalar = || hdf5::Error::from(format!("{}/{name}: a scalar, not a list (damaged)", g.name()));
@@ -231,7 +232,14 @@ impl Block {
             }
         }
         let steps = g.group("Steps")?;
-        Ok(Block { nsteps: steps.attr("NSteps")?, values: steps.dataset("Values")?, displacement, cells })
+        let values = steps.dataset("Values")?;
+        if !values.is_resizable() {
+            return Err(hdf5::Error::from(format!(
+                "{}: a list of fixed length, not resizable (damaged)",
+                values.name()
+            )));
+        }
+        Ok(Block { nsteps: steps.attr("NSteps")?, values, displacement, cells })
     }
 
     fn write_times(&self, b: &FrameRows) -> hdf5::Result<()> {

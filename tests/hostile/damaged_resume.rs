@@ -54,3 +54,81 @@ fn series_of_the_wrong_shape_are_refused_on_resume() {
         assert!(std::fs::read(&out).unwrap() == before, "{name} {shape:?}: the file was changed");
     }
 }
+
+/// Add 1 (0.5 if f64) to entry `k` of the list `name` (i64, or f64 / u8 by its type) in the file `out`; with
+/// `k` = [`CUT`], cut it to half its length; with `k` = [`FIXED`], store it again with a fixed length.
+const CUT: usize = usize::MAX;
+const FIXED: usize = usize::MAX - 1;
+
+fn damage_list(out: &std::path::Path, name: &str, k: usize) {
+    let _g = fork_guard();
+    let f = hdf5::File::open_rw(out).unwrap();
+    let ds = f.dataset(name).unwrap();
+    let (dir, base) = name.rsplit_once('/').unwrap();
+    let dtype = ds.dtype().unwrap();
+    macro_rules! bump {
+        ($t:ty, $one:expr) => {{
+            let mut v: Vec<$t> = ds.read_raw().unwrap();
+            if k == CUT && ds.is_resizable() {
+                ds.resize(v.len() / 2).unwrap();
+            } else if k == CUT || k == FIXED {
+                v.truncate(if k == CUT { v.len() / 2 } else { v.len() });
+                drop(ds);
+                f.group(dir).unwrap().unlink(base).unwrap();
+                f.group(dir).unwrap().new_dataset::<$t>().shape([v.len()]).create(base).unwrap().write_raw(&v).unwrap();
+            } else {
+                v[k] += $one;
+                ds.write_raw(&v).unwrap();
+            }
+        }};
+    }
+    if dtype.is::<f64>() {
+        bump!(f64, 0.5)
+    } else if dtype.is::<u8>() {
+        bump!(u8, 1)
+    } else {
+        bump!(i64, 1)
+    }
+}
+
+/// The system shall refuse a `--resume` whose ParaView view holds a list that `--resume` keeps as it is
+/// (the blocks' geometry, their per-frame offsets, the kept frames' times) but that is not this run's,
+/// in length or in an entry, naming the list and calling it damage, with the file left as it was.
+#[test]
+fn view_lists_that_resume_keeps_are_checked() {
+    let scene = scene_with("lists.toml", "steps = 40", "steps = 8");
+    let out = tmp("damaged_lists.h5");
+    for (name, k, want) in [
+        ("VTKHDF/body/NumberOfCells", 0, "/VTKHDF/body/NumberOfCells holds 9 at entry 0, this run's 8"),
+        ("VTKHDF/body/NumberOfPoints", 0, "/VTKHDF/body/NumberOfPoints holds 25 at entry 0, this run's 24"),
+        ("VTKHDF/contact/NumberOfConnectivityIds", 0, "/VTKHDF/contact/NumberOfConnectivityIds holds 5"),
+        ("VTKHDF/body/Connectivity", 5, "/VTKHDF/body/Connectivity holds 6 at entry 5, this run's 5"),
+        ("VTKHDF/contact/Offsets", CUT, "/VTKHDF/contact/Offsets holds 1 entries, this run's has 3"),
+        ("VTKHDF/body/Types", 7, "/VTKHDF/body/Types holds 6 at entry 7, this run's 5"),
+        ("VTKHDF/contact/Points", 4, "/VTKHDF/contact/Points holds"),
+        ("VTKHDF/body/Steps/NumberOfParts", 3, "/VTKHDF/body/Steps/NumberOfParts holds 2 at entry 3, this run's 1"),
+        ("VTKHDF/contact/Steps/PartOffsets", 0, "/VTKHDF/contact/Steps/PartOffsets holds 1 at entry 0, this run's 0"),
+        ("VTKHDF/body/Steps/CellOffsets", CUT, "/VTKHDF/body/Steps/CellOffsets holds 4 entries, this run's has 9"),
+        ("VTKHDF/body/Steps/PointDataOffsets/displacement", 2, "PointDataOffsets/displacement holds 49 at entry 2"),
+        ("VTKHDF/contact/Steps/CellDataOffsets/slip", 1, "/VTKHDF/contact/Steps/CellDataOffsets/slip holds 3 at"),
+        ("VTKHDF/body/Steps/Values", 1, "/VTKHDF/body/Steps/Values holds 0.625 at entry 1, this run's 0.125"),
+        ("VTKHDF/contact/Steps/Values", CUT, "/VTKHDF/contact/Steps/Values holds 4 entries, this run's has 5"),
+        ("VTKHDF/body/Steps/Values", FIXED, "/VTKHDF/body/Steps/Values: a list of fixed length"),
+    ] {
+        let _ = std::fs::remove_file(&out);
+        let o = spawn(bin().args(["run", &scene, "-q", "-o", s(&out), "--force"])).wait_with_output().unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        {
+            let _g = fork_guard();
+            let f = hdf5::File::open_rw(&out).unwrap();
+            f.group("tresca/steps").unwrap().attr("completed").unwrap().write_scalar(&5i64).unwrap();
+        }
+        damage_list(&out, name, k);
+        let before = std::fs::read(&out).unwrap();
+        let o = spawn(bin().args(["run", &scene, "-q", "-o", s(&out), "--resume"])).wait_with_output().unwrap();
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{name} {k}: {e}");
+        assert!(e.contains(want) && e.contains("damaged") && !e.contains("panicked"), "{name} {k}: {e}");
+        assert!(std::fs::read(&out).unwrap() == before, "{name} {k}: the file was changed");
+    }
+}
