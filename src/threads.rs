@@ -59,7 +59,7 @@ pub fn set(n: usize) -> Result<()> {
     let n = n.max(1);
     COUNT.store(n, Ordering::Relaxed);
     match rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
-        // only a refused thread has a source (an `io::Error`); a pool built before is kept
+        // only a refused thread has a source (the I/O error); a pool built before is kept
         Err(e) => match std::error::Error::source(&e) {
             Some(io) => Err(refused("rayon's pool of worker threads", io)),
             None => Ok(()),

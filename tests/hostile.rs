@@ -30,6 +30,18 @@ fn tmp(name: &str) -> PathBuf {
     common::tmp_in("tresca-hostile", name)
 }
 
+/// `cmd` with its address space limited to `bytes` (`setrlimit(RLIMIT_AS)` in the child).
+fn address_space(cmd: &mut Command, bytes: u64) -> &mut Command {
+    // SAFETY: setrlimit in the child between fork and exec.
+    unsafe {
+        cmd.pre_exec(move || {
+            let lim = libc::rlimit { rlim_cur: bytes, rlim_max: bytes };
+            libc::setrlimit(libc::RLIMIT_AS, &lim);
+            Ok(())
+        })
+    }
+}
+
 fn run(args: &[&str]) -> Output {
     spawn(bin().args(args)).wait_with_output().unwrap()
 }

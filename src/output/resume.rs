@@ -10,7 +10,6 @@ use super::paths;
 use super::reserve;
 use super::tresca::Tresca;
 use super::vtkhdf::{Frames, VtkHdf};
-use super::vtkhdf_lists;
 use super::xdmf::Xdmf;
 use super::{ioerr, partial_path, Opened, Options, Run, Writer};
 use crate::error::{Error, Result};
@@ -78,7 +77,7 @@ impl Writer {
         let misfit = tresca.misfit(run.space, completed);
         let short = (vtk.room() < frames_done).then(|| format!("the VTKHDF frame arrays hold {} frames", vtk.room()));
         let kept: Vec<f64> = frame_list.iter().map(|&(_, t)| t).collect();
-        let lists = || vtkhdf_lists::misfit(&file, &fields, contact, frames.total(), &kept);
+        let lists = || VtkHdf::misfit(&file, &fields, contact, frames.total(), &kept);
         if let Some(what) = misfit.or(short).or_else(lists) {
             return Err(Error::Io {
                 path: path.to_path_buf(),

@@ -22,7 +22,7 @@
 use super::fields::{Fields, StepFields, TENSOR};
 use super::h5::{attr, attr_fixed_ascii, attr_vec, put, Raw, Series};
 use super::rows::{append, bytes};
-use super::vtkhdf_lists::{cell_offsets, connectivity, frame_offsets};
+use super::vtkhdf_lists::{block_misfit, cell_offsets, connectivity, frame_offsets};
 use hdf5::plist::group_create::LinkCreationOrder;
 use hdf5::{Attribute, Dataset, Extent, Extents, File, Group};
 
@@ -51,18 +51,18 @@ pub fn contact_cells(normal: bool) -> &'static [(&'static str, usize)] {
 
 /// What a block is: its name and index in the collection, its cells (points per cell and VTK cell
 /// type) and its cell arrays.
-pub(super) struct BlockKind {
-    pub(super) name: &'static str,
+struct BlockKind {
+    name: &'static str,
     index: i64,
-    pub(super) per_cell: usize,
-    pub(super) vtk_type: u8,
-    pub(super) arrays: &'static [(&'static str, usize)],
+    per_cell: usize,
+    vtk_type: u8,
+    arrays: &'static [(&'static str, usize)],
 }
 
 /// The body: triangles (VTK type 5).
-pub(super) const BODY: BlockKind = BlockKind { name: "body", index: 0, per_cell: 3, vtk_type: 5, arrays: &BODY_CELLS };
+const BODY: BlockKind = BlockKind { name: "body", index: 0, per_cell: 3, vtk_type: 5, arrays: &BODY_CELLS };
 /// The contact line: Γ_C edges as lines (VTK type 3), with the cell arrays of `contact_cells(normal)`.
-pub(super) fn contact_kind(normal: bool) -> BlockKind {
+fn contact_kind(normal: bool) -> BlockKind {
     BlockKind { name: "contact", index: 1, per_cell: 2, vtk_type: 3, arrays: contact_cells(normal) }
 }
 
@@ -286,6 +286,25 @@ impl VtkHdf {
         let body = Block::open(&root.group("body")?, &BODY_CELLS)?;
         let contact = if contact { Some(Block::open(&root.group("contact")?, contact_cells(normal))?) } else { None };
         Ok(VtkHdf { body, contact })
+    }
+
+    /// The first list of the view in `file` that `--resume` keeps as it is but that is not the one of a run
+    /// with these `fields`, Γ_C and normal unknowns (`contact`), `frames` frames in all and the frame
+    /// times `kept` committed (`super::vtkhdf_lists`); `None` if all are.
+    pub fn misfit(
+        file: &File,
+        f: &Fields,
+        (contact, normal): (bool, bool),
+        frames: usize,
+        kept: &[f64],
+    ) -> Option<String> {
+        let contact = contact.then(|| (contact_kind(normal), &f.contact_points));
+        std::iter::once((BODY, &f.points)).chain(contact).find_map(|(kind, points)| {
+            match file.group(&format!("VTKHDF/{}", kind.name)) {
+                Ok(g) => block_misfit(&g, (kind.per_cell, kind.vtk_type, kind.arrays), points, frames, kept),
+                Err(_) => Some(format!("VTKHDF/{} is missing", kind.name)),
+            }
+        })
     }
 
     /// The frames every frame array has room for (the least).

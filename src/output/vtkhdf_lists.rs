@@ -3,11 +3,10 @@
 //! `Connectivity`, `Offsets`, `Types`), its offsets for every frame of the run (`Steps/*Offsets`,
 //! `Steps/NumberOfParts`) and the times of the frames it keeps (`Steps/Values`). A list that is not the
 //! run's, in length or in an entry, would have ParaView draw the frames on the wrong points or rows: it is
-//! damage, named before the file is changed (as `Tresca::misfit` names a series of the wrong shape).
+//! damage, named before the file is changed (as `Tresca::misfit` names a series of the wrong shape;
+//! `VtkHdf::misfit` asks it of each block).
 
-use super::fields::Fields;
-use super::vtkhdf::{contact_kind, BlockKind, BODY};
-use hdf5::{File, Group, H5Type};
+use hdf5::{Group, H5Type};
 use std::fmt::Debug;
 
 /// `n·b` for the frames n of 0..m: where frame n's rows start in a per-frame array of b rows a frame.
@@ -25,46 +24,36 @@ pub(super) fn connectivity(np: usize) -> Vec<i64> {
     (0..np as i64).collect()
 }
 
-/// The first list of the view in `file` that is not the one of a run with these `fields`, Γ_C and normal
-/// unknowns (`contact`), `frames` frames in all and the frame times `kept` committed; `None` if all are.
-pub(super) fn misfit(
-    file: &File,
-    fields: &Fields,
-    (contact, normal): (bool, bool),
-    frames: usize,
+/// The first list of block `g` (of `points`, `per_cell` points to a cell of VTK type `vtk_type`, the cell
+/// arrays `arrays`) that is not the one of a run of `m` frames in all and the frame times `kept`
+/// committed; `None` if all are.
+pub(super) fn block_misfit(
+    g: &Group,
+    (per_cell, vtk_type, arrays): (usize, u8, &[(&str, usize)]),
+    points: &[[f64; 3]],
+    m: usize,
     kept: &[f64],
 ) -> Option<String> {
-    let contact = contact.then(|| (contact_kind(normal), &fields.contact_points));
-    std::iter::once((BODY, &fields.points)).chain(contact).find_map(|(kind, points)| {
-        match file.group(&format!("VTKHDF/{}", kind.name)) {
-            Ok(g) => block_misfit(&g, &kind, points, frames, kept),
-            Err(_) => Some(format!("VTKHDF/{} is missing", kind.name)),
-        }
-    })
-}
-
-/// [`misfit`] for one block of `points`.
-fn block_misfit(g: &Group, kind: &BlockKind, points: &[[f64; 3]], m: usize, kept: &[f64]) -> Option<String> {
     let np = points.len();
-    let nc = np / kind.per_cell;
+    let nc = np / per_cell;
     let mut ints = vec![
         ("NumberOfPoints".to_string(), vec![np as i64]),
         ("NumberOfCells".into(), vec![nc as i64]),
         ("NumberOfConnectivityIds".into(), vec![np as i64]),
         ("Connectivity".into(), connectivity(np)),
-        ("Offsets".into(), cell_offsets(nc, kind.per_cell)),
+        ("Offsets".into(), cell_offsets(nc, per_cell)),
         ("Steps/NumberOfParts".into(), vec![1; m]),
         ("Steps/PointDataOffsets/displacement".into(), frame_offsets(m, np)),
     ];
     for list in ["PartOffsets", "PointOffsets", "CellOffsets", "ConnectivityIdOffsets"] {
         ints.push((format!("Steps/{list}"), vec![0; m]));
     }
-    for (array, _) in kind.arrays {
+    for (array, _) in arrays {
         ints.push((format!("Steps/CellDataOffsets/{array}"), frame_offsets(m, nc)));
     }
     ints.iter()
         .find_map(|(name, want)| differs(g, name, want, false))
-        .or_else(|| differs(g, "Types", &vec![kind.vtk_type; nc], false))
+        .or_else(|| differs(g, "Types", &vec![vtk_type; nc], false))
         .or_else(|| differs(g, "Points", points.as_flattened(), false))
         // longer once a stopped run's frames are given back their room; `--resume` cuts it to `kept`
         .or_else(|| differs(g, "Steps/Values", kept, true))

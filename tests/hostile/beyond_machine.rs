@@ -5,7 +5,6 @@
 
 use super::{base, s, tmp};
 use crate::common::{bin, spawn, stderr};
-use std::os::unix::process::CommandExt;
 use std::process::Output;
 
 /// `cmd` with its address space limited to 4 GB (a regression allocating beyond the machine fails
@@ -16,15 +15,7 @@ fn limited(args: &[&str], env: Option<(&str, &str)>) -> Output {
     if let Some((k, v)) = env {
         c.env(k, v);
     }
-    // SAFETY: setrlimit in the child between fork and exec.
-    unsafe {
-        c.pre_exec(|| {
-            let lim = libc::rlimit { rlim_cur: 4 << 30, rlim_max: 4 << 30 };
-            libc::setrlimit(libc::RLIMIT_AS, &lim);
-            Ok(())
-        });
-    }
-    spawn(&mut c).wait_with_output().unwrap()
+    spawn(super::address_space(&mut c, 4 << 30)).wait_with_output().unwrap()
 }
 
 /// The system shall refuse a thread count beyond what a run starts (`threads::MAX`, or the cores if

@@ -5,6 +5,7 @@
 use super::{s, scene_with, tmp};
 use crate::common::{bin, fork_guard, spawn, stderr};
 use hdf5::Group;
+use std::path::Path;
 
 /// Replace the dataset `name` of `g` by one of `shape` (zeros of its type f64, or u8 for `status`).
 fn replace(g: &Group, name: &str, shape: &[usize]) {
@@ -36,33 +37,37 @@ fn series_of_the_wrong_shape_are_refused_on_resume() {
         ("tresca/contact", "gap", vec![7, 2], "/tresca/contact/gap holds 7 steps, 20 were committed"),
         ("VTKHDF/body/CellData", "strain", vec![328, 5], "/VTKHDF/body/CellData/strain: rows of shape [5], not [6]"),
     ] {
-        let _ = std::fs::remove_file(&out);
-        let o = spawn(bin().args(["run", &scene, "-q", "-o", s(&out), "--force"])).wait_with_output().unwrap();
-        assert!(o.status.success(), "{}", stderr(&o));
-        {
-            let _g = fork_guard();
-            let f = hdf5::File::open_rw(&out).unwrap();
-            f.group("tresca/steps").unwrap().attr("completed").unwrap().write_scalar(&20i64).unwrap();
-            replace(&f.group(group).unwrap(), name, &shape);
-        }
-        let before = std::fs::read(&out).unwrap();
-        let o = spawn(bin().args(["run", &scene, "-q", "-o", s(&out), "--resume"])).wait_with_output().unwrap();
-        let e = stderr(&o);
-        assert_eq!(o.status.code(), Some(1), "{name} {shape:?}: {e}");
-        assert!(e.contains(want) && !e.contains("panicked"), "{name} {shape:?}: {e}");
-        assert!(e.contains("damaged"), "{name} {shape:?}: {e}");
-        assert!(std::fs::read(&out).unwrap() == before, "{name} {shape:?}: the file was changed");
+        let damage = |f: &hdf5::File| replace(&f.group(group).unwrap(), name, &shape);
+        refused_after(&scene, &out, 20, damage, want, &format!("{name} {shape:?}"));
     }
 }
 
-/// Add 1 (0.5 if f64) to entry `k` of the list `name` (i64, or f64 / u8 by its type) in the file `out`; with
+/// Run `scene` to `out`, set its counter of committed steps to `completed`, `damage` it, and require that
+/// `--resume` exits 1 with `want` in a message calling it damage, no panic and the file left as it was.
+fn refused_after(scene: &str, out: &Path, completed: i64, damage: impl FnOnce(&hdf5::File), want: &str, case: &str) {
+    let _ = std::fs::remove_file(out);
+    let o = spawn(bin().args(["run", scene, "-q", "-o", s(out), "--force"])).wait_with_output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    {
+        let _g = fork_guard();
+        let f = hdf5::File::open_rw(out).unwrap();
+        f.group("tresca/steps").unwrap().attr("completed").unwrap().write_scalar(&completed).unwrap();
+        damage(&f);
+    }
+    let before = std::fs::read(out).unwrap();
+    let o = spawn(bin().args(["run", scene, "-q", "-o", s(out), "--resume"])).wait_with_output().unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{case}: {e}");
+    assert!(e.contains(want) && e.contains("damaged") && !e.contains("panicked"), "{case}: {e}");
+    assert!(std::fs::read(out).unwrap() == before, "{case}: the file was changed");
+}
+
+/// Add 1 (0.5 if f64) to entry `k` of the list `name` (i64, or f64 / u8 by its type) of `f`; with
 /// `k` = [`CUT`], cut it to half its length; with `k` = [`FIXED`], store it again with a fixed length.
 const CUT: usize = usize::MAX;
 const FIXED: usize = usize::MAX - 1;
 
-fn damage_list(out: &std::path::Path, name: &str, k: usize) {
-    let _g = fork_guard();
-    let f = hdf5::File::open_rw(out).unwrap();
+fn damage_list(f: &hdf5::File, name: &str, k: usize) {
     let ds = f.dataset(name).unwrap();
     let (dir, base) = name.rsplit_once('/').unwrap();
     let dtype = ds.dtype().unwrap();
@@ -115,20 +120,6 @@ fn view_lists_that_resume_keeps_are_checked() {
         ("VTKHDF/contact/Steps/Values", CUT, "/VTKHDF/contact/Steps/Values holds 4 entries, this run's has 5"),
         ("VTKHDF/body/Steps/Values", FIXED, "/VTKHDF/body/Steps/Values: a list of fixed length"),
     ] {
-        let _ = std::fs::remove_file(&out);
-        let o = spawn(bin().args(["run", &scene, "-q", "-o", s(&out), "--force"])).wait_with_output().unwrap();
-        assert!(o.status.success(), "{}", stderr(&o));
-        {
-            let _g = fork_guard();
-            let f = hdf5::File::open_rw(&out).unwrap();
-            f.group("tresca/steps").unwrap().attr("completed").unwrap().write_scalar(&5i64).unwrap();
-        }
-        damage_list(&out, name, k);
-        let before = std::fs::read(&out).unwrap();
-        let o = spawn(bin().args(["run", &scene, "-q", "-o", s(&out), "--resume"])).wait_with_output().unwrap();
-        let e = stderr(&o);
-        assert_eq!(o.status.code(), Some(1), "{name} {k}: {e}");
-        assert!(e.contains(want) && e.contains("damaged") && !e.contains("panicked"), "{name} {k}: {e}");
-        assert!(std::fs::read(&out).unwrap() == before, "{name} {k}: the file was changed");
+        refused_after(&scene, &out, 5, |f| damage_list(f, name, k), want, &format!("{name} {k}"));
     }
 }

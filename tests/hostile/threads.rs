@@ -3,10 +3,9 @@
 //! held by `ulimit -u`). Each refused thread is a typed error naming it, or its work is done on the
 //! thread that asked, never a panic or a half-written results file.
 
-use super::{base, no_leftovers, s, tmp};
+use super::{address_space, base, no_leftovers, s, tmp};
 use crate::common::{bin, spawn, stderr};
 use std::collections::BTreeSet;
-use std::os::unix::process::CommandExt;
 use std::process::Output;
 
 /// Each thread's stack (`RUST_MIN_STACK`, read by std and so by rayon's pool): far above what the run
@@ -18,15 +17,7 @@ const STACK: u64 = 4 << 30;
 fn run_limited(args: &[&str], limit: u64) -> Output {
     let mut c = bin();
     c.args(args).env("RUST_MIN_STACK", STACK.to_string());
-    // SAFETY: setrlimit in the child between fork and exec.
-    unsafe {
-        c.pre_exec(move || {
-            let lim = libc::rlimit { rlim_cur: limit, rlim_max: limit };
-            libc::setrlimit(libc::RLIMIT_AS, &lim);
-            Ok(())
-        });
-    }
-    spawn(&mut c).wait_with_output().unwrap()
+    spawn(address_space(&mut c, limit)).wait_with_output().unwrap()
 }
 
 /// The system shall end a run whose threads the system refuses with exit code 1 and a message naming the
