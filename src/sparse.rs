@@ -97,16 +97,19 @@ pub fn symmetric_matvec(k: &SparseColMat<usize, f64>, x: &[f64], y: &mut [f64]) 
     let (cp, ri, val) = (s.col_ptr(), s.row_idx(), k.val());
     for j in 0..s.ncols() {
         let xj = x[j];
+        // row j's sum, continued in a register: the column's other rows are i ≠ j
+        let mut yj = y[j];
         for p in cp[j]..cp[j + 1] {
             let i = ri[p];
             if i == j {
-                y[j] += val[p] * xj;
+                yj += val[p] * xj;
             } else {
                 // K_ji = K_ij: the term x_i of row j (after its terms from columns < j), and x_j of row i
-                y[j] += val[p] * x[i];
+                yj += val[p] * x[i];
                 y[i] += val[p] * xj;
             }
         }
+        y[j] = yj;
     }
 }
 
