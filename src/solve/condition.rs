@@ -1,6 +1,6 @@
 //! The condition number of K, estimated from its factor: a cheap guard against nearly singular
 //! stiffness matrices (floating pieces, slivers, weak jump terms), checked once per run by `stepping`
-//! (the solves on a second thread, while the load superposition and the condensation are formed).
+//! (on a thread of its own, while the load superposition and the condensation are formed).
 
 use super::cholesky::Factor;
 use faer::sparse::SparseColMat;
@@ -15,8 +15,8 @@ const COND_TOL: f64 = 1e-2;
 /// K: λ_max as the largest Ritz value of the Lanczos process for K (matrix products,
 /// [`largest_eigenvalue`]) and 1/λ_min = λ_max(K⁻¹) as the largest Ritz value of the Lanczos process
 /// for K⁻¹ (solves with the factor, [`largest_inverse_eigenvalue`]), each from a fixed start vector so
-/// the estimate is deterministic. The two are independent, so `stepping` runs the solves on a second
-/// thread and the products on the main one once its own set-up work is done. Ritz values lie in the
+/// the estimate is deterministic. `stepping` runs both, one after the other, on a thread of its own
+/// once the factor is made. Ritz values lie in the
 /// spectrum and converge from below, faster than power iteration (at 24,640 unknowns 4 solves instead
 /// of 7 of inverse iteration, and about 5 products instead of 12 of power iteration). Each process
 /// stops once its Ritz value changes by less than [`COND_TOL`] relative (at least 3, at most `iters`

@@ -1,8 +1,9 @@
 //! The guard against a nearly singular stiffness matrix: a K whose condition-number estimate
 //! (`solve::condition`) exceeds [`MAX_CONDITION`] is refused with the likeliest cause named.
 //!
-//! The estimate's solves (λ_max(K⁻¹), a few passes over the factor) run on a thread of their own
-//! ([`Pending`]) while the set-up ends and the first steps are computed; no step result is handed out
+//! The estimate (λ_max(K) by products with K, then λ_max(K⁻¹) by a few passes over the factor) runs on a
+//! thread of its own ([`Pending`]) from the end of the factorisation, while the set-up ends and the first
+//! steps are computed (beside the factorisation it would take a core from the factorisation's threads); no step result is handed out
 //! before the verdict (`Problem::conditioned`): the steps computed before it are held back (up to a
 //! budget, `stepping::run`), and a run that fails before it reports a refused K rather than what
 //! followed from it.
@@ -16,6 +17,7 @@ use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::solve::cholesky::Factor;
 use crate::solve::condition;
+use faer::sparse::SparseColMat;
 use std::sync::{Arc, Mutex, OnceLock};
 use std::thread::JoinHandle;
 
@@ -29,30 +31,31 @@ pub enum Guard {
     Skip,
 }
 
-/// The condition estimate λ_max(K) · λ_max(K⁻¹) of a run, its solves under way on their own thread.
+/// Lanczos steps of each half of the estimate at most (`solve::condition`), one vector of n values each.
+pub(super) const LAMBDA_ITERS: usize = 12;
+
+/// The condition estimate λ_max(K) · λ_max(K⁻¹) of a run, under way on its own thread.
 pub(super) struct Pending {
-    /// λ_max(K).
-    top: f64,
     solves: Mutex<Option<JoinHandle<f64>>>,
-    /// λ_max(K⁻¹) computed on the caller's thread, where the system refused the solves a thread.
+    /// The estimate computed on the caller's thread, where the system refused it a thread.
     here: Option<f64>,
     /// `None` once K is accepted, else the message it was refused with.
     verdict: OnceLock<Option<String>>,
 }
 
 impl Pending {
-    /// Start the solves for λ_max(K⁻¹) with the factor of the n × n matrix K (λ_max(K) = `top`); where
-    /// no thread can be started, they are done here.
-    pub(super) fn start(factor: &Arc<Factor>, n: usize, top: f64) -> Pending {
-        let f = Arc::clone(factor);
-        let solves = std::thread::Builder::new().spawn(move || condition::largest_inverse_eigenvalue(&f, n, 12));
-        let here = solves.is_err().then(|| condition::largest_inverse_eigenvalue(factor, n, 12));
-        Pending { top, solves: Mutex::new(solves.ok()), here, verdict: OnceLock::new() }
+    /// Start the estimate of K (its lower triangle `k`) with its factor; where no thread can be started,
+    /// it is made here.
+    pub(super) fn start(factor: &Arc<Factor>, k: &Arc<SparseColMat<usize, f64>>) -> Pending {
+        let (f, kk) = (Arc::clone(factor), Arc::clone(k));
+        let solves = std::thread::Builder::new().spawn(move || estimate(&f, &kk));
+        let here = solves.is_err().then(|| estimate(factor, k));
+        Pending { solves: Mutex::new(solves.ok()), here, verdict: OnceLock::new() }
     }
 
     /// No estimate ([`Guard::Skip`]): K is accepted.
     pub(super) fn skipped() -> Pending {
-        Pending { top: f64::NAN, solves: Mutex::new(None), here: None, verdict: OnceLock::from(None) }
+        Pending { solves: Mutex::new(None), here: None, verdict: OnceLock::from(None) }
     }
 
     /// Whether the estimate is in (or its thread ended): [`Pending::verdict`] would not wait.
@@ -66,7 +69,7 @@ impl Pending {
         let v = self.verdict.get_or_init(|| {
             let solves = self.solves.lock().unwrap_or_else(|e| e.into_inner()).take();
             match (solves.map(|h| h.join()), self.here) {
-                (Some(Ok(inverse)), _) | (None, Some(inverse)) => check(self.top * inverse, scene, mesh, space).err(),
+                (Some(Ok(kappa)), _) | (None, Some(kappa)) => check(kappa, scene, mesh, space).err(),
                 _ => Some("the condition estimate failed".into()),
             }
         });
@@ -75,6 +78,12 @@ impl Pending {
             Some(msg) => Err(Error::Linear(msg.clone())),
         }
     }
+}
+
+/// λ_max(K) · λ_max(K⁻¹) (`solve::condition`).
+fn estimate(factor: &Factor, k: &SparseColMat<usize, f64>) -> f64 {
+    let top = condition::largest_eigenvalue(k, LAMBDA_ITERS);
+    top * condition::largest_inverse_eigenvalue(factor, k.nrows(), LAMBDA_ITERS)
 }
 
 /// Largest accepted condition-number estimate of K: beyond it fewer than 4 of the 16 digits survive.

@@ -17,7 +17,6 @@ use crate::scene::Scene;
 use crate::solve::cholesky::{fill_order_at, Factor, Symbolic};
 use crate::solve::cholesky::{Graph, ND_MIN_SIZE};
 use crate::solve::condense::{condense, Condensation};
-use crate::solve::condition;
 use crate::solve::free::{FreeResponse, BLOCK_BYTES};
 use crate::solve::kernel::Kernel;
 use crate::solve::superpose::LoadBasis;
@@ -41,9 +40,6 @@ const AFTER_FACTOR_BYTES: u64 = 242;
 /// From this many unknowns the set-up's freed temporaries go back to the kernel before the factorisation;
 /// below, they are a few MB the factor reuses, and mapping them again costs page faults (CHANGELOG.md).
 const RELEASE_MIN: usize = 100_000;
-
-/// Lanczos steps of λ_max(K) at most (`solve::condition`), one vector of n values each.
-const LAMBDA_ITERS: usize = 12;
 
 /// The problem, or the set-up's error, each with the result of the work run beside the set-up.
 type WithBeside<R> = std::result::Result<(Problem, Option<R>), (Error, Option<R>)>;
@@ -99,7 +95,7 @@ impl Problem {
             space,
             data,
             law,
-            stiffness: Arc::new(stiffness),
+            stiffness,
             free,
             friction,
             errors,
@@ -158,7 +154,7 @@ struct PhaseEnds {
 
 /// The operators the set-up builds from a [`Discretised`] problem, with the instants its phases ended at.
 struct Operators {
-    stiffness: SparseColMat<usize, f64>,
+    stiffness: Arc<SparseColMat<usize, f64>>,
     free: FreeResponse,
     friction: Option<Friction>,
     errors: Option<Arc<ErrorEvaluator>>,
@@ -173,11 +169,10 @@ impl Discretised {
     ///    before K's pattern is made) and the symbolic factorisation (it needs only K's pattern, which is
     ///    the mesh's; the loads stay on the main thread, so the results file's creation, beside from the
     ///    start on small meshes, keeps its share of the two cores);
-    /// 2. the numeric factorisation; beside it the factor's pages are mapped, then λ_max(K) of the
-    ///    condition estimate is computed, the exact solution bound to the error quadrature and step 0
-    ///    (u⁰ = I_CR u₀ with its true errors) computed;
+    /// 2. the numeric factorisation; beside it the factor's pages are mapped, then the exact solution
+    ///    bound to the error quadrature and step 0 (u⁰ = I_CR u₀ with its true errors) computed;
     /// 3. the load superposition and the condensation; beside them, and beside the first steps, the
-    ///    solves of the condition estimate (see `conditioning`).
+    ///    condition estimate (λ_max(K), then the solves of λ_max(K⁻¹); see `conditioning`).
     ///
     /// `beside` runs on a thread of its own, from the start below [`DEFER_BESIDE_MIN`] unknowns (on small
     /// meshes it is the longest part, for example creating the results file), else from phase 3: phases 1
@@ -240,11 +235,10 @@ impl Discretised {
                 let name = if nested { "nested dissection by coordinates" } else { "AMD" };
                 let symbolic = Symbolic::from_symmetric(full.as_ref().as_ref(), contact, order)?.ordered_by(name);
                 // on top of the factor: K's values (its lower triangle, assembled meanwhile), the blocks of
-                // steps, and the larger of what comes beside the numeric factorisation (λ_max(K)'s Lanczos
-                // vectors) and after it ([`AFTER_FACTOR_BYTES`])
+                // steps, and what comes after it ([`AFTER_FACTOR_BYTES`], the condition estimate's Lanczos
+                // vectors included)
                 let n = space.n_dofs as u64;
-                let lanczos = 8 * (LAMBDA_ITERS as u64 + 2) * n;
-                let beside = 8 * symbolic.pattern_nnz() as u64 + lanczos.max(AFTER_FACTOR_BYTES * n) + BLOCK_BYTES;
+                let beside = 8 * symbolic.pattern_nnz() as u64 + AFTER_FACTOR_BYTES * n + BLOCK_BYTES;
                 if !nested || symbolic.fits(beside) {
                     return Ok(symbolic);
                 }
@@ -285,6 +279,7 @@ impl Discretised {
     ) -> Result<Operators> {
         let (scene, space) = (&self.scene, &self.space);
         let t2 = Instant::now();
+        let stiffness = Arc::new(stiffness);
         let Factored { factor, conditioning, errors, step0 } = self.factor(&stiffness, symbolic)?;
         let t3 = Instant::now();
         phase3();
@@ -299,9 +294,9 @@ impl Discretised {
         Ok(Operators { stiffness, free, friction, errors, conditioning, step0, ends })
     }
 
-    /// Phase 2: the numeric factorisation; beside it λ_max(K), the error quadrature and step 0; after it
-    /// the condition estimate's solves are started (neither with [`Guard::Skip`]).
-    pub(super) fn factor(&self, stiffness: &SparseColMat<usize, f64>, symbolic: Symbolic) -> Result<Factored> {
+    /// Phase 2: the numeric factorisation; beside it the error quadrature and step 0; after it the
+    /// condition estimate is started on its own thread (not with [`Guard::Skip`]).
+    pub(super) fn factor(&self, stiffness: &Arc<SparseColMat<usize, f64>>, symbolic: Symbolic) -> Result<Factored> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
         // the set-up's temporaries are freed: their pages go back before the factor's are mapped
         if space.n_dofs >= RELEASE_MIN {
@@ -310,22 +305,23 @@ impl Discretised {
         // a floating body: K_# (the rigid motions pinned, `solve::kernel`), K itself stays a_h's matrix
         let pinned = self.kernel.as_ref().map(|k| k.pin(stiffness));
         let (factor, aside) = Factor::numeric_beside(symbolic, pinned.as_ref().unwrap_or(stiffness), || {
-            let top = (self.guard == Guard::Estimate).then(|| condition::largest_eigenvalue(stiffness, LAMBDA_ITERS));
             let has_data = self.data.is_some();
             let errors =
                 scene.exact.as_ref().map(|x| ErrorEvaluator::new(mesh, space, has_data, law, scene.rho).with_exact(x));
             let step0 = initial_state(self.parts(), stiffness, errors.as_ref()).ok();
-            (top, errors, step0)
+            (errors, step0)
         });
         let factor = factor?;
         drop(pinned);
-        let (top, errors, step0) = aside.unwrap_or((Some(f64::NAN), None, None));
+        let (errors, step0) = aside.unwrap_or((None, None));
         // A nearly singular K (ρ → 0: plain CR fails Korn's inequality; ν → ½ far beyond locking-free
         // ranges) factorises without complaint but returns meaningless displacements: it is refused
-        // by the condition estimate, whose solves run on their own thread from here on (conditioning).
+        // by the condition estimate, which runs on its own thread from here on (conditioning).
         let factor = Arc::new(factor);
-        let conditioning =
-            Arc::new(top.map_or_else(Pending::skipped, |top| Pending::start(&factor, stiffness.nrows(), top)));
+        let conditioning = Arc::new(match self.guard {
+            Guard::Estimate => Pending::start(&factor, stiffness),
+            Guard::Skip => Pending::skipped(),
+        });
         Ok(Factored { factor, conditioning, errors: errors.map(Arc::new), step0 })
     }
 

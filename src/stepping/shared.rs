@@ -100,6 +100,7 @@ impl MeshSetUp {
         let t1 = Instant::now();
         let (stiffness, loads, symbolic) = p0.assemble()?;
         let t2 = Instant::now();
+        let stiffness = Arc::new(stiffness);
         let f = p0.factor(&stiffness, symbolic)?;
         let t3 = Instant::now();
         let condensation = p0.condense(&f.factor)?;
@@ -111,7 +112,7 @@ impl MeshSetUp {
             space,
             data,
             law,
-            stiffness: Arc::new(stiffness),
+            stiffness,
             loads,
             factor: f.factor,
             condensation,
