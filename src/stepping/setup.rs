@@ -3,6 +3,7 @@
 //! results file there).
 
 use super::conditioning::{Guard, Pending};
+use super::timeline::Timeline;
 use super::{initial_state, Parts, Problem, SetupTimes, StepResult};
 use crate::error::{Error, Result};
 use crate::fem::assemble::{stiffness_values, EdgePattern};
@@ -207,7 +208,8 @@ impl Discretised {
     /// Phase 1: K (its lower triangle), the loads and the symbolic factorisation.
     pub(super) fn assemble(&self) -> Result<(SparseColMat<usize, f64>, Loads, Symbolic)> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
-        let pattern = EdgePattern::new(mesh);
+        let tl = Timeline::new();
+        let pattern = tl.stage("main", "edge pattern", || EdgePattern::new(mesh));
         // contact unknowns last: the condensation then comes from the factor (solve::condense)
         let contact: Vec<usize> = space.contact_dofs();
         // The ordering needs only the graph of the edges, so the second thread starts on it before K's
@@ -215,17 +217,25 @@ impl Discretised {
         // thread is the longer one and ends phase 1.
         let (tx, rx) = std::sync::mpsc::sync_channel::<Arc<SymbolicSparseColMat<usize>>>(1);
         let (val, loads, symbolic, k_pattern) = std::thread::scope(|s| {
-            let (pattern, contact) = (&pattern, &contact);
+            let (pattern, contact, tl) = (&pattern, &contact, &tl);
             let symbolic = s.spawn(move || {
-                let (first, start, adj) = pattern.unknown_graph(space);
-                let graph = Graph::new(first, start, adj)
-                    .ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
-                let points = EdgePattern::unknown_points(mesh, space);
+                let graph = tl.stage("ordering", "graph", || {
+                    let (first, start, adj) = pattern.unknown_graph(space);
+                    Graph::new(first, start, adj)
+                });
+                let graph =
+                    graph.ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
                 let nested = space.n_dofs >= ND_MIN_SIZE;
-                let order = fill_order_at(&graph, Some(&points), nested)?;
-                let full = rx.recv().map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
+                let order = tl.stage("ordering", "dissection", || {
+                    fill_order_at(&graph, Some(&EdgePattern::unknown_points(mesh, space)), nested)
+                })?;
+                let full = tl.stage("ordering", "wait for K's pattern", || rx.recv());
+                let full = full.map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
                 let name = if nested { "nested dissection by coordinates" } else { "AMD" };
-                let symbolic = Symbolic::from_symmetric(full.as_ref().as_ref(), contact, order)?.ordered_by(name);
+                let symbolic = tl.stage("ordering", "symbolic", || {
+                    Symbolic::from_symmetric(full.as_ref().as_ref(), contact, order)
+                })?;
+                let symbolic = symbolic.ordered_by(name);
                 // on top of the factor: K's values (its lower triangle, assembled meanwhile), the blocks of
                 // steps, and the larger of what comes beside the numeric factorisation (λ_max(K)'s Lanczos
                 // vectors) and after it ([`AFTER_FACTOR_BYTES`])
@@ -244,20 +254,24 @@ impl Discretised {
             // K is kept as its lower triangle, the one the factorisation reads (half the memory); its
             // values are assembled on the full pattern, which the symbolic factorisation reads meanwhile
             // (both triangles: no permuted copy of its lower triangle is needed there), and compacted
-            let full = Arc::new(pattern.unknown_pattern(space));
+            let full = Arc::new(tl.stage("main", "K's pattern", || pattern.unknown_pattern(space)));
             // a thread that failed before taking it has dropped the receiver: its error is the one reported
             let _ = tx.send(Arc::clone(&full));
-            let val = stiffness_values(pattern, full.as_ref().as_ref(), mesh, space, law, scene.rho);
-            let k_pattern = lower_pattern(full.as_ref().as_ref());
-            let val = lower_values(full.as_ref().as_ref(), val);
+            let full_ref = full.as_ref().as_ref();
+            let val = tl.stage("main", "K's values", || {
+                stiffness_values(pattern, full_ref, mesh, space, law, scene.rho)
+            });
+            let k_pattern = tl.stage("main", "lower pattern", || lower_pattern(full_ref));
+            let val = tl.stage("main", "lower values", || lower_values(full_ref, val));
             drop(full);
-            let loads = Loads::new(scene, mesh, space, self.data.as_ref())?;
+            let loads = tl.stage("main", "loads", || Loads::new(scene, mesh, space, self.data.as_ref()))?;
+            let symbolic = tl.stage("main", "join", || symbolic.join());
             let symbolic = symbolic
-                .join()
                 .map_err(|_| Error::Linear("the symbolic factorisation failed".into()))
                 .and_then(|r| r)?;
             Ok((val, loads, symbolic, k_pattern))
         })?;
+        tl.print();
         Ok((SparseColMat::new(k_pattern, val), loads, symbolic))
     }
 
