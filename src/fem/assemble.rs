@@ -112,7 +112,11 @@ struct Values<'a> {
     pattern: &'a EdgePattern,
     space: &'a CrSpace,
     col_ptr: &'a [usize],
-    /// Where block p's rows start within a column of its edge (the same in both columns).
+    stored: Triangles,
+    /// The unknowns of each edge.
+    count: Vec<usize>,
+    /// Where block p's rows start within a column of its edge: with both triangles stored, the same in
+    /// both columns; with the lower one, after the edge's own rows, for a block below the diagonal.
     off: Vec<usize>,
     val: Vec<f64>,
     /// Blocks of a tangential edge: position p → (column edge, sum).
@@ -131,8 +135,9 @@ impl Values<'_> {
         match da {
             EdgeDof::Free(cols) if matches!(db, EdgeDof::Free(_)) => {
                 for (c, &col) in cols.iter().enumerate() {
-                    let at = self.col_ptr[col] + self.off[p];
-                    self.val[at..at + 2].iter_mut().zip(m[c]).for_each(|(v, x)| *v += x);
+                    if let Some((at, from)) = self.rows_at(p, a, col, c) {
+                        self.val[at..at + 2 - from].iter_mut().zip(&m[c][from..]).for_each(|(v, x)| *v += x);
+                    }
                 }
             }
             _ => {
@@ -146,14 +151,28 @@ impl Values<'_> {
         }
     }
 
+    /// Where the rows of block p (edge b = `idx[p]` in edge a's row) are stored in column `col`, edge a's
+    /// c-th unknown: (position, the first of b's unknowns stored there), `None` if none is (the block
+    /// above the diagonal when only the lower triangle is stored). Edges' unknowns are numbered in the
+    /// edges' order, so b's rows lie below a's column when b > a.
+    fn rows_at(&self, p: usize, a: usize, col: usize, c: usize) -> Option<(usize, usize)> {
+        use std::cmp::Ordering::{Equal, Greater, Less};
+        match (self.stored, self.pattern.idx[p].cmp(&a)) {
+            (Triangles::Both, _) => Some((self.col_ptr[col] + self.off[p], 0)),
+            (Triangles::Lower, Less) => None,
+            (Triangles::Lower, Equal) => Some((self.col_ptr[col], c)),
+            (Triangles::Lower, Greater) => Some((self.col_ptr[col] + self.count[a] - c + self.off[p], 0)),
+        }
+    }
+
     /// The entries of the projected blocks.
     fn finish(mut self) -> Vec<f64> {
         for (&p, &(a, blk)) in &self.projected {
             let b = self.pattern.idx[p];
-            for (l, w) in self.space.edge_dof[a].terms() {
-                let at = self.col_ptr[l] + self.off[p];
-                for (i, (_, v)) in self.space.edge_dof[b].terms().enumerate() {
-                    self.val[at + i] =
+            for (c, (l, w)) in self.space.edge_dof[a].terms().enumerate() {
+                let Some((at, from)) = self.rows_at(p, a, l, c) else { continue };
+                for (i, (_, v)) in self.space.edge_dof[b].terms().enumerate().skip(from) {
+                    self.val[at + i - from] =
                         v[0] * (blk[0][0] * w[0] + blk[1][0] * w[1]) + v[1] * (blk[0][1] * w[0] + blk[1][1] * w[1]);
                 }
             }
@@ -162,19 +181,28 @@ impl Values<'_> {
     }
 }
 
+/// Which triangles of the symmetric K are stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Triangles {
+    /// Both: [`EdgePattern::unknown_pattern`].
+    Both,
+    /// The lower one (rows ≥ columns), the one a run keeps: [`EdgePattern::unknown_pattern_lower`].
+    Lower,
+}
+
 /// Assemble K (both triangles of the symmetric matrix stored).
 pub fn stiffness(mesh: &Mesh, space: &CrSpace, law: &Elasticity, rho: f64) -> SparseColMat<usize, f64> {
     let pattern = EdgePattern::new(mesh);
     let k = pattern.unknown_pattern(space);
-    let val = stiffness_values(&pattern, k.as_ref(), mesh, space, law, rho);
+    let val = stiffness_values(&pattern, (k.as_ref(), Triangles::Both), mesh, space, law, rho);
     SparseColMat::new(k, val)
 }
 
-/// K's values in its pattern `k_pattern` ([`EdgePattern::unknown_pattern`] of `pattern`), both made
-/// beforehand (the set-up shares K's pattern with the symbolic factorisation).
+/// K's values in its pattern `k_pattern` of the triangles `stored` (of `pattern`: the lower triangle alone
+/// or both), made beforehand. Every stored entry is the same sum, in the same order, either way.
 pub fn stiffness_values(
     pattern: &EdgePattern,
-    k_pattern: SymbolicSparseColMatRef<'_, usize>,
+    (k_pattern, stored): (SymbolicSparseColMatRef<'_, usize>, Triangles),
     mesh: &Mesh,
     space: &CrSpace,
     law: &Elasticity,
@@ -186,13 +214,18 @@ pub fn stiffness_values(
         let mut at = 0;
         for p in pattern.ptr[a]..pattern.ptr[a + 1] {
             off[p] = at;
-            at += count[pattern.idx[p]];
+            // with the lower triangle, only the blocks below the diagonal are offset
+            if stored == Triangles::Both || pattern.idx[p] > a {
+                at += count[pattern.idx[p]];
+            }
         }
     }
     let mut k = Values {
         pattern,
         space,
         col_ptr: k_pattern.col_ptr(),
+        stored,
+        count,
         off,
         val: vec![0.0; k_pattern.compute_nnz()],
         projected: HashMap::new(),

@@ -6,7 +6,7 @@ use super::conditioning::{Guard, Pending};
 use super::timeline::Timeline;
 use super::{initial_state, Parts, Problem, SetupTimes, StepResult};
 use crate::error::{Error, Result};
-use crate::fem::assemble::{stiffness_values, EdgePattern};
+use crate::fem::assemble::{stiffness_values, EdgePattern, Triangles};
 use crate::fem::elasticity::Elasticity;
 use crate::fem::lifting::BoundaryData;
 use crate::fem::loads::Loads;
@@ -22,9 +22,7 @@ use crate::solve::condition;
 use crate::solve::free::{FreeResponse, BLOCK_BYTES};
 use crate::solve::kernel::Kernel;
 use crate::solve::superpose::LoadBasis;
-use crate::sparse::{lower_pattern, lower_values};
 use faer::sparse::SparseColMat;
-use faer::sparse::SymbolicSparseColMat;
 use nalgebra::DMatrix;
 use std::sync::Arc;
 use std::time::Instant;
@@ -212,10 +210,9 @@ impl Discretised {
         let pattern = tl.stage("main", "edge pattern", || EdgePattern::new(mesh));
         // contact unknowns last: the condensation then comes from the factor (solve::condense)
         let contact: Vec<usize> = space.contact_dofs();
-        // The ordering needs only the graph of the edges, so the second thread starts on it before K's
-        // pattern (of the unknowns) is made, which it needs only for the symbolic factorisation: that
-        // thread is the longer one and ends phase 1.
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Arc<SymbolicSparseColMat<usize>>>(1);
+        // The ordering and the symbolic factorisation need only the graph of the edges (K's pattern is
+        // its expansion: `Symbolic::from_graph`), so the second thread computes them while this one makes
+        // K, without waiting for it.
         let (val, loads, symbolic, k_pattern) = std::thread::scope(|s| {
             let (pattern, contact, tl) = (&pattern, &contact, &tl);
             let symbolic = s.spawn(move || {
@@ -229,12 +226,8 @@ impl Discretised {
                 let order = tl.stage("ordering", "dissection", || {
                     fill_order_at(&graph, Some(&EdgePattern::unknown_points(mesh, space)), nested)
                 })?;
-                let full = tl.stage("ordering", "wait for K's pattern", || rx.recv());
-                let full = full.map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
                 let name = if nested { "nested dissection by coordinates" } else { "AMD" };
-                let symbolic = tl.stage("ordering", "symbolic", || {
-                    Symbolic::from_symmetric(full.as_ref().as_ref(), contact, order)
-                })?;
+                let symbolic = tl.stage("ordering", "symbolic", || Symbolic::from_graph(&graph, contact, order))?;
                 let symbolic = symbolic.ordered_by(name);
                 // on top of the factor: K's values (its lower triangle, assembled meanwhile), the blocks of
                 // steps, and the larger of what comes beside the numeric factorisation (λ_max(K)'s Lanczos
@@ -248,27 +241,19 @@ impl Discretised {
                 // The factor of the coordinate bisection does not fit: METIS's ordering fills less
                 // (about 13 % on Example 5.1 at 6.3 M unknowns) for a slower ordering (tens of seconds).
                 drop(symbolic);
-                Symbolic::from_symmetric(full.as_ref().as_ref(), contact, fill_order_at(&graph, None, true)?)
+                Symbolic::from_graph(&graph, contact, fill_order_at(&graph, None, true)?)
                     .map(|s| s.ordered_by("METIS nested dissection (the factor by coordinates did not fit in memory)"))
             });
-            // K is kept as its lower triangle, the one the factorisation reads (half the memory); its
-            // values are assembled on the full pattern, which the symbolic factorisation reads meanwhile
-            // (both triangles: no permuted copy of its lower triangle is needed there), and compacted
-            let full = Arc::new(tl.stage("main", "K's pattern", || pattern.unknown_pattern(space)));
-            // a thread that failed before taking it has dropped the receiver: its error is the one reported
-            let _ = tx.send(Arc::clone(&full));
-            let full_ref = full.as_ref().as_ref();
+            // K is kept as its lower triangle, the one the factorisation reads (half the memory), and
+            // assembled straight into it
+            let k_pattern = tl.stage("main", "K's lower pattern", || pattern.unknown_pattern_lower(space));
             let val = tl.stage("main", "K's values", || {
-                stiffness_values(pattern, full_ref, mesh, space, law, scene.rho)
+                stiffness_values(pattern, (k_pattern.as_ref(), Triangles::Lower), mesh, space, law, scene.rho)
             });
-            let k_pattern = tl.stage("main", "lower pattern", || lower_pattern(full_ref));
-            let val = tl.stage("main", "lower values", || lower_values(full_ref, val));
-            drop(full);
             let loads = tl.stage("main", "loads", || Loads::new(scene, mesh, space, self.data.as_ref()))?;
             let symbolic = tl.stage("main", "join", || symbolic.join());
-            let symbolic = symbolic
-                .map_err(|_| Error::Linear("the symbolic factorisation failed".into()))
-                .and_then(|r| r)?;
+            let symbolic =
+                symbolic.map_err(|_| Error::Linear("the symbolic factorisation failed".into())).and_then(|r| r)?;
             Ok((val, loads, symbolic, k_pattern))
         })?;
         tl.print();
