@@ -13,7 +13,8 @@
 //! tangential one on Γ_C, none on Γ_D), whose numbering follows the edges, so every column comes out
 //! sorted. Entries that are zero for every mesh (the x–y coupling of two edges that meet only through
 //! a jump term) are stored too, so the pattern is known before the values: the symbolic factorisation
-//! is computed from it while the values are assembled. The 2 × 2 blocks of the midpoint values (volume
+//! is computed from it (from the graph of the edges, its block form) while the values are assembled, in
+//! the lower triangle alone in a run ([`Triangles`]). The 2 × 2 blocks of the midpoint values (volume
 //! terms triangle by triangle, then jump terms edge by edge) are added straight into K's values, those
 //! of a tangential Γ_C edge projected once summed. Cost O(edges); the former triplet route (4M triplets
 //! sorted by column at 24,640 unknowns) took 40 % of Example 5.1's set-up.
@@ -301,8 +302,8 @@ pub fn stiffness_values(
 
 impl EdgePattern {
     /// The pattern of K on the unknowns: K[k, l] for every unknown k of an edge a and l of an edge b
-    /// coupled to a, known before K's values (the symbolic factorisation is computed from it beside
-    /// the assembly). Entries that are zero for every mesh are stored too (the x–y coupling of two
+    /// coupled to a, known before K's values (the symbolic factorisation is computed from its block form,
+    /// the graph of the edges, beside the assembly). Entries that are zero for every mesh are stored too (the x–y coupling of two
     /// edges that meet only through a jump term): with them K's pattern is this one whatever its
     /// values. Symmetric, every column sorted (block row b read as a column gives the column's rows in
     /// increasing order, since the unknowns are numbered edge by edge).

@@ -168,10 +168,11 @@ struct Operators {
 
 impl Discretised {
     /// Assembly, factorisation, superposition and condensation, in three phases:
-    /// 1. K's pattern, values and the loads; beside them the ordering (from the graph of the edges, begun
-    ///    before K's pattern is made) and the symbolic factorisation (it needs only K's pattern, which is
-    ///    the mesh's; the loads stay on the main thread, so the results file's creation, beside from the
-    ///    start on small meshes, keeps its share of the two cores);
+    /// 1. K (its lower triangle: pattern and values) and the loads; beside them the ordering and the
+    ///    symbolic factorisation, both from the graph of the edges (K's pattern is its expansion, so they
+    ///    never wait for K; the loads stay on the main thread, so the results file's creation, beside
+    ///    from the start on small meshes, keeps its share of the two cores). `TRESCA_TIMELINE` prints
+    ///    the stages of both threads (`stepping::timeline`);
     /// 2. the numeric factorisation; beside it the factor's pages are mapped, then λ_max(K) of the
     ///    condition estimate is computed, the exact solution bound to the error quadrature and step 0
     ///    (u⁰ = I_CR u₀ with its true errors) computed;
