@@ -12,7 +12,7 @@
 //!
 //! In a real run every buffer is fresh memory, whose first touch costs about 2.4 µs a page on the
 //! project's VMs; from the second pass on the allocator reuses memory, so these are compute costs.
-use tresca_cr::fem::assemble::{stiffness_values, EdgePattern};
+use tresca_cr::fem::assemble::{stiffness_values, EdgePattern, Triangles};
 use tresca_cr::fem::elasticity::Elasticity;
 use tresca_cr::fem::lifting::BoundaryData;
 use tresca_cr::fem::loads::Loads;
@@ -63,21 +63,19 @@ fn main() {
         let points = (!metis).then(|| EdgePattern::unknown_points(&mesh, &space));
         let order = fill_order_at(&graph, points.as_deref(), nested).unwrap();
         tm(if nested { "nested dissection" } else { "amd" }, t.elapsed());
+        let contact: Vec<usize> = space.contact_dofs();
         let t = Clock::now();
-        let pat = pattern.unknown_pattern(&space);
-        tm("unknown pattern", t.elapsed());
-        let contact: Vec<usize> = space.contact.iter().map(|c| c.dof).collect();
-        let t = Clock::now();
-        let sym = Symbolic::from_symmetric(pat.as_ref(), &contact, order).unwrap();
+        let sym = Symbolic::from_graph(&graph, &contact, order).unwrap();
         tm("symbolic", t.elapsed());
         sizes = (sym.pattern_nnz(), sym.len_val(), sym.flops_and_entries().0, sym.n_supernodes());
         if symbolic_only {
             continue;
         }
         let t = Clock::now();
-        let val = stiffness_values(&pattern, pat.as_ref(), &mesh, &space, &law, scene.rho);
-        let lower = tresca_cr::sparse::lower_pattern(pat.as_ref());
-        let val = tresca_cr::sparse::lower_values(pat.as_ref(), val);
+        let lower = pattern.unknown_pattern_lower(&space);
+        tm("lower pattern", t.elapsed());
+        let t = Clock::now();
+        let val = stiffness_values(&pattern, (lower.as_ref(), Triangles::Lower), &mesh, &space, &law, scene.rho);
         tm("stiffness", t.elapsed());
         let k = faer::sparse::SparseColMat::new(lower, val);
         let t = Clock::now();

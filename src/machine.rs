@@ -118,3 +118,16 @@ pub fn available_disk(dir: &Path) -> Option<u64> {
     }
     Some((st.f_bavail as u64).saturating_mul(st.f_frsize as u64))
 }
+
+/// CPU seconds the calling thread has used (`CLOCK_THREAD_CPUTIME_ID`; 0 where the clock cannot be read).
+pub fn thread_cpu_seconds() -> f64 {
+    // SAFETY: a timespec is plain data, which clock_gettime fills.
+    let (rc, ts) = unsafe {
+        let mut ts: libc::timespec = std::mem::zeroed();
+        (libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts), ts)
+    };
+    if rc != 0 {
+        return 0.0;
+    }
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}

@@ -13,7 +13,8 @@
 //! tangential one on Γ_C, none on Γ_D), whose numbering follows the edges, so every column comes out
 //! sorted. Entries that are zero for every mesh (the x–y coupling of two edges that meet only through
 //! a jump term) are stored too, so the pattern is known before the values: the symbolic factorisation
-//! is computed from it while the values are assembled. The 2 × 2 blocks of the midpoint values (volume
+//! is computed from it (from the graph of the edges, its block form) while the values are assembled, in
+//! the lower triangle alone in a run ([`Triangles`]). The 2 × 2 blocks of the midpoint values (volume
 //! terms triangle by triangle, then jump terms edge by edge) are added straight into K's values, those
 //! of a tangential Γ_C edge projected once summed. Cost O(edges); the former triplet route (4M triplets
 //! sorted by column at 24,640 unknowns) took 40 % of Example 5.1's set-up.
@@ -33,13 +34,33 @@ pub struct EdgePattern {
     idx: Vec<usize>,
 }
 
+/// From this many edges [`EdgePattern::new`] makes the two halves of its rows on rayon's threads (with
+/// one thread in force, one after the other): everything else of the set-up's phase 1 waits for it (at
+/// refine 8 of Example 5.1, 0.8 M edges, 0.18 s of one core). Below, about 10 ms of work, handing it
+/// to the pool (tens of µs) and copying the second half save too little to matter.
+const SPLIT_MIN_EDGES: usize = 50_000;
+
 impl EdgePattern {
     pub fn new(mesh: &Mesh) -> EdgePattern {
         let ne = mesh.edges.len();
+        if ne < SPLIT_MIN_EDGES {
+            return EdgePattern::rows(mesh, 0..ne);
+        }
+        let (mut first, second) =
+            rayon::join(|| EdgePattern::rows(mesh, 0..ne / 2), || EdgePattern::rows(mesh, ne / 2..ne));
+        let base = first.idx.len();
+        first.ptr.extend(second.ptr[1..].iter().map(|&p| p + base));
+        first.idx.extend_from_slice(&second.idx);
+        first
+    }
+
+    /// The rows of the edges `edges` alone (their pointers from 0).
+    fn rows(mesh: &Mesh, edges: std::ops::Range<usize>) -> EdgePattern {
+        let ne = edges.len();
         let (mut ptr, mut idx) = (Vec::with_capacity(ne + 1), Vec::with_capacity(14 * ne));
         ptr.push(0);
         let mut near: Vec<usize> = Vec::with_capacity(32);
-        for e in 0..ne {
+        for e in edges {
             near.clear();
             let (t1, t2) = mesh.edge_tris[e];
             for t in std::iter::once(t1).chain(t2) {
@@ -112,7 +133,11 @@ struct Values<'a> {
     pattern: &'a EdgePattern,
     space: &'a CrSpace,
     col_ptr: &'a [usize],
-    /// Where block p's rows start within a column of its edge (the same in both columns).
+    stored: Triangles,
+    /// The unknowns of each edge.
+    count: Vec<usize>,
+    /// Where block p's rows start within a column of its edge: with both triangles stored, the same in
+    /// both columns; with the lower one, after the edge's own rows, for a block below the diagonal.
     off: Vec<usize>,
     val: Vec<f64>,
     /// Blocks of a tangential edge: position p → (column edge, sum).
@@ -131,8 +156,9 @@ impl Values<'_> {
         match da {
             EdgeDof::Free(cols) if matches!(db, EdgeDof::Free(_)) => {
                 for (c, &col) in cols.iter().enumerate() {
-                    let at = self.col_ptr[col] + self.off[p];
-                    self.val[at..at + 2].iter_mut().zip(m[c]).for_each(|(v, x)| *v += x);
+                    if let Some((at, from)) = self.rows_at(p, a, col, c) {
+                        self.val[at..at + 2 - from].iter_mut().zip(&m[c][from..]).for_each(|(v, x)| *v += x);
+                    }
                 }
             }
             _ => {
@@ -146,14 +172,28 @@ impl Values<'_> {
         }
     }
 
+    /// Where the rows of block p (edge b = `idx[p]` in edge a's row) are stored in column `col`, edge a's
+    /// c-th unknown: (position, the first of b's unknowns stored there), `None` if none is (the block
+    /// above the diagonal when only the lower triangle is stored). Edges' unknowns are numbered in the
+    /// edges' order, so b's rows lie below a's column when b > a.
+    fn rows_at(&self, p: usize, a: usize, col: usize, c: usize) -> Option<(usize, usize)> {
+        use std::cmp::Ordering::{Equal, Greater, Less};
+        match (self.stored, self.pattern.idx[p].cmp(&a)) {
+            (Triangles::Both, _) => Some((self.col_ptr[col] + self.off[p], 0)),
+            (Triangles::Lower, Less) => None,
+            (Triangles::Lower, Equal) => Some((self.col_ptr[col], c)),
+            (Triangles::Lower, Greater) => Some((self.col_ptr[col] + self.count[a] - c + self.off[p], 0)),
+        }
+    }
+
     /// The entries of the projected blocks.
     fn finish(mut self) -> Vec<f64> {
         for (&p, &(a, blk)) in &self.projected {
             let b = self.pattern.idx[p];
-            for (l, w) in self.space.edge_dof[a].terms() {
-                let at = self.col_ptr[l] + self.off[p];
-                for (i, (_, v)) in self.space.edge_dof[b].terms().enumerate() {
-                    self.val[at + i] =
+            for (c, (l, w)) in self.space.edge_dof[a].terms().enumerate() {
+                let Some((at, from)) = self.rows_at(p, a, l, c) else { continue };
+                for (i, (_, v)) in self.space.edge_dof[b].terms().enumerate().skip(from) {
+                    self.val[at + i - from] =
                         v[0] * (blk[0][0] * w[0] + blk[1][0] * w[1]) + v[1] * (blk[0][1] * w[0] + blk[1][1] * w[1]);
                 }
             }
@@ -162,19 +202,28 @@ impl Values<'_> {
     }
 }
 
+/// Which triangles of the symmetric K are stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Triangles {
+    /// Both: [`EdgePattern::unknown_pattern`].
+    Both,
+    /// The lower one (rows ≥ columns), the one a run keeps: [`EdgePattern::unknown_pattern_lower`].
+    Lower,
+}
+
 /// Assemble K (both triangles of the symmetric matrix stored).
 pub fn stiffness(mesh: &Mesh, space: &CrSpace, law: &Elasticity, rho: f64) -> SparseColMat<usize, f64> {
     let pattern = EdgePattern::new(mesh);
     let k = pattern.unknown_pattern(space);
-    let val = stiffness_values(&pattern, k.as_ref(), mesh, space, law, rho);
+    let val = stiffness_values(&pattern, (k.as_ref(), Triangles::Both), mesh, space, law, rho);
     SparseColMat::new(k, val)
 }
 
-/// K's values in its pattern `k_pattern` ([`EdgePattern::unknown_pattern`] of `pattern`), both made
-/// beforehand (the set-up shares K's pattern with the symbolic factorisation).
+/// K's values in its pattern `k_pattern` of the triangles `stored` (of `pattern`: the lower triangle alone
+/// or both), made beforehand. Every stored entry is the same sum, in the same order, either way.
 pub fn stiffness_values(
     pattern: &EdgePattern,
-    k_pattern: SymbolicSparseColMatRef<'_, usize>,
+    (k_pattern, stored): (SymbolicSparseColMatRef<'_, usize>, Triangles),
     mesh: &Mesh,
     space: &CrSpace,
     law: &Elasticity,
@@ -186,13 +235,18 @@ pub fn stiffness_values(
         let mut at = 0;
         for p in pattern.ptr[a]..pattern.ptr[a + 1] {
             off[p] = at;
-            at += count[pattern.idx[p]];
+            // with the lower triangle, only the blocks below the diagonal are offset
+            if stored == Triangles::Both || pattern.idx[p] > a {
+                at += count[pattern.idx[p]];
+            }
         }
     }
     let mut k = Values {
         pattern,
         space,
         col_ptr: k_pattern.col_ptr(),
+        stored,
+        count,
         off,
         val: vec![0.0; k_pattern.compute_nnz()],
         projected: HashMap::new(),
@@ -248,8 +302,8 @@ pub fn stiffness_values(
 
 impl EdgePattern {
     /// The pattern of K on the unknowns: K[k, l] for every unknown k of an edge a and l of an edge b
-    /// coupled to a, known before K's values (the symbolic factorisation is computed from it beside
-    /// the assembly). Entries that are zero for every mesh are stored too (the x–y coupling of two
+    /// coupled to a, known before K's values (the symbolic factorisation is computed from its block form,
+    /// the graph of the edges, beside the assembly). Entries that are zero for every mesh are stored too (the x–y coupling of two
     /// edges that meet only through a jump term): with them K's pattern is this one whatever its
     /// values. Symmetric, every column sorted (block row b read as a column gives the column's rows in
     /// increasing order, since the unknowns are numbered edge by edge).
@@ -281,5 +335,23 @@ impl EdgePattern {
             }
         }
         SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{EdgePattern, SPLIT_MIN_EDGES};
+    use crate::mesh::{Diagonal, Mesh, MeshSpec};
+
+    /// The system shall make the same pattern of coupled edges in two halves (on a mesh of
+    /// [`SPLIT_MIN_EDGES`] edges or more) as in one piece.
+    #[test]
+    fn the_pattern_in_two_halves_is_the_pattern_in_one() {
+        let corners = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]];
+        let spec = MeshSpec::Structured { corners, cells: [130, 130], diagonal: Diagonal::First, refine: 0 };
+        let mesh = Mesh::from_spec(&spec).unwrap();
+        assert!(mesh.edges.len() >= SPLIT_MIN_EDGES, "{} edges: the split is not exercised", mesh.edges.len());
+        let (split, whole) = (EdgePattern::new(&mesh), EdgePattern::rows(&mesh, 0..mesh.edges.len()));
+        assert_eq!((split.ptr, split.idx), (whole.ptr, whole.idx));
     }
 }

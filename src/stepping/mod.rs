@@ -28,6 +28,7 @@ mod normal;
 mod run;
 mod setup;
 mod shared;
+pub mod timeline;
 
 pub use audit::{Audit, AuditState};
 pub use conditioning::{Guard, MAX_CONDITION};

@@ -3,9 +3,10 @@
 //! results file there).
 
 use super::conditioning::{Guard, Pending};
+use super::timeline::Timeline;
 use super::{initial_state, Parts, Problem, SetupTimes, StepResult};
 use crate::error::{Error, Result};
-use crate::fem::assemble::{stiffness_values, EdgePattern};
+use crate::fem::assemble::{stiffness_values, EdgePattern, Triangles};
 use crate::fem::elasticity::Elasticity;
 use crate::fem::lifting::BoundaryData;
 use crate::fem::loads::Loads;
@@ -20,9 +21,7 @@ use crate::solve::condense::{condense, Condensation};
 use crate::solve::free::{FreeResponse, BLOCK_BYTES};
 use crate::solve::kernel::Kernel;
 use crate::solve::superpose::LoadBasis;
-use crate::sparse::{lower_pattern, lower_values};
 use faer::sparse::SparseColMat;
-use faer::sparse::SymbolicSparseColMat;
 use nalgebra::DMatrix;
 use std::sync::Arc;
 use std::time::Instant;
@@ -165,10 +164,11 @@ struct Operators {
 
 impl Discretised {
     /// Assembly, factorisation, superposition and condensation, in three phases:
-    /// 1. K's pattern, values and the loads; beside them the ordering (from the graph of the edges, begun
-    ///    before K's pattern is made) and the symbolic factorisation (it needs only K's pattern, which is
-    ///    the mesh's; the loads stay on the main thread, so the results file's creation, beside from the
-    ///    start on small meshes, keeps its share of the two cores);
+    /// 1. K (its lower triangle: pattern and values) and the loads; beside them the ordering and the
+    ///    symbolic factorisation, both from the graph of the edges (K's pattern is its expansion, so they
+    ///    never wait for K; the loads stay on the main thread, so the results file's creation, beside
+    ///    from the start on small meshes, keeps its share of the two cores). `TRESCA_TIMELINE` prints
+    ///    the stages of both threads (`stepping::timeline`);
     /// 2. the numeric factorisation; beside it the factor's pages are mapped, then the exact solution
     ///    bound to the error quadrature and step 0 (u⁰ = I_CR u₀ with its true errors) computed;
     /// 3. the load superposition and the condensation; beside them, and beside the first steps, the
@@ -215,25 +215,29 @@ impl Discretised {
     /// Phase 1: K (its lower triangle), the loads and the symbolic factorisation.
     pub(super) fn assemble(&self) -> Result<(SparseColMat<usize, f64>, Loads, Symbolic)> {
         let (scene, mesh, space, law) = (&self.scene, &self.mesh, &self.space, &self.law);
-        let pattern = EdgePattern::new(mesh);
+        let tl = Timeline::new();
+        let pattern = tl.stage("main", "edge pattern", || EdgePattern::new(mesh));
         // contact unknowns last: the condensation then comes from the factor (solve::condense)
         let contact: Vec<usize> = space.contact_dofs();
-        // The ordering needs only the graph of the edges, so the second thread starts on it before K's
-        // pattern (of the unknowns) is made, which it needs only for the symbolic factorisation: that
-        // thread is the longer one and ends phase 1.
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Arc<SymbolicSparseColMat<usize>>>(1);
+        // The ordering and the symbolic factorisation need only the graph of the edges (K's pattern is
+        // its expansion: `Symbolic::from_graph`), so the second thread computes them while this one makes
+        // K, without waiting for it.
         let (val, loads, symbolic, k_pattern) = std::thread::scope(|s| {
-            let (pattern, contact) = (&pattern, &contact);
+            let (pattern, contact, tl) = (&pattern, &contact, &tl);
             let symbolic = crate::threads::scoped(s, "the ordering and symbolic factorisation", move || {
-                let (first, start, adj) = pattern.unknown_graph(space);
-                let graph = Graph::new(first, start, adj)
-                    .ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
-                let points = EdgePattern::unknown_points(mesh, space);
+                let graph = tl.stage("ordering", "graph", || {
+                    let (first, start, adj) = pattern.unknown_graph(space);
+                    Graph::new(first, start, adj)
+                });
+                let graph =
+                    graph.ok_or_else(|| Error::Linear("internal: the graph of the unknowns is malformed".into()))?;
                 let nested = space.n_dofs >= ND_MIN_SIZE;
-                let order = fill_order_at(&graph, Some(&points), nested)?;
-                let full = rx.recv().map_err(|_| Error::Linear("internal: K's pattern was not made".into()))?;
+                let order = tl.stage("ordering", "dissection", || {
+                    fill_order_at(&graph, Some(&EdgePattern::unknown_points(mesh, space)), nested)
+                })?;
                 let name = if nested { "nested dissection by coordinates" } else { "AMD" };
-                let symbolic = Symbolic::from_symmetric(full.as_ref().as_ref(), contact, order)?.ordered_by(name);
+                let symbolic = tl.stage("ordering", "symbolic", || Symbolic::from_graph(&graph, contact, order))?;
+                let symbolic = symbolic.ordered_by(name);
                 // on top of the factor: K's values (its lower triangle, assembled meanwhile), the blocks of
                 // steps, and what comes after it ([`AFTER_FACTOR_BYTES`], the condition estimate's Lanczos
                 // vectors included)
@@ -245,26 +249,22 @@ impl Discretised {
                 // The factor of the coordinate bisection does not fit: METIS's ordering fills less
                 // (about 13 % on Example 5.1 at 6.3 M unknowns) for a slower ordering (tens of seconds).
                 drop(symbolic);
-                Symbolic::from_symmetric(full.as_ref().as_ref(), contact, fill_order_at(&graph, None, true)?)
+                Symbolic::from_graph(&graph, contact, fill_order_at(&graph, None, true)?)
                     .map(|s| s.ordered_by("METIS nested dissection (the factor by coordinates did not fit in memory)"))
             })?;
-            // K is kept as its lower triangle, the one the factorisation reads (half the memory); its
-            // values are assembled on the full pattern, which the symbolic factorisation reads meanwhile
-            // (both triangles: no permuted copy of its lower triangle is needed there), and compacted
-            let full = Arc::new(pattern.unknown_pattern(space));
-            // a thread that failed before taking it has dropped the receiver: its error is the one reported
-            let _ = tx.send(Arc::clone(&full));
-            let val = stiffness_values(pattern, full.as_ref().as_ref(), mesh, space, law, scene.rho);
-            let k_pattern = lower_pattern(full.as_ref().as_ref());
-            let val = lower_values(full.as_ref().as_ref(), val);
-            drop(full);
-            let loads = Loads::new(scene, mesh, space, self.data.as_ref())?;
-            let symbolic = symbolic
-                .join()
-                .map_err(|_| Error::Linear("the symbolic factorisation failed".into()))
-                .and_then(|r| r)?;
+            // K is kept as its lower triangle, the one the factorisation reads (half the memory), and
+            // assembled straight into it
+            let k_pattern = tl.stage("main", "K's lower pattern", || pattern.unknown_pattern_lower(space));
+            let val = tl.stage("main", "K's values", || {
+                stiffness_values(pattern, (k_pattern.as_ref(), Triangles::Lower), mesh, space, law, scene.rho)
+            });
+            let loads = tl.stage("main", "loads", || Loads::new(scene, mesh, space, self.data.as_ref()))?;
+            let symbolic = tl.stage("main", "join", || symbolic.join());
+            let symbolic =
+                symbolic.map_err(|_| Error::Linear("the symbolic factorisation failed".into())).and_then(|r| r)?;
             Ok((val, loads, symbolic, k_pattern))
         })?;
+        tl.print();
         Ok((SparseColMat::new(k_pattern, val), loads, symbolic))
     }
 

@@ -325,3 +325,53 @@ fn graph_from_the_mesh_is_the_graph_of_k() {
         assert_eq!(from_mesh, Graph::of_matrix(&p.stiffness, &p.space.unknown_groups()), "{case}");
     }
 }
+
+/// Requirement (issue 44, phase 1 without waiting for K's pattern): the symbolic factorisation made from
+/// the graph of the unknowns (`Symbolic::from_graph`, read as the pattern of its unknowns) shall be the
+/// one made from K's pattern (`Symbolic::from_symmetric`): the same ordering and the same structure of L,
+/// row indices in the same order, so the numeric factorisation and every result are unchanged.
+#[test]
+fn symbolic_from_the_graph_is_that_of_k() {
+    use tresca_cr::fem::assemble::EdgePattern;
+    use tresca_cr::solve::cholesky::{fill_order, Graph, Symbolic};
+    for case in ["mms_rotated", "paper_example_5_1", "hertz_a05", "trapezoid", "floating_block", "lshape_adapt"] {
+        let path = format!("{}/verification/cases/{case}.toml", env!("CARGO_MANIFEST_DIR"));
+        let p = Problem::new(Scene::from_file(std::path::Path::new(&path)).unwrap()).unwrap();
+        let pattern = EdgePattern::new(&p.mesh);
+        let (first, start, adj) = pattern.unknown_graph(&p.space);
+        let graph = Graph::new(first, start, adj).expect("consistent graph");
+        let contact = p.space.contact_dofs();
+        for nested in [false, true] {
+            let order = fill_order(&graph, nested).unwrap();
+            let full = pattern.unknown_pattern(&p.space);
+            let of_k = Symbolic::from_symmetric(full.as_ref(), &contact, order.clone()).unwrap();
+            let of_graph = Symbolic::from_graph(&graph, &contact, order).unwrap();
+            assert!(of_k.same_structure(&of_graph), "{case}, nested dissection {nested}");
+        }
+    }
+}
+
+/// Requirement (issue 44, K assembled in its lower triangle): the values assembled directly in K's lower
+/// triangle (`stiffness_values` with `Triangles::Lower` on `EdgePattern::unknown_pattern_lower`) shall be the lower triangle
+/// of the full assembly, pattern and values bit for bit, with free edges, contact edges of one unknown
+/// (tangential) and of two (a frame with a normal unknown).
+#[test]
+fn lower_triangle_assembled_directly_is_that_of_k() {
+    use tresca_cr::fem::assemble::{stiffness_values, EdgePattern, Triangles};
+    use tresca_cr::sparse::{lower_pattern, lower_values};
+    for case in ["paper_example_5_1", "mms_signorini_stop", "mms_rotated", "trapezoid", "floating_block"] {
+        let path = format!("{}/verification/cases/{case}.toml", env!("CARGO_MANIFEST_DIR"));
+        let p = Problem::new(Scene::from_file(std::path::Path::new(&path)).unwrap()).unwrap();
+        let (mesh, space, law, rho) = (&p.mesh, &p.space, &p.law, p.scene.rho);
+        let pattern = EdgePattern::new(mesh);
+        let full = pattern.unknown_pattern(space);
+        let both = stiffness_values(&pattern, (full.as_ref(), Triangles::Both), mesh, space, law, rho);
+        let expected = lower_values(full.as_ref(), both);
+        let (expected_pattern, lower) = (lower_pattern(full.as_ref()), pattern.unknown_pattern_lower(space));
+        assert_eq!(lower.col_ptr(), expected_pattern.col_ptr(), "{case}: column pointers");
+        assert_eq!(lower.row_idx(), expected_pattern.row_idx(), "{case}: row indices");
+        let got = stiffness_values(&pattern, (lower.as_ref(), Triangles::Lower), mesh, space, law, rho);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&got), bits(&expected), "{case}: values");
+    }
+}

@@ -54,6 +54,26 @@ impl<'a> Cols<'a> {
     }
 }
 
+/// A symmetric pattern (both triangles) read column by column: stored ([`Cols`]) or the graph of the
+/// unknowns' groups expanded (`solve::cholesky::ordering::Graph`), which are the same pattern when the
+/// groups' blocks are stored whole (K's pattern, `fem::assemble::EdgePattern`).
+pub trait Adjacency {
+    /// Entries in all (both triangles, the diagonal once).
+    fn entries(&self) -> usize;
+    /// `f(i)` for every row i of column j (the diagonal included), in no particular order.
+    fn each(&self, j: usize, f: impl FnMut(usize));
+}
+
+impl Adjacency for Cols<'_> {
+    fn entries(&self) -> usize {
+        self.idx.len()
+    }
+
+    fn each(&self, j: usize, f: impl FnMut(usize)) {
+        self.col(j).iter().copied().for_each(f);
+    }
+}
+
 /// Both triangles of the symmetric pattern whose lower triangle `pattern` holds (entries above the
 /// diagonal are skipped, so both triangles may be stored): column j holds the i with A_ij ≠ 0, in no
 /// particular order.
@@ -91,13 +111,18 @@ pub fn symmetric(pattern: SymbolicSparseColMatRef<'_, usize>) -> Pattern {
 /// [`symmetric`] makes it or K's full pattern), `fwd[new] = old` and `inv[old] = new`: column j holds
 /// the i ≤ j, made column by column in the new order (written in sequence; faer's supernodal analysis
 /// reads each column as a set).
-pub fn permuted_upper(sym: Cols<'_>, fwd: &[usize], inv: &[usize]) -> Pattern {
+pub fn permuted_upper(sym: &impl Adjacency, fwd: &[usize], inv: &[usize]) -> Pattern {
     let n = fwd.len();
     let mut ptr = Vec::with_capacity(n + 1);
-    let mut idx = Vec::with_capacity(sym.idx.len().div_ceil(2) + n);
+    let mut idx = Vec::with_capacity(sym.entries().div_ceil(2) + n);
     ptr.push(0);
     for (j, &old) in fwd.iter().enumerate() {
-        idx.extend(sym.col(old).iter().map(|&i| inv[i]).filter(|&i| i <= j));
+        sym.each(old, |i| {
+            let i = inv[i];
+            if i <= j {
+                idx.push(i);
+            }
+        });
         ptr.push(idx.len());
     }
     Pattern { ptr, idx }
@@ -158,7 +183,12 @@ pub fn postorder(parent: &[usize]) -> Vec<usize> {
 /// c_j, the entries of L's column j (diagonal included), from the symmetric pattern `sym` of A
 /// (the rows i > j of P A Pᵀ's column j are the `inv[r]` > j of `sym`'s column `fwd[j]`), the tree
 /// and a postorder of it (Gilbert, Ng, Peyton; Davis §4.5).
-pub fn column_counts(sym: Cols<'_>, (fwd, inv): (&[usize], &[usize]), parent: &[usize], post: &[usize]) -> Vec<usize> {
+pub fn column_counts(
+    sym: &impl Adjacency,
+    (fwd, inv): (&[usize], &[usize]),
+    parent: &[usize],
+    post: &[usize],
+) -> Vec<usize> {
     let n = parent.len();
     let mut first = vec![NONE; n];
     let mut delta = vec![0isize; n];
@@ -175,16 +205,14 @@ pub fn column_counts(sym: Cols<'_>, (fwd, inv): (&[usize], &[usize]), parent: &[
         if parent[j] != NONE {
             delta[parent[j]] -= 1;
         }
-        for i in sym.col(fwd[j]).iter().map(|&r| inv[r]) {
-            match leaves.leaf(i, j) {
-                Leaf::First => delta[j] += 1,
-                Leaf::Subsequent(q) => {
-                    delta[j] += 1;
-                    delta[q] -= 1;
-                }
-                Leaf::Not => {}
+        sym.each(fwd[j], |r| match leaves.leaf(inv[r], j) {
+            Leaf::First => delta[j] += 1,
+            Leaf::Subsequent(q) => {
+                delta[j] += 1;
+                delta[q] -= 1;
             }
-        }
+            Leaf::Not => {}
+        });
         if parent[j] != NONE {
             leaves.ancestor[j] = parent[j];
         }
@@ -301,7 +329,7 @@ mod tests {
             let mut fwd = vec![0; n];
             inv.iter().enumerate().for_each(|(old, &new)| fwd[new] = old);
             let sym = symmetric(pattern.as_ref());
-            let upper = permuted_upper(sym.cols(), &fwd, &inv);
+            let upper = permuted_upper(&sym.cols(), &fwd, &inv);
             let parent = elimination_tree(&upper);
             let post = postorder(&parent);
             let mut seen = vec![false; n];
@@ -310,7 +338,7 @@ mod tests {
                 assert!(parent[j] == NONE || post[k + 1..].contains(&parent[j]), "postorder: {j} after its parent");
             }
             assert!(seen.iter().all(|&s| s), "the postorder visits every node");
-            let counts = column_counts(sym.cols(), (&fwd, &inv), &parent, &post);
+            let counts = column_counts(&sym.cols(), (&fwd, &inv), &parent, &post);
             let (faer_parent, faer_counts) = faer_counts(&upper);
             assert_eq!(parent, faer_parent, "elimination tree, n = {n}");
             assert_eq!(counts, faer_counts, "column counts, n = {n}");

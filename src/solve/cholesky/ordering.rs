@@ -14,6 +14,7 @@
 //! bit-identical results. If METIS cannot be used (tiny or edgeless graphs, indices beyond i32, an
 //! error) the ordering falls back to AMD: the ordering only affects speed.
 
+use super::etree::Adjacency;
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::amd;
@@ -153,6 +154,44 @@ impl Graph {
             fwd.extend(self.first[g]..self.first[g + 1]);
         }
         fwd
+    }
+}
+
+/// The pattern of the unknowns a [`Graph`] stands for: unknown k is coupled to the unknowns of its own
+/// vertex (itself included) and of the adjacent vertices, every block of two coupled vertices whole, as
+/// in K's pattern (`fem::assemble::EdgePattern::unknown_pattern`), so the symbolic factorisation can be
+/// computed from the graph without K's pattern ([`super::symbolic::Symbolic::from_graph`]).
+pub(super) struct Expanded<'a> {
+    graph: &'a Graph,
+    /// The vertex of each unknown.
+    vertex: Vec<usize>,
+    entries: usize,
+}
+
+impl Graph {
+    /// The pattern of the unknowns it stands for.
+    pub(super) fn expanded(&self) -> Expanded<'_> {
+        let mut vertex = vec![0usize; self.unknowns()];
+        let mut entries = 0;
+        let width = |g: usize| self.first[g + 1] - self.first[g];
+        for g in 0..self.n_vertices() {
+            vertex[self.first[g]..self.first[g + 1]].fill(g);
+            entries += width(g) * (width(g) + self.neighbours(g).iter().map(|&h| width(h)).sum::<usize>());
+        }
+        Expanded { graph: self, vertex, entries }
+    }
+}
+
+impl Adjacency for Expanded<'_> {
+    fn entries(&self) -> usize {
+        self.entries
+    }
+
+    fn each(&self, j: usize, mut f: impl FnMut(usize)) {
+        let (g, first) = (self.vertex[j], &self.graph.first);
+        for h in std::iter::once(g).chain(self.graph.neighbours(g).iter().copied()) {
+            (first[h]..first[h + 1]).for_each(&mut f);
+        }
     }
 }
 

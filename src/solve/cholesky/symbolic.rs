@@ -7,7 +7,7 @@
 //! structure as faer's complete analysis, whose row-subtree walk costs O(|L|).
 
 use super::dissect::coordinate_dissection;
-use super::etree::{column_counts, elimination_tree, permuted_upper, postorder, symmetric, Cols, NONE};
+use super::etree::{column_counts, elimination_tree, permuted_upper, postorder, symmetric, Adjacency, Cols, NONE};
 use super::ordering::{amd_order, nested_dissection, Graph};
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -46,7 +46,16 @@ impl Symbolic {
     pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>, last: &[usize], base: Vec<usize>) -> Result<Symbolic> {
         let (fwd, inv) = ordering_with_last(pattern.nrows(), last, base)?;
         let sym = symmetric(pattern);
-        let (symbolic, pattern_nnz) = supernodal_structure(sym.cols(), (&fwd, &inv))?;
+        let (symbolic, pattern_nnz) = supernodal_structure(&sym.cols(), (&fwd, &inv))?;
+        Ok(Symbolic::of_parts(symbolic, (fwd, inv), last, pattern_nnz))
+    }
+
+    /// As [`Symbolic::new`], from the graph of the unknowns' groups (`fem::assemble::EdgePattern::unknown_graph`)
+    /// read as the pattern of its unknowns, every block of two coupled groups whole: K's pattern, which
+    /// need not be made first (the same structure as [`Symbolic::from_symmetric`] of K's pattern).
+    pub fn from_graph(graph: &Graph, last: &[usize], base: Vec<usize>) -> Result<Symbolic> {
+        let (fwd, inv) = ordering_with_last(graph.unknowns(), last, base)?;
+        let (symbolic, pattern_nnz) = supernodal_structure(&graph.expanded(), (&fwd, &inv))?;
         Ok(Symbolic::of_parts(symbolic, (fwd, inv), last, pattern_nnz))
     }
 
@@ -59,7 +68,7 @@ impl Symbolic {
     ) -> Result<Symbolic> {
         let cols = Cols::of(sym).ok_or_else(|| Error::Linear("internal: the pattern is not compact".into()))?;
         let (fwd, inv) = ordering_with_last(sym.nrows(), last, base)?;
-        let (symbolic, pattern_nnz) = supernodal_structure(cols, (&fwd, &inv))?;
+        let (symbolic, pattern_nnz) = supernodal_structure(&cols, (&fwd, &inv))?;
         Ok(Symbolic::of_parts(symbolic, (fwd, inv), last, pattern_nnz))
     }
 
@@ -92,6 +101,17 @@ impl Symbolic {
     /// The supernodes of L (relaxed).
     pub fn n_supernodes(&self) -> usize {
         self.symbolic.n_supernodes()
+    }
+
+    /// Whether `other` is the same factorisation: the same ordering, pattern entries and structure of L
+    /// (its supernodes and their row indices, in the same order).
+    pub fn same_structure(&self, other: &Symbolic) -> bool {
+        let (a, b) = (&self.symbolic, &other.symbolic);
+        (&self.fwd, &self.inv, &self.last, self.pattern_nnz) == (&other.fwd, &other.inv, &other.last, other.pattern_nnz)
+            && a.supernode_begin() == b.supernode_begin()
+            && a.supernode_end() == b.supernode_end()
+            && a.col_ptr_for_row_idx() == b.col_ptr_for_row_idx()
+            && a.row_idx() == b.row_idx()
     }
 
     /// The same, its ordering named `ordering` (reported by runs: [`super::factor::Factor::ordering`]).
@@ -189,11 +209,11 @@ pub(super) fn lower_nnz(pattern: SymbolicSparseColMatRef<'_, usize>) -> usize {
 }
 
 /// L's supernodal structure for the ordering (fwd, inv) of the symmetric pattern `sym` (both
-/// triangles): the elimination tree and column counts of [`super::etree`], then faer's supernodal
+/// triangles; the order of a column's rows does not matter): the elimination tree and column counts of [`super::etree`], then faer's supernodal
 /// analysis (supernodes, relaxed as faer's default, and their row patterns); with the entries of the
 /// pattern's lower triangle (as many as P A Pᵀ's upper one has).
 fn supernodal_structure(
-    sym: Cols<'_>,
+    sym: &impl Adjacency,
     (fwd, inv): (&[usize], &[usize]),
 ) -> Result<(SymbolicSupernodalCholesky<usize>, usize)> {
     let n = fwd.len();
