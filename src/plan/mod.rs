@@ -28,7 +28,6 @@ pub mod corners;
 pub mod model;
 pub mod pilot;
 mod search;
-mod step_cost;
 pub mod two_term;
 
 use crate::error::{Error, Result};
@@ -132,11 +131,6 @@ pub(crate) fn samples(levels: &[LevelResult]) -> Vec<(CostSample, usize)> {
         .collect()
 }
 
-/// Per-step cost samples: the time pilot's levels and the levels on a second mesh ([`step_cost`]).
-pub(crate) fn step_samples(time: &Study, second: Option<&[LevelResult]>) -> Vec<(CostSample, usize)> {
-    samples(&[time.levels.as_slice(), second.unwrap_or(&[])].concat())
-}
-
 pub(crate) fn space_samples(levels: &[LevelResult]) -> Vec<CostSample> {
     samples(levels).into_iter().map(|(c, _)| c).collect()
 }
@@ -236,30 +230,14 @@ fn space_pilot(
     let mut run = Runner::new(s, nh, cache)?;
     let mut notes = Vec::new();
     let mut r = r0;
-    // the cost of a step on the mesh above the time pilot's, once the space pilot has set it up
-    let step_mesh = time.levels.first().map_or(r0 + 3, |l| l.refine + 1);
-    let mut step_levels: Option<Vec<LevelResult>> = None;
     loop {
-        let cost = CostModel::fit(&space_samples(run.levels()), &step_samples(time, step_levels.as_deref()));
+        let cost = CostModel::fit(&space_samples(run.levels()), &samples(&time.levels));
         let predicted = |r: u32| cost.map_or(0.0, |c| c.predict(unknowns(s, r).unwrap_or(0) as f64, nh));
-        if step_levels.is_none() && run.levels().iter().any(|l| l.refine == step_mesh) {
-            let n0 = s.times.len() - 1;
-            let n = unknowns(s, step_mesh)? as f64;
-            let at = cost.map_or(0.0, |c| c.predict(n, nh.max(n0 / 2)));
-            let (levels, took, note) =
-                step_cost::second_mesh(s, (step_mesh, nh, n0), cache, at, options.pilot_budget - spent - run.spent)?;
-            spent += took;
-            notes.push(note);
-            step_levels = Some(levels);
-            continue;
-        }
-        let step_levels = step_levels.as_deref().unwrap_or(&[]);
         if run.levels().len() as u32 >= SPACE_LEVELS {
             let (order_limit, corner_notes) = observed_limit(s, time, run.levels())?;
             let study = run.study();
-            let wall = spent + run.spent;
             let pilots =
-                Pilots { space: &study, time, step_levels, time_fit, time_ratio: *time_ratio, order_limit, wall };
+                Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, order_limit, wall: spent + run.spent };
             let (draft, floor) = refuse_floor(s, time, run.levels(), decide(s, options, &pilots, vec![])?)?;
             let extend = match draft.best.first() {
                 // an error floor: no pilot level changes that
@@ -284,15 +262,7 @@ fn space_pilot(
             let (order_limit, corner_notes) = observed_limit(s, time, run.levels())?;
             notes.extend(corner_notes);
             let study = run.study();
-            let pilots = Pilots {
-                space: &study,
-                time,
-                step_levels,
-                time_fit,
-                time_ratio: *time_ratio,
-                order_limit,
-                wall: spent,
-            };
+            let pilots = Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, order_limit, wall: spent };
             let (mut done, _) = refuse_floor(s, time, run.levels(), decide(s, options, &pilots, notes)?)?;
             if done.refused.is_none() && (run.levels().len() as u32) < SPACE_LEVELS {
                 done.refused = Some("fewer than four space levels: no asymptotic-range check".into());

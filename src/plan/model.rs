@@ -15,19 +15,10 @@
 //! solve). S = c_S n^a, its exponent a from the two finest space pilot levels where both set-ups are long
 //! enough to be timed ([`MEASURABLE_SETUP`]), else the least growth [`SETUP_EXPONENT`]`.0`, clamped to what
 //! the algorithms do at the plans' sizes: between n^1.2 (measured) and O(n^1.5) (sparse Cholesky of a 2D
-//! mesh). s = a + c n ln n: a fixed overhead a per step (the expression evaluation's threads, the
-//! friction solve's set-up, a step's bookkeeping) and c n ln n, the triangular solves with a
-//! fill-reducing factor of a 2D mesh (the load's quadrature, linear in n, and the friction work, O(n_c²)
-//! per iteration with n_c ∝ √n under uniform refinement, grow no faster). Its samples: on each of two
-//! meshes, the time pilot's and the next finer one (`plan::step_cost`), the levels with at least half
-//! the most steps run there (per-step costs measured over a few steps are dominated by the first steps'
-//! extra Newton iterations and by start-up). The fit is the tightest law below every sample (next
-//! paragraph): among a, c ≥ 0 with a + c mᵢ ≤ sᵢ (m = n ln n) at every sample, a + c m at a plan's m
-//! beyond the samples' is largest for a = 0 and c = minᵢ sᵢ/mᵢ (moving δ from c·m_j to a changes the
-//! plan's prediction by δ(1 − m/m_j) < 0), so s = c n ln n with the smallest implied constant. The
-//! overhead a is what raises the coarse mesh's constant, and the finer mesh's sample, where a weighs
-//! four times less, is what lowers it: on mms_data_front (the loads quadrature at every step) the
-//! refine-2 constant alone over-predicted refine 5's steps 1.6×.
+//! mesh). s = c n ln n, the cost of the triangular solves with a fill-reducing factor of a 2D mesh (the
+//! friction work, O(n_c²) per iteration with n_c ∝ √n under uniform refinement, is smaller), from the time
+//! pilot's levels with at least half the most steps: per-step costs measured over a few steps are dominated
+//! by the first steps' extra Newton iterations and by start-up.
 //!
 //! **Why minima.** Each sample gives the constant it implies, c_S = S/n^a or c = s/(n ln n), and the model
 //! takes the smallest over the samples that measure it (the two finest space levels; the longest time
@@ -167,9 +158,8 @@ pub struct CostModel {
 impl CostModel {
     /// Fit S to the `space` samples: exponent from the two largest n where both set-ups are measurable
     /// ([`MEASURABLE_SETUP`]; else the least, [`SETUP_EXPONENT`]`.0`), clamped to [`SETUP_EXPONENT`], the
-    /// constant the smallest the two imply; and s(n) = c n ln n with c the smallest the `time` samples
-    /// imply that have at least half the most steps run on their mesh (their n), on every mesh sampled
-    /// (module doc: the per-step law, why minima). None without samples.
+    /// constant the smallest the two imply; and s(n) = c n ln n with c the smallest the `time` samples with
+    /// at least half the most steps per set-up imply (module doc: why minima). None without samples.
     pub fn fit(space: &[CostSample], time: &[(CostSample, usize)]) -> Option<CostModel> {
         // a phase too fast for the clock still costs something
         fn floor(t: f64) -> f64 {
@@ -191,11 +181,10 @@ impl CostModel {
         };
         let setup_c = finest.iter().map(|c| floor(c.setup) / c.n.powf(alpha)).reduce(f64::min)?;
         let time: Vec<(CostSample, usize)> = time.iter().copied().filter(|(c, _)| c.n > 1.0).collect();
-        // the long levels of each mesh: at least half the most steps run on that mesh
-        let most = |n: f64| time.iter().filter(|(c, _)| c.n == n).map(|&(_, steps)| steps).max().unwrap_or(0);
+        let most = time.iter().map(|&(_, steps)| steps).max()?;
         let step = time
             .iter()
-            .filter(|&&(c, steps)| 2 * steps >= most(c.n))
+            .filter(|&&(_, steps)| 2 * steps >= most)
             .map(|(c, _)| floor(c.step) / (c.n * c.n.ln()))
             .reduce(f64::min)?;
         Some(CostModel { setup: PowerLaw { c: setup_c, p: alpha }, step })
@@ -268,25 +257,6 @@ mod tests {
         let flat = [CostSample { n: 1e3, setup: 0.2, step: 0.0 }, CostSample { n: 4e3, setup: 0.22, step: 0.0 }];
         assert_eq!(CostModel::fit(&flat, &time).unwrap().setup.p, SETUP_EXPONENT.0);
         assert!(CostModel::fit(&[], &time).is_none() && CostModel::fit(&space, &[]).is_none());
-    }
-
-    /// The system shall take the cost of a step from the finer of two meshes when a fixed per-step
-    /// overhead a inflates the coarse one's: steps s = a + c n ln n with a the cost of 3000 unknowns'
-    /// steps, sampled on n₁ at 64–256 steps and on n₂ = 4n₁ at 32 steps (less than half the coarse mesh's
-    /// most: it is long on its own mesh), predict the finer mesh's implied constant, within a/(c m₂) of
-    /// the true steps at 16n₂ (the overhead's share there), not the coarse one's 1 + a/(c m₁).
-    #[test]
-    fn a_fixed_step_overhead_is_taken_from_the_finer_mesh() {
-        let (c, a) = (1e-8, 1e-8 * 3000.0 * 3000f64.ln());
-        let step = |n: f64| a + c * n * n.ln();
-        let sample = |n: f64| CostSample { n, setup: 1e-6 * n.powf(1.2), step: step(n) };
-        let (n1, n2) = (1552.0, 6176.0);
-        let time = [(sample(n1), 64), (sample(n1), 128), (sample(n1), 256), (sample(n2), 32)];
-        let m = CostModel::fit(&[sample(n1), sample(n2)], &time).unwrap();
-        assert!((m.step - step(n2) / (n2 * n2.ln())).abs() < 1e-12 * m.step, "{m:?}");
-        let n = 16.0 * n2;
-        let over = m.step_at(n) / step(n) - 1.0;
-        assert!(over > 0.0 && over <= a / (c * n2 * n2.ln()), "over-predicted by {over}");
     }
 
     /// A slow sample does not move the model: the finest set-up timed 1.5× slow (noise only adds) leaves the

@@ -4,22 +4,20 @@
 use super::model::{Combine, CostModel, ErrorModel, PowerLaw, TimeError, ORTHOGONAL_BETA};
 use super::pilot::{fit, Fit, Quantity};
 use super::{
-    space_samples, step_samples, Candidate, Options, Plan, EXTENSION_SHARE, MAX_EXTRAPOLATION, MAX_REFINE, MAX_STEPS,
+    samples, space_samples, Candidate, Options, Plan, EXTENSION_SHARE, MAX_EXTRAPOLATION, MAX_REFINE, MAX_STEPS,
     NEGLIGIBLE_SHARE,
 };
 use crate::error::Result;
 use crate::scene::budget::{available_memory, Estimate};
 use crate::scene::{Method, Scene};
 use crate::study::richardson::FS_THREE;
-use crate::study::{LevelResult, Study};
+use crate::study::Study;
 
 /// What the pilot runs gave: the space and time sequences, the time sequence's fit and grid ratio, and
 /// the wall time they took.
 pub(super) struct Pilots<'a> {
     pub(super) space: &'a Study,
     pub(super) time: &'a Study,
-    /// The cost of a step on a second mesh ([`super::step_cost`]).
-    pub(super) step_levels: &'a [LevelResult],
     pub(super) time_fit: &'a Fit,
     pub(super) time_ratio: usize,
     /// min(1, α_min) of the scene ([`super::Plan::order_limit`]).
@@ -29,10 +27,10 @@ pub(super) struct Pilots<'a> {
 
 /// Fit the models to the pilots and search (module doc).
 pub(super) fn decide(s: &Scene, options: &Options, pilots: &Pilots, mut notes: Vec<String>) -> Result<Plan> {
-    let Pilots { space, time, step_levels, time_fit, time_ratio, order_limit, wall } = *pilots;
+    let Pilots { space, time, time_fit, time_ratio, order_limit, wall } = *pilots;
     let space_fit = fit(space, &options.quantity, Some(order_limit))?;
     notes.extend(space_fit.bounded.clone());
-    let cost = CostModel::fit(&space_samples(&space.levels), &step_samples(time, Some(step_levels)));
+    let cost = CostModel::fit(&space_samples(&space.levels), &samples(&time.levels));
     let mut plan = Plan {
         options: options.clone(),
         space: space.clone(),
