@@ -187,3 +187,24 @@ fn refusals_and_bad_input() {
         assert!(err.contains(want), "{args:?}: {err}");
     }
 }
+
+/// Requirement (issue 42): where the pilots see slip on both sides of a polygonised curve's vertex (the
+/// Hertz cylinder's 179.31° vertices, α = π/ω − 1 = 0.0039, the slip paradox: an error floor, not a
+/// rate), the system shall promise no refinement: the plan is refused with exit code 3 and no error model
+/// (so no adaptive route either), the refusal names those vertices (their angle and the sliding pair) and
+/// says why; the vertices the pilots saw separated are not named. Before, refine 0 was planned at 1e-3
+/// from its own estimate, which no floor enters.
+#[test]
+fn a_slip_paradox_floor_is_refused() {
+    let hertz = "verification/cases/hertz_a05.toml";
+    let p = plan(&scene(hertz), &options(1e-3)).unwrap();
+    let why = p.refused.clone().expect("refused");
+    assert!(p.best.is_empty() && p.error.is_none() && p.over_budget.is_none(), "{p:?}");
+    assert!(why.contains("a floor, not a rate") && why.contains("179.31° sliding–sliding"), "{why}");
+    // (0.0121, 0.0001) lies in the contact zone (slip); (0.0846, 0.0036) outside it (separated)
+    assert!(why.contains("(0.0121, 0.0001)") && !why.contains("(0.0846, 0.0036)"), "{why}");
+    let out = bin().args(["plan", hertz, "--target", "1e-3"]).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(3), "{text}");
+    assert!(text.contains("No plan: the error has a floor") && !text.contains("Adaptive route"), "{text}");
+}

@@ -37,3 +37,29 @@ fn a_contact_side_takes_its_worst_condition() {
     assert_eq!(corner["sides"], serde_json::json!(["clamped", "free"]));
     assert!(corner["alpha"].as_f64().unwrap() < 1.0);
 }
+
+/// The system shall mark a point whose exponent gives an error floor rather than a rate (α ≤ 1/12: h^α
+/// falls by less than 2× over the 12 refinements a scene allows): the Hertz cylinder's polygonised arc in
+/// contact has vertices of 179.31° whose sides may both slip, α = π/ω − 1 = 0.0039 (the slip paradox),
+/// and `check` says so; its free arc's vertices (free–free, no exponent below 1) and the L-shape's corner
+/// are not floors.
+#[test]
+fn check_marks_a_slip_paradox_floor() {
+    let s = singular("verification/cases/hertz_a05.toml", "hertz.json");
+    let points = s["points"].as_array().unwrap();
+    let floors: Vec<&serde_json::Value> = points.iter().filter(|p| p["floor"] == true).collect();
+    assert!(!floors.is_empty());
+    for p in &floors {
+        let omega = p["angle"].as_f64().unwrap();
+        assert_eq!(p["sides"], serde_json::json!(["sliding", "sliding"]));
+        assert!(omega < std::f64::consts::PI, "{p}");
+        let alpha = p["alpha"].as_f64().unwrap();
+        assert!((alpha - (std::f64::consts::PI / omega - 1.0)).abs() < 1e-6 && alpha <= 1.0 / 12.0, "{p}");
+    }
+    assert!(points.iter().filter(|p| p["sides"] == serde_json::json!(["free", "free"])).all(|p| p["floor"] == false));
+    let l = singular("verification/cases/mms_lshape.toml", "lshape-floor.json");
+    assert!(l["points"].as_array().unwrap().iter().all(|p| p["floor"] == false));
+    let text = spawn(bin().args(["check", &root("verification/cases/hertz_a05.toml")])).wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("polygonised curve: slip-paradox floor"), "{text}");
+}

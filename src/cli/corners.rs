@@ -1,10 +1,12 @@
 //! `check`'s singular exponents: one line per polygon corner and change of condition, with the leading
 //! exponent α of plane-strain elasticity there ([`tresca_cr::fem::singular`]), and the orders that
 //! follow from the smallest: min(1, Re α) in h under uniform refinement, N^(−1/2) in the unknowns N under
-//! adaptive refinement.
+//! adaptive refinement. Points whose α gives an error floor rather than a rate
+//! ([`tresca_cr::fem::singular::FLOOR_EXPONENT`]: a polygonised curve's vertices between sliding sides,
+//! the slip paradox) are marked and counted apart.
 
 use super::summary::{Singular, SingularPoint};
-use tresca_cr::fem::singular::{uniform_order, Singularity};
+use tresca_cr::fem::singular::{uniform_order, Singularity, FLOOR_EXPONENT};
 use tresca_cr::scene::{Part, PartKind};
 
 /// The human lines (the first a header) and the `--json` record.
@@ -16,6 +18,14 @@ pub fn describe(points: &[Singularity], parts: &[Part]) -> (Vec<String>, Singula
          adaptive O(N^-0.5)",
         points.len()
     ));
+    let floors = points.iter().filter(|s| s.floor()).count();
+    if floors > 0 {
+        lines.push(format!(
+            "           {floors} of them with α ≤ {FLOOR_EXPONENT:.4} (polygonised curve: slip-paradox floor): an error \
+             floor of about c√(2μαω) (c the tangential displacement there), not a rate; `plan` refuses the scene where \
+             its pilots see slip on both sides of one"
+        ));
+    }
     let mut json = Singular { points: Vec::new(), uniform_order: order, adaptive_order: 0.5 };
     for s in points {
         let names = s.parts.map(|p| parts[p].name.as_str());
@@ -27,8 +37,9 @@ pub fn describe(points: &[Singularity], parts: &[Part]) -> (Vec<String>, Singula
         let contact = s.parts.iter().any(|&p| matches!(parts[p].kind, PartKind::Contact(_)));
         let how =
             if contact { "  (contact: the bound over stick and slip; `plan` uses its pilots' states)" } else { "" };
+        let floor = if s.floor() { "  polygonised curve: slip-paradox floor" } else { "" };
         lines.push(format!(
-            "           ({:.6}, {:.6}) angle {:>7.2}°  {}–{} ({}–{})  alpha = {alpha}{how}",
+            "           ({:.6}, {:.6}) angle {:>7.2}°  {}–{} ({}–{})  alpha = {alpha}{floor}{how}",
             s.point[0],
             s.point[1],
             s.angle.to_degrees(),
@@ -45,6 +56,7 @@ pub fn describe(points: &[Singularity], parts: &[Part]) -> (Vec<String>, Singula
             sides: s.sides.map(|x| x.name().to_string()),
             alpha: s.alpha.map(|a| a.re),
             alpha_imag: s.alpha.map(|a| a.im),
+            floor: s.floor(),
         });
     }
     (lines, json)

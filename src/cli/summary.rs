@@ -23,7 +23,8 @@
 //! would report them; `steps`; `solver`, `tol`,
 //! `max_iter`; `exact` (true errors computed); `setup` ([`Phases`], of the level set up); `memory`, `disk`: the pre-run estimate
 //! of the peak memory and of the results file (bytes); `singular` ([`Singular`]): every polygon corner and
-//! change of condition with its leading exponent α, `uniform_order` = min(1, min Re α), `adaptive_order` ½.
+//! change of condition with its leading exponent α and `floor` (α ≤ `fem::singular::FLOOR_EXPONENT`: an error
+//! floor, not a rate), `uniform_order` = min(1, min Re α), `adaptive_order` ½.
 //!
 //! `run` ([`RunSummary`]): `refine` (the mesh level), `unknowns`, `paper_dofs`, `contact_edges`, `steps` (time
 //! steps of the run); `solver`, `tol`; `setup` ([`Phases`]); `ordering` (how K's fill-reducing ordering
@@ -240,6 +241,10 @@ pub struct SingularPoint {
     pub sides: [String; 2],
     pub alpha: Option<f64>,
     pub alpha_imag: Option<f64>,
+    /// α ≤ `fem::singular::FLOOR_EXPONENT`: an error floor, not a rate (a polygonised curve's vertex
+    /// between sliding sides); `plan` refuses where its pilots confirm one.
+    #[serde(default)]
+    pub floor: bool,
 }
 
 /// One time step's statistics.

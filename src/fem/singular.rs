@@ -6,6 +6,13 @@
 //! part may stick (clamped, the tangential motion held) or slip (sliding, u·n given and σ_τ = ±g_a, data
 //! that do not change the exponent): its bound is the smaller of the two. Adaptive refinement that
 //! resolves the singularities reaches N^(−1/2) in the number of unknowns N whatever α.
+//!
+//! **A floor, not a rate.** An exponent at most [`FLOOR_EXPONENT`] lowers the error by less than 2× over
+//! every uniform refinement a scene allows (h^α over [`crate::scene::MAX_REFINE`] halvings: 2^{α·12} ≤ 2).
+//! It arises where two sliding sides (contact that slips, symmetry) meet at an angle ω just below π,
+//! α = π/ω − 1: the vertices of a polygonised curve (`docs/plan.md`, the slip paradox), whose singular
+//! part carries an energy 2μc²αω R^{2α} within R of the vertex, all of it at scales no mesh resolves:
+//! an error floor of about c√(2μαω) (c the tangential displacement there) that no refinement lowers.
 
 use super::space::CrSpace;
 use super::williams::{leading_exponent, Side};
@@ -31,10 +38,19 @@ pub struct Singularity {
     pub observed: bool,
 }
 
+/// The exponent up to which a point gives an error floor rather than a rate (module doc): h^α falls by at
+/// most 2× over [`crate::scene::MAX_REFINE`] halvings of h.
+pub const FLOOR_EXPONENT: f64 = 1.0 / crate::scene::MAX_REFINE as f64;
+
 impl Singularity {
     /// min(1, Re α): the energy-norm order in h that uniform refinement reaches near this point.
     pub fn uniform_order(&self) -> f64 {
         self.alpha.map_or(1.0, |a| a.re.min(1.0))
+    }
+
+    /// Whether the point gives an error floor, not a rate (Re α ≤ [`FLOOR_EXPONENT`], module doc).
+    pub fn floor(&self) -> bool {
+        self.uniform_order() <= FLOOR_EXPONENT
     }
 }
 

@@ -238,8 +238,10 @@ fn space_pilot(
             let study = run.study();
             let pilots =
                 Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, order_limit, wall: spent + run.spent };
-            let draft = decide(s, options, &pilots, vec![])?;
+            let (draft, floor) = refuse_floor(s, time, run.levels(), decide(s, options, &pilots, vec![])?)?;
             let extend = match draft.best.first() {
+                // an error floor: no pilot level changes that
+                _ if floor => false,
                 // not yet in the asymptotic range, or bounded only for want of consistent estimates
                 _ if draft.space_fit.not_in_range().is_some() || draft.space_fit.unsettled => true,
                 Some(b) => b.refine > r - 1 + MAX_EXTRAPOLATION && predicted(r) <= EXTENSION_SHARE * b.wall,
@@ -261,7 +263,7 @@ fn space_pilot(
             notes.extend(corner_notes);
             let study = run.study();
             let pilots = Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, order_limit, wall: spent };
-            let mut done = decide(s, options, &pilots, notes)?;
+            let (mut done, _) = refuse_floor(s, time, run.levels(), decide(s, options, &pilots, notes)?)?;
             if done.refused.is_none() && (run.levels().len() as u32) < SPACE_LEVELS {
                 done.refused = Some("fewer than four space levels: no asymptotic-range check".into());
                 done.best.clear();
@@ -277,6 +279,16 @@ fn space_pilot(
 fn observed_limit(s: &Scene, time: &Study, space: &[LevelResult]) -> Result<(f64, Vec<String>)> {
     let levels: Vec<&LevelResult> = time.levels.iter().chain(space).collect();
     corners::order_limit(s, &levels)
+}
+
+/// `plan` refused, with no error model, when the pilots' states give an error floor
+/// ([`corners::floor_refusal`]), and whether it was.
+fn refuse_floor(s: &Scene, time: &Study, space: &[LevelResult], mut plan: Plan) -> Result<(Plan, bool)> {
+    let levels: Vec<&LevelResult> = time.levels.iter().chain(space).collect();
+    let Some(why) = corners::floor_refusal(s, &levels)? else { return Ok((plan, false)) };
+    plan.refused = Some(why);
+    (plan.best, plan.over_budget, plan.error) = (vec![], None, None);
+    Ok((plan, true))
 }
 
 /// The time pilot's first grid: N/2^j for the largest j ≤ 4 that divides N and leaves at least

@@ -25,8 +25,9 @@ def rows(scene):
         a = p["alpha"]
         alpha = "none below 1" if a is None else (f"{a:.6f}" if not p["alpha_imag"] else
                                                  f"{a:.6f} ± {p['alpha_imag']:.6f}i")
+        floor = " (floor: slip paradox)" if p.get("floor") else ""
         out.append(f"({p['x']:.4g}, {p['y']:.4g}) | {p['angle'] * 180 / 3.141592653589793:.2f}° | "
-                   f"{' – '.join(p['parts'])} | {' – '.join(p['sides'])} | {alpha}")
+                   f"{' – '.join(p['parts'])} | {' – '.join(p['sides'])} | {alpha}{floor}")
     return sing["uniform_order"], out
 
 
@@ -42,7 +43,9 @@ def main(argv=None):
           "pair of side conditions and ν; `src/fem/williams.rs`); the sides are the pair that gives it (a contact "
           "side: the worse of stick = clamped and slip = sliding; `tresca-cr plan` takes its pilots' states "
           "instead, `docs/plan.md`). Order: min(1, α_min), the energy-norm order in h of uniform refinement; "
-          "adaptive refinement reaches N^(−1/2) in every scene.", ""]
+          "adaptive refinement reaches N^(−1/2) in every scene. \"floor\": α ≤ 1/12 (`check.singular`'s "
+          "`floor`), an error floor, not a rate (a polygonised curve's vertex between sliding sides: the slip "
+          "paradox); `tresca-cr plan` refuses a scene where its pilots see one (`docs/plan.md`).", ""]
     for scene in sorted(glob.glob(os.path.join(CASES, "*.toml"))):
         name = os.path.relpath(scene, ROOT)
         order, pts = rows(scene)

@@ -59,6 +59,7 @@ fn summary_round_trips_through_json() {
                 sides: ["free".into(), "free".into()],
                 alpha: Some(0.5445),
                 alpha_imag: Some(0.0),
+                floor: false,
             }],
             uniform_order: 0.5445,
             adaptive_order: 0.5,
