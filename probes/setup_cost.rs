@@ -115,14 +115,13 @@ struct Clock(f64, f64);
 
 impl Clock {
     fn read() -> (f64, f64) {
-        // SAFETY: plain system calls filling the structs given.
-        unsafe {
-            let mut ts: libc::timespec = std::mem::zeroed();
-            libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts);
+        // SAFETY: a plain system call filling the struct given.
+        let ru = unsafe {
             let mut ru: libc::rusage = std::mem::zeroed();
             libc::getrusage(libc::RUSAGE_THREAD, &mut ru);
-            (ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9, ru.ru_minflt as f64)
-        }
+            ru
+        };
+        (tresca_cr::machine::thread_cpu_seconds(), ru.ru_minflt as f64)
     }
     fn now() -> Clock {
         let (c, f) = Clock::read();
