@@ -208,3 +208,24 @@ fn a_slip_paradox_floor_is_refused() {
     assert_eq!(out.status.code(), Some(3), "{text}");
     assert!(text.contains("No plan: the error has a floor") && !text.contains("Adaptive route"), "{text}");
 }
+
+/// Requirement: the system shall time a step as `tresca-cr run` pays it (u formed at the last step only,
+/// the energy audit of every step) on the time pilot's cached set-up: `plan::step_cost::run_steps` gives
+/// `REPEATS` samples of the mesh's unknowns and the asked steps, each a finite positive cost per step, and
+/// makes no set-up or factorisation of its own.
+#[test]
+fn the_step_cost_is_timed_on_the_runs_path_on_the_cached_set_up() {
+    use tresca_cr::plan::step_cost::{run_steps, REPEATS};
+    use tresca_cr::study::SetupCache;
+    let mut s = scene("verification/cases/mms_data_front.toml");
+    s.set_refine(1).unwrap();
+    let cache = SetupCache::default();
+    let n = cache.problem(s.clone(), 1).unwrap().space.n_dofs as f64;
+    let (factorised, made) = (cache.factorised(), cache.problems());
+    let (samples, spent) = run_steps(&s, 1, 32, &cache).unwrap();
+    assert_eq!(samples.len(), REPEATS);
+    assert!(samples.iter().all(|(c, steps)| c.n == n && *steps == 32 && c.step.is_finite() && c.step > 0.0));
+    assert!(spent.is_finite() && spent >= samples.iter().map(|(c, _)| c.step * 32.0).sum::<f64>());
+    assert_eq!(cache.factorised(), factorised, "the timed runs take the cached set-up");
+    assert_eq!(cache.problems(), made + REPEATS);
+}

@@ -28,6 +28,7 @@ pub mod corners;
 pub mod model;
 pub mod pilot;
 mod search;
+pub mod step_cost;
 pub mod two_term;
 
 use crate::error::{Error, Result};
@@ -36,7 +37,7 @@ use crate::scene::{Method, Scene};
 use crate::study::SetupCache;
 use crate::study::{Level, LevelResult, Study};
 use model::{CostModel, CostSample, ErrorModel, TimeError};
-use pilot::{fit, pilot_scene, time_pilot, Fit, Quantity, Runner, TimeGrids};
+use pilot::{fit, pilot_scene, time_pilot, Fit, Quantity, Runner, TimeGrids, TimePilot};
 use search::{decide, Pilots};
 
 /// Levels of the space pilot before any extension (four: the asymptotic check needs a fourth level).
@@ -119,20 +120,17 @@ pub struct Plan {
     pub refused: Option<String>,
 }
 
-/// Cost samples of pilot levels, with their steps.
-pub(crate) fn samples(levels: &[LevelResult]) -> Vec<(CostSample, usize)> {
+/// Cost samples of the space pilot's levels: unknowns, set-up seconds (a run of the level alone, also
+/// where the pilot shared its mesh's set-up) and seconds per step.
+pub(crate) fn space_samples(levels: &[LevelResult]) -> Vec<CostSample> {
     levels
         .iter()
-        .map(|r| {
-            let step = (r.wall - r.setup).max(0.0) / r.steps as f64;
-            // the set-up of a run of the level alone, also where the pilot shared its mesh's set-up
-            (CostSample { n: r.dofs as f64, setup: r.setup + r.reused_setup, step }, r.steps)
+        .map(|r| CostSample {
+            n: r.dofs as f64,
+            setup: r.setup + r.reused_setup,
+            step: (r.wall - r.setup).max(0.0) / r.steps as f64,
         })
         .collect()
-}
-
-pub(crate) fn space_samples(levels: &[LevelResult]) -> Vec<CostSample> {
-    samples(levels).into_iter().map(|(c, _)| c).collect()
 }
 
 /// Make the plan (module doc).
@@ -161,7 +159,7 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         options.pilot_budget,
         cache,
     )?;
-    let (time, _, spent) = &time_pilot_run;
+    let TimePilot { study: time, spent, .. } = &time_pilot_run;
     let time_fit = fit(time, q, None)?;
     let mesh = time.levels[0].refine;
     let on_mesh = |p: &Plan| {
@@ -179,7 +177,7 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
         let t_total = s.times[n0] - s.times[0];
         let mut n = nt;
         while n < n0 || (law.at(t_total / n as f64) > LAW_SAMPLING_SHARE * e && n < MAX_STEPS) {
-            n *= time_pilot_run.1;
+            n *= time_pilot_run.ratio;
         }
         if n == n0 {
             return Ok(first);
@@ -220,7 +218,7 @@ pub fn plan_with_cache(scene: &Scene, options: &Options, cache: &SetupCache) -> 
 fn space_pilot(
     s: &Scene,
     options: &Options,
-    (time, time_ratio, _): &(Study, usize, f64),
+    TimePilot { study: time, ratio: time_ratio, step_costs, .. }: &TimePilot,
     time_fit: &Fit,
     nh: usize,
     mut spent: f64,
@@ -231,13 +229,20 @@ fn space_pilot(
     let mut notes = Vec::new();
     let mut r = r0;
     loop {
-        let cost = CostModel::fit(&space_samples(run.levels()), &samples(&time.levels));
+        let cost = CostModel::fit(&space_samples(run.levels()), step_costs);
         let predicted = |r: u32| cost.map_or(0.0, |c| c.predict(unknowns(s, r).unwrap_or(0) as f64, nh));
         if run.levels().len() as u32 >= SPACE_LEVELS {
             let (order_limit, corner_notes) = observed_limit(s, time, run.levels())?;
             let study = run.study();
-            let pilots =
-                Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, order_limit, wall: spent + run.spent };
+            let pilots = Pilots {
+                space: &study,
+                time,
+                step_costs,
+                time_fit,
+                time_ratio: *time_ratio,
+                order_limit,
+                wall: spent + run.spent,
+            };
             let (draft, floor) = refuse_floor(s, time, run.levels(), decide(s, options, &pilots, vec![])?)?;
             let extend = match draft.best.first() {
                 // an error floor: no pilot level changes that
@@ -262,7 +267,8 @@ fn space_pilot(
             let (order_limit, corner_notes) = observed_limit(s, time, run.levels())?;
             notes.extend(corner_notes);
             let study = run.study();
-            let pilots = Pilots { space: &study, time, time_fit, time_ratio: *time_ratio, order_limit, wall: spent };
+            let pilots =
+                Pilots { space: &study, time, step_costs, time_fit, time_ratio: *time_ratio, order_limit, wall: spent };
             let (mut done, _) = refuse_floor(s, time, run.levels(), decide(s, options, &pilots, notes)?)?;
             if done.refused.is_none() && (run.levels().len() as u32) < SPACE_LEVELS {
                 done.refused = Some("fewer than four space levels: no asymptotic-range check".into());

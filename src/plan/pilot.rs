@@ -10,7 +10,7 @@
 //!   fraction θ of the step alternates under doubling, see `verification/cases/mms_stop.toml`): the time
 //!   error C_k k^q of the space-discrete problem.
 
-use super::model::TimeError;
+use super::model::{CostSample, TimeError};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 use crate::study::estimate::level_errors;
@@ -341,8 +341,8 @@ pub struct TimeGrids {
 
 /// `steps` (at least four), then N, 4N, 16N, 64N from `first` if the doubling sequence is not in the
 /// asymptotic range (module doc) and its distances do not already bound the time error of grids of
-/// `steps` steps or more by `enough` ([`Fit::time_bound`]). Returns the study, the ratio used and the
-/// seconds spent; the levels' set-ups come from `cache`. (On a coarser mesh the time grids move the solution more — a stick–slip front crosses
+/// `steps` steps or more by `enough` ([`Fit::time_bound`]); then the run's cost of a step on its mesh
+/// ([`super::step_cost`]). The levels' set-ups come from `cache`. (On a coarser mesh the time grids move the solution more — a stick–slip front crosses
 /// fewer, larger edges — so the bound would be looser and the space pilot could not sample time coarsely.)
 pub fn time_pilot(
     scene: &Scene,
@@ -351,7 +351,7 @@ pub fn time_pilot(
     enough: f64,
     budget: f64,
     cache: &SetupCache,
-) -> Result<(Study, usize, f64)> {
+) -> Result<TimePilot> {
     let TimeGrids { refine, first, steps } = grids;
     let mut spent = 0.0;
     let mut last = None;
@@ -383,5 +383,16 @@ pub fn time_pilot(
         }
     }
     let (study, ratio) = last.expect("two ratios tried");
-    Ok((study, ratio, spent))
+    let longest = study.levels.iter().map(|l| l.steps).max().unwrap_or(steps);
+    let (step_costs, timed) = super::step_cost::run_steps(scene, refine, longest, cache)?;
+    Ok(TimePilot { study, ratio, spent: spent + timed, step_costs })
+}
+
+/// What the time pilot gives: its study, the ratio of its grids, the seconds it took (the timed runs
+/// included) and the run's per-step cost samples on its mesh ([`super::step_cost::run_steps`]).
+pub struct TimePilot {
+    pub study: Study,
+    pub ratio: usize,
+    pub spent: f64,
+    pub step_costs: Vec<(CostSample, usize)>,
 }

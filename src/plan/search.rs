@@ -1,10 +1,10 @@
 //! Step 3 of the planner (see the parent module): fit the error and cost models to the pilots and search
 //! the configurations, cheapest first, for the plan, its runners-up or the refusal.
 
-use super::model::{Combine, CostModel, ErrorModel, PowerLaw, TimeError, ORTHOGONAL_BETA};
+use super::model::{Combine, CostModel, CostSample, ErrorModel, PowerLaw, TimeError, ORTHOGONAL_BETA};
 use super::pilot::{fit, Fit, Quantity};
 use super::{
-    samples, space_samples, Candidate, Options, Plan, EXTENSION_SHARE, MAX_EXTRAPOLATION, MAX_REFINE, MAX_STEPS,
+    space_samples, Candidate, Options, Plan, EXTENSION_SHARE, MAX_EXTRAPOLATION, MAX_REFINE, MAX_STEPS,
     NEGLIGIBLE_SHARE,
 };
 use crate::error::Result;
@@ -18,6 +18,8 @@ use crate::study::Study;
 pub(super) struct Pilots<'a> {
     pub(super) space: &'a Study,
     pub(super) time: &'a Study,
+    /// The run's per-step cost samples on the time pilot's mesh ([`super::step_cost`]).
+    pub(super) step_costs: &'a [(CostSample, usize)],
     pub(super) time_fit: &'a Fit,
     pub(super) time_ratio: usize,
     /// min(1, α_min) of the scene ([`super::Plan::order_limit`]).
@@ -27,10 +29,10 @@ pub(super) struct Pilots<'a> {
 
 /// Fit the models to the pilots and search (module doc).
 pub(super) fn decide(s: &Scene, options: &Options, pilots: &Pilots, mut notes: Vec<String>) -> Result<Plan> {
-    let Pilots { space, time, time_fit, time_ratio, order_limit, wall } = *pilots;
+    let Pilots { space, time, step_costs, time_fit, time_ratio, order_limit, wall } = *pilots;
     let space_fit = fit(space, &options.quantity, Some(order_limit))?;
     notes.extend(space_fit.bounded.clone());
-    let cost = CostModel::fit(&space_samples(&space.levels), &samples(&time.levels));
+    let cost = CostModel::fit(&space_samples(&space.levels), step_costs);
     let mut plan = Plan {
         options: options.clone(),
         space: space.clone(),
