@@ -36,9 +36,9 @@ pub(super) fn amd_order(q: &Graph, control: amd::Control) -> Result<Vec<usize>> 
     Ok(q.expand(fwd.into_iter()))
 }
 
-/// Below this many unknowns K is ordered by AMD: METIS's own cost would exceed what its better ordering
-/// saves in the numeric factorisation (benchmark, medians of 3: at 394k unknowns the set-up took 12.3 s
-/// with METIS against 8.7 s with AMD; at 1.57M, 64 s against 73 s).
+/// Below this many unknowns K is ordered by AMD. The coordinate dissection needs fewer flops from a few
+/// 100,000 unknowns on, but there it saves only a few per cent of the set-up, and a lower threshold would
+/// change the factor's rounding of every run it reaches (measurement: reference/performance.md §9).
 pub const ND_MIN_SIZE: usize = 1_000_000;
 
 /// Fixed METIS seed: the ordering, hence every result, is reproducible.
