@@ -211,19 +211,25 @@ fn a_slip_paradox_floor_is_refused() {
 
 /// Requirement: the system shall time a step as `tresca-cr run` pays it (u formed at the last step only,
 /// the energy audit of every step) on the time pilot's cached set-up: `plan::step_cost::run_steps` gives
-/// `REPEATS` samples of the mesh's unknowns and the asked steps, each a finite positive cost per step, and
-/// makes no set-up or factorisation of its own.
+/// `REPEATS` samples of the level's unknowns and steps, each a finite positive cost per step, and makes no
+/// set-up or factorisation of its own; and it shall keep within the pilot budget: with no room left it
+/// runs nothing.
 #[test]
-fn the_step_cost_is_timed_on_the_runs_path_on_the_cached_set_up() {
+fn the_step_cost_is_timed_on_the_runs_path_within_the_pilot_budget() {
+    use tresca_cr::plan::pilot::Runner;
     use tresca_cr::plan::step_cost::{run_steps, REPEATS};
-    use tresca_cr::study::SetupCache;
-    let mut s = scene("verification/cases/mms_data_front.toml");
-    s.set_refine(1).unwrap();
+    use tresca_cr::study::{Level, SetupCache};
+    let s = scene("verification/cases/mms_data_front.toml");
     let cache = SetupCache::default();
-    let n = cache.problem(s.clone(), 1).unwrap().space.n_dofs as f64;
+    let mut pilot = Runner::new(&s, 32, &cache).unwrap();
+    assert!(pilot.push(Level { refine: 1, steps: 32 }, 0.0, f64::INFINITY).unwrap().is_none());
+    let level = pilot.levels()[0].clone();
     let (factorised, made) = (cache.factorised(), cache.problems());
-    let (samples, spent) = run_steps(&s, 1, 32, &cache).unwrap();
+    let (none, spent) = run_steps(&s, &level, 1e-3, 0.0, &cache).unwrap();
+    assert!(none.is_empty() && spent == 0.0 && cache.problems() == made, "no room in the budget: no run");
+    let (samples, spent) = run_steps(&s, &level, 1e-3, f64::INFINITY, &cache).unwrap();
     assert_eq!(samples.len(), REPEATS);
+    let n = level.dofs as f64;
     assert!(samples.iter().all(|(c, steps)| c.n == n && *steps == 32 && c.step.is_finite() && c.step > 0.0));
     assert!(spent.is_finite() && spent >= samples.iter().map(|(c, _)| c.step * 32.0).sum::<f64>());
     assert_eq!(cache.factorised(), factorised, "the timed runs take the cached set-up");

@@ -383,8 +383,14 @@ pub fn time_pilot(
         }
     }
     let (study, ratio) = last.expect("two ratios tried");
-    let longest = study.levels.iter().map(|l| l.steps).max().unwrap_or(steps);
-    let (step_costs, timed) = super::step_cost::run_steps(scene, refine, longest, cache)?;
+    let longest = study.levels.iter().max_by_key(|l| l.steps).expect("the time pilot ran a level");
+    let own = (longest.wall - longest.setup).max(0.0);
+    let (mut step_costs, timed) = super::step_cost::run_steps(scene, longest, own, budget - spent, cache)?;
+    if step_costs.is_empty() {
+        // no timed run fits in the pilot budget: the longest level's own steps (`super::step_cost` doc)
+        let n = longest.dofs as f64;
+        step_costs.push((CostSample { n, setup: 0.0, step: own / longest.steps as f64 }, longest.steps));
+    }
     Ok(TimePilot { study, ratio, spent: spent + timed, step_costs })
 }
 

@@ -11,6 +11,9 @@
 //! scenes' few steps (4 on mms_stop) step 0 would otherwise be most of the sample. Each gives a sample and the cost model keeps the smallest
 //! (`super::model` module doc, "Why minima": noise only slows a timing down).
 //!
+//! The timed runs count against the pilot budget: a run starts only if the level's own time fits in what
+//! is left. Where none fits, the model takes the level's own steps, as it did before these runs.
+//!
 //! What the prediction then covers: the printed command on a scene without `[exact]` and `[output]`.
 //! True errors (formed at every step with `[exact]`) and a results file add to the steps' cost.
 
@@ -18,28 +21,32 @@ use super::model::CostSample;
 use crate::error::Result;
 use crate::scene::Scene;
 use crate::stepping::RunOptions;
-use crate::study::SetupCache;
+use crate::study::{LevelResult, SetupCache};
 use std::time::Instant;
 
 /// Timed runs of the scene's steps; the smallest per-step cost is the model's.
 pub const REPEATS: usize = 3;
 
-/// [`REPEATS`] per-step samples (with their steps, for [`super::model::CostModel::fit`]) of `scene` at
-/// `refine` with `steps` steps, run as `tresca-cr run` runs without a results file or true errors, and
-/// the seconds they took in all.
+/// Up to [`REPEATS`] per-step samples (with their steps, for [`super::model::CostModel::fit`]) of `scene`
+/// on the mesh and grid of the pilot level `level`, run as `tresca-cr run` runs without a results file or
+/// true errors, and the seconds they took in all. A run is started only while the seconds spent plus
+/// `expected` (the level's own time after its set-up) stay within `budget`: none where the pilot budget
+/// has no room left, and the caller falls back to the level's own steps.
 pub fn run_steps(
     scene: &Scene,
-    refine: u32,
-    steps: usize,
+    level: &LevelResult,
+    expected: f64,
+    budget: f64,
     cache: &SetupCache,
 ) -> Result<(Vec<(CostSample, usize)>, f64)> {
+    let (refine, steps) = (level.refine, level.steps);
     let mut s = scene.clone();
     s.set_refine(refine)?;
     s.set_steps(steps)?;
     s.exact = None;
     let mut samples = Vec::with_capacity(REPEATS);
     let mut spent = 0.0;
-    for _ in 0..REPEATS {
+    while samples.len() < REPEATS && spent + expected <= budget {
         let problem = cache.problem(s.clone(), refine)?;
         let last = problem.n_steps();
         let begun = Instant::now();
