@@ -4,6 +4,7 @@ import subprocess
 import sys
 
 import h5py
+import numpy as np
 import pytest
 
 from tresca_py import audit
@@ -68,3 +69,16 @@ def test_the_system_shall_allow_rounding_that_grows_with_unknowns_stiffness_and_
     with h5py.File(bare, "w") as f:
         f.create_group("tresca")
     assert audit.rounding(bare, 1.0) == 0.0
+
+
+def test_the_system_shall_hold_the_stored_residual_to_its_terms_within_the_rounding_of_n_term_sums():
+    """The identity balance_residual = ΔE + D + j − W − W_Γ holds up to ``IDENTITY_REL`` plus the run's rounding
+    allowance (N ε grows with the unknowns), and a residual off by more is reported."""
+    e = np.array([0.0, 1.0e-3, 1.3e-3])
+    a = {"external_work": np.array([0.0, 1.0e-3, 3.0e-4]), "boundary_work": np.zeros(3), "stored_energy": e,
+         "friction_dissipation": np.zeros(3), "euler_dissipation": np.zeros(3), "balance_residual": np.zeros(3)}
+    allowance = 2e-11
+    for off, reported in ((0.5 * allowance, False), (2.0 * (audit.IDENTITY_REL + allowance), True)):
+        a["balance_residual"] = np.array([0.0, 0.0, off * 1.3e-3])
+        found = [m for m in audit.problems(a, allowance) if "differs" in m]
+        assert bool(found) == reported, (off, found)

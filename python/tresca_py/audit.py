@@ -98,7 +98,10 @@ def largest_work(a):
 
 def problems(a, allowance=0.0):
     """The audit's violations as messages (empty when the balance holds); ``allowance``: the run's
-    :func:`rounding`, added to ``BALANCE_REL``."""
+    :func:`rounding`, added to ``BALANCE_REL`` and to ``IDENTITY_REL``: the stored residual is formed from
+    matrix-free sums over the unknowns (a_h(uⁿ,δuⁿ), src/stepping/audit.rs), the identity here from the stored
+    energies, and the two differ by the rounding of those sums, which grows like N ε (observed: 2.9e-12 of
+    the terms at 49,280 unknowns, coulomb_block refine 5)."""
     out = []
     if any(not np.all(np.isfinite(v)) for v in a.values()):
         return ["energy audit: a series holds NaN or Inf"]
@@ -109,7 +112,7 @@ def problems(a, allowance=0.0):
     ident = (np.diff(a["stored_energy"]) + a["euler_dissipation"][1:] + a["friction_dissipation"][1:]
              - a["external_work"][1:] - a["boundary_work"][1:])
     err = float(np.max(np.abs(ident - a["balance_residual"][1:])))
-    if err > IDENTITY_REL * terms:
+    if err > (IDENTITY_REL + allowance) * terms:
         out.append(f"energy audit: balance_residual differs from ΔE + D + j − W − W_Γ by {err:.3e} "
                    f"(terms up to {terms:.3e})")
     res = float(np.max(np.abs(a["balance_residual"])))
