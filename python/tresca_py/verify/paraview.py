@@ -213,7 +213,12 @@ def check_files(ss, files, me):
             os.remove(png)
         p = ss.pvpython([os.path.join(ROOT, "scripts", "paraview_view.py"), os.path.relpath(h5, ROOT), "-o", png],
                         cwd=ROOT)
-        ss.check(p.returncode == 0, f"{label}: paraview_view.py exit {p.returncode} {p.stderr.strip()[-300:]}")
+        if p.returncode != 0:
+            # pvpython's whole report (a signal's stack trace is longer than the message keeps)
+            with open(os.path.join(OUT, f"{label}.stderr.txt"), "w") as f:
+                f.write(p.stderr)
+        ss.check(p.returncode == 0, f"{label}: paraview_view.py exit {p.returncode} (stderr in out/paraview/"
+                 f"{label}.stderr.txt) {p.stderr.strip()[-300:]}")
         picture(ss, label, png)
 
 
