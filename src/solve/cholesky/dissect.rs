@@ -7,15 +7,16 @@
 //! fewer entries of L than those vertices).
 //!
 //! The direction: sets of [`SEARCH_MIN`] vertices or more are cut along the direction, among those
-//! searched ([`Work::thinnest_cut`]), whose cut has the smallest separator; smaller sets across the
+//! searched (`super::direction`), whose cut has the smallest separator; smaller sets across the
 //! longer side of their bounding box. The thickness of a separator depends on the direction of the cut
 //! against the mesh: K of Crouzeix–Raviart with the jump term couples the edges of neighbouring
 //! triangles, and on Example 5.1's grid of squares cut by one diagonal a cut along an axis needs three
 //! edges per square it crosses: 1,535 for the first cut at 1.57 M unknowns, where a cut turned by 30°
-//! from the x axis needs 1,319 (of 24 directions tried). METIS finds such cuts too; the search finds
-//! them at an eighth of its cost (1.0 s of CPU against 8.1 s). On that matrix the factorisation has 20 % fewer flops (4.53e11 against 5.68e11; METIS's
-//! ordering 4.97e11) and L 7.6 % fewer stored entries (`probes/setup_cost.rs ... nd symbolic`; figures
-//! in reference/performance.md §9).
+//! from the x axis needs 1,319 (of 24 directions tried). METIS finds such cuts too; the search
+//! ([`super::direction`]) finds them at about a tenth of its cost (0.7–1.1 s of CPU against 8.1 s). On
+//! that matrix the factorisation has 20 % fewer flops (4.53e11 against 5.68e11; METIS's ordering
+//! 4.97e11) and L 8 % fewer stored entries (`probes/setup_cost.rs ... nd symbolic`; figures in
+//! reference/performance.md §9).
 //!
 //! Why: on a 2D mesh the straight cut is a separator of O(√n) vertices, as nested dissection needs for
 //! its O(n log n) fill, and it costs O(n log n) comparisons in all. METIS_NodeND finds separators of
@@ -27,38 +28,15 @@
 //! ordering depends only on the graph and the points.
 
 use super::cover;
+use super::direction::SEARCH_MIN;
 use super::ordering::Graph;
 use std::cmp::Ordering;
 
 /// Sets of at most this many vertices are not dissected further.
 const LEAF: usize = 32;
 
-/// Sets of at least this many vertices are cut across the direction, of [`ANGLES`], with the thinnest
-/// separator ([`Work::thinnest_cut`]); smaller ones across the longer side of their bounding box.
-const SEARCH_MIN: usize = 2000;
-
-/// The directions of the cuts searched: evenly spread over a half turn, the axes among them.
-const ANGLES: usize = 8;
-
-/// Refinements of the best direction, each turning it by ± half the last step.
-const REFINE: usize = 1;
-
-/// The median of a cut searched is that of every `SAMPLE`-th vertex's key.
-const SAMPLE: usize = 16;
-
 /// The normals of the cuts across the longer side: x (a cut at x = c) and y.
-const AXES: [[f64; 2]; 2] = [[1.0, 0.0], [0.0, 1.0]];
-
-/// The unit normal at angle t to the x axis, the axes exactly.
-fn direction(t: f64) -> [f64; 2] {
-    if t == 0.0 {
-        AXES[0]
-    } else if t == std::f64::consts::FRAC_PI_2 {
-        AXES[1]
-    } else {
-        [t.cos(), t.sin()]
-    }
-}
+pub(super) const AXES: [[f64; 2]; 2] = [[1.0, 0.0], [0.0, 1.0]];
 
 /// The longest distance between the points of adjacent vertices of `q` (a little more, for the rounding
 /// of the keys): no edge of the graph joins vertices whose keys differ by more.
@@ -97,29 +75,29 @@ pub fn coordinate_dissection(q: &Graph, points: &[[f64; 2]]) -> Option<Vec<usize
     Some(work.out)
 }
 
-struct Work<'a> {
+pub(super) struct Work<'a> {
+    pub(super) points: &'a [[f64; 2]],
     q: &'a Graph,
-    points: &'a [[f64; 2]],
     /// The longest distance between the points of adjacent vertices.
-    reach: f64,
+    pub(super) reach: f64,
     /// The stamp of the lower half a vertex was last put in (0: a separator's).
-    mark: Vec<u32>,
+    pub(super) mark: Vec<u32>,
     /// Scratch of [`Work::cover`]: a boundary vertex's index in the bipartite graph, and the rest.
     slot: Vec<u32>,
     scratch: Scratch,
-    search: Search,
-    stamp: u32,
+    pub(super) search: Search,
+    pub(super) stamp: u32,
     out: Vec<usize>,
 }
 
-/// The buffers of [`Work::cut_estimate`]: a sample of the keys, the vertices near the cut on either side.
+/// The buffers of a cut: the vertices near it on either side (what [`Work::cover`] reads) and, for the
+/// search of its direction (`super::direction`), the points of the set searched and a sample of keys.
 #[derive(Default)]
-struct Search {
-    /// The points of the set searched, in its order.
-    at: Vec<[f64; 2]>,
-    sample: Vec<f64>,
-    lower: Vec<usize>,
-    upper: Vec<usize>,
+pub(super) struct Search {
+    pub(super) lower: Vec<usize>,
+    pub(super) upper: Vec<usize>,
+    pub(super) at: Vec<[f64; 2]>,
+    pub(super) sample: Vec<f64>,
 }
 
 /// The buffers of [`Work::cover`], kept from one cut to the next: the vertices of each half adjacent to
@@ -171,9 +149,7 @@ impl Work<'_> {
         near_lo.extend(lower.iter().copied().filter(|&v| key(v) >= median - self.reach));
         near_up.clear();
         near_up.extend(upper.iter().copied().filter(|&v| key(v) <= median + self.reach));
-        let (near_lo, near_up) = (std::mem::take(near_lo), std::mem::take(near_up));
-        let mut separator = self.cover(&near_lo, &near_up, s);
-        (self.search.lower, self.search.upper) = (near_lo, near_up);
+        let mut separator = self.cover(s);
         separator.iter().for_each(|&v| self.mark[v] = 0);
         let lower = keep_marked(lower, &self.mark, s - 1);
         let upper = keep_marked(upper, &self.mark, s);
@@ -183,92 +159,13 @@ impl Work<'_> {
         self.out.extend_from_slice(&separator);
     }
 
-    /// The normal of the cut through the median with the smallest separator, among directions searched
-    /// coarse to fine: `axis`, then the [`ANGLES`] spread evenly over a half turn, then [`REFINE`] times
-    /// the best so far turned by ± half the last step. Each is estimated by [`Work::cut_estimate`]; a
-    /// direction replaces the best only with a smaller separator, so ties keep `axis`.
-    fn thinnest_cut(&mut self, verts: &[usize], axis: [f64; 2]) -> [f64; 2] {
-        let mut at = std::mem::take(&mut self.search.at);
-        at.clear();
-        at.extend(verts.iter().map(|&v| self.points[v]));
-        let best = self.thinnest_cut_at(verts, &at, axis);
-        self.search.at = at;
-        best
-    }
-
-    fn thinnest_cut_at(&mut self, verts: &[usize], at: &[[f64; 2]], axis: [f64; 2]) -> [f64; 2] {
-        let mut best = (self.cut_estimate(verts, at, axis), axis, f64::NAN);
-        let step = std::f64::consts::PI / ANGLES as f64;
-        for i in 0..ANGLES {
-            let t = step * i as f64;
-            let dir = direction(t);
-            if dir != axis {
-                let size = self.cut_estimate(verts, at, dir);
-                if size < best.0 {
-                    best = (size, dir, t);
-                }
-            }
-        }
-        let mut half = step / 2.0;
-        for _ in 0..REFINE {
-            let t0 = if best.2.is_nan() {
-                if axis == AXES[0] {
-                    0.0
-                } else {
-                    std::f64::consts::FRAC_PI_2
-                }
-            } else {
-                best.2
-            };
-            for t in [t0 - half, t0 + half] {
-                let dir = direction(t);
-                let size = self.cut_estimate(verts, at, dir);
-                if size < best.0 {
-                    best = (size, dir, t);
-                }
-            }
-            half /= 2.0;
-        }
-        best.1
-    }
-
-    /// The size of the separator of the cut of `verts` with normal `dir` through the median of every
-    /// [`SAMPLE`]-th key: the cover of the edges across it, which join only vertices within
-    /// [`Work::reach`] of it.
-    fn cut_estimate(&mut self, verts: &[usize], at: &[[f64; 2]], dir: [f64; 2]) -> usize {
-        let key = |p: &[f64; 2]| p[0] * dir[0] + p[1] * dir[1];
-        let Search { sample, lower, upper, .. } = &mut self.search;
-        sample.clear();
-        sample.extend(at.iter().step_by(SAMPLE).map(key));
-        let m = sample.len() / 2;
-        let median = *sample.select_nth_unstable_by(m, f64::total_cmp).1;
-        let (lo, hi) = (median - self.reach, median + self.reach);
-        lower.clear();
-        upper.clear();
-        for (&v, p) in verts.iter().zip(at) {
-            let k = key(p);
-            if k >= lo && k < median {
-                lower.push(v);
-            } else if k >= median && k <= hi {
-                upper.push(v);
-            }
-        }
-        let (lower, upper) = (std::mem::take(lower), std::mem::take(upper));
-        self.stamp += 2;
-        let s = self.stamp;
-        lower.iter().for_each(|&v| self.mark[v] = s - 1);
-        upper.iter().for_each(|&v| self.mark[v] = s);
-        let size = self.cover(&lower, &upper, s).len();
-        (self.search.lower, self.search.upper) = (lower, upper);
-        size
-    }
-
-    /// The separator of the halves `lower` (marked s − 1) and `upper` (marked s): a minimum vertex cover of
-    /// the edges between them (König: from a maximum matching of the bipartite graph of those edges), so
-    /// never larger than either half's vertices adjacent to the other.
-    fn cover(&mut self, lower: &[usize], upper: &[usize], s: u32) -> Vec<usize> {
+    /// The separator of the vertices near a cut, `self.search.lower` (marked s − 1) and `.upper` (marked
+    /// s): a minimum vertex cover of the edges between them (König: from a maximum matching of the
+    /// bipartite graph of those edges), so never larger than either side's vertices adjacent to the other.
+    pub(super) fn cover(&mut self, s: u32) -> Vec<usize> {
         let (q, mark) = (self.q, &self.mark);
         let Scratch { a, b, ptr, idx } = &mut self.scratch;
+        let Search { lower, upper, .. } = &self.search;
         let touching = |half: &[usize], other: u32, out: &mut Vec<usize>| {
             out.clear();
             out.extend(half.iter().copied().filter(|&v| q.neighbours(v).iter().any(|&w| mark[w] == other)));
@@ -371,62 +268,6 @@ mod tests {
             .filter(|v| !sep.contains(v) && p[*v][0] < 19.5)
             .any(|v| g.neighbours(v).iter().any(|&w| !sep.contains(&w) && p[w][0] > 19.5));
         assert!(!crossing);
-    }
-
-    /// An m × m grid graph of the 9-point stencil (diagonal neighbours too) with its points.
-    fn king(m: usize) -> (Graph, Vec<[f64; 2]>) {
-        let (mut start, mut adj) = (vec![0], vec![]);
-        for i in 0..m as i64 {
-            for j in 0..m as i64 {
-                for (di, dj) in [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)] {
-                    let (a, b) = (i + di, j + dj);
-                    if (0..m as i64).contains(&a) && (0..m as i64).contains(&b) {
-                        adj.push(a as usize * m + b as usize);
-                    }
-                }
-                start.push(adj.len());
-            }
-        }
-        let points = (0..m * m).map(|v| [(v % m) as f64, (v / m) as f64]).collect();
-        (Graph::new((0..=m * m).collect(), start, adj).unwrap(), points)
-    }
-
-    /// The system shall cut a large set along the direction of its thinnest separator, not only across
-    /// the longer side of its bounding box: on a 60 × 60 grid of the 9-point stencil turned by 22.5°, the
-    /// first cut follows a grid line, 60 vertices that split the rest in two halves, where a cut across
-    /// an axis needs a staircase of about 60 (1 + tan 22.5°) ≈ 85 (a diagonal neighbour crosses each step).
-    #[test]
-    fn a_large_set_is_cut_along_its_thinnest_separator() {
-        let m = 60;
-        let (g, p) = king(m);
-        assert!(g.n_vertices() >= SEARCH_MIN);
-        let (c, s) = (22.5f64.to_radians().cos(), 22.5f64.to_radians().sin());
-        let turned: Vec<[f64; 2]> = p.iter().map(|q| [c * q[0] - s * q[1], s * q[0] + c * q[1]]).collect();
-        let order = coordinate_dissection(&g, &turned).unwrap();
-        let n = g.n_vertices();
-        let sep: std::collections::HashSet<usize> = order[n - m..].iter().copied().collect();
-        // the components of the grid without those 60 vertices: two, of nearly half the vertices each
-        let mut comp = vec![usize::MAX; n];
-        let mut sizes = Vec::new();
-        for v0 in (0..n).filter(|v| !sep.contains(v)) {
-            if comp[v0] != usize::MAX {
-                continue;
-            }
-            let (mut stack, mut size) = (vec![v0], 0);
-            comp[v0] = sizes.len();
-            while let Some(v) = stack.pop() {
-                size += 1;
-                for &w in g.neighbours(v) {
-                    if !sep.contains(&w) && comp[w] == usize::MAX {
-                        comp[w] = sizes.len();
-                        stack.push(w);
-                    }
-                }
-            }
-            sizes.push(size);
-        }
-        sizes.sort_unstable();
-        assert!(sizes.len() == 2 && sizes[0] >= (n - m) * 2 / 5, "{sizes:?}");
     }
 
     #[test]

@@ -41,12 +41,13 @@
 //! # Ok::<(), tresca_cr::Error>(())
 //! ```
 //!
-//! Its modules: [`ordering`] (the graph, AMD and METIS) and [`dissect`] (coordinate bisection) with [`cover`] (its separators); [`etree`]
+//! Its modules: [`ordering`] (the graph, AMD and METIS) and [`dissect`] (coordinate bisection) with [`direction`] (the direction of each cut) and [`cover`] (its separators); [`etree`]
 //! (elimination tree, postorder, column counts) and [`symbolic`] (the symbolic factorisation); [`factor`]
 //! (numeric factorisation and solves), [`subtrees`], [`schedule`] and [`queue`] (the numeric factorisation on
 //! several threads) and [`pages`] (the factor's memory, mapped in huge pages).
 
 pub(crate) mod cover;
+pub(crate) mod direction;
 pub(crate) mod dissect;
 pub(crate) mod etree;
 pub(crate) mod factor;
