@@ -10,7 +10,7 @@ use super::dissect::{Search, Work, AXES};
 
 /// Sets of at least this many vertices are cut across the direction, of [`ANGLES`], with the thinnest
 /// separator ([`Work::thinnest_cut`]); smaller ones across the longer side of their bounding box.
-pub(super) const SEARCH_MIN: usize = 2000;
+const SEARCH_MIN: usize = 2000;
 
 /// The directions of the cuts searched: evenly spread over a half turn, the axes among them.
 const ANGLES: usize = 8;
@@ -33,11 +33,21 @@ fn direction(t: f64) -> [f64; 2] {
 }
 
 impl Work<'_> {
+    /// The normal of the cut of `verts`: [`Work::thinnest_cut`] for sets of [`SEARCH_MIN`] vertices or
+    /// more, else `axis` (across the longer side of their bounding box).
+    pub(super) fn cut_direction(&mut self, verts: &[usize], axis: [f64; 2]) -> [f64; 2] {
+        if verts.len() >= SEARCH_MIN {
+            self.thinnest_cut(verts, axis)
+        } else {
+            axis
+        }
+    }
+
     /// The normal of the cut through the median with the smallest separator, among directions searched
     /// coarse to fine: `axis`, then the [`ANGLES`] spread evenly over a half turn, then [`REFINE`] times
     /// the best so far turned by ± half the last step. Each is estimated by [`Work::cut_estimate`]; a
     /// direction replaces the best only with a smaller separator, so ties keep `axis`.
-    pub(super) fn thinnest_cut(&mut self, verts: &[usize], axis: [f64; 2]) -> [f64; 2] {
+    fn thinnest_cut(&mut self, verts: &[usize], axis: [f64; 2]) -> [f64; 2] {
         let mut at = std::mem::take(&mut self.search.at);
         at.clear();
         at.extend(verts.iter().map(|&v| self.points[v]));

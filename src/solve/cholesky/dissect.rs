@@ -6,14 +6,14 @@
 //! larger than either half's vertices adjacent to the other (on Example 5.1 at 1.57 M unknowns, 2.0 %
 //! fewer entries of L than those vertices).
 //!
-//! The direction: sets of [`SEARCH_MIN`] vertices or more are cut along the direction, among those
-//! searched (`super::direction`), whose cut has the smallest separator; smaller sets across the
+//! The direction: sets of 2,000 vertices or more are cut along the direction, among those
+//! searched (direction.rs), whose cut has the smallest separator; smaller sets across the
 //! longer side of their bounding box. The thickness of a separator depends on the direction of the cut
 //! against the mesh: K of Crouzeix–Raviart with the jump term couples the edges of neighbouring
 //! triangles, and on Example 5.1's grid of squares cut by one diagonal a cut along an axis needs three
 //! edges per square it crosses: 1,535 for the first cut at 1.57 M unknowns, where a cut turned by 30°
 //! from the x axis needs 1,319 (of 24 directions tried). METIS finds such cuts too; the search
-//! ([`super::direction`]) finds them at about a tenth of its cost (0.7–1.1 s of CPU against 8.1 s). On
+//! (direction.rs) finds them at about a tenth of its cost (0.7–1.1 s of CPU against 8.1 s). On
 //! that matrix the factorisation has 20 % fewer flops (4.53e11 against 5.68e11; METIS's ordering
 //! 4.97e11) and L 8 % fewer stored entries (`probes/setup_cost.rs ... nd symbolic`; figures in
 //! reference/performance.md §9).
@@ -28,7 +28,6 @@
 //! ordering depends only on the graph and the points.
 
 use super::cover;
-use super::direction::SEARCH_MIN;
 use super::ordering::Graph;
 use std::cmp::Ordering;
 
@@ -91,7 +90,7 @@ pub(super) struct Work<'a> {
 }
 
 /// The buffers of a cut: the vertices near it on either side (what [`Work::cover`] reads) and, for the
-/// search of its direction (`super::direction`), the points of the set searched and a sample of keys.
+/// search of its direction (direction.rs), the points of the set searched and a sample of keys.
 #[derive(Default)]
 pub(super) struct Search {
     pub(super) lower: Vec<usize>,
@@ -125,7 +124,7 @@ fn keep_marked<'v>(half: &'v mut [usize], mark: &[u32], stamp: u32) -> &'v mut [
 impl Work<'_> {
     fn dissect(&mut self, verts: &mut [usize]) {
         let axis = AXES[self.longer_axis(verts)];
-        let dir = if verts.len() >= SEARCH_MIN { self.thinnest_cut(verts, axis) } else { axis };
+        let dir = self.cut_direction(verts, axis);
         let points = self.points;
         let key = |v: usize| points[v][0] * dir[0] + points[v][1] * dir[1];
         let by = |a: &usize, b: &usize| -> Ordering { key(*a).total_cmp(&key(*b)).then(a.cmp(b)) };
