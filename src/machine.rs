@@ -103,6 +103,17 @@ pub fn release_freed_memory() {
     }
 }
 
+/// `n` zeros, written: a buffer that is read before it is written (`+=` into it) should not start as
+/// `vec![0.0; n]`, whose fresh pages the kernel maps to its shared zero page on the first read; the first
+/// write then copies that page and flushes the TLB of every core running the process, an interrupt to
+/// each (on the project's 2-core VMs K's values took 1.1 s of CPU beside the ordering thread instead of
+/// 0.45 s; reference/performance.md §9). Written zeros fault each page once, writable.
+pub fn written_zeros(n: usize) -> Vec<f64> {
+    let mut v = Vec::with_capacity(n);
+    v.resize(n, 0.0);
+    v
+}
+
 /// Free bytes (for unprivileged users) of the file system holding `dir` or its nearest existing ancestor.
 pub fn available_disk(dir: &Path) -> Option<u64> {
     use std::os::unix::ffi::OsStrExt;

@@ -248,7 +248,7 @@ pub fn stiffness_values(
         stored,
         count,
         off,
-        val: vec![0.0; k_pattern.compute_nnz()],
+        val: crate::machine::written_zeros(k_pattern.compute_nnz()),
         projected: HashMap::new(),
     };
     let elements: Vec<Element> = (0..mesh.tris.len()).map(|t| Element::new(mesh, t)).collect();

@@ -182,18 +182,21 @@ pub fn postorder(parent: &[usize]) -> Vec<usize> {
 
 /// c_j, the entries of L's column j (diagonal included), from the symmetric pattern `sym` of A
 /// (the rows i > j of P A Pᵀ's column j are the `inv[r]` > j of `sym`'s column `fwd[j]`), the tree
-/// and a postorder of it (Gilbert, Ng, Peyton; Davis §4.5).
+/// and a postorder of it (Gilbert, Ng, Peyton; Davis §4.5). Each row i counts `weight(i)` (1: the
+/// entries; a group's unknowns: those of the unknowns, `super::grouped`): its deltas are scaled by it.
 pub fn column_counts(
     sym: &impl Adjacency,
     (fwd, inv): (&[usize], &[usize]),
     parent: &[usize],
     post: &[usize],
+    weight: impl Fn(usize) -> usize,
 ) -> Vec<usize> {
+    let w = |i: usize| weight(i) as isize;
     let n = parent.len();
     let mut first = vec![NONE; n];
     let mut delta = vec![0isize; n];
     for (k, &p) in post.iter().enumerate() {
-        delta[p] = isize::from(first[p] == NONE);
+        delta[p] = if first[p] == NONE { w(p) } else { 0 };
         let mut j = p;
         while j != NONE && first[j] == NONE {
             first[j] = k;
@@ -203,15 +206,18 @@ pub fn column_counts(
     let mut leaves = Leaves { first, max_first: vec![NONE; n], prev_leaf: vec![NONE; n], ancestor: (0..n).collect() };
     for &j in post {
         if parent[j] != NONE {
-            delta[parent[j]] -= 1;
+            delta[parent[j]] -= w(j);
         }
-        sym.each(fwd[j], |r| match leaves.leaf(inv[r], j) {
-            Leaf::First => delta[j] += 1,
-            Leaf::Subsequent(q) => {
-                delta[j] += 1;
-                delta[q] -= 1;
+        sym.each(fwd[j], |r| {
+            let i = inv[r];
+            match leaves.leaf(i, j) {
+                Leaf::First => delta[j] += w(i),
+                Leaf::Subsequent(q) => {
+                    delta[j] += w(i);
+                    delta[q] -= w(i);
+                }
+                Leaf::Not => {}
             }
-            Leaf::Not => {}
         });
         if parent[j] != NONE {
             leaves.ancestor[j] = parent[j];
@@ -338,7 +344,7 @@ mod tests {
                 assert!(parent[j] == NONE || post[k + 1..].contains(&parent[j]), "postorder: {j} after its parent");
             }
             assert!(seen.iter().all(|&s| s), "the postorder visits every node");
-            let counts = column_counts(&sym.cols(), (&fwd, &inv), &parent, &post);
+            let counts = column_counts(&sym.cols(), (&fwd, &inv), &parent, &post, |_| 1);
             let (faer_parent, faer_counts) = faer_counts(&upper);
             assert_eq!(parent, faer_parent, "elimination tree, n = {n}");
             assert_eq!(counts, faer_counts, "column counts, n = {n}");

@@ -42,7 +42,7 @@
 //! ```
 //!
 //! Its modules: [`ordering`] (the graph, AMD and METIS) and [`dissect`] (coordinate bisection) with [`direction`] (the direction of each cut) and [`cover`] (its separators); [`etree`]
-//! (elimination tree, postorder, column counts) and [`symbolic`] (the symbolic factorisation); [`factor`]
+//! (elimination tree, postorder, column counts), [`grouped`] (the same on the groups' graph) and [`symbolic`] (the symbolic factorisation); [`factor`]
 //! (numeric factorisation and solves), [`subtrees`], [`schedule`] and [`queue`] (the numeric factorisation on
 //! several threads) and [`pages`] (the factor's memory, mapped in huge pages).
 
@@ -51,6 +51,7 @@ pub(crate) mod direction;
 pub(crate) mod dissect;
 pub(crate) mod etree;
 pub(crate) mod factor;
+pub(crate) mod grouped;
 pub(crate) mod ordering;
 pub(crate) mod pages;
 pub(crate) mod queue;

@@ -142,6 +142,16 @@ impl Graph {
         &self.adj[self.start[g]..self.start[g + 1]]
     }
 
+    /// `first[g]..first[g + 1]`: the unknowns of vertex g.
+    pub(super) fn first(&self) -> &[usize] {
+        &self.first
+    }
+
+    /// The adjacency as compressed rows: `start`, `adj`.
+    pub(super) fn adjacency(&self) -> (&[usize], &[usize]) {
+        (&self.start, &self.adj)
+    }
+
     /// Unknowns in all.
     pub fn unknowns(&self) -> usize {
         self.first[self.n_vertices()]

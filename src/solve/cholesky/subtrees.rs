@@ -231,6 +231,10 @@ fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Pa
     for (i, &row) in s_pattern.iter().enumerate() {
         g2l[row] = (i + s_ncols) as u32;
     }
+    if first {
+        // SAFETY: supernode s is computed by one task at a time, and this is its first
+        write_first(unsafe { ctx.values.block_mut(cpv[s], cpv[s + 1]) });
+    }
     let mut ls = block(ctx, s);
     if first {
         for j in s_start..s_end {
@@ -260,6 +264,23 @@ fn updates(ctx: &Ctx, s: usize, (from, to): (usize, usize), first: bool, par: Pa
         update(ls.rb_mut(), row_idx, col_idx, ld_mid_bot, ld_mid_bot.subrows(0, mid).transpose(), par);
     }
     s_pattern.iter().for_each(|&row| g2l[row] = u32::MAX);
+}
+
+/// Touch each page of a block of zeros (one not yet computed) by a write first: its entries are then read
+/// and written (`+=`), and a page read first is mapped to the kernel's shared zero page, whose copy on the
+/// first write flushes the TLB of the other threads' cores, an interrupt to each (on the project's 2-core
+/// VMs a tenth of the factorisation's CPU at 1.57 M unknowns; reference/performance.md §9). The pages
+/// the mapping thread (`solve::cholesky::pages`) has populated are written in place, unchanged.
+fn write_first(zeros: &mut [f64]) {
+    const PER_PAGE: usize = 4096 / std::mem::size_of::<f64>();
+    let Some(head) = zeros.first_mut() else { return };
+    // SAFETY: a volatile write of the value the entry holds (0.0), so that it is not elided
+    unsafe { std::ptr::write_volatile(head, 0.0) };
+    let skip = (PER_PAGE - (zeros.as_ptr() as usize / 8) % PER_PAGE) % PER_PAGE;
+    for v in zeros.iter_mut().skip(skip).step_by(PER_PAGE) {
+        // SAFETY: as above, on the first entry of each following page
+        unsafe { std::ptr::write_volatile(v, 0.0) };
+    }
 }
 
 /// Of supernode s, once its updates are done: the dense Cholesky factor of its diagonal block and the

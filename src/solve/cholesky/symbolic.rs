@@ -7,7 +7,9 @@
 //! structure as faer's complete analysis, whose row-subtree walk costs O(|L|).
 
 use super::dissect::coordinate_dissection;
-use super::etree::{column_counts, elimination_tree, permuted_upper, postorder, symmetric, Adjacency, Cols, NONE};
+use super::etree::{
+    column_counts, elimination_tree, permuted_upper, postorder, symmetric, Adjacency, Cols, Pattern, NONE,
+};
 use super::ordering::{amd_order, nested_dissection, Graph};
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -55,7 +57,12 @@ impl Symbolic {
     /// need not be made first (the same structure as [`Symbolic::from_symmetric`] of K's pattern).
     pub fn from_graph(graph: &Graph, last: &[usize], base: Vec<usize>) -> Result<Symbolic> {
         let (fwd, inv) = ordering_with_last(graph.unknowns(), last, base)?;
-        let (symbolic, pattern_nnz) = supernodal_structure(&graph.expanded(), (&fwd, &inv))?;
+        // on the groups' graph where the ordering keeps each group together (the same structure, a
+        // quarter of the work: super::grouped), else on the expanded pattern
+        let (symbolic, pattern_nnz) = match super::grouped::structure(graph, (&fwd, &inv)) {
+            Some(s) => supernodal_of(s.upper, &s.parent, &s.counts)?,
+            None => supernodal_structure(&graph.expanded(), (&fwd, &inv))?,
+        };
         Ok(Symbolic::of_parts(symbolic, (fwd, inv), last, pattern_nnz))
     }
 
@@ -216,10 +223,20 @@ fn supernodal_structure(
     sym: &impl Adjacency,
     (fwd, inv): (&[usize], &[usize]),
 ) -> Result<(SymbolicSupernodalCholesky<usize>, usize)> {
-    let n = fwd.len();
     let upper = permuted_upper(sym, fwd, inv);
     let parent = elimination_tree(&upper);
-    let counts = column_counts(sym, (fwd, inv), &parent, &postorder(&parent));
+    let counts = column_counts(sym, (fwd, inv), &parent, &postorder(&parent), |_| 1);
+    supernodal_of(upper, &parent, &counts)
+}
+
+/// faer's supernodal analysis of the permuted upper triangle `upper` with its elimination tree and
+/// column counts; with the entries of the pattern's lower triangle.
+fn supernodal_of(
+    upper: Pattern,
+    parent: &[usize],
+    counts: &[usize],
+) -> Result<(SymbolicSupernodalCholesky<usize>, usize)> {
+    let n = parent.len();
     // what faer's analysis relies on (it indexes by them): parents after their children, counts of
     // at least the diagonal and at most the rows below it
     let tree_ok = parent.iter().enumerate().all(|(j, &p)| p == NONE || (p > j && p < n));
@@ -235,7 +252,7 @@ fn supernodal_structure(
     // the elimination tree of a pattern is unique, and `etree::tests` checks that both agree.
     let etree = unsafe { EliminationTreeRef::<usize>::from_inner(&etree) };
     let params = CholeskySymbolicParams::default().supernodal_params;
-    factorize_supernodal_symbolic_cholesky(upper, etree, &counts, MemStack::new(&mut mem), params)
+    factorize_supernodal_symbolic_cholesky(upper, etree, counts, MemStack::new(&mut mem), params)
         .map(|s| (s, pattern_nnz))
         .map_err(|e| Error::Linear(format!("symbolic Cholesky failed: {e:?}")))
 }
