@@ -41,7 +41,7 @@ fn the_memory_check_counts_the_metis_fallback_from_the_nested_dissection_size() 
     let between = (metis + big.memory) / 2;
     assert!(big.check(Some(between), None, None).is_ok(), "fits with METIS's ordering");
     assert!(big.check(Some(metis - 1), None, None).is_err(), "fits with neither ordering");
-    let small = Estimate::of_sizes((262_144, 197_120, 256), 4, false);
+    let small = Estimate::of_sizes((65_536, 49_408, 128), 4, false);
     assert_eq!(small.memory_metis, None, "AMD below the nested-dissection size: no fallback");
     assert!(small.check(Some(small.memory - 1), None, None).is_err());
 }

@@ -6,18 +6,20 @@
 //! Calibration (Example 5.1 `--steps 4 -o`, peak RSS by `/usr/bin/time` in KiB, with K kept
 //! as its lower triangle; figures in `reference/performance.md` §8): six meshes from 24,640 to 4,817,792
 //! unknowns (refine 5–8 of `cells = [2, 2]`, refine 8 of `[3, 3]`, refine 7 of `[7, 7]`; refitted in the
-//! seventh session, when the nested dissection's cuts along the thinnest direction shrank the factor). The
+//! eighth session, when refine 7 passed to the nested dissection and its peak fell 10 %). The
 //! factor's fill grows like n log n, so the estimate is γ + n (α + β log₂ n) plus the two buffers of a
 //! block of steps (`solve::free`, 16 bytes a value, at most 16 columns and 2²⁴ values) and the dense contact
-//! parts: γ, α, β fitted by least squares of the relative misfit to the six, which it then gives within 3 %.
-//! An estimate, not a bound: the fill also depends on the ordering (AMD below 1M unknowns, nested dissection
+//! parts: γ, α, β fitted by least squares of the relative misfit to the six, which it then gives within
+//! 5.1 % (AMD's fill below the dissection's threshold and the dissection's above follow one curve only
+//! approximately).
+//! An estimate, not a bound: the fill also depends on the ordering (AMD below 200,000 unknowns, nested dissection
 //! above). The factorisation checks its exact size once the symbolic factorisation is known
 //! (`solve::cholesky::symbolic::Symbolic::fits`) and refuses a factor that would not fit, or first tries
 //! METIS's ordering, which fills a little less. The estimate gives that fallback's peak beside
 //! ([`Estimate::memory_metis`]): the coordinate nested dissection's factor has about `FILL_ND` · n log₂ n
 //! entries (13.9 at 1.57 M unknowns, 14.2–14.5 at 3.5–6.3 M) and METIS's `METIS_FILL` of them (0.972 at
 //! 6,292,480 unknowns: 2.007e9 against 2.064e9 entries), 8 bytes an entry; refine 9 of Example 5.1 ran with
-//! METIS at a 21.87 GB peak against 21.2 GB so estimated.
+//! METIS at a 21.87 GB peak against 21.1 GB so estimated.
 //!
 //! Beside the fit, what the calibration scene does not hold: the results writer's queue of steps, full
 //! (how full it gets depends on the speed of the solve), and the expressions evaluated at every volume
@@ -51,15 +53,15 @@ pub struct Estimate {
 
 /// Peak bytes of the set-up (mesh, space, K, factor) are BYTES_FIXED + unknowns · (BYTES_PER_UNKNOWN +
 /// BYTES_PER_UNKNOWN_LOG2 · log₂(unknowns)) (fitted, see the module doc).
-const BYTES_FIXED: f64 = 6.929e6;
-const BYTES_PER_UNKNOWN: f64 = 1002.6;
-const BYTES_PER_UNKNOWN_LOG2: f64 = 104.16;
+const BYTES_FIXED: f64 = 9.439e6;
+const BYTES_PER_UNKNOWN: f64 = 623.05;
+const BYTES_PER_UNKNOWN_LOG2: f64 = 120.12;
 /// Factor entries of the coordinate nested dissection per n log₂ n, and METIS's share of them (module doc).
 const FILL_ND: f64 = 14.5;
 const METIS_FILL: f64 = 0.972;
 /// From this many unknowns K is ordered by nested dissection and the set-up can fall back to METIS
 /// (`solve::cholesky::ND_MIN_SIZE`, which `tests/budget.rs` checks it equals).
-pub const FALLBACK_MIN_UNKNOWNS: u64 = 1_000_000;
+pub const FALLBACK_MIN_UNKNOWNS: u64 = 200_000;
 /// The values of the block of steps' buffers (`solve::free`): at most 16 columns and 2²⁴ values each.
 const BLOCK_COLUMNS: u64 = 16;
 const BLOCK_VALUES: u64 = 1 << 24;

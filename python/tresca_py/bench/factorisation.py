@@ -139,7 +139,7 @@ Command: `make bench-env && .venv-bench/bin/python verification/bench/factorisat
 
 {table(rows, rate1)}
 
-tresca-cr's orderings: AMD below 1,000,000 unknowns, nested dissection by coordinate bisection from there
+tresca-cr's orderings: AMD below 200,000 unknowns, nested dissection by coordinate bisection from there
 (`solve::cholesky::ordering`); {len(tre)} tresca-cr set-ups in this table.
 """
 

@@ -16,7 +16,7 @@
 //! more separator). The supernodal kernel is always used: it exposes the triangular halves and the
 //! trailing block.
 
-use super::ordering::{Graph, ND_MIN_SIZE};
+use super::ordering::{Graph, METIS_MIN_SIZE};
 use super::pages::Pages;
 use super::symbolic::{fill_order, Symbolic};
 use super::symbolic::{lower_nnz, numeric_scratch};
@@ -73,7 +73,7 @@ impl Factor {
                 "internal: unknown groups must increase from 0 to the number of unknowns".into(),
             ));
         }
-        Factor::with_order(k, last, fill_order(&Graph::of_matrix(k, first), n >= ND_MIN_SIZE)?)
+        Factor::with_order(k, last, fill_order(&Graph::of_matrix(k, first), n >= METIS_MIN_SIZE)?)
     }
 
     /// As [`Factor::with_last`], with the fill-reducing ordering `base` (position → unknown, a

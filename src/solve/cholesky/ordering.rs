@@ -1,5 +1,5 @@
-//! Fill-reducing ordering P: nested dissection for K of [`ND_MIN_SIZE`] unknowns or more, AMD (faer's)
-//! below. Why: the factorisation is flop-bound, and on a 2D mesh nested dissection gives the
+//! Fill-reducing ordering P: nested dissection for K of [`ND_MIN_SIZE`] unknowns or more ([`METIS_MIN_SIZE`]
+//! for a matrix without points), AMD (faer's) below. Why: the factorisation is flop-bound, and on a 2D mesh nested dissection gives the
 //! asymptotically optimal fill, O(n log n) entries and O(n^1.5) flops, with a smaller constant than AMD.
 //! A run knows its unknowns' points (edge midpoints), so its nested dissection is by coordinate
 //! bisection ([`super::dissect`], linear in the unknowns); without points (a matrix alone,
@@ -36,10 +36,16 @@ pub(super) fn amd_order(q: &Graph, control: amd::Control) -> Result<Vec<usize>> 
     Ok(q.expand(fwd.into_iter()))
 }
 
-/// Below this many unknowns K is ordered by AMD. The coordinate dissection needs fewer flops from a few
-/// 100,000 unknowns on, but there it saves only a few per cent of the set-up, and a lower threshold would
-/// change the factor's rounding of every run it reaches (measurement: reference/performance.md §9).
-pub const ND_MIN_SIZE: usize = 1_000_000;
+/// From this many unknowns a run's K (whose unknowns have points) is ordered by the coordinate nested
+/// dissection, below by AMD. On Example 5.1 the dissection's factor needs 42 % fewer flops than AMD's at
+/// 393,472 unknowns (refine 7: 5.58e10 against 9.59e10; set-up 1.12 s against 1.45 s, peak 11 % lower),
+/// 12.5 % fewer at 98,560 (within the set-up's noise there) and 2 % more at 24,640 (reference/performance.md §9).
+pub const ND_MIN_SIZE: usize = 200_000;
+
+/// From this many unknowns a matrix without points ([`super::factor::Factor::with_groups`]) is ordered by
+/// METIS's nested dissection, below by AMD: METIS costs seconds (1.6 s of CPU at 393,472 unknowns), which
+/// the fewer flops repay only on larger matrices.
+pub const METIS_MIN_SIZE: usize = 1_000_000;
 
 /// Fixed METIS seed: the ordering, hence every result, is reproducible.
 const ND_SEED: i32 = 42;
