@@ -27,8 +27,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// From this many unknowns the caller's work beside the set-up starts with phase 3 ([`Discretised::set_up`]):
-/// where phases 1 and 2 take seconds (1,000,000 unknowns, as the switch to nested dissection,
-/// `solve::cholesky::ND_MIN_SIZE`).
+/// where phases 1 and 2 take seconds (1,000,000 unknowns).
 const DEFER_BESIDE_MIN: usize = 1_000_000;
 
 /// Bytes an unknown that a large run allocates after the factor besides the blocks of steps (the results
@@ -238,12 +237,12 @@ impl Discretised {
                 let name = if nested { "nested dissection by coordinates" } else { "AMD" };
                 let symbolic = tl.stage("ordering", "symbolic", || Symbolic::from_graph(&graph, contact, order))?;
                 let symbolic = symbolic.ordered_by(name);
-                // on top of the factor: K's values (its lower triangle, assembled meanwhile), the blocks of
-                // steps, and what comes after it ([`AFTER_FACTOR_BYTES`], the condition estimate's Lanczos
-                // vectors included)
+                // on top of the factor: K's values (its lower triangle, assembled meanwhile) all along, and
+                // once the factorisation's scratch is freed the blocks of steps and what else comes after it
+                // ([`AFTER_FACTOR_BYTES`], the condition estimate's Lanczos vectors included)
                 let n = space.n_dofs as u64;
-                let beside = 8 * symbolic.pattern_nnz() as u64 + AFTER_FACTOR_BYTES * n + BLOCK_BYTES;
-                if !nested || symbolic.fits(beside) {
+                let (beside, after) = (8 * symbolic.pattern_nnz() as u64, AFTER_FACTOR_BYTES * n + BLOCK_BYTES);
+                if !nested || symbolic.fits(beside, after) {
                     return Ok(symbolic);
                 }
                 // The factor of the coordinate bisection does not fit: METIS's ordering fills less

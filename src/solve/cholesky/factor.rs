@@ -121,7 +121,7 @@ impl Factor {
             let e = "internal: the matrix does not have the pattern of its symbolic factorisation";
             return (Err(Error::Linear(e.into())), None);
         }
-        let par = match symbolic.par_that_fits(0, par, have) {
+        let par = match symbolic.par_that_fits((0, 0), par, have) {
             Ok(p) => p,
             Err(e) => return (Err(e), None),
         };

@@ -149,35 +149,41 @@ impl Symbolic {
         (bytes.saturating_add(subtrees.unwrap_or(0)), subtrees)
     }
 
-    /// Whether the numeric factorisation, and `more` bytes the caller will allocate beside it, fit in the
-    /// memory this machine has now (`machine::available_memory`; `true` where the machine does not say), on
-    /// the threads in force or else on one ([`Symbolic::par_that_fits`]).
-    pub fn fits(&self, more: u64) -> bool {
-        self.par_that_fits(more, self.par_in_force(), crate::machine::available_memory()).is_ok()
+    /// Whether the numeric factorisation fits in the memory this machine has now
+    /// (`machine::available_memory`; `true` where the machine does not say), on the threads in force or
+    /// else on one ([`Symbolic::par_that_fits`]), with `beside` bytes the caller holds all along and `after`
+    /// bytes it allocates once the factor is made (when the factorisation's scratch is freed).
+    pub fn fits(&self, beside: u64, after: u64) -> bool {
+        self.par_that_fits((beside, after), self.par_in_force(), crate::machine::available_memory()).is_ok()
     }
 
     /// The parallelism the numeric factorisation can afford in `have` bytes (the memory available; `None`:
-    /// unknown): `par` when its values and scratch (and `more` bytes beside them) fit, else one thread when
+    /// unknown): `par` when its values and scratch fit, with `beside` bytes held all along and `after` bytes
+    /// allocated once the scratch is freed (so the larger of scratch and `after` counts), else one thread when
     /// that fits (the factor is the same bit for bit for every thread count: docs/model.md "Threads"; one
     /// thread needs no scratch of the factorisation by subtrees), else the refusal, naming the bytes
     /// needed on one thread and those available. L's pages are mapped lazily, so an allocation that does
     /// not fit would succeed and the process be killed later. The sizes are exact once the symbolic
     /// factorisation is done, where the pre-run estimate (`scene::budget`) is a fit. With
     /// `TRESCA_SCHEDULE` set (`solve::cholesky::schedule`) the figures go to standard error.
-    pub(super) fn par_that_fits(&self, more: u64, par: Par, have: Option<u64>) -> Result<Par> {
+    pub(super) fn par_that_fits(&self, (beside, after): (u64, u64), par: Par, have: Option<u64>) -> Result<Par> {
         let (n, len_val) = (self.symbolic.nrows(), self.symbolic.len_val());
+        let factor = (len_val as u64).saturating_mul(8);
+        // the values, what is held beside, and the larger of the scratch and what comes after
+        let with = |need: u64| factor.saturating_add(beside).saturating_add(need.saturating_sub(factor).max(after));
         let (need, subtrees) = self.need(par);
-        let need = need.saturating_add(more);
+        let need = with(need);
         let chosen = match refuse_beyond(need, have, n, len_val) {
             Ok(()) => Ok(par),
-            Err(_) => refuse_beyond(self.need(Par::Seq).0.saturating_add(more), have, n, len_val).map(|()| Par::Seq),
+            Err(_) => refuse_beyond(with(self.need(Par::Seq).0), have, n, len_val).map(|()| Par::Seq),
         };
         if std::env::var_os(super::schedule::ENV).is_some() {
             let threads = chosen.as_ref().map_or("refused".into(), |p| format!("{} thread(s)", p.degree()));
             let sym = &self.symbolic;
             eprintln!(
                 "memory: {n} rows, {} supernodes, {} pattern rows, {:?} updates; factor {} B, need {need} B on {} \
-                 thread(s) (of which the schedule's {} B) with {more} B beside, available {have:?} B: {threads}",
+                 thread(s) (of which the schedule's {} B) with {beside} B beside and {after} B after, available {have:?} B: \
+                 {threads}",
                 sym.n_supernodes(),
                 sym.row_idx().len(),
                 self.updates.get(),
