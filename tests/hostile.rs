@@ -30,8 +30,35 @@ fn tmp(name: &str) -> PathBuf {
     common::tmp_in("tresca-hostile", name)
 }
 
-/// `cmd` with its address space limited to `bytes` (`setrlimit(RLIMIT_AS)` in the child).
+/// Threads of a run that may multiply dense blocks at once (the two factorisation workers, the main thread
+/// and the condition estimate's), each reserving [`kernel_reserve`] bytes of address space.
+const KERNEL_THREADS: u64 = 4;
+
+/// The address space private-gemm-x86 (faer's matrix-product kernel) reserves on each thread that multiplies,
+/// on first use: a packing buffer of twice the L3 cache the machine reports, whose refusal aborts the
+/// process (an allocation failure, not an error it returns). On a VM reporting a 480 MiB L3 that is 960 MiB
+/// a thread; on common machines tens of MiB. Read as the crate reads it: level 3 of cpu0's caches in sysfs.
+fn kernel_reserve() -> u64 {
+    let dir = std::path::Path::new("/sys/devices/system/cpu/cpu0/cache");
+    let read = |p: PathBuf, f: &str| std::fs::read_to_string(p.join(f)).ok().map(|t| t.trim().to_string());
+    let l3 = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| read(p.clone(), "level").as_deref() == Some("3"))
+        .filter_map(|p| read(p, "size"))
+        .filter_map(|s| s.strip_suffix('K').and_then(|k| k.parse::<u64>().ok()).map(|k| k << 10))
+        .max()
+        .unwrap_or(0);
+    2 * l3
+}
+
+/// `cmd` with its address space limited to `bytes` (`setrlimit(RLIMIT_AS)` in the child), plus the dense
+/// kernel's reservation on [`KERNEL_THREADS`] threads (`kernel_reserve`): the limits these tests set are
+/// for the run's own memory and thread stacks.
 fn address_space(cmd: &mut Command, bytes: u64) -> &mut Command {
+    let bytes = bytes + KERNEL_THREADS * kernel_reserve();
     // SAFETY: setrlimit in the child between fork and exec.
     unsafe {
         cmd.pre_exec(move || {

@@ -34,6 +34,12 @@ use std::cmp::Ordering;
 /// Sets of at most this many vertices are not dissected further.
 const LEAF: usize = 32;
 
+/// The first set of at least this many vertices has its upper half dissected on a second thread, when
+/// the thread count in force is 2 or more: the ordering is the same (each half's ordering depends only on
+/// its vertices, and the marks each thread compares are its own), and at 1.57 M unknowns the dissection
+/// runs beside K's assembly, so the halves share the cores with it (reference/performance.md §9).
+const SPLIT_MIN: usize = 100_000;
+
 /// The normals of the cuts across the longer side: x (a cut at x = c) and y.
 pub(super) const AXES: [[f64; 2]; 2] = [[1.0, 0.0], [0.0, 1.0]];
 
@@ -54,6 +60,11 @@ fn reach(q: &Graph, points: &[[f64; 2]]) -> f64 {
 /// points do not fit the graph (their number, a non-finite coordinate) or the vertices are too many to
 /// be numbered in `u32` (as the separators' bipartite graphs number them).
 pub fn coordinate_dissection(q: &Graph, points: &[[f64; 2]]) -> Option<Vec<usize>> {
+    dissection(q, points, crate::threads::count() > 1)
+}
+
+/// As [`coordinate_dissection`], on two threads from the first set of [`SPLIT_MIN`] vertices if `split`.
+fn dissection(q: &Graph, points: &[[f64; 2]], split: bool) -> Option<Vec<usize>> {
     let n = q.n_vertices();
     if points.len() != n || n >= u32::MAX as usize || points.iter().flatten().any(|c| !c.is_finite()) {
         return None;
@@ -68,6 +79,7 @@ pub fn coordinate_dissection(q: &Graph, points: &[[f64; 2]]) -> Option<Vec<usize
         search: Search::default(),
         stamp: 0,
         out: Vec::with_capacity(n),
+        split,
     };
     let mut verts: Vec<usize> = (0..n).collect();
     work.dissect(&mut verts);
@@ -87,6 +99,8 @@ pub(super) struct Work<'a> {
     pub(super) search: Search,
     pub(super) stamp: u32,
     out: Vec<usize>,
+    /// Whether a set of [`SPLIT_MIN`] vertices or more may still be split between two threads.
+    split: bool,
 }
 
 /// The buffers of a cut: the vertices near it on either side (what [`Work::cover`] reads) and, for the
@@ -152,10 +166,50 @@ impl Work<'_> {
         separator.iter().for_each(|&v| self.mark[v] = 0);
         let lower = keep_marked(lower, &self.mark, s - 1);
         let upper = keep_marked(upper, &self.mark, s);
-        self.dissect(lower);
-        self.dissect(upper);
+        self.dissect_halves(lower, upper);
         separator.sort_unstable_by(by);
         self.out.extend_from_slice(&separator);
+    }
+
+    /// The orderings of `lower`, then of `upper`: the upper one on a second thread (with its own copy of
+    /// the marks and its own buffers) for the first set of [`SPLIT_MIN`] vertices or more, else in turn.
+    fn dissect_halves(&mut self, lower: &mut [usize], upper: &mut [usize]) {
+        if !self.split || lower.len() + upper.len() < SPLIT_MIN {
+            self.dissect(lower);
+            self.dissect(upper);
+            return;
+        }
+        self.split = false;
+        let mut other = Work {
+            q: self.q,
+            points: self.points,
+            reach: self.reach,
+            mark: self.mark.clone(),
+            slot: vec![0; self.slot.len()],
+            scratch: Scratch::default(),
+            search: Search::default(),
+            stamp: self.stamp,
+            out: Vec::with_capacity(upper.len()),
+            split: false,
+        };
+        let refused = std::thread::scope(|s| {
+            let half = &mut *upper;
+            let started = std::thread::Builder::new().spawn_scoped(s, move || {
+                other.dissect(half);
+                other.out
+            });
+            self.dissect(lower);
+            match started.map(|h| h.join()) {
+                Ok(Ok(out)) => self.out.extend(out),
+                Ok(Err(e)) => std::panic::resume_unwind(e),
+                Err(_) => return true,
+            }
+            false
+        });
+        // a thread the system refuses: the upper half here, after the lower one
+        if refused {
+            self.dissect(upper);
+        }
     }
 
     /// The separator of the vertices near a cut, `self.search.lower` (marked s − 1) and `.upper` (marked
@@ -267,6 +321,15 @@ mod tests {
             .filter(|v| !sep.contains(v) && p[*v][0] < 19.5)
             .any(|v| g.neighbours(v).iter().any(|&w| !sep.contains(&w) && p[w][0] > 19.5));
         assert!(!crossing);
+    }
+
+    /// The system shall order a graph the same with the halves of its first large set on two threads as on
+    /// one (a 330 × 330 grid: 108,900 vertices, above `SPLIT_MIN`).
+    #[test]
+    fn two_threads_give_the_same_ordering() {
+        let (g, p) = grid(330);
+        assert!(g.n_vertices() >= SPLIT_MIN);
+        assert_eq!(dissection(&g, &p, true).unwrap(), dissection(&g, &p, false).unwrap());
     }
 
     #[test]

@@ -13,9 +13,11 @@
 //!   P_J … P_J + k.
 //!
 //! Why: the groups' graph has half the vertices and a quarter of the entries, so the tree and counts cost
-//! a quarter as much (at 1.57 M unknowns the symbolic factorisation went from 0.72 to 0.40 s of CPU,
+//! a quarter as much (at 1.57 M unknowns the symbolic factorisation went from 0.72 to 0.55 s of CPU,
 //! on the critical path of the set-up's phase 1: reference/performance.md §9). The result is the same
-//! (`tests`: against the tree, counts and pattern of the expanded graph). An ordering that splits a
+//! (`tests`: against the tree, counts and pattern of the expanded graph). With two threads or more the
+//! unknowns' upper triangle is expanded on a second thread beside the groups' tree and counts (phase 1's
+//! main thread is done with K by then). An ordering that splits a
 //! group (an unknown of it moved last without the others) is left to the expanded route: `None`.
 
 use super::etree::{column_counts, elimination_tree, postorder, Cols, Pattern, NONE};
@@ -42,18 +44,27 @@ pub(super) fn structure(graph: &Graph, (fwd, inv): (&[usize], &[usize])) -> Opti
         g_upper.idx.extend(graph.neighbours(g).iter().map(|&h| ginv[h]).filter(|&i| i < ginv[g]));
         g_upper.ptr.push(g_upper.idx.len());
     }
-    let g_parent = elimination_tree(&g_upper);
-    let (start, adj) = graph.adjacency();
-    let width = |j: usize| at[j + 1] - at[j];
-    let g_counts = column_counts(&Cols { ptr: start, idx: adj }, (gfwd, ginv), &g_parent, &postorder(&g_parent), width);
+    // the unknowns' upper triangle on a second thread (when there are two) beside the groups' tree and counts
+    let (upper, (g_parent, g_counts)) = std::thread::scope(|s| {
+        let beside = (crate::threads::count() > 1)
+            .then(|| std::thread::Builder::new().spawn_scoped(s, || expanded_upper(&g_upper, at)).ok())
+            .flatten();
+        let g_parent = elimination_tree(&g_upper);
+        let (start, adj) = graph.adjacency();
+        let width = |j: usize| at[j + 1] - at[j];
+        let post = postorder(&g_parent);
+        let g_counts = column_counts(&Cols { ptr: start, idx: adj }, (gfwd, ginv), &g_parent, &post, width);
+        let upper = match beside.map(|h| h.join()) {
+            Some(Ok(upper)) => upper,
+            Some(Err(e)) => std::panic::resume_unwind(e),
+            None => expanded_upper(&g_upper, at),
+        };
+        (upper, (g_parent, g_counts))
+    });
     let n = fwd.len();
     let (mut parent, mut counts) = (vec![NONE; n], vec![0usize; n]);
-    let mut upper = Pattern { ptr: Vec::with_capacity(n + 1), idx: Vec::new() };
-    upper.ptr.push(0);
-    let entries: usize = (0..ng).map(|j| width(j) * (width(j) + 1) / 2 + width(j) * coupled(&g_upper, j, width)).sum();
-    upper.idx.reserve_exact(entries);
     for j in 0..ng {
-        let (p, m) = (at[j], width(j));
+        let (p, m) = (at[j], at[j + 1] - at[j]);
         for k in 0..m {
             parent[p + k] = match g_parent[j] {
                 _ if k + 1 < m => p + k + 1,
@@ -61,6 +72,23 @@ pub(super) fn structure(graph: &Graph, (fwd, inv): (&[usize], &[usize])) -> Opti
                 q => at[q],
             };
             counts[p + k] = g_counts[j] - k;
+        }
+    }
+    Some(Structure { upper, parent, counts })
+}
+
+/// The unknowns' permuted upper triangle from the groups' (`at[j]`: the position of group j's first
+/// unknown): column P_J + k holds the unknowns of the groups I < J coupled to J, and P_J … P_J + k.
+fn expanded_upper(g_upper: &Pattern, at: &[usize]) -> Pattern {
+    let ng = at.len() - 1;
+    let width = |j: usize| at[j + 1] - at[j];
+    let mut upper = Pattern { ptr: Vec::with_capacity(at[ng] + 1), idx: Vec::new() };
+    upper.ptr.push(0);
+    let entries: usize = (0..ng).map(|j| width(j) * (width(j) + 1) / 2 + width(j) * coupled(g_upper, j, width)).sum();
+    upper.idx.reserve_exact(entries);
+    for j in 0..ng {
+        let p = at[j];
+        for k in 0..width(j) {
             for &i in &g_upper.idx[g_upper.ptr[j]..g_upper.ptr[j + 1]] {
                 upper.idx.extend(at[i]..at[i + 1]);
             }
@@ -68,7 +96,7 @@ pub(super) fn structure(graph: &Graph, (fwd, inv): (&[usize], &[usize])) -> Opti
             upper.ptr.push(upper.idx.len());
         }
     }
-    Some(Structure { upper, parent, counts })
+    upper
 }
 
 /// The unknowns of the groups before group j coupled to it.
