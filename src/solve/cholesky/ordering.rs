@@ -39,7 +39,7 @@ pub(super) fn amd_order(q: &Graph, control: amd::Control) -> Result<Vec<usize>> 
 /// From this many unknowns a run's K (whose unknowns have points) is ordered by the coordinate nested
 /// dissection, below by AMD. On Example 5.1 the dissection's factor needs 42 % fewer flops than AMD's at
 /// 393,472 unknowns (refine 7: 5.58e10 against 9.59e10; set-up 1.12 s against 1.45 s, peak 11 % lower),
-/// 12.5 % fewer at 98,560 (within the set-up's noise there) and 2 % more at 24,640 (reference/performance.md §9).
+/// 12.5 % fewer at 98,432 (within the set-up's noise there) and 2 % more at 24,640 (reference/performance.md §9).
 pub const ND_MIN_SIZE: usize = 200_000;
 
 /// From this many unknowns a matrix without points ([`super::factor::Factor::with_groups`]) is ordered by
