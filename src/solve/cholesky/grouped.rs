@@ -15,13 +15,18 @@
 //! Why: the groups' graph has half the vertices and a quarter of the entries, so the tree and counts cost
 //! a quarter as much (at 1.57 M unknowns the symbolic factorisation went from 0.72 to 0.55 s of CPU,
 //! on the critical path of the set-up's phase 1: reference/performance.md §9). The result is the same
-//! (`tests`: against the tree, counts and pattern of the expanded graph). With two threads or more the
-//! unknowns' upper triangle is expanded on a second thread beside the groups' tree and counts (phase 1's
-//! main thread is done with K by then). An ordering that splits a
+//! (`tests`: against the tree, counts and pattern of the expanded graph). With two threads or more (and
+//! [`BESIDE_MIN`] unknowns) the unknowns' upper triangle is expanded on a second thread beside the
+//! groups' tree and counts (phase 1's main thread is done with K by then). An ordering that splits a
 //! group (an unknown of it moved last without the others) is left to the expanded route: `None`.
 
 use super::etree::{column_counts, elimination_tree, postorder, Cols, Pattern, NONE};
 use super::ordering::Graph;
+
+/// From this many unknowns the upper triangle is expanded on a second thread: below, the expansion takes
+/// a few milliseconds at most and starting a thread (tens of µs) would be paid by every small mesh, as a
+/// planner's pilot levels make them by the hundred.
+const BESIDE_MIN: usize = 100_000;
 
 /// The permuted upper triangle, the elimination tree and the column counts of the unknowns' pattern.
 pub(super) struct Structure {
@@ -46,7 +51,7 @@ pub(super) fn structure(graph: &Graph, (fwd, inv): (&[usize], &[usize])) -> Opti
     }
     // the unknowns' upper triangle on a second thread (when there are two) beside the groups' tree and counts
     let (upper, (g_parent, g_counts)) = std::thread::scope(|s| {
-        let beside = (crate::threads::count() > 1)
+        let beside = (fwd.len() >= BESIDE_MIN && crate::threads::count() > 1)
             .then(|| std::thread::Builder::new().spawn_scoped(s, || expanded_upper(&g_upper, at)).ok())
             .flatten();
         let g_parent = elimination_tree(&g_upper);
